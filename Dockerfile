@@ -1,0 +1,15 @@
+FROM python:3.11-slim-bookworm
+RUN apt-get update \
+    && DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends \
+       libportaudio2 libsndfile1 \
+    && rm -rf /var/lib/apt/lists/*
+WORKDIR /opt/touchbench
+COPY pyproject.toml README.md ./
+COPY app ./app
+COPY benchmark ./benchmark
+COPY features ./features
+COPY drivers ./drivers
+RUN pip install --no-cache-dir .
+WORKDIR /data
+ENTRYPOINT []
+CMD ["touchbench", "--help"]

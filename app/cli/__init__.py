@@ -1,0 +1,1 @@
+"""touchbench: app/cli."""

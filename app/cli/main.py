@@ -1,0 +1,105 @@
+"""The ``touchbench`` command: one console script, one sub-command per job.
+
+Exit status: 0 success, 2 bad input or usage (one line on stderr), 1 anything unexpected.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import traceback
+from typing import Annotated
+
+import click
+import typer
+
+from app.cli import datasets as datasets_commands
+from app.cli.state import CliState
+from app.errors import USER_ERRORS
+from app.settings import get_settings
+
+EXIT_USAGE = 2
+EXIT_UNEXPECTED = 1
+
+app = typer.Typer(
+    name="touchbench",
+    help=(
+        "Benchmark classifiers for robot touch sensing, WEKA/MEKA style: import ARFF/CSV "
+        "data sets (or extract them from recordings), run k-fold cross-validation over dozens "
+        "of multi-class and multi-target classifiers, read leaderboards with WEKA's "
+        "corrected t-test, and train models for live prediction."
+    ),
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+    context_settings={"help_option_names": ["-h", "--help"]},
+)
+
+
+@app.callback()
+def root(
+    ctx: typer.Context,
+    db: Annotated[
+        str | None,
+        typer.Option(
+            "--db",
+            metavar="URL",
+            help=(
+                "SQLAlchemy URL of the store, e.g. sqlite:///touchbench.db or "
+                "postgresql://user@host/db. Default: $TOUCHBENCH_DATABASE_URL, else "
+                "sqlite:///touchbench.db in the current directory."
+            ),
+            show_default=False,
+        ),
+    ] = None,
+) -> None:
+    ctx.obj = CliState(database_url=db or get_settings().database_url)
+
+
+datasets_commands.register(app)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the CLI; returns (and, as a console script, exits with) the status."""
+    command = typer.main.get_command(app)
+    try:
+        command.main(args=argv, prog_name="touchbench", standalone_mode=False)
+    except click.exceptions.Exit as done:
+        return _exit(done.exit_code)
+    except click.exceptions.Abort:
+        print("touchbench: interrupted", file=sys.stderr)
+        return _exit(130)
+    except click.ClickException as error:
+        hint = ""
+        if isinstance(error, click.UsageError) and error.ctx is not None:
+            hint = f" (see '{error.ctx.command_path} --help')"
+        print(f"touchbench: error: {error.format_message()}{hint}", file=sys.stderr)
+        return _exit(EXIT_USAGE)
+    except USER_ERRORS as error:
+        print(f"touchbench: error: {error}", file=sys.stderr)
+        return _exit(EXIT_USAGE)
+    except KeyboardInterrupt:
+        print("touchbench: interrupted", file=sys.stderr)
+        return _exit(130)
+    except Exception as error:  # anything else is a bug: say so in one line, trace on request
+        if os.environ.get("TOUCHBENCH_DEBUG"):
+            traceback.print_exc()
+        print(
+            f"touchbench: unexpected error: {type(error).__name__}: {error} "
+            "(set TOUCHBENCH_DEBUG=1 for the traceback)",
+            file=sys.stderr,
+        )
+        return _exit(EXIT_UNEXPECTED)
+    return _exit(0)
+
+
+def _exit(code: int | None) -> int:
+    return 0 if code is None else int(code)
+
+
+def run() -> None:
+    sys.exit(main())
+
+
+if __name__ == "__main__":
+    run()

@@ -1,0 +1,27 @@
+"""What every command shares: the store URL from ``--db`` and the store opened lazily."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import typer
+
+from app.store.database import Store
+
+
+@dataclass
+class CliState:
+    database_url: str
+    _store: Store | None = field(default=None, repr=False)
+
+    @property
+    def store(self) -> Store:
+        if self._store is None:
+            self._store = Store(self.database_url)
+        return self._store
+
+
+def get_state(ctx: typer.Context) -> CliState:
+    state = ctx.find_root().obj
+    assert isinstance(state, CliState), "the root callback sets the CLI state"
+    return state

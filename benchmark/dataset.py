@@ -1,0 +1,314 @@
+"""The in-memory data set: an ARFF schema plus a float matrix, as WEKA keeps it.
+
+Every value is a float64, as in WEKA's ``Instance``: numeric values as they are, nominal
+values as the index of the declared label, string values as an index into the
+attribute's string table, dates as seconds since the Unix epoch (UTC), and missing
+values as NaN.  This keeps a whole data set in one contiguous array that converts to the
+engine's ``X`` and ``Y`` without copying the schema around.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from typing import Any, Literal
+
+import numpy as np
+
+from benchmark.errors import ConfigurationError
+
+AttributeKind = Literal["numeric", "nominal", "string", "date"]
+
+_MEKA_TARGETS = re.compile(r"(?:^|\s)-C\s+(-?\d+)")
+
+
+@dataclass(frozen=True)
+class Attribute:
+    """One ARFF attribute.
+
+    Parameters
+    ----------
+    name : str
+        The attribute's name as declared.
+    kind : {"numeric", "nominal", "string", "date"}
+        How values are encoded in :attr:`Dataset.values`.
+    values : tuple of str
+        Nominal: the declared labels in order (a value is its index).  String: the
+        string table (a value is its index).  Empty otherwise.
+    declared_type : str
+        The type keyword as written in the file (``"numeric"``, ``"REAL"``,
+        ``"integer"``...), kept so that export writes back what was read.
+    date_format : str or None
+        Date attributes: the Java ``SimpleDateFormat`` pattern, ``None`` for WEKA's
+        default ISO-8601 pattern.
+    """
+
+    name: str
+    kind: AttributeKind
+    values: tuple[str, ...] = ()
+    declared_type: str = ""
+    date_format: str | None = None
+
+    def __post_init__(self) -> None:
+        if not self.declared_type:
+            object.__setattr__(self, "declared_type", self.kind)
+
+    @property
+    def is_nominal(self) -> bool:
+        return self.kind == "nominal"
+
+    @property
+    def is_numeric(self) -> bool:
+        return self.kind == "numeric"
+
+    def label(self, code: float) -> str | None:
+        """The text of a nominal or string code, ``None`` for a missing value."""
+        if np.isnan(code):
+            return None
+        return self.values[int(code)]
+
+    def to_json(self) -> dict[str, Any]:
+        out: dict[str, Any] = {"name": self.name, "kind": self.kind}
+        if self.values:
+            out["values"] = list(self.values)
+        if self.declared_type and self.declared_type != self.kind:
+            out["declared_type"] = self.declared_type
+        if self.date_format is not None:
+            out["date_format"] = self.date_format
+        return out
+
+    @classmethod
+    def from_json(cls, data: Mapping[str, Any]) -> Attribute:
+        return cls(
+            name=data["name"],
+            kind=data["kind"],
+            values=tuple(data.get("values", ())),
+            declared_type=data.get("declared_type", data["kind"]),
+            date_format=data.get("date_format"),
+        )
+
+
+@dataclass(frozen=True)
+class Schema:
+    """Relation name, attributes in file order, and which of them are targets.
+
+    Parameters
+    ----------
+    relation : str
+        The ``@relation`` name as written (MEKA's ``-C`` options included).
+    attributes : tuple of Attribute
+        All attributes in file order.
+    target_indices : tuple of int
+        Positions of the target attributes in ``attributes`` (ascending).
+    """
+
+    relation: str
+    attributes: tuple[Attribute, ...]
+    target_indices: tuple[int, ...]
+
+    @property
+    def n_attributes(self) -> int:
+        return len(self.attributes)
+
+    @property
+    def feature_indices(self) -> tuple[int, ...]:
+        targets = set(self.target_indices)
+        return tuple(i for i in range(len(self.attributes)) if i not in targets)
+
+    @property
+    def targets(self) -> tuple[Attribute, ...]:
+        return tuple(self.attributes[i] for i in self.target_indices)
+
+    @property
+    def features(self) -> tuple[Attribute, ...]:
+        return tuple(self.attributes[i] for i in self.feature_indices)
+
+    @property
+    def target_names(self) -> tuple[str, ...]:
+        return tuple(a.name for a in self.targets)
+
+    @property
+    def feature_names(self) -> tuple[str, ...]:
+        return tuple(a.name for a in self.features)
+
+    def index(self, name: str) -> int:
+        """Position of the attribute called ``name``."""
+        for i, attribute in enumerate(self.attributes):
+            if attribute.name == name:
+                return i
+        raise ConfigurationError(
+            f"no attribute named '{name}' (attributes: {_shortlist(self.attributes)})"
+        )
+
+    def with_targets(self, target_indices: Sequence[int]) -> Schema:
+        return replace(self, target_indices=tuple(sorted(target_indices)))
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "relation": self.relation,
+            "attributes": [a.to_json() for a in self.attributes],
+            "target_indices": list(self.target_indices),
+        }
+
+    @classmethod
+    def from_json(cls, data: Mapping[str, Any]) -> Schema:
+        return cls(
+            relation=data["relation"],
+            attributes=tuple(Attribute.from_json(a) for a in data["attributes"]),
+            target_indices=tuple(data["target_indices"]),
+        )
+
+
+@dataclass
+class Dataset:
+    """A schema and its instances.
+
+    Parameters
+    ----------
+    schema : Schema
+        Attributes and targets.
+    values : ndarray of shape (n_instances, n_attributes), float64
+        Every value encoded as described in the module docstring; NaN is missing.
+    weights : ndarray of shape (n_instances,) or None
+        ARFF instance weights (``{w}`` after a row); ``None`` means all 1.
+    groups : ndarray of shape (n_instances,) or None
+        Recording/session id of each instance, for folds that keep a recording
+        on one side; ``None`` when instances are independent.
+    meta : list of dict or None
+        Per-instance provenance (source file, start and end seconds, frame
+        sequences...), kept by the store but not part of the ARFF data.
+    sparse : bool
+        Whether the source file used ARFF's sparse ``{index value}`` rows, so that an
+        export writes the same form back.
+    """
+
+    schema: Schema
+    values: np.ndarray
+    weights: np.ndarray | None = None
+    groups: np.ndarray | None = None
+    meta: list[dict[str, Any]] | None = None
+    sparse: bool = False
+    name: str | None = field(default=None, compare=False)
+
+    def __post_init__(self) -> None:
+        self.values = np.asarray(self.values, dtype=np.float64)
+        if self.values.ndim != 2 or self.values.shape[1] != self.schema.n_attributes:
+            raise ValueError(
+                f"values must have shape (n_instances, {self.schema.n_attributes}), "
+                f"got {self.values.shape}"
+            )
+
+    @property
+    def n_instances(self) -> int:
+        return int(self.values.shape[0])
+
+    @property
+    def n_features(self) -> int:
+        return len(self.schema.feature_indices)
+
+    @property
+    def n_targets(self) -> int:
+        return len(self.schema.target_indices)
+
+    @property
+    def X(self) -> np.ndarray:
+        """Feature matrix, shape (n_instances, n_features), float64."""
+        return self.values[:, list(self.schema.feature_indices)]
+
+    @property
+    def Y(self) -> np.ndarray:
+        """Target matrix of codes, shape (n_instances, n_targets), float64 (NaN missing)."""
+        return self.values[:, list(self.schema.target_indices)]
+
+    def with_targets(self, target_indices: Sequence[int]) -> Dataset:
+        """The same data with other attributes as targets."""
+        return replace(self, schema=self.schema.with_targets(target_indices))
+
+    def subset(self, rows: np.ndarray) -> Dataset:
+        """The instances at ``rows`` (an index or boolean array), schema unchanged."""
+        return replace(
+            self,
+            values=self.values[rows],
+            weights=None if self.weights is None else self.weights[rows],
+            groups=None if self.groups is None else self.groups[rows],
+            meta=None if self.meta is None else [self.meta[i] for i in np.arange(
+                self.n_instances)[rows]],
+        )
+
+    def equals(self, other: Dataset) -> bool:
+        """Same schema, same values (NaN equal to NaN), same weights."""
+        if self.schema != other.schema or self.values.shape != other.values.shape:
+            return False
+        if not np.array_equal(self.values, other.values, equal_nan=True):
+            return False
+        mine = np.ones(self.n_instances) if self.weights is None else self.weights
+        theirs = np.ones(other.n_instances) if other.weights is None else other.weights
+        return bool(np.array_equal(mine, theirs))
+
+
+def meka_target_count(relation: str) -> int | None:
+    """The ``-C N`` option of a MEKA relation name, ``None`` if it has none.
+
+    ``'Music: -C 6'`` gives 6 (the first six attributes are targets); ``-C -2`` gives
+    -2 (the last two).
+    """
+    match = _MEKA_TARGETS.search(relation.partition(":")[2] if ":" in relation else "")
+    return int(match.group(1)) if match else None
+
+
+def resolve_targets(
+    spec: int | Sequence[str] | None,
+    attribute_names: Sequence[str],
+    *,
+    relation: str = "",
+) -> tuple[int, ...]:
+    """Positions of the target attributes.
+
+    Parameters
+    ----------
+    spec : int, sequence of str, or None
+        ``N > 0``: the first N attributes; ``N < 0``: the last ``|N|``; names: those
+        attributes; ``None``: MEKA's ``-C`` in ``relation`` if present, otherwise the
+        last attribute (WEKA's convention).
+    attribute_names : sequence of str
+        All attribute names in order.
+    relation : str
+        The relation name, consulted when ``spec`` is ``None``.
+
+    Returns
+    -------
+    tuple of int
+        Ascending positions.
+    """
+    n = len(attribute_names)
+    if spec is None:
+        spec = meka_target_count(relation)
+        if spec is None:
+            return (n - 1,) if n else ()
+    if isinstance(spec, int):
+        if spec == 0 or abs(spec) >= n:
+            raise ConfigurationError(
+                f"-C {spec} asks for {abs(spec)} target(s), but there are only {n} "
+                "attributes and at least one must remain a feature"
+            )
+        return tuple(range(spec)) if spec > 0 else tuple(range(n + spec, n))
+    positions = []
+    for name in spec:
+        if name not in attribute_names:
+            raise ConfigurationError(
+                f"no attribute named '{name}' to use as a target "
+                f"(attributes: {_shortlist(attribute_names)})"
+            )
+        positions.append(list(attribute_names).index(name))
+    if len(set(positions)) != len(positions):
+        raise ConfigurationError("a target is named more than once")
+    if len(positions) >= n:
+        raise ConfigurationError("every attribute is a target; at least one must be a feature")
+    return tuple(sorted(positions))
+
+
+def _shortlist(items: Sequence[Any], limit: int = 8) -> str:
+    names = [getattr(item, "name", item) for item in items]
+    shown = ", ".join(str(n) for n in names[:limit])
+    return shown + (f", ... ({len(names)} in all)" if len(names) > limit else "")

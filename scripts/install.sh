@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Sets touchbench up on a fresh Debian machine with Python >= 3.11: the system libraries it
+# needs (PortAudio for sound-card capture, libsndfile for audio files), a .venv/ at the
+# repository root, and touchbench with its test tools installed (editable) inside it.
+# Safe to run again: it only does what is missing.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+as_root() { if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi; }
+
+apt_install() {
+  local missing=()
+  for package in "$@"; do
+    dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" \
+      || missing+=("$package")
+  done
+  if [ ${#missing[@]} -gt 0 ]; then
+    echo "installing Debian packages: ${missing[*]}" >&2
+    as_root apt-get update -qq
+    as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}" >/dev/null
+  fi
+}
+
+PYTHON=${PYTHON:-python3}
+if ! "$PYTHON" -c 'import sys; sys.exit(sys.version_info < (3, 11))' 2>/dev/null; then
+  echo "touchbench needs Python >= 3.11 as '$PYTHON' (set PYTHON=/path/to/python3.11)" >&2
+  exit 2
+fi
+
+apt_install libportaudio2 libsndfile1
+"$PYTHON" -c 'import ensurepip, venv' 2>/dev/null || apt_install python3-venv
+
+[ -x .venv/bin/python ] || "$PYTHON" -m venv .venv
+stamp=".venv/.installed-$(cat pyproject.toml | sha256sum | cut -c1-16)"
+if [ ! -f "$stamp" ]; then
+  echo "installing touchbench and its dependencies into .venv/" >&2
+  .venv/bin/python -m pip install -q --upgrade pip
+  .venv/bin/python -m pip install -q -e '.[test]'
+  rm -f .venv/.installed-*
+  touch "$stamp"
+fi

@@ -1,0 +1,143 @@
+"""The store on SQLite and PostgreSQL: round trips, deduplication, names, atomicity."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from sqlalchemy import func, select
+
+from app.errors import AppError, NotFoundError
+from app.store import datasets as store_datasets
+from app.store.database import Store
+from app.store.datasets import (
+    add_dataset,
+    dataset_digest,
+    delete_dataset,
+    find_dataset,
+    list_datasets,
+    load_dataset,
+)
+from app.store.tables import DatasetRow, InstanceRow
+from benchmark.dataset import Attribute, Dataset, Schema
+
+
+def small_dataset(n: int = 7, relation: str = "touch: -C 1") -> Dataset:
+    schema = Schema(
+        relation=relation,
+        attributes=(
+            Attribute("gesture", "nominal", ("tap", "slap", "stroke")),
+            Attribute("energy", "numeric", declared_type="real"),
+            Attribute("count", "numeric", declared_type="integer"),
+            Attribute("note", "string", ("first", "second")),
+            Attribute("when", "date"),
+        ),
+        target_indices=(0,),
+    )
+    rng = np.random.default_rng(0)
+    values = np.column_stack(
+        [
+            np.arange(n) % 3,
+            rng.normal(size=n),
+            np.arange(n) * 10,
+            np.arange(n) % 2,
+            1.7e9 + np.arange(n) * 60,
+        ]
+    ).astype(float)
+    values[2, 1] = np.nan
+    values[4, 0] = np.nan
+    return Dataset(schema=schema, values=values)
+
+
+def count_rows(store: Store) -> tuple[int, int]:
+    with store.session() as session:
+        return (
+            session.scalar(select(func.count()).select_from(DatasetRow)) or 0,
+            session.scalar(select(func.count()).select_from(InstanceRow)) or 0,
+        )
+
+
+def test_round_trip_keeps_values_missing_weights_groups_and_meta(store: Store) -> None:
+    data = small_dataset()
+    data.weights = np.linspace(0.5, 2.0, data.n_instances)
+    data.groups = np.array([f"session-{i // 3}" for i in range(data.n_instances)], dtype=object)
+    data.meta = [{"source": "a.wav", "start": float(i), "end": i + 0.5} for i in range(7)]
+    info, created = add_dataset(store, data, sha256=dataset_digest(data), source_name="a.arff")
+    assert created
+    assert (info.name, info.n_instances, info.n_features, info.targets) == (
+        "touch",
+        7,
+        4,
+        ["gesture"],
+    )
+    loaded = load_dataset(store, info.id)
+    assert loaded.equals(data)
+    assert list(loaded.groups) == list(data.groups)  # type: ignore[arg-type]
+    assert loaded.meta == data.meta
+    assert np.isnan(loaded.values[2, 1]) and np.isnan(loaded.values[4, 0])
+
+
+def test_same_content_is_stored_once(store: Store) -> None:
+    data = small_dataset()
+    first, created_first = add_dataset(store, data, sha256="a" * 64)
+    second, created_second = add_dataset(store, data, sha256="a" * 64, name="other")
+    assert created_first and not created_second
+    assert second.id == first.id
+    assert count_rows(store) == (1, 7)
+
+
+def test_default_names_are_made_unique_and_explicit_clashes_refused(store: Store) -> None:
+    one, _ = add_dataset(store, small_dataset(), sha256="1" * 64)
+    two, _ = add_dataset(store, small_dataset(), sha256="2" * 64)
+    assert (one.name, two.name) == ("touch", "touch-2")
+    with pytest.raises(AppError, match="already exists"):
+        add_dataset(store, small_dataset(), sha256="3" * 64, name="touch")
+    with pytest.raises(AppError, match="cannot be a number"):
+        add_dataset(store, small_dataset(), sha256="4" * 64, name="12")
+    assert count_rows(store) == (2, 14)
+
+
+def test_find_by_name_or_id_and_delete(store: Store) -> None:
+    info, _ = add_dataset(store, small_dataset(), sha256="1" * 64, name="mini")
+    assert find_dataset(store, "mini").id == info.id
+    assert find_dataset(store, str(info.id)).name == "mini"
+    with pytest.raises(NotFoundError, match="no dataset 'maggie'.*mini"):
+        find_dataset(store, "maggie")
+    assert delete_dataset(store, "mini").id == info.id
+    assert list_datasets(store) == []
+    assert count_rows(store) == (0, 0)
+
+
+def test_a_failure_while_importing_leaves_nothing_behind(
+    store: Store, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(store_datasets, "_INSERT_BATCH", 2)
+    real_insert = store_datasets.insert
+    calls = {"n": 0}
+
+    def failing_insert(table: object) -> object:
+        calls["n"] += 1
+        if calls["n"] == 3:
+            raise RuntimeError("disk full")
+        return real_insert(table)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(store_datasets, "insert", failing_insert)
+    with pytest.raises(RuntimeError, match="disk full"):
+        add_dataset(store, small_dataset(), sha256="f" * 64)
+    assert calls["n"] == 3
+    assert count_rows(store) == (0, 0)
+
+
+def test_reopening_a_store_keeps_its_data(store_url: str) -> None:
+    first = Store(store_url)
+    add_dataset(first, small_dataset(), sha256="1" * 64)
+    first.dispose()
+    again = Store(store_url)
+    assert [d.name for d in list_datasets(again)] == ["touch"]
+    again.dispose()
+
+
+def test_an_unusable_url_is_a_clear_error(tmp_path: object) -> None:
+    with pytest.raises(AppError, match="not a database URL"):
+        Store("nonsense")
+    with pytest.raises(AppError, match="folder does not exist"):
+        Store("sqlite:////no/such/folder/touchbench.db")

@@ -1,0 +1,20 @@
+"""Fixtures shared by every test package."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+SHARED_DATASETS = Path(__file__).resolve().parents[1].parent / "shared" / "datasets"
+
+
+@pytest.fixture(scope="session")
+def shared_datasets() -> Path:
+    """``../shared/datasets`` beside the repository; skips the test where it is absent."""
+    if not (SHARED_DATASETS / "uc3m-touch").is_dir():
+        pytest.skip(
+            f"needs the reference datasets at {SHARED_DATASETS} "
+            "(../shared/datasets beside the repository), which this checkout does not have"
+        )
+    return SHARED_DATASETS
