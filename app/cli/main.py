@@ -10,10 +10,11 @@ import sys
 import traceback
 from typing import Annotated
 
-import click
 import typer
 
+from app.cli import bench as bench_commands
 from app.cli import datasets as datasets_commands
+from app.cli import models as models_commands
 from app.cli.state import CliState
 from app.errors import USER_ERRORS
 from app.settings import get_settings
@@ -57,6 +58,8 @@ def root(
 
 
 datasets_commands.register(app)
+bench_commands.register(app)
+models_commands.register(app)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -64,16 +67,16 @@ def main(argv: list[str] | None = None) -> int:
     command = typer.main.get_command(app)
     try:
         command.main(args=argv, prog_name="touchbench", standalone_mode=False)
-    except click.exceptions.Exit as done:
+    except typer.Exit as done:
         return _exit(done.exit_code)
-    except click.exceptions.Abort:
+    except typer.Abort:
         print("touchbench: interrupted", file=sys.stderr)
         return _exit(130)
-    except click.ClickException as error:
-        hint = ""
-        if isinstance(error, click.UsageError) and error.ctx is not None:
-            hint = f" (see '{error.ctx.command_path} --help')"
-        print(f"touchbench: error: {error.format_message()}{hint}", file=sys.stderr)
+    except typer.TyperException as error:  # typer's (vendored click's) usage errors
+        context = getattr(error, "ctx", None)
+        hint = f" (see '{context.command_path} --help')" if context is not None else ""
+        message = error.format_message() if hasattr(error, "format_message") else str(error)
+        print(f"touchbench: error: {message}{hint}", file=sys.stderr)
         return _exit(EXIT_USAGE)
     except USER_ERRORS as error:
         print(f"touchbench: error: {error}", file=sys.stderr)

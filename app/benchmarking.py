@@ -1,0 +1,245 @@
+"""Benchmark runs end to end: a stored data set -> a problem -> folds -> the engine, each
+finished task written to the store as it arrives; resume; leaderboards from the store."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from app.store.database import Store
+from app.store.datasets import find_dataset, load_dataset
+from app.store.runs import (
+    RunInfo,
+    create_run,
+    finished_keys,
+    get_run,
+    load_results,
+    record_result,
+    set_status,
+)
+from benchmark.dataset import Dataset
+from benchmark.engine import Problem, TaskKey, TaskResult, run_tasks
+from benchmark.errors import ConfigurationError
+from benchmark.folds import Fold, make_folds
+from benchmark.leaderboard import Leaderboard, build_leaderboard
+
+
+@dataclass
+class RunOptions:
+    """How to cross-validate: the same options a resumed run gets back from the store."""
+
+    folds: int = 10
+    repeats: int = 1
+    seed: int = 0
+    timeout: float | None = 600.0
+
+    def to_json(self) -> dict[str, Any]:
+        return {"folds": self.folds, "repeats": self.repeats, "seed": self.seed,
+                "timeout": self.timeout}
+
+
+@dataclass
+class Callbacks:
+    """What the caller hears while a run goes on (progress bars, logs)."""
+
+    on_plan: Callable[[int, int], None] = lambda total, done: None
+    on_start: Callable[[TaskKey], None] = lambda key: None
+    on_result: Callable[[TaskResult], None] = lambda result: None
+    on_warning: Callable[[str], None] = lambda message: None
+
+
+@dataclass
+class PreparedProblem:
+    problem: Problem
+    target_names: list[str]
+    warnings: list[str] = field(default_factory=list)
+    groups: np.ndarray | None = None
+
+
+def prepare_problem(dataset: Dataset, targets: Sequence[str] | None = None) -> PreparedProblem:
+    """The engine's view of a data set: numeric X, integer target codes, nominal columns.
+
+    Parameters
+    ----------
+    dataset : Dataset
+    targets : sequence of str, optional
+        Target attributes to classify; the data set's own targets by default.
+    """
+    schema = dataset.schema
+    if targets:
+        indices = tuple(schema.index(name) for name in targets)
+    else:
+        indices = schema.target_indices
+    for i in indices:
+        attribute = schema.attributes[i]
+        if attribute.kind != "nominal":
+            raise ConfigurationError(
+                f"target '{attribute.name}' is {attribute.kind}; touchbench classifies nominal "
+                "targets (choose another with --target, or --targets when importing)"
+            )
+    if dataset.n_instances == 0:
+        raise ConfigurationError(f"dataset '{dataset.name}' has no instances")
+    warnings: list[str] = []
+    Y_codes = dataset.values[:, list(indices)]
+    labelled = ~np.isnan(Y_codes).any(axis=1)
+    if not labelled.all():
+        warnings.append(
+            f"{int((~labelled).sum())} instance(s) with a missing target value left out"
+        )
+    feature_columns = []
+    nominal: dict[int, int] = {}
+    dropped = []
+    for i in range(schema.n_attributes):
+        attribute = schema.attributes[i]
+        if i in indices or i in schema.target_indices:
+            continue  # other targets never leak in as features (WEKA's Remove filter)
+        if attribute.kind == "string":
+            dropped.append(attribute.name)
+            continue
+        if attribute.kind == "nominal":
+            nominal[len(feature_columns)] = len(attribute.values)
+        feature_columns.append(i)
+    if dropped:
+        warnings.append(f"string attribute(s) not used as features: {', '.join(dropped)}")
+    if not feature_columns:
+        raise ConfigurationError("no feature attributes left once the targets are set aside")
+    X = dataset.values[labelled][:, feature_columns]
+    Y = Y_codes[labelled].astype(np.int64)
+    names = [schema.attributes[i].name for i in indices]
+    for column, name, i in zip(Y.T, names, indices, strict=True):
+        present = np.unique(column)
+        if present.size < 2:
+            only = schema.attributes[i].values[int(present[0])] if present.size else "none"
+            raise ConfigurationError(
+                f"target '{name}' has a single class ('{only}'): nothing to classify"
+            )
+    problem = Problem(
+        X=X,
+        Y=Y,
+        n_classes=tuple(len(schema.attributes[i].values) for i in indices),
+        target_names=tuple(names),
+        nominal_features=nominal,
+    )
+    groups = None if dataset.groups is None else dataset.groups[labelled]
+    return PreparedProblem(problem, names, warnings, groups)
+
+
+def start_run(
+    store: Store,
+    dataset_ref: str,
+    classifiers: Sequence[str],
+    *,
+    targets: Sequence[str] | None = None,
+    options: RunOptions | None = None,
+    jobs: int = 1,
+    scheduler: str | None = None,
+    callbacks: Callbacks | None = None,
+) -> tuple[RunInfo, list[TaskResult]]:
+    """Create a run in the store and carry it out."""
+    options = options or RunOptions()
+    callbacks = callbacks or Callbacks()
+    info = find_dataset(store, dataset_ref)
+    prepared = prepare_problem(load_dataset(store, info.id), targets)
+    folds, fold_warnings = _folds(prepared, options)
+    config = {
+        **options.to_json(),
+        "targets_given": list(targets) if targets else None,
+        "n_tasks": len(classifiers) * len(folds),
+        "n_instances": int(prepared.problem.X.shape[0]),
+    }
+    run = create_run(
+        store,
+        dataset_id=info.id,
+        kind=prepared.problem.kind,
+        targets=prepared.target_names,
+        classifiers=list(classifiers),
+        config=config,
+    )
+    for message in prepared.warnings + fold_warnings:
+        callbacks.on_warning(message)
+    results = _execute(store, run, prepared, folds, options, jobs, scheduler, callbacks)
+    return get_run(store, run.id), results
+
+
+def resume_run(
+    store: Store,
+    run_id: int | str,
+    *,
+    jobs: int = 1,
+    scheduler: str | None = None,
+    callbacks: Callbacks | None = None,
+) -> tuple[RunInfo, list[TaskResult]]:
+    """Finish a run that was interrupted: only the tasks without a result are carried out."""
+    callbacks = callbacks or Callbacks()
+    run = get_run(store, run_id)
+    config = run.config
+    options = RunOptions(
+        folds=config["folds"], repeats=config["repeats"], seed=config["seed"],
+        timeout=config["timeout"],
+    )
+    prepared = prepare_problem(load_dataset(store, run.dataset_id), config.get("targets_given"))
+    folds, _ = _folds(prepared, options)
+    results = _execute(store, run, prepared, folds, options, jobs, scheduler, callbacks)
+    return get_run(store, run.id), results
+
+
+def run_leaderboard(
+    store: Store, run_id: int | str, *, metric: str | None = None, baseline: str | None = None
+) -> tuple[RunInfo, Leaderboard]:
+    run = get_run(store, run_id)
+    results = load_results(store, run.id)
+    if not results:
+        raise ConfigurationError(f"run {run.id} has no results yet (resume it with --resume)")
+    default_metric = "f1_weighted" if run.kind == "multiclass" else "hamming_score"
+    return run, build_leaderboard(results, metric=metric or default_metric, baseline=baseline)
+
+
+def _folds(prepared: PreparedProblem, options: RunOptions) -> tuple[list[Fold], list[str]]:
+    return make_folds(
+        prepared.problem.Y,
+        n_folds=options.folds,
+        n_repeats=options.repeats,
+        seed=options.seed,
+        groups=prepared.groups,
+    )
+
+
+def _execute(
+    store: Store,
+    run: RunInfo,
+    prepared: PreparedProblem,
+    folds: list[Fold],
+    options: RunOptions,
+    jobs: int,
+    scheduler: str | None,
+    callbacks: Callbacks,
+) -> list[TaskResult]:
+    done = finished_keys(store, run.id)
+    callbacks.on_plan(len(run.classifiers) * len(folds), len(done))
+
+    def persist(result: TaskResult) -> None:
+        record_result(store, run.id, result)
+        callbacks.on_result(result)
+
+    set_status(store, run.id, "running")
+    try:
+        run_tasks(
+            prepared.problem,
+            run.classifiers,
+            folds,
+            jobs=jobs,
+            scheduler=scheduler,
+            timeout=options.timeout,
+            random_state=options.seed,
+            skip=done,
+            on_start=callbacks.on_start,
+            on_result=persist,
+        )
+    except BaseException:
+        set_status(store, run.id, "interrupted")
+        raise
+    set_status(store, run.id, "finished")
+    return load_results(store, run.id)

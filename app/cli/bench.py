@@ -1,0 +1,257 @@
+"""Commands for benchmarking: classifiers, bench, runs, leaderboard."""
+
+from __future__ import annotations
+
+import sys
+from typing import Annotated
+
+import typer
+
+from typing import TYPE_CHECKING
+
+from app.cli.output import info, print_json, table
+from app.cli.state import get_state
+from benchmark.errors import ConfigurationError
+
+if TYPE_CHECKING:
+    from app.store.runs import RunInfo
+    from benchmark.leaderboard import Leaderboard
+
+# scikit-learn, the engine and Dask are imported by the commands that use them, so that
+# `touchbench datasets` and `--help` start at once.
+
+JsonOption = Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")]
+FORMATS = ("table", "json", "csv", "markdown", "arff")
+
+
+def register(app: typer.Typer) -> None:
+    app.command("classifiers")(classifiers_command)
+    app.command("bench")(bench_command)
+    app.command("runs")(runs_command)
+    app.command("leaderboard")(leaderboard_command)
+
+
+def classifiers_command(
+    as_json: JsonOption = False,
+    suite_name: Annotated[
+        str | None, typer.Option("--suite", help="Only this suite: fast, default or all.")
+    ] = None,
+) -> None:
+    """List the multi-class classifier catalogue (id, WEKA name, family, capabilities)."""
+    from benchmark.catalogue import CATALOGUE, get_spec, suite
+
+    ids = suite(suite_name) if suite_name else list(CATALOGUE)
+    specs = [get_spec(i) for i in ids]
+    if as_json:
+        print_json(
+            {
+                "classifiers": [
+                    {
+                        "id": s.id,
+                        "weka_name": s.weka_name,
+                        "family": s.family,
+                        "description": s.description,
+                        "probabilities": s.probabilities,
+                        "needs_scaling": s.needs_scaling,
+                        "handles_missing": s.handles_missing,
+                        "handles_nominal": s.handles_nominal,
+                        "cost": s.cost,
+                        "suites": sorted(s.suites),
+                        "limits": s.limits,
+                    }
+                    for s in specs
+                ]
+            }
+        )
+        return
+    yes = "✓"
+    table(
+        f"{len(specs)} classifiers",
+        ["id", "WEKA", "family", "proba", "scaled", "missing", "nominal", "cost", "suites"],
+        [
+            (
+                s.id,
+                s.weka_name or "",
+                s.family,
+                yes if s.probabilities else "",
+                yes if s.needs_scaling else "",
+                yes if s.handles_missing else "",
+                yes if s.handles_nominal else "",
+                s.cost,
+                ",".join(sorted(s.suites)),
+            )
+            for s in specs
+        ],
+    )
+
+
+def bench_command(
+    ctx: typer.Context,
+    dataset: Annotated[
+        str | None, typer.Argument(metavar="DATASET", help="Data set name or id.")
+    ] = None,
+    target: Annotated[
+        str | None,
+        typer.Option("--target", help="Benchmark this one target with the multi-class catalogue."),
+    ] = None,
+    classifiers: Annotated[
+        str | None,
+        typer.Option("--classifiers", "-c", metavar="ID,ID,...", help="Classifier ids to run."),
+    ] = None,
+    suite_name: Annotated[
+        str | None,
+        typer.Option("--suite", help="fast, default or all (default: default)."),
+    ] = None,
+    folds: Annotated[int, typer.Option("--folds", "-k", min=2, help="Folds per repeat.")] = 10,
+    repeats: Annotated[int, typer.Option("--repeats", "-r", min=1, help="Repeats of k-fold.")] = 1,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of folds and classifiers.")] = 0,
+    jobs: Annotated[int, typer.Option("--jobs", "-j", min=1, help="Parallel local workers.")] = 1,
+    scheduler: Annotated[
+        str | None,
+        typer.Option("--scheduler", metavar="tcp://HOST:PORT", help="Run on a Dask cluster."),
+    ] = None,
+    timeout: Annotated[
+        float, typer.Option("--timeout", min=0.0, help="Seconds per task before it is stopped.")
+    ] = 600.0,
+    metric: Annotated[
+        str | None, typer.Option("--metric", help="Rank by this metric.")
+    ] = None,
+    baseline: Annotated[
+        str | None, typer.Option("--baseline", help="Classifier the t-test compares against.")
+    ] = None,
+    resume: Annotated[
+        int | None, typer.Option("--resume", metavar="RUN", help="Finish an interrupted run.")
+    ] = None,
+    as_json: JsonOption = False,
+) -> None:
+    """Cross-validate classifiers on a data set; every finished fold is stored at once."""
+    from app.benchmarking import RunOptions, resume_run, run_leaderboard, start_run
+    from app.cli.progress import TaskProgress
+    from app.reports import leaderboard_json
+
+    store = get_state(ctx).store
+    progress = TaskProgress(enabled=False if as_json else None)
+    with progress:
+        if resume is not None:
+            if dataset is not None:
+                raise typer.BadParameter("give either DATASET or --resume RUN, not both")
+            run, _ = resume_run(
+                store, resume, jobs=jobs, scheduler=scheduler, callbacks=progress.callbacks()
+            )
+        else:
+            if dataset is None:
+                raise typer.BadParameter("missing DATASET (or --resume RUN)")
+            ids = _choose_classifiers(classifiers, suite_name)
+            run, _ = start_run(
+                store,
+                dataset,
+                ids,
+                targets=[target] if target else None,
+                options=RunOptions(folds=folds, repeats=repeats, seed=seed, timeout=timeout or None),
+                jobs=jobs,
+                scheduler=scheduler,
+                callbacks=progress.callbacks(),
+            )
+    run, board = run_leaderboard(store, run.id, metric=metric, baseline=baseline)
+    if as_json:
+        print_json(leaderboard_json(run, board))
+        return
+    _print_leaderboard(run, board)
+
+
+def runs_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
+    """List benchmark runs."""
+    from app.store.runs import list_runs
+
+    runs = list_runs(get_state(ctx).store)
+    if as_json:
+        print_json({"runs": [run.to_json() for run in runs]})
+        return
+    if not runs:
+        info("no runs yet: `touchbench bench DATASET` starts one")
+        return
+    table(
+        None,
+        ["id", "dataset", "targets", "classifiers", "tasks", "status", "started"],
+        [
+            (
+                run.id,
+                run.dataset_name,
+                ", ".join(run.targets),
+                len(run.classifiers),
+                f"{run.n_results}/{run.n_tasks}",
+                run.status,
+                run.created_at.strftime("%Y-%m-%d %H:%M"),
+            )
+            for run in runs
+        ],
+    )
+
+
+def leaderboard_command(
+    ctx: typer.Context,
+    run_id: Annotated[int, typer.Argument(metavar="RUN", help="Run id (see `touchbench runs`).")],
+    metric: Annotated[str | None, typer.Option("--metric", help="Rank by this metric.")] = None,
+    baseline: Annotated[
+        str | None, typer.Option("--baseline", help="Classifier the t-test compares against.")
+    ] = None,
+    output_format: Annotated[
+        str, typer.Option("--format", "-f", help="table, json, csv, markdown or arff.")
+    ] = "table",
+    as_json: JsonOption = False,
+) -> None:
+    """Show a run's leaderboard with WEKA's significance marks (v better, * worse)."""
+    if as_json:
+        output_format = "json"
+    if output_format not in FORMATS:
+        raise typer.BadParameter(
+            f"'{output_format}' is not one of {', '.join(FORMATS)}", param_hint="--format"
+        )
+    from app.benchmarking import run_leaderboard
+    from app.reports import leaderboard_csv, leaderboard_json, leaderboard_markdown, metric_columns
+
+    store = get_state(ctx).store
+    run, board = run_leaderboard(store, run_id, metric=metric, baseline=baseline)
+    columns = metric_columns(run, board)
+    if output_format == "json":
+        print_json(leaderboard_json(run, board))
+    elif output_format == "csv":
+        sys.stdout.write(leaderboard_csv(board, columns))
+    elif output_format == "markdown":
+        sys.stdout.write(leaderboard_markdown(run, board, columns))
+    elif output_format == "arff":
+        from app.results_export import write_results_arff
+
+        write_results_arff(store, run, sys.stdout)
+    else:
+        _print_leaderboard(run, board)
+
+
+def _choose_classifiers(classifiers: str | None, suite_name: str | None) -> list[str]:
+    if classifiers and suite_name:
+        raise typer.BadParameter("give --classifiers or --suite, not both")
+    if classifiers:
+        ids = [c.strip() for c in classifiers.split(",") if c.strip()]
+        if not ids:
+            raise ConfigurationError("--classifiers is empty")
+        return ids
+    from benchmark.catalogue import suite
+
+    return suite(suite_name or "default")
+
+
+def _print_leaderboard(run: RunInfo, board: Leaderboard) -> None:
+    from app.reports import leaderboard_rows, metric_columns
+
+    columns = metric_columns(run, board)
+    table(
+        f"run {run.id}: {run.dataset_name} ({', '.join(run.targets)}), "
+        f"{run.config.get('folds')}-fold x {run.config.get('repeats')}, ranked by {board.metric}",
+        ["#", "classifier", "", *columns, ""],
+        leaderboard_rows(board, columns),
+    )
+    v, same, worse = board.summary
+    info(
+        f"marks against {board.baseline}: v significantly better, * significantly worse "
+        f"(corrected resampled t-test, alpha 0.05); (v/ /*) = ({v}/{same}/{worse})"
+    )

@@ -1,0 +1,81 @@
+"""A progress bar for long runs: tasks done, the classifier at work, time left.
+
+Shown on stderr when it is a terminal; silent otherwise (pipes, CI, ``--json``).
+"""
+
+from __future__ import annotations
+
+import sys
+from types import TracebackType
+
+from rich.console import Console
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TextColumn,
+    TimeElapsedColumn,
+    TimeRemainingColumn,
+)
+
+from app.benchmarking import Callbacks
+from benchmark.engine import TaskKey, TaskResult
+
+
+class TaskProgress:
+    """Callbacks for :mod:`app.benchmarking` that draw a bar; a context manager."""
+
+    def __init__(self, *, enabled: bool | None = None) -> None:
+        self.enabled = sys.stderr.isatty() if enabled is None else enabled
+        self._progress = Progress(
+            TextColumn("{task.description}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TextColumn("[dim]{task.fields[current]}"),
+            TimeElapsedColumn(),
+            TextColumn("eta"),
+            TimeRemainingColumn(),
+            console=Console(stderr=True),
+            transient=False,
+            disable=not self.enabled,
+        )
+        self._task = self._progress.add_task("tasks", total=None, current="")
+        self.failures = 0
+
+    def __enter__(self) -> TaskProgress:
+        self._progress.start()
+        return self
+
+    def __exit__(
+        self,
+        kind: type[BaseException] | None,
+        error: BaseException | None,
+        trace: TracebackType | None,
+    ) -> None:
+        self._progress.stop()
+
+    def callbacks(self) -> Callbacks:
+        return Callbacks(
+            on_plan=self.plan,
+            on_start=self.start,
+            on_result=self.finish,
+            on_warning=self.warn,
+        )
+
+    def plan(self, total: int, done: int) -> None:
+        self._progress.update(self._task, total=total, completed=done)
+
+    def start(self, key: TaskKey) -> None:
+        self._progress.update(
+            self._task, current=f"{key.classifier} (repeat {key.repeat + 1}, fold {key.fold + 1})"
+        )
+
+    def finish(self, result: TaskResult) -> None:
+        if result.status != "ok":
+            self.failures += 1
+            self.warn(f"{result.key.classifier} fold {result.key.fold + 1}: {result.status}: "
+                      f"{result.error}")
+        self._progress.advance(self._task)
+
+    def warn(self, message: str) -> None:
+        self._progress.console.print(f"[yellow]warning:[/yellow] {message}", highlight=False)

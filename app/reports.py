@@ -1,0 +1,122 @@
+"""Leaderboards as people and programs read them: JSON, CSV, Markdown, WEKA results ARFF."""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from collections.abc import Sequence
+from typing import Any
+
+from app.store.runs import RunInfo
+from benchmark.leaderboard import Leaderboard, LeaderboardRow
+
+#: Columns shown in tables, by kind of problem (the ranking metric always comes first).
+TABLE_METRICS = {
+    "multiclass": ["f1_weighted", "accuracy", "kappa", "roc_auc", "fit_time"],
+    "multitarget": ["hamming_score", "exact_match", "hamming_loss", "fit_time"],
+}
+
+
+def metric_columns(run: RunInfo, board: Leaderboard) -> list[str]:
+    columns = [board.metric] + [m for m in TABLE_METRICS.get(run.kind, []) if m != board.metric]
+    available = {name for row in board.rows for name in row.metrics}
+    return [c for c in columns if c in available or c == board.metric]
+
+
+def leaderboard_json(run: RunInfo, board: Leaderboard) -> dict[str, Any]:
+    return {
+        "run_id": run.id,
+        "dataset": run.dataset_name,
+        "kind": run.kind,
+        "targets": run.targets,
+        "metric": board.metric,
+        "baseline": board.baseline,
+        "summary": {"better": board.summary[0], "same": board.summary[1], "worse": board.summary[2]},
+        "leaderboard": [row_json(row) for row in board.rows],
+    }
+
+
+def row_json(row: LeaderboardRow) -> dict[str, Any]:
+    metrics: dict[str, Any] = {}
+    for name, value in row.metrics.items():
+        if name == "per_target" and isinstance(value, dict):
+            metrics[name] = value
+        else:
+            mean, std = value
+            metrics[name] = {"mean": _finite(mean), "std": _finite(std)}
+    return {
+        "rank": row.rank,
+        "classifier": row.classifier,
+        "mark": row.mark,
+        "metrics": metrics,
+        "n_ok": row.n_ok,
+        "n_failed": row.n_failed,
+        "errors": row.errors,
+    }
+
+
+def leaderboard_rows(
+    board: Leaderboard, columns: Sequence[str]
+) -> list[tuple[Any, ...]]:
+    """Rank, classifier, mark and ``mean ± std`` per column, ready for a table."""
+    out = []
+    for row in board.rows:
+        cells: list[Any] = [row.rank, row.classifier, _mark(row, board)]
+        for column in columns:
+            value = row.metrics.get(column)
+            cells.append(_mean_std(value) if isinstance(value, tuple) else "-")
+        note = f"{row.n_failed} failed: {row.errors[0]}" if row.n_failed and row.errors else ""
+        cells.append(note)
+        out.append(tuple(cells))
+    return out
+
+
+def leaderboard_csv(board: Leaderboard, columns: Sequence[str]) -> str:
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    header = ["rank", "classifier", "mark"]
+    for column in columns:
+        header += [f"{column}_mean", f"{column}_std"]
+    writer.writerow([*header, "n_ok", "n_failed"])
+    for row in board.rows:
+        cells: list[Any] = [row.rank, row.classifier, row.mark]
+        for column in columns:
+            value = row.metrics.get(column)
+            cells += list(value) if isinstance(value, tuple) else ["", ""]
+        writer.writerow([*cells, row.n_ok, row.n_failed])
+    return buffer.getvalue()
+
+
+def leaderboard_markdown(run: RunInfo, board: Leaderboard, columns: Sequence[str]) -> str:
+    lines = [
+        f"Run {run.id} on {run.dataset_name} ({', '.join(run.targets)}), ranked by "
+        f"{board.metric}; marks against {board.baseline} (corrected resampled t-test, "
+        "alpha 0.05): v better, * worse.",
+        "",
+        "| rank | classifier | | " + " | ".join(columns) + " |",
+        "|---:|---|:-:|" + "---:|" * len(columns),
+    ]
+    for row in leaderboard_rows(board, columns):
+        rank, classifier, mark, *values, _note = row
+        lines.append(f"| {rank} | {classifier} | {mark} | " + " | ".join(values) + " |")
+    v, same, worse = board.summary
+    lines += ["", f"(v/ /*) = ({v}/{same}/{worse})"]
+    return "\n".join(lines) + "\n"
+
+
+def _mark(row: LeaderboardRow, board: Leaderboard) -> str:
+    return "(base)" if row.classifier == board.baseline else row.mark
+
+
+def _mean_std(value: tuple[float, float]) -> str:
+    mean, std = value
+    if mean is None or (isinstance(mean, float) and math.isnan(mean)):
+        return "-"
+    if std is None or (isinstance(std, float) and math.isnan(std)):
+        return f"{mean:.4f}"
+    return f"{mean:.4f} ± {std:.4f}"
+
+
+def _finite(value: Any) -> Any:
+    return None if isinstance(value, float) and not math.isfinite(value) else value
