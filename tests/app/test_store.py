@@ -141,3 +141,20 @@ def test_an_unusable_url_is_a_clear_error(tmp_path: object) -> None:
         Store("nonsense")
     with pytest.raises(AppError, match="folder does not exist"):
         Store("sqlite:////no/such/folder/touchbench.db")
+
+
+def test_head_revision_constant_matches_the_migrations() -> None:
+    from alembic.config import Config
+    from alembic.script import ScriptDirectory
+
+    from app.store.database import HEAD_REVISION, MIGRATIONS
+
+    config = Config()
+    config.set_main_option("script_location", str(MIGRATIONS))
+    assert ScriptDirectory.from_config(config).get_current_head() == HEAD_REVISION
+
+
+def test_a_fresh_store_is_migrated_to_head(store: Store) -> None:
+    from app.store.database import HEAD_REVISION
+
+    assert store.revision() == HEAD_REVISION

@@ -1,0 +1,14 @@
+"""WEKA ARFF files: read them into, and write them from, :class:`~benchmark.dataset.Dataset`.
+
+Everything WEKA's ``ArffLoader`` reads is read: dense and sparse rows, instance weights,
+numeric, nominal, string and date attributes, missing values, quotes with escapes,
+comments, and MEKA's ``-C`` target option in the relation name.  Relational attributes
+are not supported.  ``loads_arff(dumps_arff(d))`` equals ``d``.
+"""
+
+from __future__ import annotations
+
+from benchmark.arff_reader import loads_arff, read_arff
+from benchmark.arff_writer import dumps_arff, write_arff
+
+__all__ = ["dumps_arff", "loads_arff", "read_arff", "write_arff"]

@@ -1,0 +1,181 @@
+"""Reading a CSV file with a header row into a :class:`~benchmark.dataset.Dataset`.
+
+The delimiter is whichever of ``,`` ``;`` and tab splits the first lines into the same
+number of columns (the most columns wins); quoting follows RFC 4180 (a quote inside
+quotes is doubled; quoted cells may hold line breaks).  Cells are stripped of surrounding
+whitespace; empty cells, ``?``, ``NA``, ``NaN`` and ``nan`` are missing.
+
+A column is numeric when every non-missing cell is a number, otherwise nominal with its
+labels in order of first appearance.  One exception makes class labels usable: a target
+column whose cells are all integers (``0``, ``1``, ``2``...) is nominal, with its labels
+sorted by value, since a classifier needs a nominal target.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import os
+import re
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from benchmark.arff_reader import read_text_file
+from benchmark.dataset import Attribute, Dataset, Schema, resolve_targets
+from benchmark.errors import ConfigurationError, DataFormatError
+
+MISSING = frozenset({"", "?", "NA", "NaN", "nan"})
+_DELIMITERS = (",", ";", "\t")
+_SNIFF_LINES = 20
+_INTEGER = re.compile(r"[+-]?\d+")
+
+Record = tuple[int, list[str]]
+
+
+def sniff_delimiter(text: str) -> str:
+    """The delimiter among ``,`` ``;`` and tab that best splits the first lines.
+
+    Parameters
+    ----------
+    text : str
+        The file's text.
+
+    Returns
+    -------
+    str
+        The delimiter giving the same number (> 1) of columns on every sampled line, the
+        most columns if several do; else the one giving the header the most columns;
+        ``,`` for a file of one column.
+    """
+    sample = "\n".join([line for line in text.splitlines() if line.strip()][:_SNIFF_LINES])
+    consistent: list[tuple[int, str]] = []
+    header_counts: list[tuple[int, str]] = []
+    for delimiter in _DELIMITERS:
+        counts = [len(row) for row in csv.reader(io.StringIO(sample), delimiter=delimiter)]
+        counts = [count for count in counts if count]
+        if not counts:
+            continue
+        header_counts.append((counts[0], delimiter))
+        if counts[0] > 1 and len(set(counts)) == 1:
+            consistent.append((counts[0], delimiter))
+    for candidates in (consistent, header_counts):
+        best = max(candidates, key=lambda pair: pair[0], default=(1, ","))
+        if best[0] > 1:
+            return best[1]
+    return ","
+
+
+def _records(text: str, delimiter: str, source: str) -> list[Record]:
+    """Non-blank records with the 1-based line each starts on."""
+    reader = csv.reader(io.StringIO(text, newline=""), delimiter=delimiter, strict=True)
+    records: list[Record] = []
+    start = 1
+    try:
+        for row in reader:
+            if row and not (len(row) == 1 and not row[0].strip()):
+                records.append((start, [cell.strip() for cell in row]))
+            start = reader.line_num + 1
+    except csv.Error as error:
+        raise DataFormatError(
+            f"malformed CSV ({error})", source=source, line=reader.line_num
+        ) from None
+    return records
+
+
+def _check_header(line: int, names: list[str], source: str) -> None:
+    seen: set[str] = set()
+    for position, name in enumerate(names, start=1):
+        if not name:
+            raise DataFormatError(f"column {position} has no name", source=source, line=line)
+        if name in seen:
+            raise DataFormatError("duplicate column name", source=source, line=line, attribute=name)
+        seen.add(name)
+    if all(_is_number(name) for name in names):
+        raise DataFormatError(
+            "no header: the first line holds numbers, not column names", source=source, line=line
+        )
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _column(name: str, cells: list[str], *, is_target: bool) -> tuple[Attribute, np.ndarray]:
+    """The attribute and codes, shape (n_rows,), of one column of stripped cells."""
+    present = [cell for cell in cells if cell not in MISSING]
+    labels: list[str]
+    if all(_is_number(cell) for cell in present):
+        if not (is_target and present and all(_INTEGER.fullmatch(c) for c in present)):
+            numbers = [np.nan if cell in MISSING else float(cell) for cell in cells]
+            return Attribute(name, "numeric", (), "numeric"), np.array(numbers, dtype=np.float64)
+        labels = sorted(set(present), key=lambda label: (int(label), label))
+    else:
+        labels = list(dict.fromkeys(present))
+    codes = {label: float(i) for i, label in enumerate(labels)}
+    values = np.array([codes.get(cell, np.nan) for cell in cells], dtype=np.float64)
+    return Attribute(name, "nominal", tuple(labels), "nominal"), values
+
+
+def read_csv(
+    path: str | os.PathLike[str],
+    *,
+    targets: int | Sequence[str] | None = None,
+    relation: str | None = None,
+) -> Dataset:
+    """Read a CSV file whose first row names the columns.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file (UTF-8, else Latin-1).
+    targets : int, sequence of str, or None
+        ``N``: the first N columns; ``-N``: the last N; names: those columns; ``None``:
+        the last column.
+    relation : str, optional
+        The relation name; the file name without its extension by default.
+
+    Returns
+    -------
+    Dataset
+        ``values`` of shape (n_rows, n_columns), numeric and nominal attributes.
+
+    Raises
+    ------
+    DataFormatError
+        If the file is missing, empty, has no header, duplicate or empty column names,
+        rows with another number of cells than the header, or unknown targets; the
+        error names the file and the line.
+    """
+    text, source = read_text_file(path)
+    records = _records(text, sniff_delimiter(text), source)
+    if not records:
+        raise DataFormatError("empty file", source=source)
+    header_line, names = records[0]
+    _check_header(header_line, names, source)
+    try:
+        target_indices = resolve_targets(-1 if targets is None else targets, names)
+    except ConfigurationError as error:
+        raise DataFormatError(f"targets: {error}", source=source, line=header_line) from None
+    rows = records[1:]
+    for line, cells in rows:
+        if len(cells) != len(names):
+            raise DataFormatError(
+                f"expected {len(names)} columns (as in the header), found {len(cells)}",
+                source=source,
+                line=line,
+            )
+    attributes = []
+    values = np.empty((len(rows), len(names)))
+    for j, name in enumerate(names):
+        cells = [row[j] for _, row in rows]
+        attribute, codes = _column(name, cells, is_target=j in target_indices)
+        attributes.append(attribute)
+        values[:, j] = codes
+    name = Path(source).stem if relation is None else relation
+    return Dataset(Schema(name, tuple(attributes), target_indices), values)

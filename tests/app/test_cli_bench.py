@@ -1,0 +1,184 @@
+"""`touchbench classifiers / bench / runs / leaderboard`, on SQLite and PostgreSQL."""
+
+from __future__ import annotations
+
+import csv
+import io
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from sqlalchemy import create_engine, text
+
+from benchmark.arff import loads_arff
+from tests.app.cli_runner import run_cli
+from tests.app.synthetic import touch_arff
+
+METRIC_KEYS = {
+    "accuracy", "balanced_accuracy", "f1_weighted", "f1_macro", "precision_weighted",
+    "recall_weighted", "kappa", "mcc", "roc_auc", "log_loss", "fit_time", "predict_time",
+}
+
+
+def imported(capsys: pytest.CaptureFixture[str], db: str, path: Path) -> int:
+    result = run_cli(capsys, db, "import", str(path), "--json")
+    assert result.code == 0, result.err
+    return int(result.json()["id"])
+
+
+def test_classifiers_lists_at_least_fifty_with_capabilities(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    result = run_cli(capsys, f"sqlite:///{tmp_path}/t.db", "classifiers", "--json")
+    assert result.code == 0
+    entries = result.json()["classifiers"]
+    ids = {e["id"] for e in entries}
+    assert len(entries) >= 50
+    assert {"zeror", "j48", "rf", "nb", "ibk", "logistic", "svm-rbf", "mlp", "xgb"} <= ids
+    rf = next(e for e in entries if e["id"] == "rf")
+    assert rf["weka_name"] == "weka.classifiers.trees.RandomForest"
+    assert rf["probabilities"] is True
+
+
+def test_bench_json_leaderboard_and_stored_run(
+    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+) -> None:
+    imported(capsys, store_url, touch_arff(tmp_path / "t.arff"))
+    result = run_cli(
+        capsys, store_url, "bench", "touch", "--target", "gesture",
+        "--classifiers", "zeror,nb,j48", "--folds", "3", "--json",
+    )
+    assert result.code == 0, result.err
+    report = result.json()
+    board = {row["classifier"]: row for row in report["leaderboard"]}
+    assert set(board) == {"zeror", "nb", "j48"}
+    for row in board.values():
+        assert METRIC_KEYS <= set(row["metrics"])
+        assert set(row["metrics"]["f1_weighted"]) == {"mean", "std"}
+    assert board["nb"]["metrics"]["accuracy"]["mean"] > 0.8
+    assert board["zeror"]["metrics"]["accuracy"]["mean"] < 0.45
+    assert report["leaderboard"][-1]["classifier"] == "zeror"
+    assert board["zeror"]["mark"] == "*"  # significantly worse than the best
+    runs = run_cli(capsys, store_url, "runs", "--json").json()["runs"]
+    assert [(r["id"], r["status"], r["tasks_done"], r["tasks"]) for r in runs] == [
+        (report["run_id"], "finished", 9, 9)
+    ]
+
+
+def test_leaderboard_formats(
+    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+) -> None:
+    imported(capsys, store_url, touch_arff(tmp_path / "t.arff"))
+    run_id = run_cli(
+        capsys, store_url, "bench", "touch", "--target", "gesture",
+        "--classifiers", "zeror,nb", "--folds", "3", "--json",
+    ).json()["run_id"]
+    as_csv = run_cli(capsys, store_url, "leaderboard", str(run_id), "--format", "csv")
+    rows = list(csv.DictReader(io.StringIO(as_csv.out)))
+    assert [r["classifier"] for r in rows] == ["nb", "zeror"]
+    assert float(rows[0]["f1_weighted_mean"]) > float(rows[1]["f1_weighted_mean"])
+    markdown = run_cli(capsys, store_url, "leaderboard", str(run_id), "--format", "markdown")
+    assert "| 1 | nb |" in markdown.out and "(v/ /*)" in markdown.out
+    table = run_cli(capsys, store_url, "leaderboard", str(run_id), "--baseline", "zeror")
+    assert table.code == 0 and "nb" in table.out
+    by_accuracy = run_cli(
+        capsys, store_url, "leaderboard", str(run_id), "--metric", "accuracy", "--json"
+    ).json()
+    assert by_accuracy["metric"] == "accuracy"
+    arff = run_cli(capsys, store_url, "leaderboard", str(run_id), "--format", "arff")
+    results = loads_arff(arff.out)
+    names = [a.name for a in results.schema.attributes]
+    assert names[:4] == ["Key_Dataset", "Key_Run", "Key_Fold", "Key_Scheme"]
+    assert "Percent_correct" in names and "Weighted_avg_F_measure" in names
+    assert results.n_instances == 6
+
+
+@pytest.mark.parametrize(
+    ("args", "expected"),
+    [
+        (["--classifiers", "rff"], "did you mean 'rf'"),
+        (["--target", "colour"], "colour"),
+        (["--folds", "40"], "fold"),
+    ],
+)
+def test_bad_benchmark_requests_exit_2(
+    args: list[str],
+    expected: str,
+    capsys: pytest.CaptureFixture[str],
+    store_url: str,
+    tmp_path: Path,
+) -> None:
+    imported(capsys, store_url, touch_arff(tmp_path / "t.arff", n=30))
+    base = ["bench", "touch", "--target", "gesture", "--classifiers", "zeror"]
+    if "--target" in args:
+        base = ["bench", "touch", "--classifiers", "zeror"]
+    if "--classifiers" in args:
+        base = ["bench", "touch", "--target", "gesture"]
+    result = run_cli(capsys, store_url, *base, *args)
+    assert result.code == 2, result.err
+    assert len(result.err.strip().splitlines()) == 1
+    assert expected in result.err
+
+
+def test_one_class_target_and_unknown_run_exit_2(
+    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+) -> None:
+    imported(capsys, store_url, touch_arff(tmp_path / "t.arff", one_class=True, with_place=False))
+    one = run_cli(capsys, store_url, "bench", "touch", "--classifiers", "zeror")
+    assert one.code == 2 and "single class" in one.err
+    unknown = run_cli(capsys, store_url, "leaderboard", "999")
+    assert unknown.code == 2 and "no run '999'" in unknown.err
+    resume = run_cli(capsys, store_url, "bench", "--resume", "999")
+    assert resume.code == 2 and "no run '999'" in resume.err
+
+
+def _count(url: str, sql: str) -> int:
+    engine = create_engine(url.replace("postgresql://", "postgresql+psycopg://", 1))
+    try:
+        with engine.connect() as connection:
+            return int(connection.execute(text(sql)).scalar() or 0)
+    except Exception:
+        return 0
+    finally:
+        engine.dispose()
+
+
+def test_a_killed_run_resumes_without_repeating_or_duplicating(
+    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+) -> None:
+    imported(capsys, store_url, touch_arff(tmp_path / "t.arff", n=300))
+    command = [
+        sys.executable, "-m", "app.cli.main", "--db", store_url, "bench", "touch",
+        "--target", "gesture", "--classifiers", "zeror,mlp,rf,nb", "--folds", "10", "--json",
+    ]
+    child = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 120
+    while _count(store_url, "SELECT count(*) FROM fold_results") < 3:
+        assert child.poll() is None, child.stderr.read().decode() if child.stderr else ""
+        assert time.monotonic() < deadline, "the run recorded nothing in two minutes"
+        time.sleep(0.05)
+    os.kill(child.pid, signal.SIGKILL)
+    child.wait()
+    done_before = _count(store_url, "SELECT count(*) FROM fold_results")
+    assert 3 <= done_before < 40
+    first_ids = _count(store_url, "SELECT max(id) FROM fold_results")
+
+    resumed = run_cli(capsys, store_url, "bench", "--resume", "1", "--json")
+    assert resumed.code == 0, resumed.err
+    assert _count(store_url, "SELECT count(*) FROM fold_results") == 40
+    distinct = _count(
+        store_url,
+        "SELECT count(*) FROM (SELECT DISTINCT classifier, repeat, fold FROM fold_results) t",
+    )
+    assert distinct == 40
+    # rows written before the kill are kept, not rewritten
+    assert _count(store_url, f"SELECT count(*) FROM fold_results WHERE id <= {first_ids}") == (
+        done_before
+    )
+    board = resumed.json()["leaderboard"]
+    assert {row["classifier"] for row in board} == {"zeror", "mlp", "rf", "nb"}
+    assert all(row["n_ok"] == 10 for row in board)
