@@ -1,0 +1,433 @@
+"""Recordings and a labels file to a data set: drivers -> event detection -> extractor.
+
+:func:`extract_dataset` reads every recording, finds its events, turns them into
+instances with the chosen extractor, labels each instance from the labels CSV and
+returns one :class:`~benchmark.dataset.Dataset` whose targets come first (a MEKA
+``-C N`` relation), ready for the store.  Every problem is raised before anything is
+returned: :class:`~benchmark.errors.DataFormatError` for the labels file (with its
+line), :class:`~drivers.errors.DriverError` for a recording,
+:class:`~features.errors.FeatureError` for what the extractor or detector cannot use.
+
+Labels CSV (a header row, then one row per interval or per file)::
+
+    file,start,end,gesture,place        file,gesture,place
+    s1.wav,0.5,1.9,tap,head             s1.wav,tap,head
+
+``file`` is a recording's file name; ``start``/``end`` are seconds.  An instance takes
+the targets of the interval of its file it overlaps most (the earlier one on a tie);
+one that overlaps none is dropped and counted.  Without ``start``/``end``, every
+instance of a file takes that file's targets.  An empty cell or ``?`` is a missing
+target value.
+"""
+
+from __future__ import annotations
+
+import csv
+import itertools
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from benchmark.dataset import Attribute, Dataset, Schema
+from benchmark.errors import DataFormatError
+from drivers.files import read_recording
+from features.errors import FeatureError
+from features.events import EVENT_KINDS, detect_events
+from features.extractors import EXTRACTORS, Extractor, make_extractor
+from features.options import claim_options
+
+_MISSING = frozenset({"", "?"})
+
+
+@dataclass
+class ExtractionResult:
+    """A data set extracted from recordings, with the counts the CLI reports.
+
+    Parameters
+    ----------
+    dataset : Dataset
+        Targets first, then features; ``groups`` is each instance's recording file name
+        and ``meta`` holds ``source``, ``start``, ``end`` (seconds) and the extractor's
+        details.
+    n_events : int
+        Instances the extractor made from the detected events, before labelling.
+    n_labelled : int
+        Of those, the instances kept (all of them without a labels file).
+    n_dropped : int
+        Instances outside every labelled interval, or of a recording without labels.
+    warnings : list of str
+        What was left out and why, one line each.
+    """
+
+    dataset: Dataset
+    n_events: int
+    n_labelled: int
+    n_dropped: int
+    warnings: list[str] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class LabelRow:
+    """One row of a labels file: an interval (or the whole file) and its target values."""
+
+    line: int
+    start: float
+    end: float
+    values: tuple[str | None, ...]
+
+
+@dataclass(frozen=True)
+class LabelTable:
+    """A parsed labels file: target names and rows per recording file name."""
+
+    source: str
+    targets: tuple[str, ...]
+    intervals: bool
+    rows: dict[str, list[LabelRow]]
+
+
+def extract_dataset(
+    recordings: Sequence[Path],
+    *,
+    labels: Path | None,
+    extractor: str,
+    events: str | None = None,
+    name: str | None = None,
+    samplerate: float | None = None,
+    segment: float | None = None,
+    options: Mapping[str, Any] | None = None,
+) -> ExtractionResult:
+    """Turn recordings into a labelled data set.
+
+    Parameters
+    ----------
+    recordings : sequence of Path
+        WAV/FLAC/... audio, CSV time series or ``.npy`` files; file names must differ.
+    labels : Path or None
+        The labels CSV; ``None`` keeps every instance, without targets.
+    extractor : str
+        A key of :data:`features.extractors.EXTRACTORS`.
+    events : str, optional
+        ``snr``, ``dbscan`` or ``none``; the extractor's default if not given.
+    name : str, optional
+        Data set name (default: the labels file's stem, else the first recording's).
+    samplerate : float, optional
+        Sample rate for recordings that do not carry one (CSV without time, ``.npy``).
+    segment : float, optional
+        Segment seconds for events ``none`` (default: the extractor's, else whole files).
+    options : mapping, optional
+        Options of the extractor and of the event detector, in one flat mapping.
+
+    Returns
+    -------
+    ExtractionResult
+    """
+    if not recordings:
+        raise FeatureError("no recording was given")
+    chosen, detector_options = _configure(extractor, events, options or {})
+    kind = events or chosen.default_events
+    if kind == "none" and segment is None:
+        segment = chosen.default_segment
+    paths = [Path(path) for path in recordings]
+    by_name = _unique_names(paths)
+    table = read_labels(labels) if labels is not None else None
+    if table is not None:
+        _check_label_files(table, by_name)
+    dataset_name = name or (labels.stem if labels is not None else paths[0].stem)
+
+    features: list[np.ndarray] = []
+    spans: list[tuple[str, float, float]] = []
+    meta: list[dict[str, Any]] = []
+    warnings: list[str] = []
+    n_channels: int | None = None
+    for path in paths:
+        recording = read_recording(path, samplerate=samplerate)
+        n_channels = _same_channels(n_channels, recording.n_channels, path)
+        try:
+            chosen.check_input(samplerate=recording.samplerate, n_channels=recording.n_channels)
+            window = chosen.min_samples(recording.samplerate)
+            if recording.n_samples < window:
+                raise FeatureError(
+                    f"lasts {recording.n_samples} samples, shorter than one "
+                    f"'{chosen.name}' window of {window}"
+                )
+            detection = detect_events(
+                kind,
+                recording.samples,
+                samplerate=recording.samplerate,
+                segment=segment,
+                options=detector_options,
+            )
+            instances = chosen.extract(
+                recording.samples, samplerate=recording.samplerate, detection=detection
+            )
+        except FeatureError as error:
+            raise FeatureError(f"{path}: {error}") from None
+        warnings += [f"{path.name}: {text}" for text in (*detection.warnings, *instances.warnings)]
+        features.append(instances.values)
+        for (first, last), details in zip(instances.spans, instances.meta, strict=True):
+            start, end = first / recording.samplerate, last / recording.samplerate
+            spans.append((path.name, start, end))
+            meta.append({"source": path.name, "start": start, "end": end, **details})
+
+    assert n_channels is not None
+    feature_names = chosen.feature_names(n_channels)
+    matrix = np.concatenate(features) if features else np.zeros((0, len(feature_names)))
+    n_events = matrix.shape[0]
+    if table is None:
+        if n_events == 0:
+            raise FeatureError(
+                f"no event was found in {len(paths)} recording(s) with events '{kind}'"
+            )
+        keep = np.ones(n_events, dtype=bool)
+        target_attributes: list[Attribute] = []
+        codes = np.zeros((n_events, 0))
+    else:
+        keep, target_attributes, codes, label_warnings = _label(table, spans, by_name)
+        warnings += label_warnings
+        if not keep.any():
+            raise DataFormatError(
+                f"none of the {n_events} instance(s) found falls inside a labelled interval",
+                source=table.source,
+            )
+    schema = Schema(
+        relation=(
+            f"{dataset_name}: -C {len(target_attributes)}" if target_attributes else dataset_name
+        ),
+        attributes=(
+            *target_attributes,
+            *(Attribute(n, "numeric", declared_type="numeric") for n in feature_names),
+        ),
+        target_indices=tuple(range(len(target_attributes))),
+    )
+    rows = np.flatnonzero(keep)
+    dataset = Dataset(
+        schema=schema,
+        values=np.hstack([codes[rows], matrix[rows]]),
+        groups=np.array([spans[i][0] for i in rows], dtype=object),
+        meta=[meta[i] for i in rows],
+        name=dataset_name,
+    )
+    return ExtractionResult(
+        dataset=dataset,
+        n_events=n_events,
+        n_labelled=int(rows.size),
+        n_dropped=n_events - int(rows.size),
+        warnings=warnings,
+    )
+
+
+def _configure(
+    extractor: str, events: str | None, options: Mapping[str, Any]
+) -> tuple[Extractor, dict[str, Any]]:
+    """The extractor with its options, and the options left for the detector."""
+    if extractor not in EXTRACTORS:
+        raise FeatureError(f"unknown extractor '{extractor}' (known: {', '.join(EXTRACTORS)})")
+    spec = EXTRACTORS[extractor]
+    kind = events or spec.default_events
+    if kind not in EVENT_KINDS:
+        raise FeatureError(f"unknown event detection '{kind}' (known: {', '.join(EVENT_KINDS)})")
+    mine, rest = claim_options(spec.options, options)
+    detector, unknown = claim_options(EVENT_KINDS[kind].options, rest)
+    if unknown:
+        known = [o.name for o in (*spec.options, *EVENT_KINDS[kind].options)]
+        raise FeatureError(
+            f"unknown option '{sorted(unknown)[0]}' for extractor '{extractor}' with events "
+            f"'{kind}' (options: {', '.join(known) if known else 'none'})"
+        )
+    return make_extractor(extractor, mine), detector
+
+
+def _unique_names(paths: Sequence[Path]) -> dict[str, Path]:
+    by_name: dict[str, Path] = {}
+    for path in paths:
+        if path.name in by_name:
+            raise FeatureError(
+                f"two recordings are named '{path.name}' ({by_name[path.name]} and {path}); "
+                "labels name recordings by file name, so names must differ"
+            )
+        by_name[path.name] = path
+    return by_name
+
+
+def _same_channels(expected: int | None, found: int, path: Path) -> int:
+    if expected is not None and found != expected:
+        raise FeatureError(
+            f"{path}: has {found} channel(s) but the recordings before it have {expected}; "
+            "one data set needs one channel count"
+        )
+    return found
+
+
+def read_labels(path: Path) -> LabelTable:
+    """Parse a labels CSV (see the module docstring).
+
+    Raises
+    ------
+    DataFormatError
+        Missing file or columns, a row of the wrong width, a bad time, a file labelled
+        twice, or overlapping intervals of one file; with the line number.
+    """
+    source = str(path)
+    try:
+        with Path(path).open(newline="", encoding="utf-8-sig") as handle:
+            lines = list(enumerate(csv.reader(handle), 1))
+    except FileNotFoundError:
+        raise DataFormatError("no such labels file", source=source) from None
+    except (OSError, UnicodeDecodeError) as error:
+        raise DataFormatError(f"cannot read the labels file: {error}", source=source) from None
+    lines = [(number, row) for number, row in lines if any(cell.strip() for cell in row)]
+    if not lines:
+        raise DataFormatError("the labels file is empty", source=source)
+    header_line, header = lines[0][0], [cell.strip() for cell in lines[0][1]]
+    columns = {cell.lower(): i for i, cell in enumerate(header)}
+    if len(columns) != len(header):
+        raise DataFormatError("a column name appears twice", source=source, line=header_line)
+    if "file" not in columns:
+        raise DataFormatError(
+            "no 'file' column (expected file,start,end,TARGET... or file,TARGET...)",
+            source=source,
+            line=header_line,
+        )
+    if ("start" in columns) != ("end" in columns):
+        missing = "end" if "start" in columns else "start"
+        raise DataFormatError(
+            f"has one of start/end but no '{missing}' column", source=source, line=header_line
+        )
+    intervals = "start" in columns
+    special = {columns["file"], *((columns["start"], columns["end"]) if intervals else ())}
+    target_columns = [i for i in range(len(header)) if i not in special]
+    if not target_columns:
+        raise DataFormatError(
+            "no target column after file" + (",start,end" if intervals else ""),
+            source=source,
+            line=header_line,
+        )
+    rows: dict[str, list[LabelRow]] = {}
+    for number, row in lines[1:]:
+        if len(row) != len(header):
+            raise DataFormatError(
+                f"has {len(row)} fields, the header has {len(header)}", source=source, line=number
+            )
+        file_name = Path(row[columns["file"]].strip()).name
+        if not file_name:
+            raise DataFormatError("empty file name", source=source, line=number, attribute="file")
+        start, end = 0.0, math.inf
+        if intervals:
+            start = _seconds(row[columns["start"]], source, number, "start")
+            end = _seconds(row[columns["end"]], source, number, "end")
+            if end <= start:
+                raise DataFormatError(
+                    f"end ({end:g}) must be after start ({start:g})", source=source, line=number
+                )
+        values = tuple(
+            None if row[i].strip() in _MISSING else row[i].strip() for i in target_columns
+        )
+        rows.setdefault(file_name, []).append(LabelRow(number, start, end, values))
+    if not rows:
+        raise DataFormatError("the labels file has a header but no rows", source=source)
+    for file_name, entries in rows.items():
+        _check_overlaps(file_name, entries, intervals, source)
+    return LabelTable(
+        source=source,
+        targets=tuple(header[i] for i in target_columns),
+        intervals=intervals,
+        rows=rows,
+    )
+
+
+def _seconds(text: str, source: str, line: int, column: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise DataFormatError(
+            f"{text.strip()!r} is not a number of seconds",
+            source=source,
+            line=line,
+            attribute=column,
+        ) from None
+    if not math.isfinite(value) or value < 0:
+        raise DataFormatError(
+            f"{text.strip()!r} is not a time of at least 0 s",
+            source=source,
+            line=line,
+            attribute=column,
+        )
+    return value
+
+
+def _check_overlaps(file_name: str, entries: list[LabelRow], intervals: bool, source: str) -> None:
+    if not intervals:
+        if len(entries) > 1:
+            raise DataFormatError(
+                f"'{file_name}' is labelled again (first on line {entries[0].line})",
+                source=source,
+                line=entries[1].line,
+            )
+        return
+    ordered = sorted(entries, key=lambda entry: entry.start)
+    for before, after in itertools.pairwise(ordered):
+        if after.start < before.end:
+            first, second = sorted((before.line, after.line))
+            raise DataFormatError(
+                f"interval of '{file_name}' overlaps the one on line {first} "
+                f"({before.start:g}-{before.end:g} s and {after.start:g}-{after.end:g} s)",
+                source=source,
+                line=second,
+            )
+
+
+def _check_label_files(table: LabelTable, recordings: Mapping[str, Path]) -> None:
+    for file_name, entries in table.rows.items():
+        if file_name not in recordings:
+            raise DataFormatError(
+                f"names recording '{file_name}', which is not among the recordings given "
+                f"({', '.join(sorted(recordings))})",
+                source=table.source,
+                line=entries[0].line,
+                attribute="file",
+            )
+
+
+def _label(
+    table: LabelTable,
+    spans: Sequence[tuple[str, float, float]],
+    recordings: Mapping[str, Path],
+) -> tuple[np.ndarray, list[Attribute], np.ndarray, list[str]]:
+    """Which instances are kept, the target attributes, their codes, and warnings."""
+    chosen: list[LabelRow | None] = []
+    for file_name, start, end in spans:
+        best, best_overlap = None, 0.0
+        for row in table.rows.get(file_name, ()):
+            overlap = min(end, row.end) - max(start, row.start)
+            if overlap > best_overlap:
+                best, best_overlap = row, overlap
+        chosen.append(best)
+    labels_in_order: list[list[str]] = [[] for _ in table.targets]
+    for rows in table.rows.values():
+        for row in sorted(rows, key=lambda r: r.line):
+            for values, value in zip(labels_in_order, row.values, strict=True):
+                if value is not None and value not in values:
+                    values.append(value)
+    attributes = [
+        Attribute(target, "nominal", values=tuple(values), declared_type="nominal")
+        for target, values in zip(table.targets, labels_in_order, strict=True)
+    ]
+    codes = np.full((len(spans), len(attributes)), np.nan)
+    for i, match in enumerate(chosen):
+        if match is None:
+            continue
+        for j, value in enumerate(match.values):
+            if value is not None:
+                codes[i, j] = attributes[j].values.index(value)
+    keep = np.array([row is not None for row in chosen], dtype=bool)
+    warnings = [
+        f"{file_name}: no labels for this recording; its instances were dropped"
+        for file_name in recordings
+        if file_name not in table.rows
+    ]
+    return keep, attributes, codes, warnings

@@ -1,0 +1,39 @@
+"""The registry of extractors: ``--extractor NAME`` to the class that implements it.
+
+Each entry is an :class:`~features.extractors.base.Extractor` subclass carrying its
+name, description, options, default event kind and sample-rate rules;
+:func:`make_extractor` builds one with options.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from features.errors import FeatureError
+from features.extractors.band_peaks import BandPeaks
+from features.extractors.base import Extractor, Instances
+from features.extractors.mfcc import Mfcc
+from features.extractors.taxel_dft import TaxelDft
+from features.extractors.uc3m_audio import Uc3mAudio, uc3m_feature_names
+from features.extractors.window import Window
+
+EXTRACTORS: dict[str, type[Extractor]] = {
+    extractor.name: extractor for extractor in (Uc3mAudio, BandPeaks, Mfcc, TaxelDft, Window)
+}
+
+
+def make_extractor(name: str, options: Mapping[str, Any] | None = None) -> Extractor:
+    """The extractor called ``name`` with ``options``.
+
+    Raises
+    ------
+    FeatureError
+        For an unknown name or option.
+    """
+    if name not in EXTRACTORS:
+        raise FeatureError(f"unknown extractor '{name}' (known: {', '.join(EXTRACTORS)})")
+    return EXTRACTORS[name](**dict(options or {}))
+
+
+__all__ = ["EXTRACTORS", "Extractor", "Instances", "make_extractor", "uc3m_feature_names"]

@@ -1,0 +1,138 @@
+"""What every extractor is: named options, sample-rate rules, feature names, extraction."""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+import numpy as np
+
+from features._checks import as_samplerate
+from features.errors import FeatureError
+from features.events import Detection
+from features.options import Option, resolve_options
+
+
+@dataclass
+class Instances:
+    """What an extractor made of one recording.
+
+    Parameters
+    ----------
+    values : ndarray of shape (n_instances, n_features), float64
+        Feature values in the order of :meth:`Extractor.feature_names`.
+    spans : ndarray of shape (n_instances, 2), int64
+        First sample and one past the last sample each instance describes.
+    meta : list of dict
+        Per-instance details (contacts, channels, frame sequences...), JSON-compatible.
+    warnings : list of str
+        Events that gave no instance, and why.
+    """
+
+    values: np.ndarray
+    spans: np.ndarray
+    meta: list[dict[str, Any]]
+    warnings: list[str] = field(default_factory=list)
+
+    @classmethod
+    def empty(cls, n_features: int, warnings: list[str] | None = None) -> Instances:
+        return cls(
+            values=np.zeros((0, n_features)),
+            spans=np.zeros((0, 2), dtype=np.int64),
+            meta=[],
+            warnings=warnings or [],
+        )
+
+
+class Extractor(ABC):
+    """A named recipe from samples and events to instances.
+
+    Subclasses set the class attributes and implement :meth:`feature_names` and
+    :meth:`extract`; ``__init__`` only parses the options.
+
+    Attributes
+    ----------
+    name : str
+        The ``--extractor`` name.
+    description : str
+        One line for listings.
+    default_events : str
+        The event kind used when none is asked for (a key of ``EVENT_KINDS``).
+    default_segment : float or None
+        Segment seconds for events ``none`` when none is asked for (None: whole file).
+    options : tuple of Option
+        The options it accepts.
+    samplerates : tuple of float or None
+        The only sample rates it accepts; ``None`` for any within ``min_samplerate``.
+    min_samplerate : float
+        The lowest sample rate it accepts (Hz).
+    min_channels : int
+        The fewest channels it needs.
+    """
+
+    name: ClassVar[str]
+    description: ClassVar[str]
+    default_events: ClassVar[str]
+    default_segment: ClassVar[float | None] = None
+    options: ClassVar[tuple[Option, ...]] = ()
+    samplerates: ClassVar[tuple[float, ...] | None] = None
+    min_samplerate: ClassVar[float] = 0.0
+    min_channels: ClassVar[int] = 1
+
+    def __init__(self, **options: Any) -> None:
+        self.params = resolve_options(type(self).options, options, owner=f"extractor '{self.name}'")
+
+    def check_input(self, *, samplerate: float, n_channels: int) -> None:
+        """Raise :class:`FeatureError` unless this extractor can use the recording."""
+        samplerate = as_samplerate(samplerate)
+        allowed = self.samplerates
+        if allowed is not None and not any(abs(samplerate - rate) < 1e-6 for rate in allowed):
+            rates = ", ".join(f"{rate:g}" for rate in allowed)
+            raise FeatureError(
+                f"extractor '{self.name}' needs a sample rate of {rates} Hz, got {samplerate:g} Hz"
+            )
+        if samplerate < self.min_samplerate:
+            raise FeatureError(
+                f"extractor '{self.name}' needs a sample rate of at least "
+                f"{self.min_samplerate:g} Hz, got {samplerate:g} Hz"
+            )
+        if n_channels < self.min_channels:
+            raise FeatureError(
+                f"extractor '{self.name}' needs at least {self.min_channels} channels, "
+                f"got {n_channels}"
+            )
+
+    @abstractmethod
+    def min_samples(self, samplerate: float) -> int:
+        """Samples in one analysis window: the shortest recording or event it can use."""
+
+    @abstractmethod
+    def feature_names(self, n_channels: int) -> list[str]:
+        """Attribute names of the features, in order, for ``n_channels`` channels."""
+
+    @abstractmethod
+    def extract(self, y: np.ndarray, *, samplerate: float, detection: Detection) -> Instances:
+        """Instances of the events of one recording.
+
+        Parameters
+        ----------
+        y : ndarray of shape (n_channels, n_samples)
+            Finite samples.
+        samplerate : float
+            Sample rate in Hz (checked by :meth:`check_input`).
+        detection : Detection
+            The recording's events.
+        """
+
+    def _too_short(self, event_span: tuple[int, int], samplerate: float) -> str:
+        start, end = event_span
+        return (
+            f"event at {start / samplerate:.3f}-{end / samplerate:.3f} s is shorter than one "
+            f"'{self.name}' window ({self.min_samples(samplerate)} samples) and was left out"
+        )
+
+
+def channel_suffixed(names: list[str], n_channels: int) -> list[str]:
+    """``name_1 ... name_k`` for channel 1, then channel 2, ... (1-based, the UC3M style)."""
+    return [f"{name}_{channel}" for channel in range(1, n_channels + 1) for name in names]

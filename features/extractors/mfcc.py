@@ -1,0 +1,93 @@
+"""``mfcc``: mel-frequency cepstral coefficients, summarised per instance.
+
+Per channel: 30 ms frames with a 10 ms hop (98 frames in 1 s, not centred), periodic
+Hann window, power spectrum with ``n_fft`` = the frame length, 40 HTK-mel filters of
+unit area from 0 Hz to Nyquist, 14 coefficients (:mod:`features.mel`).  The instance's
+features are the mean and the standard deviation (population, ``ddof=0``) of each
+coefficient over its frames: ``mfcc1_mean_1 ... mfcc14_mean_1, mfcc1_std_1 ...`` for
+channel 1, then channel 2, ....  The frame sequence, shape (n_frames, n_mfcc *
+n_channels) in the same channel order, is kept in the instance's metadata under
+``"frames"`` for sequence models.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import numpy as np
+
+from features.events import Detection
+from features.extractors.base import Extractor, Instances, channel_suffixed
+from features.framing import frame, power_spectrogram
+from features.mel import mel_filter_bank, mel_spectrogram, mfcc
+from features.options import Option, positive_float, positive_int
+
+
+class Mfcc(Extractor):
+    """MFCC mean and standard deviation per coefficient; see the module docstring."""
+
+    name: ClassVar[str] = "mfcc"
+    description: ClassVar[str] = "14 MFCCs (40 mel filters, 30 ms / 10 ms): mean and std"
+    default_events: ClassVar[str] = "none"
+    min_samplerate: ClassVar[float] = 4000.0
+    options: ClassVar[tuple[Option, ...]] = (
+        Option("n_mfcc", 14, positive_int, "coefficients"),
+        Option("n_mels", 40, positive_int, "mel filters"),
+        Option("frame", 0.030, positive_float, "frame length in seconds"),
+        Option("hop", 0.010, positive_float, "hop in seconds"),
+    )
+
+    def frame_length(self, samplerate: float) -> int:
+        return max(1, round(self.params["frame"] * samplerate))
+
+    def hop_length(self, samplerate: float) -> int:
+        return max(1, round(self.params["hop"] * samplerate))
+
+    def min_samples(self, samplerate: float) -> int:
+        return self.frame_length(samplerate)
+
+    def feature_names(self, n_channels: int) -> list[str]:
+        count = self.params["n_mfcc"]
+        names = [f"mfcc{q}_mean" for q in range(1, count + 1)]
+        names += [f"mfcc{q}_std" for q in range(1, count + 1)]
+        return channel_suffixed(names, n_channels)
+
+    def extract(self, y: np.ndarray, *, samplerate: float, detection: Detection) -> Instances:
+        n_channels = y.shape[0]
+        frame_length, hop_length = self.frame_length(samplerate), self.hop_length(samplerate)
+        filters = mel_filter_bank(
+            samplerate=samplerate, n_fft=frame_length, n_mels=self.params["n_mels"]
+        )
+        rows, spans, meta, warnings = [], [], [], []
+        for event in detection.events:
+            segment = y[:, event.onset : event.offset]
+            if segment.shape[1] < frame_length:
+                warnings.append(self._too_short((event.onset, event.offset), samplerate))
+                continue
+            frames = frame(segment, frame_length=frame_length, hop_length=hop_length)
+            power = power_spectrogram(frames, window="hann")
+            coefficients = mfcc(
+                mel_spectrogram(power, filter_bank=filters), n_mfcc=self.params["n_mfcc"]
+            )
+            summary = np.concatenate(
+                [coefficients.mean(axis=-1), coefficients.std(axis=-1)], axis=-1
+            )
+            rows.append(summary.reshape(-1))
+            spans.append((event.onset, event.offset))
+            sequence = np.moveaxis(coefficients, -1, 0).reshape(coefficients.shape[-1], -1)
+            meta.append(
+                {
+                    "channels": list(event.channels),
+                    "n_contacts": event.n_contacts,
+                    "frames": sequence.tolist(),
+                    "frame_hop": hop_length / samplerate,
+                }
+            )
+        if not rows:
+            return Instances.empty(len(self.feature_names(n_channels)), warnings)
+        return Instances(
+            values=np.array(rows),
+            spans=np.array(spans, dtype=np.int64),
+            meta=meta,
+            warnings=warnings,
+        )

@@ -1,0 +1,73 @@
+"""``window``: raw values after a contact onset (BioTac-style events).
+
+For every event, every channel's ``length`` samples (default 25) from the onset, minus
+the mean of the ``baseline`` samples (default 3) just before the onset:
+``t0_1 ... t24_1`` for channel 1, then channel 2, ....  An onset with fewer samples
+before it uses those there are, and an onset at sample 0 is its own baseline.  An event
+too close to the end of the recording for ``length`` samples is left out with a
+warning.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import numpy as np
+
+from features.events import Detection
+from features.extractors.base import Extractor, Instances, channel_suffixed
+from features.options import Option, positive_int
+
+
+class Window(Extractor):
+    """Baseline-subtracted samples after each onset; see the module docstring."""
+
+    name: ClassVar[str] = "window"
+    description: ClassVar[str] = "raw values of N samples from the onset minus the baseline"
+    default_events: ClassVar[str] = "dbscan"
+    options: ClassVar[tuple[Option, ...]] = (
+        Option("length", 25, positive_int, "samples from the onset"),
+        Option("baseline", 3, positive_int, "samples before the onset averaged as baseline"),
+    )
+
+    def min_samples(self, samplerate: float) -> int:
+        return int(self.params["length"])
+
+    def feature_names(self, n_channels: int) -> list[str]:
+        return channel_suffixed([f"t{i}" for i in range(self.params["length"])], n_channels)
+
+    def extract(self, y: np.ndarray, *, samplerate: float, detection: Detection) -> Instances:
+        length, baseline = self.params["length"], self.params["baseline"]
+        n_samples = y.shape[1]
+        onsets = np.array([event.onset for event in detection.events], dtype=np.int64)
+        fits = onsets + length <= n_samples
+        warnings = [
+            f"event at {onset / samplerate:.3f} s leaves fewer than {length} samples before "
+            "the end of the recording and was left out"
+            for onset in onsets[~fits]
+        ]
+        onsets = onsets[fits]
+        kept = [event for event, ok in zip(detection.events, fits, strict=True) if ok]
+        if onsets.size == 0:
+            return Instances.empty(len(self.feature_names(y.shape[0])), warnings)
+        after = y[:, onsets[:, np.newaxis] + np.arange(length)]
+        reference = _baselines(y, onsets, baseline)
+        values = after - reference[:, :, np.newaxis]
+        return Instances(
+            values=np.moveaxis(values, 0, 1).reshape(onsets.size, -1),
+            spans=np.stack([onsets, onsets + length], axis=1),
+            meta=[{"channels": list(e.channels), "n_contacts": e.n_contacts} for e in kept],
+            warnings=warnings,
+        )
+
+
+def _baselines(y: np.ndarray, onsets: np.ndarray, baseline: int) -> np.ndarray:
+    """Mean of up to ``baseline`` samples before each onset, shape (n_channels, n_onsets)."""
+    cumulative = np.concatenate([np.zeros((y.shape[0], 1)), np.cumsum(y, axis=1)], axis=1)
+    starts = np.maximum(onsets - baseline, 0)
+    counts = onsets - starts
+    sums = cumulative[:, onsets] - cumulative[:, starts]
+    at_start = counts == 0
+    means = sums / np.maximum(counts, 1)
+    means[:, at_start] = y[:, onsets[at_start]]
+    return means
