@@ -1,0 +1,65 @@
+"""Simulated, labelled touch sessions written as WAV files plus a labels CSV: the input of
+the demo and of the extraction tests."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+import soundfile
+
+from drivers.simulated import SimulatedTouch, simulate_session
+
+SAMPLERATE = 44100
+#: Microphone i sits nearest place i, so a touch there is heard on channel i.
+PLACES = ("head", "left_arm", "right_arm")
+GESTURE_SECONDS = {"tap": (0.02, 0.1), "stroke": (0.3, 0.9)}
+
+
+def write_session(
+    folder: Path, name: str, *, n_touches: int, seed: int
+) -> tuple[Path, list[tuple[float, float, str, str]]]:
+    """One simulated 3-microphone session as a WAV file, and its true touches.
+
+    Returns
+    -------
+    path : Path
+    touches : list of (start, end, gesture, place)
+    """
+    rng = np.random.default_rng(seed)
+    touches: list[SimulatedTouch] = []
+    labels: list[tuple[float, float, str, str]] = []
+    onset = 0.5
+    for _ in range(n_touches):
+        gesture = str(rng.choice(list(GESTURE_SECONDS)))
+        place = int(rng.integers(len(PLACES)))
+        low, high = GESTURE_SECONDS[gesture]
+        duration = float(rng.uniform(low, high))
+        touches.append(
+            SimulatedTouch(
+                onset=onset,
+                duration=duration,
+                channels=(place,),
+                kind=gesture,  # type: ignore[arg-type]
+                amplitude=float(rng.uniform(0.15, 0.4)),
+            )
+        )
+        labels.append((onset, onset + duration, gesture, PLACES[place]))
+        onset += duration + float(rng.uniform(1.2, 1.8))  # quiet longer than the hangover
+    session = simulate_session(
+        duration=onset + 0.5, samplerate=SAMPLERATE, n_channels=len(PLACES), touches=touches,
+        seed=seed,
+    )
+    path = folder / f"{name}.wav"
+    soundfile.write(path, session.recording.samples.T, SAMPLERATE, subtype="FLOAT")
+    return path, labels
+
+
+def write_labels(path: Path, rows: list[tuple[str, float, float, str, str]]) -> Path:
+    with path.open("w", newline="", encoding="utf-8") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(["file", "start", "end", "gesture", "place"])
+        for file, start, end, gesture, place in rows:
+            writer.writerow([file, f"{start:.3f}", f"{end:.3f}", gesture, place])
+    return path
