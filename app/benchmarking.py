@@ -8,6 +8,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from benchmark.engine import Problem, TaskKey, TaskResult, run_tasks
+from benchmark.folds import Fold, make_folds
+from benchmark.leaderboard import Leaderboard, build_leaderboard
 
 from app.store.database import Store
 from app.store.datasets import find_dataset, load_dataset
@@ -21,10 +24,7 @@ from app.store.runs import (
     set_status,
 )
 from benchmark.dataset import Dataset
-from benchmark.engine import Problem, TaskKey, TaskResult, run_tasks
 from benchmark.errors import ConfigurationError
-from benchmark.folds import Fold, make_folds
-from benchmark.leaderboard import Leaderboard, build_leaderboard
 
 
 @dataclass
@@ -37,8 +37,12 @@ class RunOptions:
     timeout: float | None = 600.0
 
     def to_json(self) -> dict[str, Any]:
-        return {"folds": self.folds, "repeats": self.repeats, "seed": self.seed,
-                "timeout": self.timeout}
+        return {
+            "folds": self.folds,
+            "repeats": self.repeats,
+            "seed": self.seed,
+            "timeout": self.timeout,
+        }
 
 
 @dataclass
@@ -69,10 +73,7 @@ def prepare_problem(dataset: Dataset, targets: Sequence[str] | None = None) -> P
         Target attributes to classify; the data set's own targets by default.
     """
     schema = dataset.schema
-    if targets:
-        indices = tuple(schema.index(name) for name in targets)
-    else:
-        indices = schema.target_indices
+    indices = tuple(schema.index(n) for n in targets) if targets else schema.target_indices
     for i in indices:
         attribute = schema.attributes[i]
         if attribute.kind != "nominal":
@@ -89,7 +90,7 @@ def prepare_problem(dataset: Dataset, targets: Sequence[str] | None = None) -> P
         warnings.append(
             f"{int((~labelled).sum())} instance(s) with a missing target value left out"
         )
-    feature_columns = []
+    feature_columns: list[int] = []
     nominal: dict[int, int] = {}
     dropped = []
     for i in range(schema.n_attributes):
@@ -177,7 +178,9 @@ def resume_run(
     run = get_run(store, run_id)
     config = run.config
     options = RunOptions(
-        folds=config["folds"], repeats=config["repeats"], seed=config["seed"],
+        folds=config["folds"],
+        repeats=config["repeats"],
+        seed=config["seed"],
         timeout=config["timeout"],
     )
     prepared = prepare_problem(load_dataset(store, run.dataset_id), config.get("targets_given"))

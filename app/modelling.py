@@ -12,13 +12,13 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from benchmark.model import TrainedModel, dumps_model, fit_model, loads_model
 
 from app.store.database import Store
 from app.store.datasets import find_dataset, load_dataset
 from app.store.models import ModelInfo, load_artifact, save_model
 from benchmark.dataset import Attribute, Dataset, Schema
 from benchmark.errors import ConfigurationError, DataFormatError
-from benchmark.model import TrainedModel, dumps_model, fit_model, loads_model
 
 
 def project(dataset: Dataset, targets: Sequence[str] | None = None) -> Dataset:
@@ -28,9 +28,7 @@ def project(dataset: Dataset, targets: Sequence[str] | None = None) -> Dataset:
     value is missing are dropped.
     """
     schema = dataset.schema
-    chosen = (
-        [schema.index(name) for name in targets] if targets else list(schema.target_indices)
-    )
+    chosen = [schema.index(name) for name in targets] if targets else list(schema.target_indices)
     for i in chosen:
         if schema.attributes[i].kind != "nominal":
             raise ConfigurationError(
@@ -51,7 +49,7 @@ def project(dataset: Dataset, targets: Sequence[str] | None = None) -> Dataset:
     rows = np.flatnonzero(labelled)
     return Dataset(
         schema=projected,
-        values=dataset.values[np.ix_(rows, keep)],
+        values=dataset.values[np.ix_(rows, np.asarray(keep, dtype=np.intp))],
         weights=None if dataset.weights is None else dataset.weights[rows],
         groups=None if dataset.groups is None else dataset.groups[rows],
         name=dataset.name,
@@ -135,9 +133,7 @@ def predict(model: TrainedModel, data: Dataset, *, source: str = "input") -> Pre
     X = align_features(model.schema, data, source=source)
     codes = np.asarray(model.predict(X)).reshape(X.shape[0], -1)
     targets = model.schema.targets
-    labels = {
-        t.name: [t.values[int(c)] for c in codes[:, j]] for j, t in enumerate(targets)
-    }
+    labels = {t.name: [t.values[int(c)] for c in codes[:, j]] for j, t in enumerate(targets)}
     try:
         probas = model.predict_proba(X)
         probabilities: dict[str, np.ndarray] | None = {
@@ -170,7 +166,9 @@ def align_features(schema: Schema, data: Dataset, *, source: str = "input") -> n
     by_name = {a.name: i for i, a in enumerate(data.schema.attributes)}
     missing = [a.name for a in schema.features if a.name not in by_name]
     if missing:
-        shown = ", ".join(missing[:5]) + (f", ... ({len(missing)} in all)" if len(missing) > 5 else "")
+        shown = ", ".join(missing[:5]) + (
+            f", ... ({len(missing)} in all)" if len(missing) > 5 else ""
+        )
         raise DataFormatError(
             f"lacks {len(missing)} attribute(s) the model needs: {shown}", source=source
         )
@@ -186,7 +184,8 @@ def _translate(mine: Attribute, theirs: Attribute, column: np.ndarray, source: s
     if mine.kind == "nominal":
         if theirs.kind != "nominal":
             raise DataFormatError(
-                f"is {theirs.kind} here but nominal in the model", source=source,
+                f"is {theirs.kind} here but nominal in the model",
+                source=source,
                 attribute=mine.name,
             )
         lookup = np.array(
@@ -218,7 +217,7 @@ def _true_labels(target: Attribute, data: Dataset) -> list[str | None] | None:
 def _jsonable(params: dict[str, Any]) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for key, value in params.items():
-        out[key] = value if isinstance(value, str | int | float | bool | type(None)) else repr(value)
+        out[key] = (
+            value if isinstance(value, str | int | float | bool | type(None)) else repr(value)
+        )
     return out
-
-

@@ -8,8 +8,9 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
-from app.store.runs import RunInfo
 from benchmark.leaderboard import Leaderboard, LeaderboardRow
+
+from app.store.runs import RunInfo
 
 #: Columns shown in tables, by kind of problem (the ranking metric always comes first).
 TABLE_METRICS = {
@@ -32,7 +33,11 @@ def leaderboard_json(run: RunInfo, board: Leaderboard) -> dict[str, Any]:
         "targets": run.targets,
         "metric": board.metric,
         "baseline": board.baseline,
-        "summary": {"better": board.summary[0], "same": board.summary[1], "worse": board.summary[2]},
+        "summary": {
+            "better": board.summary[0],
+            "same": board.summary[1],
+            "worse": board.summary[2],
+        },
         "leaderboard": [row_json(row) for row in board.rows],
     }
 
@@ -56,9 +61,7 @@ def row_json(row: LeaderboardRow) -> dict[str, Any]:
     }
 
 
-def leaderboard_rows(
-    board: Leaderboard, columns: Sequence[str]
-) -> list[tuple[Any, ...]]:
+def leaderboard_rows(board: Leaderboard, columns: Sequence[str]) -> list[tuple[Any, ...]]:
     """Rank, classifier, mark and ``mean ± std`` per column, ready for a table."""
     out = []
     for row in board.rows:

@@ -48,7 +48,10 @@ def write_session(
         labels.append((onset, onset + duration, gesture, PLACES[place]))
         onset += duration + float(rng.uniform(1.2, 1.8))  # quiet longer than the hangover
     session = simulate_session(
-        duration=onset + 0.5, samplerate=SAMPLERATE, n_channels=len(PLACES), touches=touches,
+        duration=onset + 0.5,
+        samplerate=SAMPLERATE,
+        n_channels=len(PLACES),
+        touches=touches,
         seed=seed,
     )
     path = folder / f"{name}.wav"

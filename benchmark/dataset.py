@@ -212,12 +212,12 @@ class Dataset:
         return len(self.schema.target_indices)
 
     @property
-    def X(self) -> np.ndarray:
+    def X(self) -> np.ndarray:  # noqa: N802 (scikit-learn's name)
         """Feature matrix, shape (n_instances, n_features), float64."""
         return self.values[:, list(self.schema.feature_indices)]
 
     @property
-    def Y(self) -> np.ndarray:
+    def Y(self) -> np.ndarray:  # noqa: N802 (scikit-learn's name)
         """Target matrix of codes, shape (n_instances, n_targets), float64 (NaN missing)."""
         return self.values[:, list(self.schema.target_indices)]
 
@@ -232,8 +232,9 @@ class Dataset:
             values=self.values[rows],
             weights=None if self.weights is None else self.weights[rows],
             groups=None if self.groups is None else self.groups[rows],
-            meta=None if self.meta is None else [self.meta[i] for i in np.arange(
-                self.n_instances)[rows]],
+            meta=None
+            if self.meta is None
+            else [self.meta[i] for i in np.arange(self.n_instances)[rows]],
         )
 
     def equals(self, other: Dataset) -> bool:

@@ -1,7 +1,8 @@
 """Import and load times of a 100 000 x 100 data set in the store, SQLite and PostgreSQL.
 
-Load times are the best of three. Side by side in the same run: ``numpy.save``/``numpy.load`` of the same matrix on the same
-disk, the floor any store is measured against (ratio = store seconds / numpy seconds).
+Load times are the best of three. Side by side in the same run: ``numpy.save`` and
+``numpy.load`` of the same matrix on the same disk, the floor any store is measured
+against (ratio = store seconds / numpy seconds).
 
     .venv/bin/python perf/store_load.py [--rows 100000] [--columns 100] [--postgres URL]
 """

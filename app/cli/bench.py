@@ -3,19 +3,18 @@
 from __future__ import annotations
 
 import sys
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
-
-from typing import TYPE_CHECKING
 
 from app.cli.output import info, print_json, table
 from app.cli.state import get_state
 from benchmark.errors import ConfigurationError
 
 if TYPE_CHECKING:
-    from app.store.runs import RunInfo
     from benchmark.leaderboard import Leaderboard
+
+    from app.store.runs import RunInfo
 
 # scikit-learn, the engine and Dask are imported by the commands that use them, so that
 # `touchbench datasets` and `--help` start at once.
@@ -113,9 +112,7 @@ def bench_command(
     timeout: Annotated[
         float, typer.Option("--timeout", min=0.0, help="Seconds per task before it is stopped.")
     ] = 600.0,
-    metric: Annotated[
-        str | None, typer.Option("--metric", help="Rank by this metric.")
-    ] = None,
+    metric: Annotated[str | None, typer.Option("--metric", help="Rank by this metric.")] = None,
     baseline: Annotated[
         str | None, typer.Option("--baseline", help="Classifier the t-test compares against.")
     ] = None,
@@ -147,7 +144,9 @@ def bench_command(
                 dataset,
                 ids,
                 targets=[target] if target else None,
-                options=RunOptions(folds=folds, repeats=repeats, seed=seed, timeout=timeout or None),
+                options=RunOptions(
+                    folds=folds, repeats=repeats, seed=seed, timeout=timeout or None
+                ),
                 jobs=jobs,
                 scheduler=scheduler,
                 callbacks=progress.callbacks(),

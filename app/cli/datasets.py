@@ -12,7 +12,13 @@ import typer
 from app.cli.output import info, print_json, table
 from app.cli.state import get_state
 from app.importing import import_file, parse_targets
-from app.store.datasets import DatasetInfo, delete_dataset, find_dataset, list_datasets, load_dataset
+from app.store.datasets import (
+    DatasetInfo,
+    delete_dataset,
+    find_dataset,
+    list_datasets,
+    load_dataset,
+)
 from benchmark.arff import write_arff
 from benchmark.dataset import Dataset
 
@@ -189,9 +195,7 @@ def describe(dataset_info: DatasetInfo, data: Dataset) -> dict[str, Any]:
         if attribute.kind != "nominal":
             continue
         codes = data.values[:, i]
-        counts = np.bincount(
-            codes[~np.isnan(codes)].astype(int), minlength=len(attribute.values)
-        )
+        counts = np.bincount(codes[~np.isnan(codes)].astype(int), minlength=len(attribute.values))
         distribution[attribute.name] = {
             label: int(n) for label, n in zip(attribute.values, counts, strict=True)
         }

@@ -41,7 +41,9 @@ def extract_command(
     name: Annotated[str | None, typer.Option("--name", help="Data set name in the store.")] = None,
     samplerate: Annotated[
         float | None,
-        typer.Option("--samplerate", help="Sample rate (Hz) of CSV/.npy files without a time column."),
+        typer.Option(
+            "--samplerate", help="Sample rate (Hz) of CSV/.npy files without a time column."
+        ),
     ] = None,
     segment: Annotated[
         float | None,

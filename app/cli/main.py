@@ -14,6 +14,7 @@ import typer
 
 from app.cli import bench as bench_commands
 from app.cli import datasets as datasets_commands
+from app.cli import demo as demo_commands
 from app.cli import extract as extract_commands
 from app.cli import models as models_commands
 from app.cli.state import CliState
@@ -62,6 +63,7 @@ datasets_commands.register(app)
 bench_commands.register(app)
 models_commands.register(app)
 extract_commands.register(app)
+demo_commands.register(app)
 
 
 def main(argv: list[str] | None = None) -> int:

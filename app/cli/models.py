@@ -28,7 +28,8 @@ def train_command(
     ctx: typer.Context,
     dataset: Annotated[str, typer.Argument(metavar="DATASET", help="Data set name or id.")],
     classifier: Annotated[
-        str, typer.Option("--classifier", "-c", help="Classifier id (see `touchbench classifiers`).")
+        str,
+        typer.Option("--classifier", "-c", help="Classifier id (see `touchbench classifiers`)."),
     ],
     target: Annotated[
         str | None, typer.Option("--target", help="Train for this one target only.")
@@ -41,8 +42,12 @@ def train_command(
     from app.modelling import train
 
     model = train(
-        get_state(ctx).store, dataset, classifier, targets=[target] if target else None,
-        name=name, seed=seed,
+        get_state(ctx).store,
+        dataset,
+        classifier,
+        targets=[target] if target else None,
+        name=name,
+        seed=seed,
     )
     if as_json:
         print_json(model.to_json())

@@ -8,6 +8,7 @@ from __future__ import annotations
 import sys
 from types import TracebackType
 
+from benchmark.engine import TaskKey, TaskResult
 from rich.console import Console
 from rich.progress import (
     BarColumn,
@@ -19,7 +20,6 @@ from rich.progress import (
 )
 
 from app.benchmarking import Callbacks
-from benchmark.engine import TaskKey, TaskResult
 
 
 class TaskProgress:
@@ -73,8 +73,10 @@ class TaskProgress:
     def finish(self, result: TaskResult) -> None:
         if result.status != "ok":
             self.failures += 1
-            self.warn(f"{result.key.classifier} fold {result.key.fold + 1}: {result.status}: "
-                      f"{result.error}")
+            self.warn(
+                f"{result.key.classifier} fold {result.key.fold + 1}: {result.status}: "
+                f"{result.error}"
+            )
         self._progress.advance(self._task)
 
     def warn(self, message: str) -> None:

@@ -212,8 +212,8 @@ def _instance_blobs(session: Session, dataset_id: int) -> list[bytes]:
     assert dbapi is not None
     style = connection.dialect.paramstyle
     marker = {"qmark": "?", "numeric": ":1", "named": ":id"}.get(style, "%s")
-    cursor = dbapi.cursor(binary=True) if connection.dialect.driver == "psycopg" else (
-        dbapi.cursor()
+    cursor = (
+        dbapi.cursor(binary=True) if connection.dialect.driver == "psycopg" else (dbapi.cursor())
     )
     try:
         cursor.execute(

@@ -12,7 +12,8 @@ from dataclasses import dataclass
 from datetime import datetime
 from typing import Any
 
-from sqlalchemy import func, select, update
+from benchmark.engine import TaskKey, TaskResult
+from sqlalchemy import func, insert, select, update
 from sqlalchemy.dialects.postgresql import insert as postgresql_insert
 from sqlalchemy.dialects.sqlite import insert as sqlite_insert
 from sqlalchemy.orm import Session
@@ -20,7 +21,6 @@ from sqlalchemy.orm import Session
 from app.errors import NotFoundError
 from app.store.database import Store
 from app.store.tables import DatasetRow, FoldResultRow, RunRow, utcnow
-from benchmark.engine import TaskKey, TaskResult
 
 
 @dataclass(frozen=True)
@@ -97,9 +97,7 @@ def set_status(store: Store, run_id: int, status: str) -> None:
     with store.session() as session:
         finished = utcnow() if status in ("finished", "failed") else None
         session.execute(
-            update(RunRow)
-            .where(RunRow.id == run_id)
-            .values(status=status, finished_at=finished)
+            update(RunRow).where(RunRow.id == run_id).values(status=status, finished_at=finished)
         )
 
 
@@ -128,7 +126,7 @@ def record_result(store: Store, run_id: int, result: TaskResult) -> None:
             key = (result.key.classifier, result.key.repeat, result.key.fold)
             if key in _keys(session, run_id):
                 return
-            statement = FoldResultRow.__table__.insert()
+            statement = insert(FoldResultRow)
         session.execute(statement, [values])
 
 
@@ -148,7 +146,7 @@ def load_results(store: Store, run_id: int) -> list[TaskResult]:
         return [
             TaskResult(
                 key=TaskKey(row.classifier, row.repeat, row.fold),
-                status=row.status,  # type: ignore[arg-type]
+                status=row.status,
                 error=row.error,
                 metrics=dict(row.metrics),
                 confusion=row.confusion,

@@ -18,7 +18,9 @@ DEFAULT_POSTGRES = "postgresql://postgres:postgres@127.0.0.1:5432/test"
 
 
 def _psycopg_url(url: str) -> str:
-    return "postgresql+psycopg://" + url.split("://", 1)[1] if url.startswith("postgresql://") else url
+    return (
+        "postgresql+psycopg://" + url.split("://", 1)[1] if url.startswith("postgresql://") else url
+    )
 
 
 @pytest.fixture(scope="session")

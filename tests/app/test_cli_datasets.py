@@ -119,13 +119,41 @@ BAD_FILES = {
     "empty": ("empty.arff", b"", "empty"),
     "binary garbage": ("garbage.arff", bytes(range(256)) * 4, "not a text file"),
     "no @data": ("nodata.arff", "@relation r\n@attribute a numeric\n@attribute b {x,y}\n", "@data"),
-    "too few values": ("few.arff", "@relation r\n@attribute a numeric\n@attribute b {x,y}\n@data\n1,x\n2\n", ":6:"),
-    "too many values": ("many.arff", "@relation r\n@attribute a numeric\n@attribute b {x,y}\n@data\n1,x,3\n", ":5:"),
-    "undeclared nominal": ("nominal.arff", "@relation r\n@attribute a numeric\n@attribute b {x,y}\n@data\n1,z\n", "'b'"),
-    "non-number": ("nan.arff", "@relation r\n@attribute a numeric\n@attribute b {x,y}\n@data\nabc,x\n", "'a'"),
-    "unterminated quote": ("quote.arff", "@relation r\n@attribute a numeric\n@attribute b {x,'y z}\n@data\n1,x\n", ":3:"),
-    "duplicate attribute": ("dup.arff", "@relation r\n@attribute a numeric\n@attribute a {x,y}\n@data\n1,x\n", "'a'"),
-    "-C too large": ("toomany.arff", "@relation 'r: -C 5'\n@attribute a numeric\n@attribute b {x,y}\n@data\n1,x\n", "-C 5"),
+    "too few values": (
+        "few.arff",
+        "@relation r\n@attribute a numeric\n@attribute b {x,y}\n@data\n1,x\n2\n",
+        ":6:",
+    ),
+    "too many values": (
+        "many.arff",
+        "@relation r\n@attribute a numeric\n@attribute b {x,y}\n@data\n1,x,3\n",
+        ":5:",
+    ),
+    "undeclared nominal": (
+        "nominal.arff",
+        "@relation r\n@attribute a numeric\n@attribute b {x,y}\n@data\n1,z\n",
+        "'b'",
+    ),
+    "non-number": (
+        "nan.arff",
+        "@relation r\n@attribute a numeric\n@attribute b {x,y}\n@data\nabc,x\n",
+        "'a'",
+    ),
+    "unterminated quote": (
+        "quote.arff",
+        "@relation r\n@attribute a numeric\n@attribute b {x,'y z}\n@data\n1,x\n",
+        ":3:",
+    ),
+    "duplicate attribute": (
+        "dup.arff",
+        "@relation r\n@attribute a numeric\n@attribute a {x,y}\n@data\n1,x\n",
+        "'a'",
+    ),
+    "-C too large": (
+        "toomany.arff",
+        "@relation 'r: -C 5'\n@attribute a numeric\n@attribute b {x,y}\n@data\n1,x\n",
+        "-C 5",
+    ),
     "ragged CSV": ("ragged.csv", "a,b,c\n1,2,x\n3,4\n", ":3"),
 }
 
@@ -180,7 +208,10 @@ def test_real_files_import_export_and_reimport_identically(
     expected = read_arff(source)
     assert imported.json()["n_instances"] == expected.n_instances
     exported = tmp_path / "export.arff"
-    assert run_cli(capsys, store_url, "export", str(imported.json()["id"]), "-o", str(exported)).code == 0
+    assert (
+        run_cli(capsys, store_url, "export", str(imported.json()["id"]), "-o", str(exported)).code
+        == 0
+    )
     assert read_arff(exported).equals(expected)
     again = run_cli(capsys, store_url, "import", str(exported), "--name", "reimported", "--json")
     assert again.code == 0 and again.json()["created"] is True

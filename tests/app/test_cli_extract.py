@@ -22,8 +22,17 @@ def test_extract_stores_a_labelled_dataset_with_uc3m_features(
 ) -> None:
     wav, labels, n_touches = session
     result = run_cli(
-        capsys, store_url, "extract", str(wav), "--labels", str(labels),
-        "--extractor", "uc3m-audio", "--name", "sim", "--json",
+        capsys,
+        store_url,
+        "extract",
+        str(wav),
+        "--labels",
+        str(labels),
+        "--extractor",
+        "uc3m-audio",
+        "--name",
+        "sim",
+        "--json",
     )
     assert result.code == 0, result.err
     summary = result.json()

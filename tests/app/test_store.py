@@ -100,7 +100,7 @@ def test_find_by_name_or_id_and_delete(store: Store) -> None:
     info, _ = add_dataset(store, small_dataset(), sha256="1" * 64, name="mini")
     assert find_dataset(store, "mini").id == info.id
     assert find_dataset(store, str(info.id)).name == "mini"
-    with pytest.raises(NotFoundError, match="no dataset 'maggie'.*mini"):
+    with pytest.raises(NotFoundError, match=r"no dataset 'maggie'.*mini"):
         find_dataset(store, "maggie")
     assert delete_dataset(store, "mini").id == info.id
     assert list_datasets(store) == []

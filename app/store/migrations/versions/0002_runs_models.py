@@ -56,9 +56,7 @@ def upgrade() -> None:
         "models",
         sa.Column("id", sa.Integer, primary_key=True),
         sa.Column("name", sa.String(200), nullable=False, unique=True),
-        sa.Column(
-            "dataset_id", sa.Integer, sa.ForeignKey("datasets.id", ondelete="SET NULL")
-        ),
+        sa.Column("dataset_id", sa.Integer, sa.ForeignKey("datasets.id", ondelete="SET NULL")),
         sa.Column("run_id", sa.Integer, sa.ForeignKey("runs.id", ondelete="SET NULL")),
         sa.Column("classifier", sa.String(100), nullable=False),
         sa.Column("params", sa.JSON, nullable=False),
