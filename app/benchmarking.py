@@ -145,8 +145,11 @@ def start_run(
     info = find_dataset(store, dataset_ref)
     prepared = prepare_problem(load_dataset(store, info.id), targets)
     folds, fold_warnings = _folds(prepared, options)
+    effective = max(f.fold for f in folds) + 1
     config = {
         **options.to_json(),
+        "folds": effective,
+        "folds_requested": options.folds,
         "targets_given": list(targets) if targets else None,
         "n_tasks": len(classifiers) * len(folds),
         "n_instances": int(prepared.problem.X.shape[0]),

@@ -130,7 +130,6 @@ def test_leaderboard_formats(
     [
         (["--classifiers", "rff"], "did you mean 'rf'"),
         (["--target", "colour"], "colour"),
-        (["--folds", "40"], "fold"),
     ],
 )
 def test_bad_benchmark_requests_exit_2(
@@ -150,6 +149,20 @@ def test_bad_benchmark_requests_exit_2(
     assert result.code == 2, result.err
     assert len(result.err.strip().splitlines()) == 1
     assert expected in result.err
+
+
+def test_too_many_folds_fall_back_with_a_warning(
+    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+) -> None:
+    imported(capsys, store_url, touch_arff(tmp_path / "t.arff", n=30))
+    result = run_cli(
+        capsys, store_url, "bench", "touch", "--target", "gesture", "--classifiers", "zeror",
+        "--folds", "40", "--json",
+    )
+    assert result.code == 0, result.err
+    assert "only 10 instance(s): using 10 folds instead of 40" in " ".join(result.err.split())
+    run = run_cli(capsys, store_url, "runs", "--json").json()["runs"][0]
+    assert (run["config"]["folds"], run["config"]["folds_requested"], run["tasks"]) == (10, 40, 10)
 
 
 def test_one_class_target_and_unknown_run_exit_2(
