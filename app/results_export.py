@@ -1,0 +1,24 @@
+"""A run's per-fold results as WEKA Experimenter's InstanceResultListener ARFF."""
+
+from __future__ import annotations
+
+from typing import TextIO
+
+from app.store.database import Store
+from app.store.runs import RunInfo, load_results
+from benchmark.arff import write_arff
+from benchmark.catalogue import CATALOGUE
+from benchmark.errors import ConfigurationError
+from benchmark.results_arff import results_to_dataset
+
+
+def write_results_arff(store: Store, run: RunInfo, stream: TextIO) -> None:
+    """Write every successful fold of a multi-class run, one row per (run, fold, scheme)."""
+    if run.kind != "multiclass":
+        raise ConfigurationError(
+            f"run {run.id} is multi-target; WEKA's results format holds multi-class runs "
+            "(use --format csv or json)"
+        )
+    results = load_results(store, run.id)
+    name = f"{run.dataset_name}: {', '.join(run.targets)}"
+    write_arff(results_to_dataset(results, dataset_name=name, specs=CATALOGUE), stream)
