@@ -61,6 +61,11 @@ def row_json(row: LeaderboardRow) -> dict[str, Any]:
     }
 
 
+def leaderboard_header(board: Leaderboard, columns: Sequence[str]) -> list[str]:
+    notes = ["notes"] if any(row.n_failed for row in board.rows) else []
+    return ["#", "classifier", "", *columns, *notes]
+
+
 def leaderboard_rows(board: Leaderboard, columns: Sequence[str]) -> list[tuple[Any, ...]]:
     """Rank, classifier, mark and ``mean ± std`` per column, ready for a table."""
     out = []
@@ -69,8 +74,8 @@ def leaderboard_rows(board: Leaderboard, columns: Sequence[str]) -> list[tuple[A
         for column in columns:
             value = row.metrics.get(column)
             cells.append(_mean_std(value) if isinstance(value, tuple) else "-")
-        note = f"{row.n_failed} failed: {row.errors[0]}" if row.n_failed and row.errors else ""
-        cells.append(note)
+        if any(r.n_failed for r in board.rows):
+            cells.append(f"{row.n_failed} failed: {row.errors[0]}" if row.errors else "")
         out.append(tuple(cells))
     return out
 
@@ -101,7 +106,7 @@ def leaderboard_markdown(run: RunInfo, board: Leaderboard, columns: Sequence[str
         "|---:|---|:-:|" + "---:|" * len(columns),
     ]
     for row in leaderboard_rows(board, columns):
-        rank, classifier, mark, *values, _note = row
+        rank, classifier, mark, *values = row[: 3 + len(columns)]
         lines.append(f"| {rank} | {classifier} | {mark} | " + " | ".join(values) + " |")
     v, same, worse = board.summary
     lines += ["", f"(v/ /*) = ({v}/{same}/{worse})"]
@@ -118,7 +123,7 @@ def _mean_std(value: tuple[float, float]) -> str:
         return "-"
     if std is None or (isinstance(std, float) and math.isnan(std)):
         return f"{mean:.4f}"
-    return f"{mean:.4f} ± {std:.4f}"
+    return f"{mean:.4f} ±{std:.3f}"
 
 
 def _finite(value: Any) -> Any:

@@ -240,13 +240,13 @@ def _choose_classifiers(classifiers: str | None, suite_name: str | None) -> list
 
 
 def _print_leaderboard(run: RunInfo, board: Leaderboard) -> None:
-    from app.reports import leaderboard_rows, metric_columns
+    from app.reports import leaderboard_header, leaderboard_rows, metric_columns
 
     columns = metric_columns(run, board)
     table(
         f"run {run.id}: {run.dataset_name} ({', '.join(run.targets)}), "
         f"{run.config.get('folds')}-fold x {run.config.get('repeats')}, ranked by {board.metric}",
-        ["#", "classifier", "", *columns, ""],
+        leaderboard_header(board, columns),
         leaderboard_rows(board, columns),
     )
     v, same, worse = board.summary

@@ -11,7 +11,8 @@ from typing import Any
 from rich.console import Console
 from rich.table import Table
 
-console = Console(highlight=False, soft_wrap=False)
+#: Pipes and files get a wide page: nobody wants a leaderboard wrapped at 80 columns.
+console = Console(highlight=False, soft_wrap=False, width=None if sys.stdout.isatty() else 160)
 err_console = Console(stderr=True, highlight=False)
 
 
@@ -35,7 +36,7 @@ def table(
 ) -> None:
     out = Table(title=title, title_justify="left", header_style="bold")
     for i, column in enumerate(columns):
-        out.add_column(column, justify=(justify[i] if justify else "left"))  # type: ignore[arg-type]
+        out.add_column(column, justify=(justify[i] if justify else "left"), no_wrap=i < 2)  # type: ignore[arg-type]
     for row in rows:
         out.add_row(*(format_cell(value) for value in row))
     console.print(out)
