@@ -12,13 +12,13 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from benchmark.model import TrainedModel, dumps_model, fit_model, loads_model
 
 from app.store.database import Store
 from app.store.datasets import find_dataset, load_dataset
 from app.store.models import ModelInfo, load_artifact, save_model
 from benchmark.dataset import Attribute, Dataset, Schema
 from benchmark.errors import ConfigurationError, DataFormatError
+from benchmark.model import TrainedModel, dumps_model, fit_model, loads_model
 
 
 def project(dataset: Dataset, targets: Sequence[str] | None = None) -> Dataset:

@@ -8,9 +8,8 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
-from benchmark.leaderboard import Leaderboard, LeaderboardRow
-
 from app.store.runs import RunInfo
+from benchmark.leaderboard import Leaderboard, LeaderboardRow
 
 #: Columns shown in tables, by kind of problem (the ranking metric always comes first).
 TABLE_METRICS = {

@@ -9,12 +9,11 @@ import typer
 
 from app.cli.output import info, print_json, table
 from app.cli.state import get_state
-from benchmark.errors import ConfigurationError
 
 if TYPE_CHECKING:
-    from benchmark.leaderboard import Leaderboard
-
+    from app.benchmarking import IndependentResult
     from app.store.runs import RunInfo
+    from benchmark.leaderboard import Leaderboard
 
 # scikit-learn, the engine and Dask are imported by the commands that use them, so that
 # `touchbench datasets` and `--help` start at once.
@@ -35,9 +34,19 @@ def classifiers_command(
     suite_name: Annotated[
         str | None, typer.Option("--suite", help="Only this suite: fast, default or all.")
     ] = None,
+    multi_target: Annotated[
+        bool,
+        typer.Option(
+            "--multi-target", help="List the multi-target configurations (META:BASE) instead."
+        ),
+    ] = False,
 ) -> None:
-    """List the multi-class classifier catalogue (id, WEKA name, family, capabilities)."""
+    """List the classifier catalogue (id, WEKA name, family, capabilities)."""
     from benchmark.catalogue import CATALOGUE, get_spec, suite
+
+    if multi_target:
+        _print_multitarget(suite_name, as_json)
+        return
 
     ids = suite(suite_name) if suite_name else list(CATALOGUE)
     specs = [get_spec(i) for i in ids]
@@ -84,6 +93,48 @@ def classifiers_command(
     )
 
 
+def _print_multitarget(suite_name: str | None, as_json: bool) -> None:
+    from benchmark.multitarget import META_METHODS, multitarget_configurations, parse_config
+    from benchmark.multitarget.suites import multitarget_suite
+
+    ids = (
+        multitarget_suite(suite_name)
+        if suite_name
+        else multitarget_configurations(include_multilabel=True)
+    )
+    entries = []
+    for config in ids:
+        meta, base = parse_config(config)
+        spec = META_METHODS[meta]
+        entries.append(
+            {
+                "id": config,
+                "meta": meta,
+                "base": base or None,
+                "method": spec.name,
+                "follows": spec.follows,
+                "binary_only": spec.binary_only,
+            }
+        )
+    if as_json:
+        print_json({"classifiers": entries})
+        return
+    table(
+        f"{len(entries)} multi-target configurations",
+        ["id", "method", "base", "follows", "targets"],
+        [
+            (
+                e["id"],
+                e["method"],
+                e["base"] or "",
+                e["follows"],
+                "binary only" if e["binary_only"] else "any",
+            )
+            for e in entries
+        ],
+    )
+
+
 def bench_command(
     ctx: typer.Context,
     dataset: Annotated[
@@ -119,12 +170,34 @@ def bench_command(
     resume: Annotated[
         int | None, typer.Option("--resume", metavar="RUN", help="Finish an interrupted run.")
     ] = None,
+    independent: Annotated[
+        bool,
+        typer.Option(
+            "--independent",
+            help=(
+                "Multi-target data: benchmark each target separately with multi-class "
+                "classifiers and report the product of the best scores (the paper's comparison)."
+            ),
+        ),
+    ] = False,
     as_json: JsonOption = False,
 ) -> None:
-    """Cross-validate classifiers on a data set; every finished fold is stored at once."""
-    from app.benchmarking import RunOptions, resume_run, run_leaderboard, start_run
+    """Cross-validate classifiers on a data set; every finished fold is stored at once.
+
+    A data set with several targets gets the multi-target configurations (META:BASE, e.g.
+    bcc:rf) unless --target picks one target for the multi-class catalogue.
+    """
+    from app.benchmarking import (
+        RunOptions,
+        default_classifiers,
+        independent_runs,
+        resume_run,
+        run_leaderboard,
+        start_run,
+    )
     from app.cli.progress import TaskProgress
     from app.reports import leaderboard_json
+    from app.store.datasets import find_dataset
 
     store = get_state(ctx).store
     progress = TaskProgress(enabled=False if as_json else None)
@@ -138,15 +211,36 @@ def bench_command(
         else:
             if dataset is None:
                 raise typer.BadParameter("missing DATASET (or --resume RUN)")
-            ids = _choose_classifiers(classifiers, suite_name)
+            if classifiers and suite_name:
+                raise typer.BadParameter("give --classifiers or --suite, not both")
+            if independent and target:
+                raise typer.BadParameter("--independent benchmarks every target; drop --target")
+            if classifiers:
+                ids = [c.strip() for c in classifiers.split(",") if c.strip()]
+            else:
+                n_targets = (
+                    1 if (target or independent) else len(find_dataset(store, dataset).targets)
+                )
+                ids = default_classifiers(n_targets, suite_name or "default")
+            options = RunOptions(folds=folds, repeats=repeats, seed=seed, timeout=timeout or None)
+            if independent:
+                result = independent_runs(
+                    store,
+                    dataset,
+                    ids,
+                    options=options,
+                    jobs=jobs,
+                    scheduler=scheduler,
+                    callbacks=progress.callbacks(),
+                )
+                _print_independent(result, as_json)
+                return
             run, _ = start_run(
                 store,
                 dataset,
                 ids,
                 targets=[target] if target else None,
-                options=RunOptions(
-                    folds=folds, repeats=repeats, seed=seed, timeout=timeout or None
-                ),
+                options=options,
                 jobs=jobs,
                 scheduler=scheduler,
                 callbacks=progress.callbacks(),
@@ -226,17 +320,29 @@ def leaderboard_command(
         _print_leaderboard(run, board)
 
 
-def _choose_classifiers(classifiers: str | None, suite_name: str | None) -> list[str]:
-    if classifiers and suite_name:
-        raise typer.BadParameter("give --classifiers or --suite, not both")
-    if classifiers:
-        ids = [c.strip() for c in classifiers.split(",") if c.strip()]
-        if not ids:
-            raise ConfigurationError("--classifiers is empty")
-        return ids
-    from benchmark.catalogue import suite
-
-    return suite(suite_name or "default")
+def _print_independent(result: IndependentResult, as_json: bool) -> None:
+    if as_json:
+        print_json(result.to_json())
+        return
+    rows: list[tuple[object, ...]] = []
+    for target, (run, board) in result.runs.items():
+        best = board.rows[0]
+        rows.append(
+            (
+                target,
+                run.id,
+                best.classifier,
+                f"{best.metrics['accuracy'][0]:.4f}",
+                f"{best.metrics['f1_weighted'][0]:.4f}",
+            )
+        )
+    product = result.product
+    rows.append(("product", "", "", f"{product['accuracy']:.4f}", f"{product['f1_weighted']:.4f}"))
+    table(
+        "each target classified independently (best multi-class classifier per target)",
+        ["target", "run", "best", "accuracy", "f1_weighted"],
+        rows,
+    )
 
 
 def _print_leaderboard(run: RunInfo, board: Leaderboard) -> None:

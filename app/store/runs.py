@@ -12,7 +12,6 @@ from dataclasses import dataclass
 from datetime import datetime
 from typing import Any
 
-from benchmark.engine import TaskKey, TaskResult
 from sqlalchemy import func, insert, select, update
 from sqlalchemy.dialects.postgresql import insert as postgresql_insert
 from sqlalchemy.dialects.sqlite import insert as sqlite_insert
@@ -21,6 +20,7 @@ from sqlalchemy.orm import Session
 from app.errors import NotFoundError
 from app.store.database import Store
 from app.store.tables import DatasetRow, FoldResultRow, RunRow, utcnow
+from benchmark.engine import TaskKey, TaskResult
 
 
 @dataclass(frozen=True)
@@ -146,7 +146,7 @@ def load_results(store: Store, run_id: int) -> list[TaskResult]:
         return [
             TaskResult(
                 key=TaskKey(row.classifier, row.repeat, row.fold),
-                status=row.status,
+                status=row.status,  # type: ignore[arg-type]  # a Status literal in the column
                 error=row.error,
                 metrics=dict(row.metrics),
                 confusion=row.confusion,

@@ -156,8 +156,17 @@ def test_too_many_folds_fall_back_with_a_warning(
 ) -> None:
     imported(capsys, store_url, touch_arff(tmp_path / "t.arff", n=30))
     result = run_cli(
-        capsys, store_url, "bench", "touch", "--target", "gesture", "--classifiers", "zeror",
-        "--folds", "40", "--json",
+        capsys,
+        store_url,
+        "bench",
+        "touch",
+        "--target",
+        "gesture",
+        "--classifiers",
+        "zeror",
+        "--folds",
+        "40",
+        "--json",
     )
     assert result.code == 0, result.err
     assert "only 10 instance(s): using 10 folds instead of 40" in " ".join(result.err.split())

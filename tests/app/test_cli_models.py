@@ -16,14 +16,19 @@ def trained(capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path) 
     path = touch_arff(tmp_path / "t.arff", n=120)
     assert run_cli(capsys, store_url, "import", str(path)).code == 0
     result = run_cli(
-        capsys, store_url, "train", "touch", "--classifier", "nb", "--target", "gesture",
+        capsys,
+        store_url,
+        "train",
+        "touch",
+        "--classifier",
+        "nb",
+        "--target",
+        "gesture",
         "--json",
     )
     assert result.code == 0, result.err
     model = result.json()
-    assert (model["name"], model["classifier"], model["targets"]) == (
-        "touch-nb", "nb", ["gesture"]
-    )
+    assert (model["name"], model["classifier"], model["targets"]) == ("touch-nb", "nb", ["gesture"])
     assert len(model["sha256"]) == 64 and model["size_bytes"] > 0
     return path
 
