@@ -238,6 +238,40 @@ def run_leaderboard(
     return run, build_leaderboard(results, metric=metric or default_metric, baseline=baseline)
 
 
+PerTargetSummary = dict[str, dict[str, dict[str, tuple[float, float]]]]
+
+
+def per_target_summary(store: Store, run_id: int) -> PerTargetSummary:
+    """Mean and standard deviation over folds of each target's scores, per classifier.
+
+    Returns
+    -------
+    dict
+        classifier -> target -> metric (accuracy, f1_weighted, ...) -> (mean, std).
+    """
+    collected: dict[str, dict[str, dict[str, list[float]]]] = {}
+    for result in load_results(store, run_id):
+        if result.status != "ok" or not result.per_target:
+            continue
+        by_target = collected.setdefault(result.key.classifier, {})
+        for target, scores in result.per_target.items():
+            for name, value in scores.items():
+                by_target.setdefault(target, {}).setdefault(name, []).append(value)
+    return {
+        classifier: {
+            target: {
+                name: (
+                    float(np.mean(values)),
+                    float(np.std(values, ddof=1)) if len(values) > 1 else float("nan"),
+                )
+                for name, values in scores.items()
+            }
+            for target, scores in targets.items()
+        }
+        for classifier, targets in collected.items()
+    }
+
+
 @dataclass
 class IndependentResult:
     """The paper's other approach: each target's best multi-class classifier, separately.
@@ -317,6 +351,7 @@ def _folds(prepared: PreparedProblem, options: RunOptions) -> tuple[list[Fold], 
         n_repeats=options.repeats,
         seed=options.seed,
         groups=prepared.groups,
+        target_names=prepared.target_names,
     )
 
 

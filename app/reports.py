@@ -5,7 +5,7 @@ from __future__ import annotations
 import csv
 import io
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from app.store.runs import RunInfo
@@ -24,7 +24,23 @@ def metric_columns(run: RunInfo, board: Leaderboard) -> list[str]:
     return [c for c in columns if c in available or c == board.metric]
 
 
-def leaderboard_json(run: RunInfo, board: Leaderboard) -> dict[str, Any]:
+def leaderboard_json(
+    run: RunInfo,
+    board: Leaderboard,
+    per_target: Mapping[str, Mapping[str, Mapping[str, tuple[float, float]]]] | None = None,
+) -> dict[str, Any]:
+    """The report of a run; multi-target rows carry ``metrics.per_target`` when given."""
+    rows = [row_json(row) for row in board.rows]
+    for row in rows:
+        targets = (per_target or {}).get(row["classifier"])
+        if targets:
+            row["metrics"]["per_target"] = {
+                target: {
+                    name: {"mean": _finite(mean), "std": _finite(std)}
+                    for name, (mean, std) in scores.items()
+                }
+                for target, scores in targets.items()
+            }
     return {
         "run_id": run.id,
         "dataset": run.dataset_name,
@@ -37,7 +53,7 @@ def leaderboard_json(run: RunInfo, board: Leaderboard) -> dict[str, Any]:
             "same": board.summary[1],
             "worse": board.summary[2],
         },
-        "leaderboard": [row_json(row) for row in board.rows],
+        "leaderboard": rows,
     }
 
 

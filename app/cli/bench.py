@@ -191,6 +191,7 @@ def bench_command(
         RunOptions,
         default_classifiers,
         independent_runs,
+        per_target_summary,
         resume_run,
         run_leaderboard,
         start_run,
@@ -247,7 +248,7 @@ def bench_command(
             )
     run, board = run_leaderboard(store, run.id, metric=metric, baseline=baseline)
     if as_json:
-        print_json(leaderboard_json(run, board))
+        print_json(leaderboard_json(run, board, per_target_summary(store, run.id)))
         return
     _print_leaderboard(run, board)
 
@@ -300,14 +301,14 @@ def leaderboard_command(
         raise typer.BadParameter(
             f"'{output_format}' is not one of {', '.join(FORMATS)}", param_hint="--format"
         )
-    from app.benchmarking import run_leaderboard
+    from app.benchmarking import per_target_summary, run_leaderboard
     from app.reports import leaderboard_csv, leaderboard_json, leaderboard_markdown, metric_columns
 
     store = get_state(ctx).store
     run, board = run_leaderboard(store, run_id, metric=metric, baseline=baseline)
     columns = metric_columns(run, board)
     if output_format == "json":
-        print_json(leaderboard_json(run, board))
+        print_json(leaderboard_json(run, board, per_target_summary(store, run.id)))
     elif output_format == "csv":
         sys.stdout.write(leaderboard_csv(board, columns))
     elif output_format == "markdown":

@@ -22,6 +22,9 @@ from app.store.database import Store
 from app.store.tables import DatasetRow, FoldResultRow, RunRow, utcnow
 from benchmark.engine import TaskKey, TaskResult
 
+#: Multi-target folds keep their per-target scores in the metrics column under this key.
+PER_TARGET = "per_target"
+
 
 @dataclass(frozen=True)
 class RunInfo:
@@ -110,7 +113,11 @@ def record_result(store: Store, run_id: int, result: TaskResult) -> None:
         "fold": result.key.fold,
         "status": result.status,
         "error": result.error,
-        "metrics": result.metrics,
+        "metrics": (
+            {**result.metrics, PER_TARGET: result.per_target}
+            if result.per_target
+            else result.metrics
+        ),
         "confusion": result.confusion,
         "n_train": result.n_train,
         "n_test": result.n_test,
@@ -143,18 +150,23 @@ def load_results(store: Store, run_id: int) -> list[TaskResult]:
             .where(FoldResultRow.run_id == run_id)
             .order_by(FoldResultRow.classifier, FoldResultRow.repeat, FoldResultRow.fold)
         )
-        return [
-            TaskResult(
-                key=TaskKey(row.classifier, row.repeat, row.fold),
-                status=row.status,  # type: ignore[arg-type]  # a Status literal in the column
-                error=row.error,
-                metrics=dict(row.metrics),
-                confusion=row.confusion,
-                n_train=row.n_train,
-                n_test=row.n_test,
+        results = []
+        for row in rows:
+            metrics = dict(row.metrics)
+            per_target = metrics.pop(PER_TARGET, None)
+            results.append(
+                TaskResult(
+                    key=TaskKey(row.classifier, row.repeat, row.fold),
+                    status=row.status,  # type: ignore[arg-type]  # a Status literal in the column
+                    error=row.error,
+                    metrics=metrics,
+                    confusion=row.confusion,
+                    n_train=row.n_train,
+                    n_test=row.n_test,
+                    per_target=per_target,
+                )
             )
-            for row in rows
-        ]
+        return results
 
 
 def _keys(session: Session, run_id: int) -> set[tuple[str, int, int]]:
