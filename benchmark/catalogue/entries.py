@@ -1,0 +1,878 @@
+"""The catalogue's entries: one :class:`ClassifierSpec` per configuration.
+
+Plain scikit-learn classes are their own factories; composite models (wrappers and
+ensembles around a base estimator) are built by the module-level functions below, which
+take the outer model's parameters so that ``params`` shows them.  Nested ``random_state``
+parameters are set by :func:`benchmark.catalogue.build_pipeline`, not here.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from sklearn.base import BaseEstimator
+from sklearn.calibration import CalibratedClassifierCV
+from sklearn.discriminant_analysis import LinearDiscriminantAnalysis, QuadraticDiscriminantAnalysis
+from sklearn.dummy import DummyClassifier
+from sklearn.ensemble import (
+    AdaBoostClassifier,
+    BaggingClassifier,
+    ExtraTreesClassifier,
+    GradientBoostingClassifier,
+    HistGradientBoostingClassifier,
+    RandomForestClassifier,
+    StackingClassifier,
+    VotingClassifier,
+)
+from sklearn.gaussian_process import GaussianProcessClassifier
+from sklearn.gaussian_process.kernels import RBF, ConstantKernel
+from sklearn.linear_model import (
+    LogisticRegression,
+    Perceptron,
+    RidgeClassifier,
+    RidgeClassifierCV,
+    SGDClassifier,
+)
+from sklearn.multiclass import OneVsOneClassifier, OneVsRestClassifier, OutputCodeClassifier
+from sklearn.naive_bayes import BernoulliNB, ComplementNB, GaussianNB, MultinomialNB
+from sklearn.neighbors import KNeighborsClassifier, NearestCentroid
+from sklearn.neural_network import MLPClassifier
+from sklearn.pipeline import make_pipeline
+from sklearn.preprocessing import KBinsDiscretizer
+from sklearn.svm import SVC, LinearSVC, NuSVC
+from sklearn.tree import DecisionTreeClassifier, ExtraTreeClassifier
+
+from benchmark.catalogue.estimators import LabelEncodedClassifier, OneRuleClassifier
+from benchmark.catalogue.spec import ClassifierSpec
+
+FAST = frozenset({"fast", "default"})
+DEFAULT = frozenset({"default"})
+ALL_ONLY: frozenset[str] = frozenset()
+
+XGB_PARAMS: dict[str, Any] = {
+    "n_estimators": 300,
+    "max_depth": 6,
+    "learning_rate": 0.1,
+    "subsample": 0.9,
+    "colsample_bytree": 0.8,
+    "tree_method": "hist",
+}
+HGB_PARAMS: dict[str, Any] = {"max_iter": 300, "learning_rate": 0.1}
+
+
+# Factories of composite models -------------------------------------------------------
+
+
+def xgboost_classifier(**params: Any) -> BaseEstimator:
+    """XGBoost behind a label encoder, so that folds missing a class still fit."""
+    from xgboost import XGBClassifier  # imported on use: it costs every worker 0.5 s
+
+    return LabelEncodedClassifier(XGBClassifier(**params))
+
+
+def discretized_naive_bayes(n_bins: int = 10) -> BaseEstimator:
+    """Equal-frequency discretisation followed by categorical naive Bayes."""
+    from sklearn.naive_bayes import CategoricalNB
+
+    return make_pipeline(
+        KBinsDiscretizer(n_bins=n_bins, encode="ordinal", strategy="quantile"),
+        CategoricalNB(min_categories=n_bins),
+    )
+
+
+def bagged_trees(n_estimators: int = 50, max_samples: float = 1.0) -> BaseEstimator:
+    """Bagging of unpruned decision trees (WEKA's Bagging with REPTree, roughly)."""
+    return BaggingClassifier(
+        DecisionTreeClassifier(), n_estimators=n_estimators, max_samples=max_samples
+    )
+
+
+def random_subspace_trees(n_estimators: int = 50, max_features: float = 0.5) -> BaseEstimator:
+    """Decision trees each on a random half of the features (WEKA's RandomSubSpace)."""
+    return BaggingClassifier(
+        DecisionTreeClassifier(),
+        n_estimators=n_estimators,
+        max_features=max_features,
+        bootstrap=False,
+    )
+
+
+def boosted_stumps(n_estimators: int = 100, learning_rate: float = 1.0) -> BaseEstimator:
+    """AdaBoost (SAMME) over decision stumps, like WEKA's AdaBoostM1 default."""
+    return AdaBoostClassifier(
+        DecisionTreeClassifier(max_depth=1),
+        n_estimators=n_estimators,
+        learning_rate=learning_rate,
+    )
+
+
+def boosted_trees(
+    n_estimators: int = 100, max_depth: int = 3, learning_rate: float = 0.5
+) -> BaseEstimator:
+    """AdaBoost (SAMME) over small trees."""
+    return AdaBoostClassifier(
+        DecisionTreeClassifier(max_depth=max_depth),
+        n_estimators=n_estimators,
+        learning_rate=learning_rate,
+    )
+
+
+def calibrated(base: str, method: str = "sigmoid", cv: int = 3) -> BaseEstimator:
+    """A base model with probabilities from cross-validated calibration."""
+    return CalibratedClassifierCV(_BASES[base](), method=method, cv=cv, ensemble=False)
+
+
+def one_vs_rest(base: str) -> BaseEstimator:
+    """One binary model per class."""
+    return OneVsRestClassifier(_BASES[base]())
+
+
+def one_vs_one(base: str) -> BaseEstimator:
+    """One binary model per pair of classes, majority vote."""
+    return OneVsOneClassifier(_BASES[base]())
+
+
+def output_codes(base: str, code_size: float = 2.0) -> BaseEstimator:
+    """Error-correcting output codes: random binary problems, nearest code wins."""
+    return OutputCodeClassifier(_BASES[base](), code_size=code_size)
+
+
+def gaussian_process(length_scale: float = 10.0, optimize: bool = False) -> BaseEstimator:
+    """Laplace-approximated GP classifier (one-vs-rest) with an RBF kernel.
+
+    The kernel's hyperparameters stay fixed unless ``optimize``: fitting them multiplies
+    the (already cubic) cost by the optimiser's iterations.
+    """
+    kernel = ConstantKernel(1.0) * RBF(length_scale=length_scale)
+    return GaussianProcessClassifier(kernel=kernel, optimizer="fmin_l_bfgs_b" if optimize else None)
+
+
+def soft_voting() -> BaseEstimator:
+    """Average of the probabilities of XGBoost, histogram boosting and a calibrated RBF SVM."""
+    return VotingClassifier(
+        [
+            ("xgb", xgboost_classifier(**XGB_PARAMS)),
+            ("hgb", HistGradientBoostingClassifier(**HGB_PARAMS)),
+            ("svm", CalibratedClassifierCV(_rbf_svm(), cv=3, ensemble=False)),
+        ],
+        voting="soft",
+    )
+
+
+def hard_voting() -> BaseEstimator:
+    """Majority vote of logistic regression, random forest and an RBF SVM."""
+    return VotingClassifier(
+        [("logistic", _logistic()), ("rf", _forest()), ("svm", SVC(C=10.0))], voting="hard"
+    )
+
+
+def stacking(cv: int = 5) -> BaseEstimator:
+    """Random forest, extra trees, RBF SVM and logistic regression, stacked by logistic."""
+    return StackingClassifier(
+        [
+            ("rf", _forest()),
+            ("extra_trees", ExtraTreesClassifier(n_estimators=200)),
+            ("svm", SVC(C=10.0)),
+            ("logistic", _logistic()),
+        ],
+        final_estimator=LogisticRegression(max_iter=1000),
+        cv=cv,
+    )
+
+
+def _logistic() -> BaseEstimator:
+    return LogisticRegression(C=10.0, max_iter=2000)
+
+
+def _forest() -> BaseEstimator:
+    return RandomForestClassifier(n_estimators=200)
+
+
+def _entropy_tree() -> BaseEstimator:
+    return DecisionTreeClassifier(criterion="entropy", min_samples_leaf=2)
+
+
+def _linear_svm() -> BaseEstimator:
+    return LinearSVC(C=1.0, max_iter=5000)
+
+
+def _rbf_svm() -> BaseEstimator:
+    return SVC(C=10.0)
+
+
+_BASES = {
+    "logistic": _logistic,
+    "svm-linear": _linear_svm,
+    "svm-rbf": _rbf_svm,
+    "nb": GaussianNB,
+    "j48": _entropy_tree,
+}
+
+
+# The entries -------------------------------------------------------------------------
+
+
+def _spec(
+    id: str,
+    factory: Any,
+    params: dict[str, Any],
+    *,
+    family: str,
+    description: str,
+    weka: str | None = None,
+    probabilities: bool = True,
+    scaling: str | None = None,
+    missing: bool = False,
+    nominal: bool = False,
+    cost: str = "fast",
+    suites: frozenset[str] = DEFAULT,
+    limits: str = "",
+) -> ClassifierSpec:
+    return ClassifierSpec(
+        id=id,
+        weka_name=weka,
+        family=family,
+        description=description,
+        factory=factory,
+        params=params,
+        probabilities=probabilities,
+        needs_scaling=scaling is not None,
+        handles_missing=missing,
+        handles_nominal=nominal,
+        cost=cost,  # type: ignore[arg-type]
+        suites=suites,
+        limits=limits,
+        scaling=scaling or "standard",  # type: ignore[arg-type]
+    )
+
+
+W = "weka.classifiers."
+
+SPECS: tuple[ClassifierSpec, ...] = (
+    # Baselines and rules
+    _spec(
+        "zeror",
+        DummyClassifier,
+        {"strategy": "prior"},
+        family="majority",
+        description="Majority class; class priors as probabilities",
+        weka=W + "rules.ZeroR",
+        suites=FAST,
+    ),
+    _spec(
+        "oner",
+        OneRuleClassifier,
+        {"min_bucket": 6},
+        family="rules",
+        description="Best single-feature interval rule (OneR-like)",
+        weka=W + "rules.OneR",
+        suites=FAST,
+        limits="intervals from a 1-D tree, not OneR's bucket merging",
+    ),
+    _spec(
+        "stump",
+        DecisionTreeClassifier,
+        {"max_depth": 1},
+        family="trees",
+        description="Decision stump: one binary split",
+        weka=W + "trees.DecisionStump",
+        missing=True,
+        limits="predicts at most two classes",
+    ),
+    # Single trees
+    _spec(
+        "j48",
+        DecisionTreeClassifier,
+        {"criterion": "entropy", "min_samples_leaf": 2},
+        family="trees",
+        description="C4.5-like entropy tree, at least 2 instances per leaf",
+        weka=W + "trees.J48",
+        missing=True,
+        suites=FAST,
+        limits="information gain, binary splits, no error-based pruning",
+    ),
+    _spec(
+        "j48-pruned",
+        DecisionTreeClassifier,
+        {"criterion": "entropy", "min_samples_leaf": 2, "ccp_alpha": 0.002},
+        family="trees",
+        description="Entropy tree with cost-complexity pruning",
+        weka=W + "trees.J48",
+        missing=True,
+        limits="cost-complexity pruning instead of C4.5's confidence pruning",
+    ),
+    _spec(
+        "cart",
+        DecisionTreeClassifier,
+        {"criterion": "gini", "min_samples_leaf": 2},
+        family="trees",
+        description="CART: Gini tree",
+        weka=W + "trees.SimpleCart",
+        missing=True,
+    ),
+    _spec(
+        "random-tree",
+        DecisionTreeClassifier,
+        {"max_features": "log2", "criterion": "entropy"},
+        family="trees",
+        description="Unpruned tree over log2(d) random features per node",
+        weka=W + "trees.RandomTree",
+        missing=True,
+    ),
+    _spec(
+        "extra-tree",
+        ExtraTreeClassifier,
+        {},
+        family="trees",
+        description="One extremely randomised tree",
+        missing=True,
+        suites=ALL_ONLY,
+    ),
+    # Forests and bagging
+    _spec(
+        "rf",
+        RandomForestClassifier,
+        {"n_estimators": 100},
+        family="forests",
+        description="Random forest, 100 trees, sqrt(d) features per split",
+        weka=W + "trees.RandomForest",
+        missing=True,
+        suites=FAST,
+    ),
+    _spec(
+        "rf-500",
+        RandomForestClassifier,
+        {"n_estimators": 500},
+        family="forests",
+        description="Random forest, 500 trees",
+        weka=W + "trees.RandomForest",
+        missing=True,
+        suites=ALL_ONLY,
+    ),
+    _spec(
+        "rf-balanced",
+        RandomForestClassifier,
+        {"n_estimators": 100, "class_weight": "balanced"},
+        family="forests",
+        description="Random forest with class weights inversely proportional to frequency",
+        weka=W + "trees.RandomForest",
+        missing=True,
+        suites=ALL_ONLY,
+    ),
+    _spec(
+        "extra-trees",
+        ExtraTreesClassifier,
+        {"n_estimators": 300},
+        family="forests",
+        description="Extremely randomised trees, 300 trees",
+        missing=True,
+    ),
+    _spec(
+        "bagging",
+        bagged_trees,
+        {"n_estimators": 50, "max_samples": 1.0},
+        family="bagging",
+        description="Bagging of 50 unpruned trees",
+        weka=W + "meta.Bagging",
+    ),
+    _spec(
+        "random-subspace",
+        random_subspace_trees,
+        {"n_estimators": 50, "max_features": 0.5},
+        family="bagging",
+        description="50 trees, each on half of the features",
+        weka=W + "meta.RandomSubSpace",
+    ),
+    # Boosting
+    _spec(
+        "adaboost",
+        boosted_stumps,
+        {"n_estimators": 100, "learning_rate": 1.0},
+        family="boosting",
+        description="AdaBoost (SAMME) over 100 decision stumps",
+        weka=W + "meta.AdaBoostM1",
+    ),
+    _spec(
+        "adaboost-tree",
+        boosted_trees,
+        {"n_estimators": 100, "max_depth": 3, "learning_rate": 0.5},
+        family="boosting",
+        description="AdaBoost (SAMME) over 100 depth-3 trees",
+        weka=W + "meta.AdaBoostM1",
+    ),
+    _spec(
+        "hgb",
+        HistGradientBoostingClassifier,
+        HGB_PARAMS,
+        family="boosting",
+        description="Histogram gradient boosting, native missing values and nominal features",
+        missing=True,
+        nominal=True,
+        limits="nominal attributes with more than 255 labels are one-hot encoded instead",
+    ),
+    _spec(
+        "gbm",
+        GradientBoostingClassifier,
+        {"n_estimators": 100, "max_depth": 3},
+        family="boosting",
+        description="Gradient boosting of depth-3 trees, 100 stages",
+        weka=W + "meta.LogitBoost",
+        cost="slow",
+    ),
+    _spec(
+        "xgb",
+        xgboost_classifier,
+        XGB_PARAMS,
+        family="boosting",
+        description="XGBoost, 300 rounds of depth-6 trees",
+        missing=True,
+    ),
+    # Nearest neighbours (attributes normalised to [0, 1] as WEKA's EuclideanDistance does)
+    _spec(
+        "ibk",
+        KNeighborsClassifier,
+        {"n_neighbors": 1},
+        family="nearest-neighbours",
+        description="1-nearest neighbour, features normalised to [0, 1]",
+        weka=W + "lazy.IBk",
+        scaling="minmax",
+        suites=FAST,
+    ),
+    _spec(
+        "ibk3",
+        KNeighborsClassifier,
+        {"n_neighbors": 3},
+        family="nearest-neighbours",
+        description="3-nearest neighbours",
+        weka=W + "lazy.IBk",
+        scaling="minmax",
+    ),
+    _spec(
+        "ibk5",
+        KNeighborsClassifier,
+        {"n_neighbors": 5},
+        family="nearest-neighbours",
+        description="5-nearest neighbours",
+        weka=W + "lazy.IBk",
+        scaling="minmax",
+    ),
+    _spec(
+        "ibk10",
+        KNeighborsClassifier,
+        {"n_neighbors": 10},
+        family="nearest-neighbours",
+        description="10-nearest neighbours",
+        weka=W + "lazy.IBk",
+        scaling="minmax",
+    ),
+    _spec(
+        "ibk-w",
+        KNeighborsClassifier,
+        {"n_neighbors": 10, "weights": "distance"},
+        family="nearest-neighbours",
+        description="10-nearest neighbours weighted by 1/distance",
+        weka=W + "lazy.IBk",
+        scaling="minmax",
+    ),
+    _spec(
+        "ibk5-std",
+        KNeighborsClassifier,
+        {"n_neighbors": 5},
+        family="nearest-neighbours",
+        description="5-nearest neighbours on standardised features",
+        weka=W + "lazy.IBk",
+        scaling="standard",
+    ),
+    # Naive Bayes
+    _spec(
+        "nb",
+        GaussianNB,
+        {},
+        family="naive-bayes",
+        description="Gaussian naive Bayes",
+        weka=W + "bayes.NaiveBayes",
+        suites=FAST,
+    ),
+    _spec(
+        "nb-discretized",
+        discretized_naive_bayes,
+        {"n_bins": 10},
+        family="naive-bayes",
+        description="Naive Bayes on 10 equal-frequency bins per feature",
+        weka=W + "bayes.NaiveBayes",
+        limits="unsupervised quantile bins, not WEKA's supervised discretisation (-D)",
+    ),
+    _spec(
+        "nb-bernoulli",
+        BernoulliNB,
+        {"binarize": 0.0},
+        family="naive-bayes",
+        description="Bernoulli naive Bayes on features above their mean",
+        scaling="standard",
+    ),
+    _spec(
+        "nb-multinomial",
+        MultinomialNB,
+        {"alpha": 1.0},
+        family="naive-bayes",
+        description="Multinomial naive Bayes on [0, 1]-scaled features",
+        weka=W + "bayes.NaiveBayesMultinomial",
+        scaling="minmax",
+    ),
+    _spec(
+        "nb-complement",
+        ComplementNB,
+        {"alpha": 1.0},
+        family="naive-bayes",
+        description="Complement naive Bayes on [0, 1]-scaled features",
+        scaling="minmax",
+    ),
+    # Discriminant analysis
+    _spec(
+        "lda",
+        LinearDiscriminantAnalysis,
+        {"solver": "svd"},
+        family="discriminant-analysis",
+        description="Linear discriminant analysis",
+        weka=W + "functions.LDA",
+        suites=FAST,
+    ),
+    _spec(
+        "lda-shrinkage",
+        LinearDiscriminantAnalysis,
+        {"solver": "lsqr", "shrinkage": "auto"},
+        family="discriminant-analysis",
+        description="LDA with Ledoit-Wolf shrinkage",
+        scaling="standard",
+    ),
+    _spec(
+        "qda",
+        QuadraticDiscriminantAnalysis,
+        {"reg_param": 0.1},
+        family="discriminant-analysis",
+        description="Quadratic discriminant analysis, covariance regularised by 0.1",
+        weka=W + "functions.QDA",
+        scaling="standard",
+    ),
+    # Logistic regression
+    _spec(
+        "logistic",
+        LogisticRegression,
+        {"C": 10.0, "max_iter": 2000},
+        family="logistic",
+        description="Multinomial logistic regression with a ridge (C=10) on standardised features",
+        weka=W + "functions.Logistic",
+        scaling="standard",
+        suites=FAST,
+    ),
+    _spec(
+        "logistic-weak",
+        LogisticRegression,
+        {"C": 1000.0, "max_iter": 5000},
+        family="logistic",
+        description="Nearly unregularised logistic regression (WEKA's ridge 1e-8)",
+        weka=W + "functions.Logistic",
+        scaling="standard",
+    ),
+    _spec(
+        "logistic-l1",
+        LogisticRegression,
+        {"C": 1.0, "l1_ratio": 1.0, "solver": "saga", "max_iter": 3000},
+        family="logistic",
+        description="Logistic regression with a lasso (L1) penalty",
+        scaling="standard",
+        cost="slow",
+        suites=ALL_ONLY,
+    ),
+    _spec(
+        "logistic-balanced",
+        LogisticRegression,
+        {"C": 10.0, "max_iter": 2000, "class_weight": "balanced"},
+        family="logistic",
+        description="Logistic regression with balanced class weights",
+        scaling="standard",
+        suites=ALL_ONLY,
+    ),
+    # Support vector machines
+    _spec(
+        "svm-linear",
+        LinearSVC,
+        {"C": 1.0, "max_iter": 5000},
+        family="svm",
+        description="Linear SVM (liblinear, one-vs-rest)",
+        weka=W + "functions.SMO",
+        probabilities=False,
+        scaling="standard",
+    ),
+    _spec(
+        "svm-linear-smo",
+        SVC,
+        {"kernel": "linear", "C": 1.0},
+        family="svm",
+        description="Linear-kernel SVM (libsvm, one-vs-one) like SMO's PolyKernel -E 1",
+        weka=W + "functions.SMO",
+        probabilities=False,
+        scaling="minmax",
+    ),
+    _spec(
+        "svm-poly",
+        SVC,
+        {"kernel": "poly", "degree": 2, "C": 10.0, "coef0": 1.0},
+        family="svm",
+        description="Quadratic-kernel SVM",
+        weka=W + "functions.SMO",
+        probabilities=False,
+        scaling="standard",
+    ),
+    _spec(
+        "svm-rbf",
+        SVC,
+        {"kernel": "rbf", "C": 10.0, "gamma": "scale"},
+        family="svm",
+        description="RBF-kernel SVM on standardised features",
+        weka=W + "functions.SMO",
+        probabilities=False,
+        scaling="standard",
+    ),
+    _spec(
+        "svm-rbf-balanced",
+        SVC,
+        {"kernel": "rbf", "C": 10.0, "class_weight": "balanced"},
+        family="svm",
+        description="RBF-kernel SVM with balanced class weights",
+        weka=W + "functions.SMO",
+        probabilities=False,
+        scaling="standard",
+        suites=ALL_ONLY,
+    ),
+    _spec(
+        "nusvc",
+        NuSVC,
+        {"nu": 0.3, "kernel": "rbf"},
+        family="svm",
+        description="Nu-SVM with an RBF kernel (nu=0.3)",
+        weka=W + "functions.LibSVM",
+        probabilities=False,
+        scaling="standard",
+        limits="fails ('specified nu is infeasible') when a class is much rarer than nu",
+    ),
+    # Neural networks
+    _spec(
+        "mlp",
+        MLPClassifier,
+        {"hidden_layer_sizes": (100,), "alpha": 1e-3, "max_iter": 500, "early_stopping": True},
+        family="neural-network",
+        description="Multilayer perceptron, one hidden layer of 100",
+        weka=W + "functions.MultilayerPerceptron",
+        scaling="standard",
+    ),
+    _spec(
+        "mlp-deep",
+        MLPClassifier,
+        {"hidden_layer_sizes": (256, 128), "alpha": 1e-3, "max_iter": 500, "early_stopping": True},
+        family="neural-network",
+        description="Multilayer perceptron, hidden layers 256 and 128",
+        weka=W + "functions.MultilayerPerceptron",
+        scaling="standard",
+        suites=ALL_ONLY,
+    ),
+    # Linear models trained by SGD and friends
+    _spec(
+        "sgd-hinge",
+        SGDClassifier,
+        {"loss": "hinge", "alpha": 1e-4},
+        family="linear-sgd",
+        description="Linear SVM trained by SGD",
+        weka=W + "functions.SGD",
+        probabilities=False,
+        scaling="standard",
+    ),
+    _spec(
+        "sgd-log",
+        SGDClassifier,
+        {"loss": "log_loss", "alpha": 1e-4},
+        family="linear-sgd",
+        description="Logistic regression trained by SGD",
+        weka=W + "functions.SGD",
+        scaling="standard",
+    ),
+    _spec(
+        "sgd-modified-huber",
+        SGDClassifier,
+        {"loss": "modified_huber", "alpha": 1e-4},
+        family="linear-sgd",
+        description="Modified-Huber loss linear model trained by SGD",
+        scaling="standard",
+    ),
+    _spec(
+        "perceptron",
+        Perceptron,
+        {},
+        family="linear-sgd",
+        description="Perceptron (one-vs-rest)",
+        weka=W + "functions.VotedPerceptron",
+        probabilities=False,
+        scaling="standard",
+    ),
+    _spec(
+        "pa",
+        SGDClassifier,
+        {"loss": "hinge", "penalty": None, "learning_rate": "pa1", "eta0": 1.0},
+        family="linear-sgd",
+        description="Passive-aggressive (PA-I) linear classifier",
+        probabilities=False,
+        scaling="standard",
+    ),
+    _spec(
+        "ridge",
+        RidgeClassifier,
+        {"alpha": 1.0},
+        family="linear",
+        description="Ridge regression on one-vs-rest targets",
+        probabilities=False,
+        scaling="standard",
+    ),
+    _spec(
+        "ridge-cv",
+        RidgeClassifierCV,
+        {"alphas": (0.1, 1.0, 10.0, 100.0)},
+        family="linear",
+        description="Ridge classifier with the penalty chosen by leave-one-out",
+        probabilities=False,
+        scaling="standard",
+    ),
+    # Prototypes and Gaussian processes
+    _spec(
+        "nearest-centroid",
+        NearestCentroid,
+        {},
+        family="prototype",
+        description="Nearest class mean",
+        scaling="standard",
+    ),
+    _spec(
+        "nearest-centroid-shrunk",
+        NearestCentroid,
+        {"shrink_threshold": 0.5},
+        family="prototype",
+        description="Nearest shrunken centroid",
+        scaling="standard",
+    ),
+    _spec(
+        "gp",
+        gaussian_process,
+        {"length_scale": 10.0, "optimize": False},
+        family="gaussian-process",
+        description="Gaussian process classifier, fixed RBF kernel (length 10), one-vs-rest",
+        weka=W + "functions.GaussianProcesses",
+        scaling="standard",
+        cost="slow",
+        suites=ALL_ONLY,
+        limits="memory and time grow with the cube of the training size",
+    ),
+    # Calibration and multi-class wrappers
+    _spec(
+        "calibrated-svm-linear",
+        calibrated,
+        {"base": "svm-linear", "method": "sigmoid"},
+        family="calibration",
+        description="Linear SVM with sigmoid-calibrated probabilities",
+        weka=W + "functions.SMO",
+        scaling="standard",
+    ),
+    _spec(
+        "calibrated-svm-rbf",
+        calibrated,
+        {"base": "svm-rbf", "method": "sigmoid"},
+        family="calibration",
+        description="RBF SVM with sigmoid-calibrated probabilities",
+        weka=W + "functions.SMO",
+        scaling="standard",
+    ),
+    _spec(
+        "calibrated-nb",
+        calibrated,
+        {"base": "nb", "method": "isotonic"},
+        family="calibration",
+        description="Gaussian naive Bayes, isotonic calibration",
+    ),
+    _spec(
+        "ovr-logistic",
+        one_vs_rest,
+        {"base": "logistic"},
+        family="multiclass-wrapper",
+        description="One-vs-rest logistic regressions",
+        weka=W + "meta.MultiClassClassifier",
+        scaling="standard",
+    ),
+    _spec(
+        "ovr-svm-rbf",
+        one_vs_rest,
+        {"base": "svm-rbf"},
+        family="multiclass-wrapper",
+        description="One-vs-rest RBF SVMs",
+        weka=W + "meta.MultiClassClassifier",
+        probabilities=False,
+        scaling="standard",
+    ),
+    _spec(
+        "ovo-logistic",
+        one_vs_one,
+        {"base": "logistic"},
+        family="multiclass-wrapper",
+        description="One-vs-one logistic regressions, majority vote",
+        weka=W + "meta.MultiClassClassifier",
+        probabilities=False,
+        scaling="standard",
+    ),
+    _spec(
+        "ovo-j48",
+        one_vs_one,
+        {"base": "j48"},
+        family="multiclass-wrapper",
+        description="One-vs-one entropy trees, majority vote",
+        probabilities=False,
+        weka=W + "meta.MultiClassClassifier",
+    ),
+    _spec(
+        "ecoc",
+        output_codes,
+        {"base": "logistic", "code_size": 2.0},
+        family="multiclass-wrapper",
+        description="Error-correcting output codes over logistic regressions",
+        weka=W + "meta.MultiClassClassifier",
+        probabilities=False,
+        scaling="standard",
+    ),
+    # Voting and stacking
+    _spec(
+        "voting",
+        soft_voting,
+        {},
+        family="voting",
+        description="Soft vote of XGBoost, histogram boosting and calibrated RBF SVM",
+        weka=W + "meta.Vote",
+        scaling="standard",
+        cost="slow",
+    ),
+    _spec(
+        "voting-hard",
+        hard_voting,
+        {},
+        family="voting",
+        description="Majority vote of logistic regression, random forest and RBF SVM",
+        weka=W + "meta.Vote",
+        probabilities=False,
+        scaling="standard",
+    ),
+    _spec(
+        "stacking",
+        stacking,
+        {"cv": 5},
+        family="stacking",
+        description="RF, extra trees, RBF SVM and logistic stacked by logistic regression",
+        weka=W + "meta.Stacking",
+        scaling="standard",
+        cost="slow",
+    ),
+)

@@ -1,0 +1,62 @@
+"""From a catalogue entry to a scikit-learn pipeline that preprocesses each fold itself."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from sklearn.pipeline import Pipeline
+
+from benchmark.catalogue.spec import ClassifierSpec
+from benchmark.preprocessing import make_preprocessor
+
+#: HistGradientBoosting's limit on the labels of a native categorical feature.
+MAX_NATIVE_LABELS = 255
+
+
+def pipeline_for_spec(
+    spec: ClassifierSpec,
+    *,
+    nominal_features: Mapping[int, int] | None = None,
+    n_features: int,
+    random_state: int | None = 0,
+) -> Pipeline:
+    """The pipeline ``[("preprocess", ColumnTransformer), ("classifier", estimator)]``.
+
+    Parameters
+    ----------
+    spec : ClassifierSpec
+        The configuration to build.
+    nominal_features : mapping of int to int, optional
+        Feature column index to its number of declared labels (codes ``0..k-1``, NaN
+        missing); every other column is numeric with NaN for missing.
+    n_features : int
+        Number of data-set feature columns; columns after them pass through unchanged.
+    random_state : int or None
+        Seed given to every ``random_state`` parameter of the estimator, nested ones
+        included.
+
+    Returns
+    -------
+    Pipeline
+        Unfitted; ``fit(X, y)`` takes X of shape (n_samples, n_features + n_extra) and
+        integer labels y of shape (n_samples,).
+    """
+    nominal = dict(nominal_features or {})
+    native = spec.handles_nominal and all(k <= MAX_NATIVE_LABELS for k in nominal.values())
+    preprocessor, native_positions = make_preprocessor(
+        n_features=n_features,
+        nominal_features=nominal,
+        impute=not spec.handles_missing,
+        scaling=spec.scaling if spec.needs_scaling else None,
+        native_nominal=native,
+    )
+    estimator = spec.make_estimator()
+    if native_positions:
+        estimator.set_params(categorical_features=native_positions)
+    seeds = {
+        name: random_state
+        for name in estimator.get_params(deep=True)
+        if name == "random_state" or name.endswith("__random_state")
+    }
+    estimator.set_params(**seeds)
+    return Pipeline([("preprocess", preprocessor), ("classifier", estimator)])

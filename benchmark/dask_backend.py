@@ -1,0 +1,136 @@
+"""Running the engine's tasks on an existing Dask distributed cluster.
+
+The run's pickled :class:`~benchmark.task.TaskContext` is scattered to every Dask worker
+once.  Each Dask worker thread keeps one :class:`~benchmark.worker.Worker` subprocess per
+run (Dask worker processes are daemonic and may not fork ``multiprocessing`` children,
+but they may start subprocesses), so time limits and crash isolation work as they do
+locally.  The client keeps as many tasks in flight as the cluster has threads, so that
+``on_start`` is called roughly when a task really starts.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import threading
+import uuid
+from collections import deque
+from collections.abc import Callable, Sequence
+
+from benchmark.errors import BenchmarkError, ConfigurationError
+from benchmark.task import TaskKey, TaskResult, failed_result
+from benchmark.worker import Worker, WorkerDiedError
+
+#: Seconds to wait for the scheduler to answer.
+CONNECT_TIMEOUT = "10s"
+
+_LOCAL_WORKERS: dict[tuple[str, int], Worker] = {}
+_LOCAL_LOCK = threading.Lock()
+
+
+def run_on_dask(
+    scheduler: str,
+    context: bytes,
+    tasks: Sequence[TaskKey],
+    *,
+    timeout: float | None,
+    on_start: Callable[[TaskKey], None],
+    on_result: Callable[[TaskResult], None],
+) -> None:
+    """Run ``tasks`` on the cluster at ``scheduler``, reporting each result as it arrives.
+
+    Raises
+    ------
+    ConfigurationError
+        The scheduler cannot be reached.
+    """
+    from distributed import Client, Future, as_completed
+
+    try:
+        client = Client(scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False)
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise ConfigurationError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
+    token = uuid.uuid4().hex
+    try:
+        [data] = client.scatter([context], broadcast=True, hash=False)
+        slots = max(1, sum(client.nthreads().values()))
+        queue = deque(tasks)
+        keys: dict[Future, TaskKey] = {}
+
+        def submit() -> Future:
+            key = queue.popleft()
+            on_start(key)
+            future = client.submit(
+                run_remote_task,
+                data,
+                token,
+                key,
+                timeout,
+                pure=False,
+                key=f"touchbench-{token}-{key}",
+            )
+            keys[future] = key
+            return future
+
+        running = as_completed([submit() for _ in range(min(slots, len(queue)))], loop=client.loop)
+        for future in running:
+            try:
+                result = future.result()
+            except BenchmarkError:
+                raise
+            except Exception as exc:
+                result = failed_result(keys[future], "error", f"Dask: {exc}", None)
+            on_result(result)
+            if queue:
+                running.add(submit())
+    finally:
+        with contextlib.suppress(Exception):
+            client.run(release_remote_workers, token)
+        client.close()
+
+
+def run_remote_task(context: bytes, token: str, key: TaskKey, timeout: float | None) -> TaskResult:
+    """Run one task on this Dask worker through the calling thread's worker process."""
+    slot = (token, threading.get_ident())
+    with _LOCAL_LOCK:
+        worker = _LOCAL_WORKERS.get(slot)
+        if worker is None or worker.process.poll() is not None:
+            worker = Worker(context)
+            _LOCAL_WORKERS[slot] = worker
+    try:
+        while not worker.ready:
+            kind, payload = worker.receive()
+            if kind == "broken":
+                raise BenchmarkError(payload)
+    except WorkerDiedError as died:
+        _forget(slot)
+        raise RuntimeError(f"a worker process could not start: {died}") from None
+    worker.submit(key, timeout)
+    if not worker.connection.poll(timeout):
+        worker.kill()
+        _forget(slot)
+        return failed_result(
+            key, "timeout", f"timed out after {timeout:g} s (worker process killed)", None
+        )
+    try:
+        kind, payload = worker.receive()
+    except WorkerDiedError as died:
+        _forget(slot)
+        return failed_result(key, "error", str(died), None)
+    return payload
+
+
+def release_remote_workers(token: str) -> int:
+    """Stop this Dask worker's worker processes of run ``token``; returns how many."""
+    with _LOCAL_LOCK:
+        slots = [slot for slot in _LOCAL_WORKERS if slot[0] == token]
+        workers = [_LOCAL_WORKERS.pop(slot) for slot in slots]
+    for worker in workers:
+        worker.close()
+    return len(workers)
+
+
+def _forget(slot: tuple[str, int]) -> None:
+    with _LOCAL_LOCK:
+        worker = _LOCAL_WORKERS.pop(slot, None)
+    if worker is not None:
+        worker.close()

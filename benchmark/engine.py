@@ -1,0 +1,265 @@
+"""The cross-validation engine: every classifier on every fold, in parallel, with time limits.
+
+Tasks (one classifier on one fold) run in worker processes (:mod:`benchmark.worker`) that
+each receive the run's data once.  Locally, ``jobs`` workers take tasks from one queue;
+with ``scheduler="tcp://host:port"`` the tasks go to a Dask distributed cluster, where each
+Dask worker thread keeps such a worker process (:mod:`benchmark.dask_backend`).
+
+Why our own pool rather than joblib's: a task that overruns its time limit must be
+stopped, native code included, without losing the other workers or their data, and a
+worker that crashes (segfault, out-of-memory kill) must cost one task, not the run.
+joblib can neither cancel one running task nor survive a killed worker without
+restarting its whole pool; here the parent kills that one process group and starts a
+replacement.
+
+Every finished task is reported at once through ``on_result`` (in the calling process),
+so that the caller can store it; ``skip`` resumes a run without repeating what is done.
+"""
+
+from __future__ import annotations
+
+import os
+import pickle
+import time
+from collections import deque
+from collections.abc import Callable, Collection, Mapping, Sequence
+from multiprocessing.connection import wait
+
+from benchmark.catalogue import CATALOGUE, ClassifierSpec, unknown_classifier_message
+from benchmark.errors import BenchmarkError, ConfigurationError
+from benchmark.folds import Fold
+from benchmark.problem import Problem
+from benchmark.task import TaskContext, TaskKey, TaskResult, failed_result
+from benchmark.worker import Worker, WorkerDiedError
+
+__all__ = ["Problem", "TaskKey", "TaskResult", "available_cores", "plan_tasks", "run_tasks"]
+
+ResultCallback = Callable[[TaskResult], None]
+StartCallback = Callable[[TaskKey], None]
+
+
+def run_tasks(
+    problem: Problem,
+    classifiers: Sequence[str],
+    folds: Sequence[Fold],
+    *,
+    jobs: int = 1,
+    scheduler: str | None = None,
+    timeout: float | None = 600.0,
+    random_state: int = 0,
+    skip: Collection[TaskKey] = (),
+    on_start: StartCallback | None = None,
+    on_result: ResultCallback | None = None,
+    extra_specs: Mapping[str, ClassifierSpec] | None = None,
+) -> list[TaskResult]:
+    """Cross-validate classifiers on a problem.
+
+    Parameters
+    ----------
+    problem : Problem
+        Features and targets.  One target: catalogue classifiers; several targets:
+        multi-target configurations (``META:BASE``) of :mod:`benchmark.multitarget`.
+    classifiers : sequence of str
+        Classifier ids, run in this order (duplicates ignored).
+    folds : sequence of Fold
+        The folds, shared by every classifier (:func:`benchmark.folds.make_folds`).
+    jobs : int
+        Local worker processes; -1 for one per core.  Ignored with ``scheduler``.
+    scheduler : str, optional
+        Address of a Dask distributed scheduler (``tcp://host:port``) to run on instead.
+    timeout : float or None
+        Seconds one task may take before its worker is killed; ``None`` for no limit.
+    random_state : int
+        Seed of every classifier.
+    skip : collection of TaskKey
+        Tasks already done (a resumed run); they are neither run nor returned.
+    on_start : callable, optional
+        Called with each task's key when it starts.
+    on_result : callable, optional
+        Called in the calling process with each result as soon as it arrives.
+    extra_specs : mapping of str to ClassifierSpec, optional
+        Multi-class classifiers that are not in the catalogue (they win over catalogue
+        entries of the same id).  Their factories must be importable by the workers.
+
+    Returns
+    -------
+    list of TaskResult
+        One per task run, classifier-major in the order of ``classifiers`` and ``folds``.
+        Classifiers that raise, run out of memory, crash or time out give results with
+        status ``error`` or ``timeout``; the run goes on.
+
+    Raises
+    ------
+    ConfigurationError
+        Unknown classifier ids, no folds, impossible ``jobs`` or ``timeout``, an
+        unreachable scheduler.
+    """
+    specs, tasks = plan_tasks(problem, classifiers, folds, skip=skip, extra_specs=extra_specs)
+    if timeout is not None and not timeout > 0:
+        raise ConfigurationError(f"timeout must be a positive number of seconds, got {timeout}")
+    if not tasks:
+        return []
+    context = pickle.dumps(
+        TaskContext(problem, specs, list(folds), random_state), protocol=pickle.HIGHEST_PROTOCOL
+    )
+    sizes = {(f.repeat, f.fold): (int(f.train.size), int(f.test.size)) for f in folds}
+    results: dict[TaskKey, TaskResult] = {}
+
+    def deliver(result: TaskResult) -> None:
+        if result.status != "ok":
+            result.n_train, result.n_test = sizes[(result.key.repeat, result.key.fold)]
+        results[result.key] = result
+        if on_result is not None:
+            on_result(result)
+
+    started = on_start or _ignore
+    if scheduler:
+        from benchmark.dask_backend import run_on_dask
+
+        run_on_dask(scheduler, context, tasks, timeout=timeout, on_start=started, on_result=deliver)
+    else:
+        _run_local(context, tasks, _worker_count(jobs, len(tasks)), timeout, started, deliver)
+    return [results[key] for key in tasks if key in results]
+
+
+def plan_tasks(
+    problem: Problem,
+    classifiers: Sequence[str],
+    folds: Sequence[Fold],
+    *,
+    skip: Collection[TaskKey] = (),
+    extra_specs: Mapping[str, ClassifierSpec] | None = None,
+) -> tuple[dict[str, ClassifierSpec], list[TaskKey]]:
+    """Check the classifier ids and list the tasks still to run.
+
+    Returns
+    -------
+    specs : dict of str to ClassifierSpec
+        The multi-class specs the workers need (empty for multi-target problems).
+    tasks : list of TaskKey
+        Classifier-major, without the keys in ``skip``.
+    """
+    ids = list(dict.fromkeys(classifiers))
+    if not ids:
+        raise ConfigurationError("no classifiers to run")
+    if not folds:
+        raise ConfigurationError("no folds to run the classifiers on")
+    specs: dict[str, ClassifierSpec] = {}
+    if problem.kind == "multiclass":
+        known = {**CATALOGUE, **(extra_specs or {})}
+        for classifier in ids:
+            if classifier not in known:
+                raise ConfigurationError(unknown_classifier_message(classifier, known))
+            specs[classifier] = known[classifier]
+    else:
+        from benchmark.multitarget import build_multitarget
+
+        for classifier in ids:
+            build_multitarget(
+                classifier,
+                nominal_features=problem.nominal_features,
+                n_features=problem.n_features,
+                n_classes=problem.n_classes,
+            )
+    done = set(skip)
+    tasks = [
+        key
+        for classifier in ids
+        for fold in folds
+        if (key := TaskKey(classifier, fold.repeat, fold.fold)) not in done
+    ]
+    return specs, tasks
+
+
+def available_cores() -> int:
+    """CPU cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not Linux
+        return os.cpu_count() or 1
+
+
+def _worker_count(jobs: int, n_tasks: int) -> int:
+    if jobs == -1:
+        jobs = available_cores()
+    if jobs < 1:
+        raise ConfigurationError(f"jobs must be a positive number of processes or -1, got {jobs}")
+    return min(jobs, n_tasks)
+
+
+def _run_local(
+    context: bytes,
+    tasks: Sequence[TaskKey],
+    n_workers: int,
+    timeout: float | None,
+    on_start: StartCallback,
+    deliver: ResultCallback,
+) -> None:
+    """Run ``tasks`` on ``n_workers`` local worker processes, one task each at a time.
+
+    A worker that dies or overruns its task's time limit is replaced while tasks remain.
+    """
+    queue = deque(tasks)
+    pool = [Worker(context) for _ in range(n_workers)]
+    try:
+        while queue or any(w.task is not None for w in pool):
+            for worker in pool:
+                if worker.ready and worker.task is None and queue:
+                    key = queue.popleft()
+                    on_start(key)
+                    worker.submit(key, timeout)
+            arrived = wait([w.connection for w in pool], timeout=_time_left(pool))
+            survivors = []
+            for worker in pool:
+                alive = worker.connection not in arrived or _take_message(worker, deliver)
+                task = worker.task
+                if alive and task is not None and _past_deadline(worker):
+                    worker.kill()
+                    deliver(failed_result(task, "timeout", _timeout_message(timeout), None))
+                    alive = False
+                if alive:
+                    survivors.append(worker)
+                    continue
+                worker.close()
+                if queue:
+                    survivors.append(Worker(context))
+            pool = survivors
+    finally:
+        for worker in pool:
+            worker.close()
+
+
+def _take_message(worker: Worker, deliver: ResultCallback) -> bool:
+    """Handle one message of ``worker``; ``False`` if the worker has died."""
+    try:
+        kind, payload = worker.receive()
+    except WorkerDiedError as died:
+        if worker.task is None and not worker.ready:
+            raise RuntimeError(f"a worker process could not start: {died}") from None
+        if worker.task is not None:
+            deliver(failed_result(worker.task, "error", str(died), None))
+        return False
+    if kind == "result":
+        deliver(payload)
+    elif kind == "broken":
+        raise BenchmarkError(payload)
+    return True
+
+
+def _past_deadline(worker: Worker) -> bool:
+    return worker.deadline is not None and time.monotonic() >= worker.deadline
+
+
+def _time_left(workers: Sequence[Worker]) -> float | None:
+    deadlines = [w.deadline for w in workers if w.task is not None and w.deadline is not None]
+    if not deadlines:
+        return None
+    return max(0.0, min(deadlines) - time.monotonic())
+
+
+def _timeout_message(timeout: float | None) -> str:
+    return f"timed out after {timeout:g} s (worker process killed)"
+
+
+def _ignore(key: TaskKey) -> None:
+    return None

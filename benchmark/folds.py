@@ -1,0 +1,199 @@
+"""Cross-validation folds, computed once per run so that every classifier sees the same ones.
+
+One target: stratified k-fold per repeat (seed ``seed + repeat``).  Several targets:
+stratified on the joint label combination when every combination is common enough, plain
+shuffled k-fold otherwise.  With recording/session groups, a group never straddles
+training and test.  When the data cannot support the requested number of folds, the
+largest feasible number is used and a warning line says so.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from sklearn.model_selection import GroupKFold, KFold, StratifiedGroupKFold, StratifiedKFold
+
+from benchmark.errors import ConfigurationError
+
+
+@dataclass(frozen=True)
+class Fold:
+    """One train/test split.
+
+    Parameters
+    ----------
+    repeat : int
+        0-based repetition of the whole k-fold partition.
+    fold : int
+        0-based fold within the repetition.
+    train, test : ndarray of shape (n_train,) and (n_test,), int64
+        Instance indices, sorted.
+    """
+
+    repeat: int
+    fold: int
+    train: np.ndarray
+    test: np.ndarray
+
+
+def make_folds(
+    Y: np.ndarray,
+    *,
+    n_folds: int = 10,
+    n_repeats: int = 1,
+    seed: int = 0,
+    groups: np.ndarray | None = None,
+    target_names: Sequence[str] | None = None,
+) -> tuple[list[Fold], list[str]]:
+    """Repeated (stratified, group-aware) k-fold splits.
+
+    Parameters
+    ----------
+    Y : ndarray of shape (n_instances, n_targets) or (n_instances,)
+        Integer target codes.
+    n_folds : int
+        Requested number of folds (at least 2).
+    n_repeats : int
+        Number of repetitions, each shuffled with seed ``seed + repeat``.
+    seed : int
+        Base random seed.
+    groups : ndarray of shape (n_instances,), optional
+        Recording/session id per instance; instances of a group stay together.
+    target_names : sequence of str, optional
+        Names used in messages (default ``target 1``, ``target 2``...).
+
+    Returns
+    -------
+    folds : list of Fold
+        ``n_repeats * k`` folds, repeat-major.
+    warnings : list of str
+        One line per adjustment made (fewer folds, unstratified splits...).
+
+    Raises
+    ------
+    ConfigurationError
+        Empty data, a target with a single class, fewer than two instances or groups, or
+        impossible parameters.
+    """
+    Y = np.asarray(Y)
+    if Y.ndim == 1:
+        Y = Y[:, None]
+    if Y.ndim != 2:
+        raise ConfigurationError(f"targets must be a 2-D array, got shape {Y.shape}")
+    n_instances, n_targets = Y.shape
+    names = list(target_names or [f"target {t + 1}" for t in range(n_targets)])
+    _check_parameters(n_folds, n_repeats, n_instances, n_targets)
+    if groups is not None:
+        groups = np.asarray(groups)
+        if groups.shape != (n_instances,):
+            raise ConfigurationError(
+                f"groups must have one entry per instance ({n_instances}), got {groups.shape}"
+            )
+    for t in range(n_targets):
+        values = np.unique(Y[:, t])
+        if values.size < 2:
+            raise ConfigurationError(
+                f"target '{names[t]}' has a single class (code {int(values[0])}) among the "
+                f"{n_instances} instances; classification needs at least two"
+            )
+    notes: list[str] = []
+    strata, stratified = _strata(Y, n_folds, names, notes, grouped=groups is not None)
+    k = _feasible_folds(n_folds, strata if stratified else None, groups, notes)
+    folds = [
+        Fold(repeat, fold, np.sort(train).astype(np.int64), np.sort(test).astype(np.int64))
+        for repeat in range(n_repeats)
+        for fold, (train, test) in enumerate(
+            _splits(k, strata, stratified, groups, seed + repeat, n_instances)
+        )
+    ]
+    return folds, notes
+
+
+def _check_parameters(n_folds: int, n_repeats: int, n_instances: int, n_targets: int) -> None:
+    if n_instances == 0:
+        raise ConfigurationError("the data set is empty: there is nothing to cross-validate")
+    if n_targets == 0:
+        raise ConfigurationError("no target attribute to predict")
+    if n_folds < 2:
+        raise ConfigurationError(f"the number of folds must be at least 2, got {n_folds}")
+    if n_repeats < 1:
+        raise ConfigurationError(f"the number of repeats must be at least 1, got {n_repeats}")
+    if n_instances < 2:
+        raise ConfigurationError("cross-validation needs at least 2 instances, got 1")
+
+
+def _strata(
+    Y: np.ndarray, n_folds: int, names: Sequence[str], notes: list[str], *, grouped: bool
+) -> tuple[np.ndarray, bool]:
+    """The labels to stratify on and whether stratification is used."""
+    if Y.shape[1] == 1:
+        return Y[:, 0], True
+    _, joint, counts = np.unique(Y, axis=0, return_inverse=True, return_counts=True)
+    joint = joint.reshape(-1)
+    if counts.min() >= n_folds:
+        notes.append(f"folds stratified on the {counts.size} combinations of {', '.join(names)}")
+        return joint, True
+    notes.append(
+        f"folds not stratified: {int((counts < n_folds).sum())} of the {counts.size} "
+        f"combinations of {', '.join(names)} have fewer than {n_folds} instances "
+        + ("(group k-fold)" if grouped else "(plain shuffled k-fold)")
+    )
+    return joint, False
+
+
+def _feasible_folds(
+    n_folds: int, strata: np.ndarray | None, groups: np.ndarray | None, notes: list[str]
+) -> int:
+    """The largest number of folds, at most ``n_folds``, that the data supports."""
+    if groups is not None:
+        n_groups = np.unique(groups).size
+        if n_groups < 2:
+            raise ConfigurationError(
+                "all instances belong to one recording/session group; group-aware folds "
+                "need at least 2 groups"
+            )
+        if n_groups < n_folds:
+            notes.append(f"only {n_groups} groups: using {n_groups} folds instead of {n_folds}")
+            return n_groups
+        return n_folds
+    if strata is None:
+        return n_folds
+    smallest = int(np.bincount(np.unique(strata, return_inverse=True)[1]).min())
+    k = max(2, min(n_folds, smallest))
+    if k < n_folds:
+        notes.append(
+            f"the smallest class has only {smallest} instance(s): using {k} folds instead "
+            f"of {n_folds}"
+        )
+    if smallest < 2:
+        notes.append(
+            "a class has a single instance: it is tested in one fold without ever being trained on"
+        )
+    return k
+
+
+def _splits(
+    k: int,
+    strata: np.ndarray,
+    stratified: bool,
+    groups: np.ndarray | None,
+    seed: int,
+    n_instances: int,
+) -> list[tuple[np.ndarray, np.ndarray]]:
+    placeholder = np.zeros((n_instances, 1))
+    splitter: StratifiedKFold | KFold | StratifiedGroupKFold | GroupKFold
+    if groups is None and stratified:
+        splitter = StratifiedKFold(n_splits=k, shuffle=True, random_state=seed)
+    elif groups is None:
+        splitter = KFold(n_splits=k, shuffle=True, random_state=seed)
+    elif stratified:
+        splitter = StratifiedGroupKFold(n_splits=k, shuffle=True, random_state=seed)
+    else:
+        splitter = GroupKFold(n_splits=k, shuffle=True, random_state=seed)
+    with warnings.catch_warnings():
+        # scikit-learn warns about classes smaller than k; _feasible_folds reported it.
+        warnings.simplefilter("ignore", UserWarning)
+        return list(splitter.split(placeholder, strata, groups))

@@ -1,0 +1,248 @@
+"""Leaderboards: per-classifier means and standard deviations, ranks, and WEKA's marks.
+
+Like WEKA's Experimenter, every classifier is compared with a baseline on the folds both
+completed, with the corrected resampled t-test: ``v`` marks a classifier significantly
+better than the baseline, ``*`` significantly worse (in the metric's own direction: a lower
+log loss is better).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+
+from benchmark.errors import ConfigurationError
+from benchmark.metrics import LOWER_IS_BETTER
+from benchmark.significance import corrected_resampled_ttest
+from benchmark.task import TaskResult
+
+Mark = Literal["v", "*", ""]
+
+#: Distinct error messages kept per classifier.
+MAX_ERRORS = 3
+
+
+@dataclass
+class LeaderboardRow:
+    """One classifier's line.
+
+    Parameters
+    ----------
+    rank : int
+        1 for the best; ties share a rank; classifiers without a score come last.
+    classifier : str
+    metrics : dict of str to (float, float)
+        Mean and sample standard deviation over the successful folds (NaN where no fold
+        has the metric; standard deviation 0 for a single fold).
+    mark : {"v", "*", ""}
+        Significantly better / worse than the baseline on the ranking metric.
+    n_ok, n_failed : int
+        Successful and failed (error or timeout) tasks.
+    errors : list of str
+        Distinct failure messages, at most three.
+    """
+
+    rank: int
+    classifier: str
+    metrics: dict[str, tuple[float, float]]
+    mark: Mark = ""
+    n_ok: int = 0
+    n_failed: int = 0
+    errors: list[str] = field(default_factory=list)
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "rank": self.rank,
+            "classifier": self.classifier,
+            "mark": self.mark,
+            "metrics": {
+                name: {"mean": _finite(mean), "std": _finite(std)}
+                for name, (mean, std) in self.metrics.items()
+            },
+            "n_ok": self.n_ok,
+            "n_failed": self.n_failed,
+            "errors": list(self.errors),
+        }
+
+
+@dataclass
+class Leaderboard:
+    """A ranked comparison of classifiers on one run.
+
+    Parameters
+    ----------
+    metric : str
+        The ranking metric.
+    baseline : str
+        The classifier the marks compare against.
+    rows : list of LeaderboardRow
+        Best first.
+    summary : (int, int, int)
+        WEKA's (v/ /*): classifiers significantly better than, not different from, and
+        significantly worse than the baseline (the baseline and classifiers without a
+        comparable fold are not counted).
+    alpha : float
+        Significance level of the marks.
+    """
+
+    metric: str
+    baseline: str
+    rows: list[LeaderboardRow]
+    summary: tuple[int, int, int]
+    alpha: float = 0.05
+
+    def row(self, classifier: str) -> LeaderboardRow:
+        """The row of ``classifier``."""
+        for row in self.rows:
+            if row.classifier == classifier:
+                return row
+        raise KeyError(classifier)
+
+    def to_json(self) -> dict[str, Any]:
+        """JSON-ready data; NaN becomes ``null``."""
+        better, same, worse = self.summary
+        return {
+            "metric": self.metric,
+            "baseline": self.baseline,
+            "alpha": self.alpha,
+            "test": "corrected resampled t-test (Nadeau and Bengio; WEKA PairedCorrectedTTester)",
+            "summary": {"better": better, "same": same, "worse": worse},
+            "leaderboard": [row.to_json() for row in self.rows],
+        }
+
+
+def build_leaderboard(
+    results: Sequence[TaskResult],
+    *,
+    metric: str = "f1_weighted",
+    baseline: str | None = None,
+    alpha: float = 0.05,
+) -> Leaderboard:
+    """Rank the classifiers of a run and mark significant differences from a baseline.
+
+    Parameters
+    ----------
+    results : sequence of TaskResult
+        Every task result of the run (failed ones included).
+    metric : str
+        The ranking metric; descending, or ascending for :data:`LOWER_IS_BETTER` ones.
+    baseline : str, optional
+        The classifier to compare against; default the best ranked.
+    alpha : float
+        Significance level.
+
+    Raises
+    ------
+    ConfigurationError
+        No results, a metric no result has, a baseline not in the run or without a
+        successful fold.
+    """
+    if not results:
+        raise ConfigurationError("no results to rank")
+    by_classifier: dict[str, list[TaskResult]] = defaultdict(list)
+    for result in results:
+        by_classifier[result.key.classifier].append(result)
+    available = sorted({name for r in results if r.ok for name in r.metrics})
+    if metric not in available:
+        raise ConfigurationError(
+            f"unknown metric '{metric}' for this run (metrics: {', '.join(available) or 'none'})"
+        )
+    lower = metric in LOWER_IS_BETTER
+    rows = [_summarise(classifier, rs, available) for classifier, rs in by_classifier.items()]
+    rows.sort(key=lambda row: _sort_key(row, metric, lower))
+    _assign_ranks(rows, metric)
+    ranked = [row for row in rows if not math.isnan(row.metrics[metric][0])]
+    if baseline is None:
+        if not ranked:
+            raise ConfigurationError(f"no classifier has a {metric} score: every task failed")
+        baseline = ranked[0].classifier
+    elif baseline not in by_classifier:
+        raise ConfigurationError(
+            f"baseline '{baseline}' is not in this run (classifiers: {', '.join(by_classifier)})"
+        )
+    base_scores = _scores(by_classifier[baseline], metric)
+    if not base_scores:
+        raise ConfigurationError(f"baseline '{baseline}' has no successful fold with {metric}")
+    counts = {"v": 0, "": 0, "*": 0}
+    ratio = _test_train_ratio(results)
+    for row in rows:
+        if row.classifier == baseline:
+            continue
+        scores = _scores(by_classifier[row.classifier], metric)
+        paired = sorted(set(scores) & set(base_scores))
+        if len(paired) < 2:
+            continue
+        _, _, sign = corrected_resampled_ttest(
+            np.array([scores[k] for k in paired]),
+            np.array([base_scores[k] for k in paired]),
+            test_train_ratio=ratio,
+            alpha=alpha,
+        )
+        if lower:
+            sign = -sign
+        row.mark = "v" if sign > 0 else "*" if sign < 0 else ""
+        counts[row.mark] += 1
+    return Leaderboard(metric, baseline, rows, (counts["v"], counts[""], counts["*"]), alpha)
+
+
+def _summarise(classifier: str, results: list[TaskResult], names: list[str]) -> LeaderboardRow:
+    ok = [r for r in results if r.ok]
+    failed = [r for r in results if not r.ok]
+    metrics = {}
+    for name in names:
+        values = np.array([r.metrics.get(name, math.nan) for r in ok], dtype=np.float64)
+        values = values[~np.isnan(values)]
+        if values.size == 0:
+            metrics[name] = (math.nan, math.nan)
+        else:
+            std = float(values.std(ddof=1)) if values.size > 1 else 0.0
+            metrics[name] = (float(values.mean()), std)
+    errors: list[str] = []
+    for r in failed:
+        message = r.error or r.status
+        if message not in errors and len(errors) < MAX_ERRORS:
+            errors.append(message)
+    return LeaderboardRow(0, classifier, metrics, "", len(ok), len(failed), errors)
+
+
+def _sort_key(row: LeaderboardRow, metric: str, lower: bool) -> tuple[int, float, str]:
+    mean = row.metrics[metric][0]
+    if math.isnan(mean):
+        return (1 if row.n_ok else 2, 0.0, row.classifier)
+    return (0, mean if lower else -mean, row.classifier)
+
+
+def _assign_ranks(rows: list[LeaderboardRow], metric: str) -> None:
+    """Competition ranking (1, 2, 2, 4): equal means share a rank."""
+    previous: float | None = None
+    for position, row in enumerate(rows, start=1):
+        mean = row.metrics[metric][0]
+        if previous is not None and mean == previous:
+            row.rank = rows[position - 2].rank
+        else:
+            row.rank = position
+        previous = mean
+
+
+def _scores(results: list[TaskResult], metric: str) -> dict[tuple[int, int], float]:
+    """Metric per (repeat, fold) of the successful tasks that have it."""
+    return {
+        (r.key.repeat, r.key.fold): r.metrics[metric]
+        for r in results
+        if r.ok and not math.isnan(r.metrics.get(metric, math.nan))
+    }
+
+
+def _test_train_ratio(results: Sequence[TaskResult]) -> float:
+    """Mean ``n_test / n_train`` over the run's folds (1/9 for 10-fold CV)."""
+    ratios = [r.n_test / r.n_train for r in results if r.n_train > 0]
+    return float(np.mean(ratios)) if ratios else 0.0
+
+
+def _finite(value: float) -> float | None:
+    return None if math.isnan(value) else value

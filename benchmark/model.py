@@ -1,0 +1,207 @@
+"""Models trained on a whole data set, and their serialisation.
+
+A :class:`TrainedModel` keeps the schema it was trained on, so that new instances can be
+checked and predicted with the labels of that schema.  Serialised models are plain pickles;
+:func:`loads_model` refuses bytes whose SHA-256 differs from the digest recorded when they
+were stored, because unpickling runs code.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import pickle
+from dataclasses import dataclass, field
+from importlib import metadata
+from typing import Any
+
+import numpy as np
+from sklearn.base import BaseEstimator
+
+from benchmark.catalogue import build_pipeline, get_spec
+from benchmark.dataset import Dataset, Schema
+from benchmark.errors import ConfigurationError
+from benchmark.metrics import expand_proba
+from benchmark.problem import feature_matrix, problem_from_dataset
+
+#: Libraries whose versions are recorded with a model.
+RECORDED_LIBRARIES = ("numpy", "scikit-learn", "xgboost")
+
+
+@dataclass
+class TrainedModel:
+    """A fitted classifier and what it needs to predict.
+
+    Parameters
+    ----------
+    classifier : str
+        Catalogue id (one target) or ``META:BASE`` configuration (several targets).
+    params : dict
+        The configuration's parameters and its ``random_state``.
+    schema : Schema
+        The training data's schema: features in order, targets and their labels.
+    estimator : BaseEstimator
+        The fitted estimator (a catalogue pipeline or a multi-target classifier).
+    versions : dict of str to str
+        Versions of the libraries the model was fitted with.
+    """
+
+    classifier: str
+    params: dict[str, Any]
+    schema: Schema
+    estimator: BaseEstimator
+    versions: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def n_classes(self) -> tuple[int, ...]:
+        return tuple(len(target.values) for target in self.schema.targets)
+
+    def predict(self, X: np.ndarray) -> np.ndarray:
+        """Predicted target codes.
+
+        Parameters
+        ----------
+        X : ndarray of shape (n_instances, n_features)
+            Features in the order of ``schema.features`` (as :attr:`Dataset.X`), nominal
+            values as codes of the schema's labels, NaN for missing.
+
+        Returns
+        -------
+        ndarray of shape (n_instances, n_targets), int64
+        """
+        features = self._features(X)
+        predicted = np.asarray(self.estimator.predict(features), dtype=np.int64)
+        return predicted.reshape(features.shape[0], -1)
+
+    def predict_proba(self, X: np.ndarray) -> list[np.ndarray]:
+        """Class probabilities per target.
+
+        Parameters
+        ----------
+        X : ndarray of shape (n_instances, n_features)
+            As for :meth:`predict`.
+
+        Returns
+        -------
+        list of ndarray of shape (n_instances, n_classes[t])
+            One matrix per target, columns in the order of the target's labels.
+
+        Raises
+        ------
+        NotImplementedError
+            The classifier gives no probabilities.
+        """
+        features = self._features(X)
+        if not hasattr(self.estimator, "predict_proba"):
+            raise NotImplementedError(f"classifier '{self.classifier}' gives no probabilities")
+        if len(self.schema.target_indices) == 1:
+            proba = self.estimator.predict_proba(features)
+            return [expand_proba(proba, self.estimator.classes_, n_classes=self.n_classes[0])]
+        return [np.asarray(p, dtype=np.float64) for p in self.estimator.predict_proba(features)]
+
+    def _features(self, X: np.ndarray) -> np.ndarray:
+        X = np.asarray(X, dtype=np.float64)
+        expected = len(self.schema.feature_indices)
+        if X.ndim != 2 or X.shape[1] != expected:
+            raise ConfigurationError(
+                f"the model expects {expected} feature columns "
+                f"({', '.join(self.schema.feature_names[:5])}...), got an array of shape "
+                f"{X.shape}"
+            )
+        return feature_matrix(self.schema, X)[0]
+
+
+def fit_model(dataset: Dataset, classifier_id: str, *, random_state: int = 0) -> TrainedModel:
+    """Fit a classifier on every instance of a data set.
+
+    Parameters
+    ----------
+    dataset : Dataset
+        Training data; its targets decide between a catalogue classifier (one target)
+        and a multi-target configuration (several).
+    classifier_id : str
+        Catalogue id or ``META:BASE`` configuration id.
+    random_state : int
+        Seed of the classifier.
+
+    Raises
+    ------
+    ConfigurationError
+        Unknown classifier, a target that is not nominal or has a single class, no data.
+    """
+    problem, _ = problem_from_dataset(dataset)
+    if problem.n_instances == 0:
+        raise ConfigurationError("the data set has no instance with a known target to train on")
+    for name, column in zip(problem.target_names, problem.Y.T, strict=True):
+        if np.unique(column).size < 2:
+            raise ConfigurationError(
+                f"target '{name}' has a single class in the training data; nothing to learn"
+            )
+    estimator: Any
+    if problem.kind == "multiclass":
+        spec = get_spec(classifier_id)
+        estimator = build_pipeline(
+            spec,
+            nominal_features=problem.nominal_features,
+            n_features=problem.n_features,
+            random_state=random_state,
+        )
+        estimator.fit(problem.X, problem.Y[:, 0])
+        params: dict[str, Any] = dict(spec.params)
+    else:
+        from benchmark.multitarget import build_multitarget
+
+        estimator = build_multitarget(
+            classifier_id,
+            nominal_features=problem.nominal_features,
+            n_features=problem.n_features,
+            random_state=random_state,
+            n_classes=problem.n_classes,
+        )
+        estimator.fit(problem.X, problem.Y)
+        params = {"config": classifier_id}
+    params["random_state"] = random_state
+    return TrainedModel(classifier_id, params, dataset.schema, estimator, _library_versions())
+
+
+def model_digest(data: bytes) -> str:
+    """Hex SHA-256 of serialised model bytes."""
+    return hashlib.sha256(data).hexdigest()
+
+
+def dumps_model(model: TrainedModel) -> bytes:
+    """Serialise a model (a pickle; store :func:`model_digest` of it beside it)."""
+    return pickle.dumps(model, protocol=pickle.HIGHEST_PROTOCOL)
+
+
+def loads_model(data: bytes, *, sha256: str) -> TrainedModel:
+    """Deserialise a model after checking its bytes against their recorded digest.
+
+    Raises
+    ------
+    ConfigurationError
+        The digest differs (the bytes are not the ones stored, so they are not unpickled)
+        or the bytes are not a model.
+    """
+    actual = model_digest(data)
+    if actual != sha256.strip().lower():
+        raise ConfigurationError(
+            f"model bytes do not match their recorded sha256 ({sha256[:12]}..., got "
+            f"{actual[:12]}...); refusing to load them"
+        )
+    try:
+        model = pickle.loads(data)
+    except Exception as exc:
+        raise ConfigurationError(f"the stored model cannot be loaded: {exc}") from None
+    if not isinstance(model, TrainedModel):
+        raise ConfigurationError(f"the stored bytes hold a {type(model).__name__}, not a model")
+    return model
+
+
+def _library_versions() -> dict[str, str]:
+    versions = {}
+    for name in RECORDED_LIBRARIES:
+        try:
+            versions[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            continue
+    return versions

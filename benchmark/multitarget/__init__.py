@@ -1,0 +1,66 @@
+"""Multi-target and multi-label classification: MEKA's meta-classifiers as scikit-learn
+estimators, MEKA's measures, and the ``META:BASE`` configuration registry.
+
+Every estimator takes ``X`` of shape (n_samples, n_features), float64 with NaN for
+missing values, and ``Y`` of shape (n_samples, n_targets) of integer class codes;
+``predict`` returns (n_samples, n_targets) int codes and ``predict_proba`` a list of
+one (n_samples, n_classes[t]) matrix per target.
+"""
+
+from __future__ import annotations
+
+from benchmark.multitarget._base import MultiTargetClassifier
+from benchmark.multitarget._target_classifier import TargetClassifier
+from benchmark.multitarget._targets import TargetError
+from benchmark.multitarget.bayesian_chain import BayesianClassifierChain
+from benchmark.multitarget.chains import ClassifierChain, ProbabilisticClassifierChain
+from benchmark.multitarget.combination import LabelCombination, NearestSetReplacement, PrunedSets
+from benchmark.multitarget.ensembles import EnsembleClassifierChains, EnsemblePrunedSets
+from benchmark.multitarget.metrics import (
+    LOSS_METRICS,
+    MULTILABEL_METRICS,
+    MULTITARGET_METRICS,
+    multitarget_scores,
+)
+from benchmark.multitarget.multilabel import MultiLabelAdapter
+from benchmark.multitarget.rakeld import RAkELd
+from benchmark.multitarget.registry import (
+    DEFAULT_BASES,
+    META_METHODS,
+    MetaSpec,
+    build_multitarget,
+    check_targets,
+    multitarget_configurations,
+    parse_config,
+)
+from benchmark.multitarget.relevance import ClassRelevance
+from benchmark.multitarget.superclass import SuperClassClassifier
+
+__all__ = [
+    "DEFAULT_BASES",
+    "LOSS_METRICS",
+    "META_METHODS",
+    "MULTILABEL_METRICS",
+    "MULTITARGET_METRICS",
+    "BayesianClassifierChain",
+    "ClassRelevance",
+    "ClassifierChain",
+    "EnsembleClassifierChains",
+    "EnsemblePrunedSets",
+    "LabelCombination",
+    "MetaSpec",
+    "MultiLabelAdapter",
+    "MultiTargetClassifier",
+    "NearestSetReplacement",
+    "ProbabilisticClassifierChain",
+    "PrunedSets",
+    "RAkELd",
+    "SuperClassClassifier",
+    "TargetClassifier",
+    "TargetError",
+    "build_multitarget",
+    "check_targets",
+    "multitarget_configurations",
+    "multitarget_scores",
+    "parse_config",
+]

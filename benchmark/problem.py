@@ -1,0 +1,166 @@
+"""The engine's view of a data set: a feature matrix, integer targets, and their shapes."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+
+from benchmark.dataset import Dataset, Schema
+from benchmark.errors import ConfigurationError
+
+
+@dataclass(frozen=True, eq=False)
+class Problem:
+    """What the engine cross-validates.
+
+    Parameters
+    ----------
+    X : ndarray of shape (n_instances, n_features), float64
+        Features; nominal ones as label codes; NaN for missing values.
+    Y : ndarray of shape (n_instances, n_targets), int64
+        Target label codes ``0..n_classes[t]-1`` (no missing values).
+    n_classes : tuple of int
+        Number of declared labels per target.
+    target_names : tuple of str
+        Name per target.
+    nominal_features : mapping of int to int
+        Nominal feature column index to its number of declared labels.
+    groups : ndarray of shape (n_instances,) or None
+        Recording/session id per instance, for group-aware folds.
+    """
+
+    X: np.ndarray
+    Y: np.ndarray
+    n_classes: tuple[int, ...]
+    target_names: tuple[str, ...]
+    nominal_features: Mapping[int, int] = field(default_factory=dict)
+    groups: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        X = np.asarray(self.X, dtype=np.float64)
+        Y = np.asarray(self.Y)
+        if Y.ndim == 1:
+            Y = Y[:, None]
+        if X.ndim != 2 or Y.ndim != 2 or X.shape[0] != Y.shape[0]:
+            raise ConfigurationError(
+                f"X must be (n_instances, n_features) and Y (n_instances, n_targets); "
+                f"got {X.shape} and {Y.shape}"
+            )
+        if not np.all(np.isfinite(Y)) or not np.array_equal(Y, np.round(Y)):
+            raise ConfigurationError("target codes must be whole numbers without missing values")
+        Y = Y.astype(np.int64)
+        if len(self.n_classes) != Y.shape[1] or len(self.target_names) != Y.shape[1]:
+            raise ConfigurationError(
+                f"{Y.shape[1]} target column(s) but {len(self.n_classes)} class counts and "
+                f"{len(self.target_names)} target names"
+            )
+        for t, (name, k) in enumerate(zip(self.target_names, self.n_classes, strict=True)):
+            if Y.shape[0] and (Y[:, t].min() < 0 or Y[:, t].max() >= k):
+                raise ConfigurationError(f"codes of target '{name}' must lie in 0..{k - 1}")
+        object.__setattr__(self, "X", X)
+        object.__setattr__(self, "Y", Y)
+        object.__setattr__(self, "n_classes", tuple(int(k) for k in self.n_classes))
+        object.__setattr__(self, "target_names", tuple(self.target_names))
+        object.__setattr__(self, "nominal_features", dict(self.nominal_features))
+
+    @property
+    def kind(self) -> Literal["multiclass", "multitarget"]:
+        """``"multiclass"`` with one target, ``"multitarget"`` with several."""
+        return "multiclass" if self.Y.shape[1] == 1 else "multitarget"
+
+    @property
+    def n_instances(self) -> int:
+        return int(self.X.shape[0])
+
+    @property
+    def n_features(self) -> int:
+        return int(self.X.shape[1])
+
+    @property
+    def n_targets(self) -> int:
+        return int(self.Y.shape[1])
+
+
+def usable_feature_columns(schema: Schema) -> list[int]:
+    """Positions, among the schema's features, of those a classifier can use.
+
+    String attributes are left out: their codes index a per-file string table and carry
+    no order or meaning a classifier could learn.  Dates count as numeric (seconds).
+    """
+    return [i for i, a in enumerate(schema.features) if a.kind != "string"]
+
+
+def feature_matrix(schema: Schema, X: np.ndarray) -> tuple[np.ndarray, dict[int, int]]:
+    """The usable columns of a data set's feature matrix, and which of them are nominal.
+
+    Parameters
+    ----------
+    schema : Schema
+        The data set's schema.
+    X : ndarray of shape (n_instances, n_schema_features)
+        Features in schema order (:attr:`Dataset.X`).
+
+    Returns
+    -------
+    X : ndarray of shape (n_instances, n_usable_features)
+    nominal_features : dict of int to int
+        Column of the returned matrix to its number of declared labels.
+    """
+    columns = usable_feature_columns(schema)
+    features = schema.features
+    nominal = {
+        position: len(features[column].values)
+        for position, column in enumerate(columns)
+        if features[column].kind == "nominal"
+    }
+    return np.asarray(X, dtype=np.float64)[:, columns], nominal
+
+
+def problem_from_dataset(dataset: Dataset) -> tuple[Problem, list[str]]:
+    """Turn a data set with nominal targets into a :class:`Problem`.
+
+    Instances whose target is missing are left out (WEKA does the same when it
+    evaluates); string attributes are not used as features; instance weights are not
+    used.  Each such adjustment adds a line to the returned warnings.
+
+    Raises
+    ------
+    ConfigurationError
+        A target that is not nominal, no usable feature, or no instance with all targets.
+    """
+    schema = dataset.schema
+    if not schema.target_indices:
+        raise ConfigurationError("the data set has no target attribute")
+    for target in schema.targets:
+        if target.kind != "nominal":
+            raise ConfigurationError(
+                f"target '{target.name}' is a {target.kind} attribute; classifiers need a "
+                "nominal target"
+            )
+    notes: list[str] = []
+    unused = [a.name for a in schema.features if a.kind == "string"]
+    if unused:
+        notes.append(f"string attribute(s) not used as features: {', '.join(unused)}")
+    X, nominal = feature_matrix(schema, dataset.X)
+    if X.shape[1] == 0:
+        raise ConfigurationError(
+            "the data set has no numeric, nominal or date feature to learn from"
+        )
+    Y = dataset.Y
+    complete = ~np.isnan(Y).any(axis=1)
+    if not complete.all():
+        notes.append(f"{int((~complete).sum())} instance(s) with a missing target value left out")
+    if dataset.weights is not None and not np.all(dataset.weights == 1):
+        notes.append("instance weights are not used: every instance counts once")
+    problem = Problem(
+        X=X[complete],
+        Y=Y[complete].astype(np.int64),
+        n_classes=tuple(len(a.values) for a in schema.targets),
+        target_names=schema.target_names,
+        nominal_features=nominal,
+        groups=None if dataset.groups is None else np.asarray(dataset.groups)[complete],
+    )
+    return problem, notes

@@ -1,0 +1,334 @@
+"""One task (one classifier on one fold), run in the current process.
+
+The engine runs :func:`execute_task` inside worker processes; everything a worker needs is
+in a :class:`TaskContext`, sent to each worker once.  A classifier that raises is recorded
+as an ``error`` result here; timeouts and crashes are the engine's business.
+"""
+
+from __future__ import annotations
+
+import math
+import pickle
+import time
+import traceback
+import warnings
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+
+from benchmark.catalogue import ClassifierSpec, build_pipeline
+from benchmark.folds import Fold
+from benchmark.metrics import confusion_matrix, expand_proba, multiclass_scores
+from benchmark.problem import Problem
+
+Status = Literal["ok", "error", "timeout"]
+
+#: At most this many distinct warnings are kept per task.
+MAX_WARNINGS = 5
+
+
+@dataclass(frozen=True, order=True)
+class TaskKey:
+    """Which classifier on which fold (0-based repeat and fold)."""
+
+    classifier: str
+    repeat: int
+    fold: int
+
+    def __str__(self) -> str:
+        return f"{self.classifier} (repeat {self.repeat + 1}, fold {self.fold + 1})"
+
+
+@dataclass
+class TaskResult:
+    """The outcome of one task.
+
+    Parameters
+    ----------
+    key : TaskKey
+    status : {"ok", "error", "timeout"}
+    error : str or None
+        ``"ExceptionType: message"`` (or what stopped the worker) unless ``ok``.
+    metrics : dict of str to float
+        Scores (:data:`benchmark.metrics.MULTICLASS_METRICS`, or the multi-target scores)
+        and costs: ``fit_time`` and ``predict_time`` (wall seconds), ``fit_cpu_time`` and
+        ``predict_cpu_time`` (CPU seconds of the worker process), ``model_size`` (bytes of
+        the pickled fitted model).  Empty unless ``ok``.
+    confusion : list or None
+        Multi-class: the (n_classes, n_classes) matrix, rows true.  Multi-target: one such
+        matrix per target.
+    n_train, n_test : int
+        Fold sizes.
+    warnings : list of str
+        Distinct warnings the classifier emitted (convergence...), at most five.
+    per_target : dict or None
+        Multi-target: scores per target name.
+    """
+
+    key: TaskKey
+    status: Status
+    error: str | None
+    metrics: dict[str, float]
+    confusion: list[Any] | None
+    n_train: int
+    n_test: int
+    warnings: list[str] = field(default_factory=list)
+    per_target: dict[str, dict[str, float]] | None = None
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"
+
+    def to_json(self) -> dict[str, Any]:
+        """JSON-ready data (NaN as ``null``); :meth:`from_json` restores it."""
+        return {
+            "classifier": self.key.classifier,
+            "repeat": self.key.repeat,
+            "fold": self.key.fold,
+            "status": self.status,
+            "error": self.error,
+            "metrics": {name: _json_number(v) for name, v in self.metrics.items()},
+            "confusion": self.confusion,
+            "n_train": self.n_train,
+            "n_test": self.n_test,
+            "warnings": list(self.warnings),
+            "per_target": None
+            if self.per_target is None
+            else {
+                target: {name: _json_number(v) for name, v in scores.items()}
+                for target, scores in self.per_target.items()
+            },
+        }
+
+    @classmethod
+    def from_json(cls, data: Mapping[str, Any]) -> TaskResult:
+        per_target = data.get("per_target")
+        return cls(
+            key=TaskKey(data["classifier"], int(data["repeat"]), int(data["fold"])),
+            status=data["status"],
+            error=data.get("error"),
+            metrics={name: _from_json_number(v) for name, v in data["metrics"].items()},
+            confusion=data.get("confusion"),
+            n_train=int(data["n_train"]),
+            n_test=int(data["n_test"]),
+            warnings=list(data.get("warnings", ())),
+            per_target=None
+            if per_target is None
+            else {
+                target: {name: _from_json_number(v) for name, v in scores.items()}
+                for target, scores in per_target.items()
+            },
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class TaskContext:
+    """Everything a worker needs to run any task of one run.
+
+    Parameters
+    ----------
+    problem : Problem
+    specs : mapping of str to ClassifierSpec
+        Multi-class classifiers by id (catalogue entries and any extra ones).
+    folds : sequence of Fold
+    random_state : int
+        Seed of every classifier.
+    """
+
+    problem: Problem
+    specs: Mapping[str, ClassifierSpec]
+    folds: Sequence[Fold]
+    random_state: int = 0
+
+    def fold(self, repeat: int, fold: int) -> Fold:
+        for candidate in self.folds:
+            if candidate.repeat == repeat and candidate.fold == fold:
+                return candidate
+        raise KeyError(f"no fold {fold} in repeat {repeat}")
+
+
+def failed_result(key: TaskKey, status: Status, error: str, fold: Fold | None) -> TaskResult:
+    """A result for a task that produced no scores."""
+    return TaskResult(
+        key=key,
+        status=status,
+        error=error,
+        metrics={},
+        confusion=None,
+        n_train=0 if fold is None else int(fold.train.size),
+        n_test=0 if fold is None else int(fold.test.size),
+    )
+
+
+def execute_task(context: TaskContext, key: TaskKey) -> TaskResult:
+    """Fit, predict and score one classifier on one fold; exceptions become errors."""
+    fold = context.fold(key.repeat, key.fold)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            if context.problem.kind == "multiclass":
+                result = _run_multiclass(context, key, fold)
+            else:
+                result = _run_multitarget(context, key, fold)
+        except MemoryError as exc:
+            result = failed_result(key, "error", f"MemoryError: out of memory {exc}".strip(), fold)
+        except Exception as exc:
+            result = failed_result(key, "error", describe_exception(exc), fold)
+    result.warnings = _distinct_warnings(caught)
+    return result
+
+
+def describe_exception(exc: BaseException) -> str:
+    """``"Type: message (at file:line in function)"`` for the innermost frame."""
+    text = f"{type(exc).__name__}: {exc}".rstrip(": ")
+    frames = traceback.extract_tb(exc.__traceback__)
+    if frames:
+        last = frames[-1]
+        text += f" (at {last.filename.rsplit('/', 1)[-1]}:{last.lineno} in {last.name})"
+    return text
+
+
+def _run_multiclass(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResult:
+    problem = context.problem
+    n_classes = problem.n_classes[0]
+    model = build_pipeline(
+        context.specs[key.classifier],
+        nominal_features=problem.nominal_features,
+        n_features=problem.n_features,
+        random_state=context.random_state,
+    )
+    y = problem.Y[:, 0]
+    timer = _Timer()
+    model.fit(problem.X[fold.train], y[fold.train])
+    fit_time, fit_cpu = timer.lap()
+    X_test = problem.X[fold.test]
+    y_pred = np.asarray(model.predict(X_test), dtype=np.int64)
+    proba = None
+    if context.specs[key.classifier].probabilities:
+        proba = expand_proba(model.predict_proba(X_test), model.classes_, n_classes=n_classes)
+    predict_time, predict_cpu = timer.lap()
+    scores, confusion = multiclass_scores(y[fold.test], y_pred, proba, n_classes=n_classes)
+    scores.update(_costs(fit_time, fit_cpu, predict_time, predict_cpu, model))
+    return TaskResult(key, "ok", None, scores, confusion, int(fold.train.size), int(fold.test.size))
+
+
+def _run_multitarget(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResult:
+    from benchmark.multitarget import build_multitarget, multitarget_scores
+
+    problem = context.problem
+    model = build_multitarget(
+        key.classifier,
+        nominal_features=problem.nominal_features,
+        n_features=problem.n_features,
+        random_state=context.random_state,
+        n_classes=problem.n_classes,
+    )
+    timer = _Timer()
+    model.fit(problem.X[fold.train], problem.Y[fold.train])
+    fit_time, fit_cpu = timer.lap()
+    X_test = problem.X[fold.test]
+    Y_pred = np.asarray(model.predict(X_test), dtype=np.int64).reshape(len(fold.test), -1)
+    probas = None
+    if hasattr(model, "predict_proba"):
+        try:
+            probas = [np.asarray(p, dtype=np.float64) for p in model.predict_proba(X_test)]
+        except (AttributeError, NotImplementedError):
+            probas = None
+    predict_time, predict_cpu = timer.lap()
+    Y_test = problem.Y[fold.test]
+    scores = dict(
+        multitarget_scores(
+            Y_test,
+            Y_pred,
+            probas,
+            n_classes=problem.n_classes,
+            target_names=problem.target_names,
+        )
+    )
+    per_target = scores.pop("per_target", None)
+    metrics = {name: float(v) for name, v in scores.items() if isinstance(v, int | float)}
+    metrics.update(_costs(fit_time, fit_cpu, predict_time, predict_cpu, model))
+    confusion = [
+        confusion_matrix(Y_test[:, t], Y_pred[:, t], n_classes=k).tolist()
+        for t, k in enumerate(problem.n_classes)
+    ]
+    return TaskResult(
+        key,
+        "ok",
+        None,
+        metrics,
+        confusion,
+        int(fold.train.size),
+        int(fold.test.size),
+        per_target=per_target,
+    )
+
+
+class _Timer:
+    """Wall and CPU seconds since the previous lap."""
+
+    def __init__(self) -> None:
+        self._wall = time.perf_counter()
+        self._cpu = time.process_time()
+
+    def lap(self) -> tuple[float, float]:
+        wall, cpu = time.perf_counter(), time.process_time()
+        laps = (wall - self._wall, cpu - self._cpu)
+        self._wall, self._cpu = wall, cpu
+        return laps
+
+
+class _ByteCounter:
+    """A write-only file that only counts what is written to it."""
+
+    def __init__(self) -> None:
+        self.size = 0
+
+    def write(self, data: bytes | pickle.PickleBuffer) -> int:
+        # Protocol 5 hands large buffers over as PickleBuffer objects, which have no len().
+        size = memoryview(data).nbytes
+        self.size += size
+        return size
+
+
+def pickled_size(obj: object) -> float:
+    """Bytes of ``obj`` pickled with the highest protocol; NaN if it cannot be pickled."""
+    counter = _ByteCounter()
+    try:
+        pickle.dump(obj, counter, protocol=pickle.HIGHEST_PROTOCOL)
+    except Exception:
+        return math.nan
+    return float(counter.size)
+
+
+def _costs(
+    fit_time: float, fit_cpu: float, predict_time: float, predict_cpu: float, model: object
+) -> dict[str, float]:
+    return {
+        "fit_time": fit_time,
+        "predict_time": predict_time,
+        "fit_cpu_time": fit_cpu,
+        "predict_cpu_time": predict_cpu,
+        "model_size": pickled_size(model),
+    }
+
+
+def _distinct_warnings(caught: Sequence[warnings.WarningMessage]) -> list[str]:
+    seen: list[str] = []
+    for message in caught:
+        text = f"{message.category.__name__}: {message.message}"
+        if text not in seen:
+            seen.append(text)
+        if len(seen) == MAX_WARNINGS:
+            break
+    return seen
+
+
+def _json_number(value: float) -> float | None:
+    return None if value is None or math.isnan(value) else value
+
+
+def _from_json_number(value: float | None) -> float:
+    return math.nan if value is None else float(value)

@@ -1,0 +1,277 @@
+"""The engine end to end: worker processes, callbacks, resume, failures, jobs, Dask."""
+
+from __future__ import annotations
+
+import os
+import resource
+import signal
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from sklearn.base import BaseEstimator, ClassifierMixin
+
+from benchmark.catalogue import ClassifierSpec, get_spec
+from benchmark.engine import Problem, TaskKey, TaskResult, run_tasks
+from benchmark.errors import ConfigurationError
+from benchmark.folds import make_folds
+
+# Deliberately misbehaving classifiers.  The engine's workers import them from this module.
+
+
+class SleepingClassifier(ClassifierMixin, BaseEstimator):
+    """A runaway fit: writes its process id to ``pid_file``, then sleeps in C for an hour."""
+
+    def __init__(self, pid_file: str = "") -> None:
+        self.pid_file = pid_file
+
+    def fit(self, X: np.ndarray, y: np.ndarray) -> SleepingClassifier:
+        if self.pid_file:
+            Path(self.pid_file).write_text(str(os.getpid()))
+        time.sleep(3600)
+        return self
+
+
+class FailingClassifier(ClassifierMixin, BaseEstimator):
+    def fit(self, X: np.ndarray, y: np.ndarray) -> FailingClassifier:
+        raise ValueError("deliberate failure")
+
+
+class MemoryHogClassifier(ClassifierMixin, BaseEstimator):
+    """Asks for 16 GB under an address-space limit of 512 MB more than it uses."""
+
+    def fit(self, X: np.ndarray, y: np.ndarray) -> MemoryHogClassifier:
+        soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+        in_use = int(Path("/proc/self/statm").read_text().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+        resource.setrlimit(resource.RLIMIT_AS, (in_use + 512 * 2**20, hard))
+        try:
+            np.ones(2 * 2**30, dtype=np.float64)
+        finally:
+            resource.setrlimit(resource.RLIMIT_AS, (soft, hard))
+        return self
+
+
+class SelfKillingClassifier(ClassifierMixin, BaseEstimator):
+    """Dies as the kernel's out-of-memory killer would kill it."""
+
+    def fit(self, X: np.ndarray, y: np.ndarray) -> SelfKillingClassifier:
+        os.kill(os.getpid(), signal.SIGKILL)
+        return self
+
+
+def stand_in(classifier_id: str, factory: type, **params: object) -> ClassifierSpec:
+    return replace(
+        get_spec("zeror"), id=classifier_id, factory=factory, params=params, probabilities=False
+    )
+
+
+def small_problem(n: int = 90) -> Problem:
+    rng = np.random.default_rng(0)
+    y = np.arange(n) % 3
+    X = rng.normal(size=(n, 4)) + 2.0 * y[:, None]
+    X[::11, 2] = np.nan
+    return Problem(X=X, Y=y[:, None], n_classes=(3,), target_names=("gesture",))
+
+
+@pytest.fixture(scope="module")
+def problem() -> Problem:
+    return small_problem()
+
+
+@pytest.fixture(scope="module")
+def folds(problem: Problem) -> list:
+    return make_folds(problem.Y, n_folds=3)[0]
+
+
+def scores_only(results: list[TaskResult]) -> list[tuple[TaskKey, str, dict[str, float]]]:
+    costs = {"fit_time", "predict_time", "fit_cpu_time", "predict_cpu_time"}
+    return [
+        (r.key, r.status, {k: v for k, v in r.metrics.items() if k not in costs}) for r in results
+    ]
+
+
+def test_every_task_runs_once_and_is_reported_in_the_calling_process(problem, folds) -> None:
+    started: list[TaskKey] = []
+    reported: list[tuple[TaskKey, int]] = []
+    results = run_tasks(
+        problem,
+        ["zeror", "nb", "zeror"],
+        folds,
+        on_start=started.append,
+        on_result=lambda r: reported.append((r.key, os.getpid())),
+    )
+    expected = [TaskKey(c, 0, k) for c in ("zeror", "nb") for k in range(3)]
+    assert [r.key for r in results] == expected
+    assert started == expected
+    assert [key for key, _ in reported] == expected
+    assert {pid for _, pid in reported} == {os.getpid()}
+    assert all(r.status == "ok" for r in results)
+    assert results[3].metrics["accuracy"] > 0.8
+    assert results[0].metrics["accuracy"] == pytest.approx(1 / 3)
+    assert (results[0].n_train, results[0].n_test) == (60, 30)
+
+
+def test_an_interrupted_run_resumes_without_repeating_tasks(problem, folds) -> None:
+    stored: list[TaskResult] = []
+
+    def store_then_interrupt(result: TaskResult) -> None:
+        stored.append(result)
+        if len(stored) == 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_tasks(problem, ["nb", "j48"], folds, jobs=2, on_result=store_then_interrupt)
+    assert len(stored) == 2
+    done = {r.key for r in stored}
+    rest = run_tasks(problem, ["nb", "j48"], folds, jobs=2, skip=done, on_result=stored.append)
+    assert {r.key for r in rest}.isdisjoint(done)
+    assert sorted(r.key for r in stored) == sorted(
+        TaskKey(c, 0, k) for c in ("nb", "j48") for k in range(3)
+    )
+    assert run_tasks(problem, ["nb", "j48"], folds, skip={r.key for r in stored}) == []
+
+
+def test_errors_crashes_memory_and_timeouts_are_recorded_and_the_run_goes_on(
+    problem, folds, tmp_path: Path
+) -> None:
+    pid_file = tmp_path / "sleeper.pid"
+    specs = {
+        "failing": stand_in("failing", FailingClassifier),
+        "sleeper": stand_in("sleeper", SleepingClassifier, pid_file=str(pid_file)),
+        "hog": stand_in("hog", MemoryHogClassifier),
+        "killer": stand_in("killer", SelfKillingClassifier),
+    }
+    two_folds = folds[:2]
+    results = run_tasks(
+        problem,
+        ["failing", "sleeper", "hog", "killer", "nb"],
+        two_folds,
+        jobs=2,
+        timeout=2.0,
+        extra_specs=specs,
+    )
+    by_classifier: dict[str, list[TaskResult]] = {}
+    for result in results:
+        by_classifier.setdefault(result.key.classifier, []).append(result)
+    assert len(results) == 10
+    for result in by_classifier["failing"]:
+        assert result.status == "error"
+        assert str(result.error).startswith("ValueError: deliberate failure")
+    for result in by_classifier["sleeper"]:
+        assert result.status == "timeout"
+        assert result.error == "timed out after 2 s (worker process killed)"
+        assert (result.n_train, result.n_test) == (60, 30)
+    for result in by_classifier["hog"]:
+        assert result.status == "error"
+        assert str(result.error).startswith("MemoryError")
+    for result in by_classifier["killer"]:
+        assert result.status == "error"
+        assert str(result.error).startswith(
+            "worker process killed by signal SIGKILL (out of memory?)"
+        )
+    assert [r.status for r in by_classifier["nb"]] == ["ok", "ok"]
+    sleeper_pid = int(pid_file.read_text())
+    with pytest.raises(ProcessLookupError):
+        os.kill(sleeper_pid, 0)
+
+
+def test_two_jobs_give_the_same_scores_as_one(problem, folds) -> None:
+    classifiers = ["rf", "logistic", "ibk"]
+    one = run_tasks(problem, classifiers, folds, jobs=1, random_state=3)
+    two = run_tasks(problem, classifiers, folds, jobs=2, random_state=3)
+    assert scores_only(one) == scores_only(two)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"classifiers": ["rff"]}, "unknown classifier 'rff'; did you mean 'rf'"),
+        ({"classifiers": []}, "no classifiers to run"),
+        ({"folds": []}, "no folds"),
+        ({"timeout": 0}, "timeout must be a positive number"),
+        ({"jobs": 0}, "jobs must be a positive number"),
+    ],
+)
+def test_bad_input_is_refused_before_anything_runs(problem, folds, kwargs, message) -> None:
+    arguments = {"classifiers": ["nb"], "folds": folds, **kwargs}
+    with pytest.raises(ConfigurationError, match=message):
+        run_tasks(problem, arguments.pop("classifiers"), arguments.pop("folds"), **arguments)
+
+
+def test_multitarget_problems_run_multitarget_configurations() -> None:
+    rng = np.random.default_rng(2)
+    Y = np.column_stack([np.arange(60) % 3, (np.arange(60) // 3) % 2])
+    X = rng.normal(size=(60, 3)) + 2.0 * Y @ np.array([[1.0, 0, 0], [0, 0, 1.0]])
+    problem = Problem(X=X, Y=Y, n_classes=(3, 2), target_names=("gesture", "place"))
+    folds, _ = make_folds(Y, n_folds=2)
+    results = run_tasks(problem, ["cr:nb"], folds)
+    assert [r.status for r in results] == ["ok", "ok"]
+    assert all(r.metrics["hamming_score"] > 0.6 for r in results)
+    with pytest.raises(ConfigurationError):
+        run_tasks(problem, ["nope:nb"], folds)
+
+
+def test_dask_local_cluster_runs_the_same_tasks(problem, folds) -> None:
+    distributed = pytest.importorskip("distributed")
+    specs = {"failing": stand_in("failing", FailingClassifier)}
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=2, processes=True, dashboard_address=None
+    ) as cluster:
+        reported: list[TaskKey] = []
+        results = run_tasks(
+            problem,
+            ["nb", "failing", "j48"],
+            folds,
+            scheduler=cluster.scheduler_address,
+            extra_specs=specs,
+            on_result=lambda r: reported.append(r.key),
+        )
+    local = run_tasks(problem, ["nb", "j48"], folds)
+    assert sorted(reported) == sorted(r.key for r in results)
+    assert [r.key.classifier for r in results] == ["nb"] * 3 + ["failing"] * 3 + ["j48"] * 3
+    assert all(str(r.error).startswith("ValueError: deliberate failure") for r in results[3:6])
+    assert scores_only(results[:3] + results[6:]) == scores_only(local)
+
+
+def test_an_unreachable_scheduler_is_a_configuration_error(problem, folds, monkeypatch) -> None:
+    monkeypatch.setattr("benchmark.dask_backend.CONNECT_TIMEOUT", "1s")
+    with pytest.raises(ConfigurationError, match="cannot reach the Dask scheduler"):
+        run_tasks(problem, ["nb"], folds, scheduler="tcp://127.0.0.1:9")
+
+
+def test_workers_do_not_outlive_a_killed_run(tmp_path: Path) -> None:
+    """kill -9 of the process running the engine ends its workers, even mid-fit."""
+    import subprocess
+    import sys
+
+    pid_file = tmp_path / "sleeper.pid"
+    sleeper = f"stand_in('sleeper', SleepingClassifier, pid_file={str(pid_file)!r})"
+    script = (
+        "from tests.benchmark.test_engine import *\n"
+        f"specs = {{'sleeper': {sleeper}}}\n"
+        "p = small_problem()\n"
+        "run_tasks(p, ['sleeper'], make_folds(p.Y, n_folds=2)[0], extra_specs=specs)\n"
+    )
+    root = Path(__file__).resolve().parents[2]
+    runner = subprocess.Popen([sys.executable, "-c", script], cwd=root)
+    try:
+        deadline = time.monotonic() + 60
+        text = ""
+        while not text and time.monotonic() < deadline:
+            time.sleep(0.1)
+            text = pid_file.read_text() if pid_file.exists() else ""
+        worker = int(text)
+    finally:
+        runner.kill()
+        runner.wait()
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline:
+        try:
+            os.kill(worker, 0)
+        except ProcessLookupError:
+            return
+        time.sleep(0.2)
+    os.kill(worker, signal.SIGKILL)
+    pytest.fail("the worker was still running 10 s after its parent was killed")

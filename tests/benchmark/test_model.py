@@ -1,0 +1,105 @@
+"""Trained models: fit on a whole data set, predict with the schema's labels, serialise."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from benchmark.dataset import Attribute, Dataset, Schema
+from benchmark.errors import ConfigurationError
+from benchmark.model import TrainedModel, dumps_model, fit_model, loads_model, model_digest
+
+
+def dataset(n: int = 90, targets: int = 1) -> Dataset:
+    rng = np.random.default_rng(0)
+    gesture = np.arange(n) % 3
+    place = (np.arange(n) // 3) % 2
+    colour = (gesture + (rng.random(n) < 0.2)) % 2
+    level = 0.3 * rng.normal(size=n) + 6.0 * gesture + 2.0 * place
+    attributes = [
+        Attribute("gesture", "nominal", ("tap", "slap", "stroke")),
+        Attribute("place", "nominal", ("head", "arm")),
+        Attribute("colour", "nominal", ("red", "blue")),
+        Attribute("note", "string", ("a", "b")),
+        Attribute("level", "numeric", (), "numeric"),
+    ]
+    values = np.column_stack([gesture, place, colour, np.zeros(n), level]).astype(np.float64)
+    values[::10, 4] = np.nan
+    target_indices = (0,) if targets == 1 else (0, 1)
+    return Dataset(Schema("touch", tuple(attributes), target_indices), values)
+
+
+def features(data: Dataset) -> np.ndarray:
+    return data.X
+
+
+def test_fit_predict_and_probabilities_of_a_catalogue_classifier() -> None:
+    data = dataset()
+    model = fit_model(data, "logistic", random_state=4)
+    assert model.classifier == "logistic"
+    assert model.params["random_state"] == 4 and model.params["C"] == 10.0
+    assert "scikit-learn" in model.versions
+    predicted = model.predict(data.X)
+    assert predicted.shape == (90, 1) and predicted.dtype == np.int64
+    assert np.mean(predicted[:, 0] == data.Y[:, 0]) > 0.8
+    [proba] = model.predict_proba(data.X)
+    assert proba.shape == (90, 3)
+    np.testing.assert_allclose(proba.sum(axis=1), 1.0)
+
+
+def test_a_model_without_probabilities_says_so() -> None:
+    model = fit_model(dataset(), "svm-rbf")
+    with pytest.raises(NotImplementedError, match="classifier 'svm-rbf' gives no probabilities"):
+        model.predict_proba(dataset().X)
+
+
+def test_multitarget_models_predict_every_target() -> None:
+    data = dataset(targets=2)
+    model = fit_model(data, "cc:j48")
+    predicted = model.predict(data.X)
+    assert predicted.shape == (90, 2)
+    assert np.mean(predicted == data.Y) > 0.8
+    probas = model.predict_proba(data.X)
+    assert [p.shape for p in probas] == [(90, 3), (90, 2)]
+
+
+def test_wrong_feature_count_is_refused() -> None:
+    model = fit_model(dataset(), "nb")
+    with pytest.raises(ConfigurationError, match="expects 4 feature columns"):
+        model.predict(np.zeros((2, 5)))
+
+
+@pytest.mark.parametrize(
+    ("classifier", "mutate", "message"),
+    [
+        ("rff", None, "unknown classifier 'rff'; did you mean 'rf'"),
+        ("nb", "one_class", "target 'gesture' has a single class"),
+        ("nb", "numeric_target", "target 'level' is a numeric attribute"),
+    ],
+)
+def test_bad_training_requests(classifier: str, mutate: str | None, message: str) -> None:
+    data = dataset()
+    if mutate == "one_class":
+        data.values[:, 0] = 1
+    if mutate == "numeric_target":
+        data = data.with_targets([4])
+    with pytest.raises(ConfigurationError, match=message):
+        fit_model(data, classifier)
+
+
+def test_serialised_models_load_only_with_their_digest() -> None:
+    data = dataset()
+    model = fit_model(data, "j48")
+    blob = dumps_model(model)
+    digest = model_digest(blob)
+    again = loads_model(blob, sha256=digest.upper())
+    assert isinstance(again, TrainedModel) and again.schema == model.schema
+    np.testing.assert_array_equal(again.predict(data.X), model.predict(data.X))
+    tampered = blob[:-1] + bytes([blob[-1] ^ 1])
+    with pytest.raises(ConfigurationError, match="do not match their recorded sha256"):
+        loads_model(tampered, sha256=digest)
+    import pickle
+
+    other = pickle.dumps({"not": "a model"})
+    with pytest.raises(ConfigurationError, match="hold a dict, not a model"):
+        loads_model(other, sha256=model_digest(other))
