@@ -11,11 +11,12 @@ from datetime import datetime
 from typing import Any
 
 import numpy as np
-from sqlalchemy import delete, func, insert, select
+from sqlalchemy import delete, insert, select
 from sqlalchemy.orm import Session
 
-from app.errors import AppError, NotFoundError
+from app.errors import AppError
 from app.store.database import Store
+from app.store.naming import find_row, free_name
 from app.store.tables import DatasetRow, InstanceRow
 from benchmark.dataset import Dataset, Schema
 
@@ -113,7 +114,7 @@ def add_dataset(
         if name is not None:
             _check_name(session, name)
         else:
-            name = _free_name(session, default_name(dataset.schema.relation))
+            name = free_name(session, DatasetRow, default_name(dataset.schema.relation))
         row = DatasetRow(
             name=name,
             relation=dataset.schema.relation,
@@ -257,18 +258,6 @@ def _instance_extras(
     return weights, groups, meta
 
 
-def _row(session: Session, ref: str | int) -> DatasetRow:
-    text = str(ref)
-    row = session.scalars(select(DatasetRow).where(DatasetRow.name == text)).first()
-    if row is None and text.isdigit():
-        row = session.get(DatasetRow, int(text))
-    if row is None:
-        names = session.scalars(select(DatasetRow.name).order_by(DatasetRow.id)).all()
-        known = ", ".join(names[:10]) if names else "the store has none; import one first"
-        raise NotFoundError(f"no dataset '{text}' (datasets: {known})")
-    return row
-
-
 def _check_name(session: Session, name: str) -> None:
     if not name.strip():
         raise AppError("a dataset name cannot be empty")
@@ -281,15 +270,7 @@ def _check_name(session: Session, name: str) -> None:
         )
 
 
-def _free_name(session: Session, base: str) -> str:
-    taken = set(
-        session.scalars(
-            select(DatasetRow.name).where(func.lower(DatasetRow.name).like(base.lower() + "%"))
-        )
+def _row(session: Session, ref: str | int) -> DatasetRow:
+    return find_row(
+        session, DatasetRow, ref, kind="dataset", hint="the store has none; import one first"
     )
-    if base not in taken:
-        return base
-    suffix = 2
-    while f"{base}-{suffix}" in taken:
-        suffix += 1
-    return f"{base}-{suffix}"

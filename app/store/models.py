@@ -12,8 +12,9 @@ from typing import Any
 from sqlalchemy import select
 from sqlalchemy.orm import Session
 
-from app.errors import AppError, NotFoundError
+from app.errors import AppError
 from app.store.database import Store
+from app.store.naming import find_row, free_name
 from app.store.tables import DatasetRow, ModelRow
 
 
@@ -67,7 +68,7 @@ def save_model(
             else None
         )
         if name is None:
-            name = _free_name(session, f"{dataset_name or 'model'}-{classifier}")
+            name = free_name(session, ModelRow, f"{dataset_name or 'model'}-{classifier}")
         elif session.scalars(select(ModelRow).where(ModelRow.name == name)).first() is not None:
             raise AppError(f"a model named '{name}' already exists; choose another --name")
         row = ModelRow(
@@ -101,25 +102,9 @@ def load_artifact(store: Store, ref: str | int) -> tuple[ModelInfo, bytes]:
 
 
 def _row(session: Session, ref: str | int) -> ModelRow:
-    text = str(ref)
-    row = session.scalars(select(ModelRow).where(ModelRow.name == text)).first()
-    if row is None and text.isdigit():
-        row = session.get(ModelRow, int(text))
-    if row is None:
-        names = session.scalars(select(ModelRow.name).order_by(ModelRow.id)).all()
-        known = ", ".join(names[:10]) if names else "none yet; `touchbench train` makes one"
-        raise NotFoundError(f"no model '{text}' (models: {known})")
-    return row
-
-
-def _free_name(session: Session, base: str) -> str:
-    taken = set(session.scalars(select(ModelRow.name).where(ModelRow.name.like(base + "%"))))
-    if base not in taken:
-        return base
-    suffix = 2
-    while f"{base}-{suffix}" in taken:
-        suffix += 1
-    return f"{base}-{suffix}"
+    return find_row(
+        session, ModelRow, ref, kind="model", hint="none yet; `touchbench train` makes one"
+    )
 
 
 def _info(session: Session, row: ModelRow) -> ModelInfo:
