@@ -9,7 +9,19 @@ from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.utils import Tags
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from benchmark.multitarget._targets import validate_targets
+from benchmark.multitarget._targets import TargetError, validate_targets
+
+
+def check_at_least_one(name: str, value: int) -> None:
+    """Check that the count parameter ``name`` is at least 1.
+
+    Raises
+    ------
+    TargetError
+        ``value`` is below 1.
+    """
+    if value < 1:
+        raise TargetError(f"{name} must be at least 1, got {value}")
 
 
 class MultiTargetClassifier(ClassifierMixin, BaseEstimator):

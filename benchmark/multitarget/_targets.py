@@ -1,4 +1,4 @@
-"""Target matrices: validation, class counts, one-hot codes and joint combinations.
+"""Target matrices: validation, class counts, one-hot codes, joint combinations, subsets.
 
 A multi-target matrix ``Y`` has shape (n_samples, n_targets) and holds, for each target
 ``t``, integer codes ``0 .. n_classes[t] - 1`` (WEKA's nominal encoding).
@@ -6,6 +6,7 @@ A multi-target matrix ``Y`` has shape (n_samples, n_targets) and holds, for each
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -138,3 +139,26 @@ def combination_marginals(
 def all_binary(n_classes: Sequence[int]) -> bool:
     """Whether every target has at most two classes (a multi-label problem)."""
     return all(k <= 2 for k in n_classes)
+
+
+def random_partition(
+    n_targets: int, subset_size: int, rng: np.random.RandomState
+) -> list[np.ndarray]:
+    """Random disjoint subsets of the targets, of near-equal size (RAkELd's partition).
+
+    Parameters
+    ----------
+    n_targets : int
+    subset_size : int
+        Targets per subset, at least 1; the targets are split into
+        ``ceil(n_targets / subset_size)`` subsets whose sizes differ by at most one.
+    rng : RandomState
+        Draws the shuffle of the targets.
+
+    Returns
+    -------
+    list of ndarray
+        The target indices of each subset, in shuffled order.
+    """
+    shuffled = rng.permutation(n_targets)
+    return list(np.array_split(shuffled, math.ceil(n_targets / subset_size)))

@@ -106,8 +106,18 @@ class _PrunedCombination(LabelCombination):
     lowered until some remains, as MEKA does (``pruning_`` tells the value used).
     """
 
-    pruning: int
-    n_replacements: int
+    def __init__(
+        self,
+        estimator: Any,
+        *,
+        pruning: int = 1,
+        n_replacements: int = 1,
+        n_classes: Sequence[int] | None = None,
+    ) -> None:
+        self.estimator = estimator
+        self.pruning = pruning
+        self.n_replacements = n_replacements
+        self.n_classes = n_classes
 
     def _replacements(
         self, combination: np.ndarray, frequent: np.ndarray, counts: np.ndarray
@@ -184,19 +194,6 @@ class PrunedSets(_PrunedCombination):
         The pruning value actually used.
     """
 
-    def __init__(
-        self,
-        estimator: Any,
-        *,
-        pruning: int = 1,
-        n_replacements: int = 1,
-        n_classes: Sequence[int] | None = None,
-    ) -> None:
-        self.estimator = estimator
-        self.pruning = pruning
-        self.n_replacements = n_replacements
-        self.n_classes = n_classes
-
     def _replacements(
         self, combination: np.ndarray, frequent: np.ndarray, counts: np.ndarray
     ) -> np.ndarray:
@@ -240,19 +237,6 @@ class NearestSetReplacement(_PrunedCombination):
     pruning_ : int
         The pruning value actually used.
     """
-
-    def __init__(
-        self,
-        estimator: Any,
-        *,
-        pruning: int = 1,
-        n_replacements: int = 1,
-        n_classes: Sequence[int] | None = None,
-    ) -> None:
-        self.estimator = estimator
-        self.pruning = pruning
-        self.n_replacements = n_replacements
-        self.n_classes = n_classes
 
     def _replacements(
         self, combination: np.ndarray, frequent: np.ndarray, counts: np.ndarray

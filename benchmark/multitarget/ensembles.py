@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 from sklearn.utils import check_random_state
 
-from benchmark.multitarget._base import MultiTargetClassifier
+from benchmark.multitarget._base import MultiTargetClassifier, check_at_least_one
 from benchmark.multitarget._targets import TargetError
 from benchmark.multitarget.chains import ClassifierChain
 from benchmark.multitarget.combination import PrunedSets
@@ -50,8 +50,7 @@ class _VotingEnsemble(MultiTargetClassifier):
         self
         """
         X_checked, codes = self._validate_training_data(X, Y)
-        if self.n_estimators < 1:
-            raise TargetError(f"n_estimators must be at least 1, got {self.n_estimators}")
+        check_at_least_one("n_estimators", self.n_estimators)
         if not 0.0 < self.max_samples <= 1.0:
             raise TargetError(f"max_samples must be in (0, 1], got {self.max_samples}")
         rng = check_random_state(self.random_state)

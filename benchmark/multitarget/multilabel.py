@@ -9,7 +9,6 @@ ragged NumPy array, its MLARAM calls ``scipy.ones``).
 
 from __future__ import annotations
 
-import math
 import warnings
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
@@ -23,7 +22,7 @@ from sklearn.utils import check_random_state
 
 from benchmark.multitarget._base import MultiTargetClassifier
 from benchmark.multitarget._target_classifier import TargetClassifier
-from benchmark.multitarget._targets import TargetError, all_binary, one_hot
+from benchmark.multitarget._targets import TargetError, all_binary, one_hot, random_partition
 
 #: Methods that need a base classifier, and those that have none.
 METHODS_WITH_BASE = ("br", "cc", "lp", "rakeld", "rakelo")
@@ -177,9 +176,9 @@ class MultiLabelAdapter(MultiTargetClassifier):
         if self.method == "lp":
             return powerset
         if self.method == "rakeld":
-            n_subsets = math.ceil(n_labels / max(self.labelset_size, 1))
             subsets = [
-                part.tolist() for part in np.array_split(rng.permutation(n_labels), n_subsets)
+                part.tolist()
+                for part in random_partition(n_labels, max(self.labelset_size, 1), rng)
             ]
             return skml.ensemble.LabelSpacePartitioningClassifier(
                 classifier=powerset,

@@ -2,15 +2,14 @@
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 from sklearn.utils import check_random_state
 
-from benchmark.multitarget._base import MultiTargetClassifier
-from benchmark.multitarget._targets import TargetError
+from benchmark.multitarget._base import MultiTargetClassifier, check_at_least_one
+from benchmark.multitarget._targets import random_partition
 from benchmark.multitarget.combination import NearestSetReplacement
 
 
@@ -142,9 +141,8 @@ class RAkELd(PartitionedCombinations):
         self
         """
         X_checked, codes = self._validate_training_data(X, Y)
-        if self.subset_size < 1:
-            raise TargetError(f"subset_size must be at least 1, got {self.subset_size}")
-        shuffled = check_random_state(self.random_state).permutation(self.n_targets_)
-        n_subsets = math.ceil(self.n_targets_ / self.subset_size)
-        self._fit_partition(X_checked, codes, list(np.array_split(shuffled, n_subsets)))
+        check_at_least_one("subset_size", self.subset_size)
+        rng = check_random_state(self.random_state)
+        partition = random_partition(self.n_targets_, self.subset_size, rng)
+        self._fit_partition(X_checked, codes, partition)
         return self

@@ -80,12 +80,9 @@ class BandPeaks(Extractor):
         n_channels = y.shape[0]
         vertical = (self.params["vertical"] or n_channels) - 1
         horizontal = [c for c in range(n_channels) if c != vertical]
-        rows, spans, meta, warnings = [], [], [], []
-        for event in detection.events:
-            segment = y[:, event.onset : event.offset]
-            if segment.shape[1] < self.min_samples(samplerate):
-                warnings.append(self._too_short((event.onset, event.offset), samplerate))
-                continue
+        rows, spans, meta = [], [], []
+        segments, warnings = self._long_enough(y, samplerate=samplerate, detection=detection)
+        for event, segment in segments:
             level = rms(segment[:, :, np.newaxis])[:, 0]
             theta = math.atan2(level[vertical], float(np.sqrt(np.sum(level[horizontal] ** 2))))
             spectrum, frequencies = _amplitude_spectrum(segment[vertical], samplerate)

@@ -10,7 +10,7 @@ import numpy as np
 
 from features._checks import as_samplerate
 from features.errors import FeatureError
-from features.events import Detection
+from features.events import Detection, Event
 from features.options import Option, resolve_options
 
 
@@ -124,6 +124,38 @@ class Extractor(ABC):
         detection : Detection
             The recording's events.
         """
+
+    def _long_enough(
+        self, y: np.ndarray, *, samplerate: float, detection: Detection
+    ) -> tuple[list[tuple[Event, np.ndarray]], list[str]]:
+        """The events at least one analysis window long, with their samples.
+
+        Parameters
+        ----------
+        y : ndarray of shape (n_channels, n_samples)
+            Finite samples.
+        samplerate : float
+            Sample rate in Hz.
+        detection : Detection
+            The recording's events.
+
+        Returns
+        -------
+        segments : list of (Event, ndarray of shape (n_channels, n_event_samples))
+            In event order, each event of at least :meth:`min_samples` samples and its
+            samples.
+        warnings : list of str
+            In event order, one :meth:`_too_short` message per event left out.
+        """
+        segments: list[tuple[Event, np.ndarray]] = []
+        warnings: list[str] = []
+        for event in detection.events:
+            segment = y[:, event.onset : event.offset]
+            if segment.shape[1] < self.min_samples(samplerate):
+                warnings.append(self._too_short((event.onset, event.offset), samplerate))
+                continue
+            segments.append((event, segment))
+        return segments, warnings
 
     def _too_short(self, event_span: tuple[int, int], samplerate: float) -> str:
         start, end = event_span

@@ -58,12 +58,9 @@ class Mfcc(Extractor):
         filters = mel_filter_bank(
             samplerate=samplerate, n_fft=frame_length, n_mels=self.params["n_mels"]
         )
-        rows, spans, meta, warnings = [], [], [], []
-        for event in detection.events:
-            segment = y[:, event.onset : event.offset]
-            if segment.shape[1] < frame_length:
-                warnings.append(self._too_short((event.onset, event.offset), samplerate))
-                continue
+        rows, spans, meta = [], [], []
+        segments, warnings = self._long_enough(y, samplerate=samplerate, detection=detection)
+        for event, segment in segments:
             frames = frame(segment, frame_length=frame_length, hop_length=hop_length)
             power = power_spectrogram(frames, window="hann")
             coefficients = mfcc(

@@ -56,12 +56,9 @@ class TaxelDft(Extractor):
     def extract(self, y: np.ndarray, *, samplerate: float, detection: Detection) -> Instances:
         window, step = self.params["window"], self.params["step"]
         bins = self.bins
-        blocks, spans, meta, warnings = [], [], [], []
-        for event in detection.events:
-            segment = y[:, event.onset : event.offset]
-            if segment.shape[1] < window:
-                warnings.append(self._too_short((event.onset, event.offset), samplerate))
-                continue
+        blocks, spans, meta = [], [], []
+        segments, warnings = self._long_enough(y, samplerate=samplerate, detection=detection)
+        for event, segment in segments:
             spectrum = stft(frame(segment, frame_length=window, hop_length=step), window=None)
             real = spectrum.real[:, bins.start : bins.stop, :]
             blocks.append(np.moveaxis(real, -1, 0).reshape(real.shape[-1], -1))
