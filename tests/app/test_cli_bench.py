@@ -244,3 +244,14 @@ def test_a_killed_run_resumes_without_repeating_or_duplicating(
     board = resumed.json()["leaderboard"]
     assert {row["classifier"] for row in board} == {"zeror", "mlp", "rf", "nb"}
     assert all(row["n_ok"] == 10 for row in board)
+
+
+def test_an_empty_dataset_cannot_be_benchmarked(
+    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+) -> None:
+    empty = tmp_path / "empty.arff"
+    empty.write_text("@relation e\n@attribute a numeric\n@attribute c {x,y}\n@data\n")
+    assert run_cli(capsys, store_url, "import", str(empty)).code == 0
+    result = run_cli(capsys, store_url, "bench", "e", "-c", "zeror")
+    assert result.code == 2 and "dataset 'e' has no instances" in result.err
+    assert run_cli(capsys, store_url, "runs", "--json").json() == {"runs": []}

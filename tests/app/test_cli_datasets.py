@@ -216,3 +216,16 @@ def test_real_files_import_export_and_reimport_identically(
     again = run_cli(capsys, store_url, "import", str(exported), "--name", "reimported", "--json")
     assert again.code == 0 and again.json()["created"] is True
     assert read_arff(exported).schema.target_names == expected.schema.target_names
+
+
+@pytest.mark.shared
+def test_the_damaged_reference_results_file_is_refused_at_its_line(
+    capsys: pytest.CaptureFixture[str], store_url: str, shared_datasets: Path
+) -> None:
+    # Line 207 of this file is the tail of a row whose start is missing (the published
+    # file is damaged); WEKA and liac-arff refuse it too.
+    source = shared_datasets / "uc3m-touch/mini/weka_results_place.arff"
+    result = run_cli(capsys, store_url, "import", str(source))
+    assert result.code == 2
+    assert "weka_results_place.arff:207: unterminated quote" in result.err
+    assert run_cli(capsys, store_url, "datasets", "--json").json() == {"datasets": []}
