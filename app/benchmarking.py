@@ -25,6 +25,7 @@ from benchmark.engine import Problem, TaskKey, TaskResult, run_tasks
 from benchmark.errors import ConfigurationError
 from benchmark.folds import Fold, make_folds
 from benchmark.leaderboard import Leaderboard, build_leaderboard
+from benchmark.problem import problem_from_dataset, restrict_targets
 
 
 @dataclass
@@ -60,7 +61,6 @@ class PreparedProblem:
     problem: Problem
     target_names: list[str]
     warnings: list[str] = field(default_factory=list)
-    groups: np.ndarray | None = None
 
 
 def prepare_problem(dataset: Dataset, targets: Sequence[str] | None = None) -> PreparedProblem:
@@ -70,62 +70,21 @@ def prepare_problem(dataset: Dataset, targets: Sequence[str] | None = None) -> P
     ----------
     dataset : Dataset
     targets : sequence of str, optional
-        Target attributes to classify; the data set's own targets by default.
+        Target attributes to classify; the data set's own targets by default (the others
+        are left out, never used as features).
     """
-    schema = dataset.schema
-    indices = tuple(schema.index(n) for n in targets) if targets else schema.target_indices
-    for i in indices:
-        attribute = schema.attributes[i]
-        if attribute.kind != "nominal":
-            raise ConfigurationError(
-                f"target '{attribute.name}' is {attribute.kind}; touchbench classifies nominal "
-                "targets (choose another with --target, or --targets when importing)"
-            )
     if dataset.n_instances == 0:
         raise ConfigurationError(f"dataset '{dataset.name}' has no instances")
-    warnings: list[str] = []
-    Y_codes = dataset.values[:, list(indices)]
-    labelled = ~np.isnan(Y_codes).any(axis=1)
-    if not labelled.all():
-        warnings.append(
-            f"{int((~labelled).sum())} instance(s) with a missing target value left out"
-        )
-    feature_columns: list[int] = []
-    nominal: dict[int, int] = {}
-    dropped = []
-    for i in range(schema.n_attributes):
-        attribute = schema.attributes[i]
-        if i in indices or i in schema.target_indices:
-            continue  # other targets never leak in as features (WEKA's Remove filter)
-        if attribute.kind == "string":
-            dropped.append(attribute.name)
-            continue
-        if attribute.kind == "nominal":
-            nominal[len(feature_columns)] = len(attribute.values)
-        feature_columns.append(i)
-    if dropped:
-        warnings.append(f"string attribute(s) not used as features: {', '.join(dropped)}")
-    if not feature_columns:
-        raise ConfigurationError("no feature attributes left once the targets are set aside")
-    X = dataset.values[labelled][:, feature_columns]
-    Y = Y_codes[labelled].astype(np.int64)
-    names = [schema.attributes[i].name for i in indices]
-    for column, name, i in zip(Y.T, names, indices, strict=True):
+    restricted = restrict_targets(dataset, targets)
+    problem, warnings = problem_from_dataset(restricted)
+    for column, target in zip(problem.Y.T, restricted.schema.targets, strict=True):
         present = np.unique(column)
         if present.size < 2:
-            only = schema.attributes[i].values[int(present[0])] if present.size else "none"
+            only = target.values[int(present[0])] if present.size else "none"
             raise ConfigurationError(
-                f"target '{name}' has a single class ('{only}'): nothing to classify"
+                f"target '{target.name}' has a single class ('{only}'): nothing to classify"
             )
-    problem = Problem(
-        X=X,
-        Y=Y,
-        n_classes=tuple(len(schema.attributes[i].values) for i in indices),
-        target_names=tuple(names),
-        nominal_features=nominal,
-    )
-    groups = None if dataset.groups is None else dataset.groups[labelled]
-    return PreparedProblem(problem, names, warnings, groups)
+    return PreparedProblem(problem, list(problem.target_names), warnings)
 
 
 def default_classifiers(n_targets: int, suite_name: str = "default") -> list[str]:
@@ -350,7 +309,7 @@ def _folds(prepared: PreparedProblem, options: RunOptions) -> tuple[list[Fold], 
         n_folds=options.folds,
         n_repeats=options.repeats,
         seed=options.seed,
-        groups=prepared.groups,
+        groups=prepared.problem.groups,
         target_names=prepared.target_names,
     )
 

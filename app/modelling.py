@@ -17,43 +17,9 @@ from app.store.database import Store
 from app.store.datasets import find_dataset, load_dataset
 from app.store.models import ModelInfo, load_artifact, save_model
 from benchmark.dataset import Attribute, Dataset, Schema
-from benchmark.errors import ConfigurationError, DataFormatError
+from benchmark.errors import DataFormatError
 from benchmark.model import TrainedModel, dumps_model, fit_model, loads_model
-
-
-def project(dataset: Dataset, targets: Sequence[str] | None = None) -> Dataset:
-    """The data set reduced to the chosen targets and the usable features.
-
-    Other declared targets and string attributes are left out; instances whose target
-    value is missing are dropped.
-    """
-    schema = dataset.schema
-    chosen = [schema.index(name) for name in targets] if targets else list(schema.target_indices)
-    for i in chosen:
-        if schema.attributes[i].kind != "nominal":
-            raise ConfigurationError(
-                f"target '{schema.attributes[i].name}' is {schema.attributes[i].kind}; "
-                "touchbench classifies nominal targets"
-            )
-    keep = [
-        i
-        for i, attribute in enumerate(schema.attributes)
-        if i in chosen or (i not in schema.target_indices and attribute.kind != "string")
-    ]
-    projected = Schema(
-        relation=schema.relation,
-        attributes=tuple(schema.attributes[i] for i in keep),
-        target_indices=tuple(keep.index(i) for i in sorted(chosen)),
-    )
-    labelled = ~np.isnan(dataset.values[:, chosen]).any(axis=1)
-    rows = np.flatnonzero(labelled)
-    return Dataset(
-        schema=projected,
-        values=dataset.values[np.ix_(rows, np.asarray(keep, dtype=np.intp))],
-        weights=None if dataset.weights is None else dataset.weights[rows],
-        groups=None if dataset.groups is None else dataset.groups[rows],
-        name=dataset.name,
-    )
+from benchmark.problem import restrict_targets
 
 
 def train(
@@ -68,7 +34,7 @@ def train(
 ) -> ModelInfo:
     """Fit a classifier on every instance of a data set and store the model."""
     info = find_dataset(store, dataset_ref)
-    data = project(load_dataset(store, info.id), targets)
+    data = restrict_targets(load_dataset(store, info.id), targets)
     model = fit_model(data, classifier, random_state=seed)
     return save_model(
         store,

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from dataclasses import dataclass, field
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
 from typing import Literal
 
 import numpy as np
@@ -164,3 +164,35 @@ def problem_from_dataset(dataset: Dataset) -> tuple[Problem, list[str]]:
         groups=None if dataset.groups is None else np.asarray(dataset.groups)[complete],
     )
     return problem, notes
+
+
+def restrict_targets(dataset: Dataset, targets: Sequence[str] | None = None) -> Dataset:
+    """The data set with only the chosen targets, ready for :func:`problem_from_dataset`.
+
+    The other declared targets are dropped rather than turned into features (WEKA's
+    Experimenter removes them the same way), and so are string attributes, so that a
+    model's schema lists exactly the features it uses.
+
+    Parameters
+    ----------
+    dataset : Dataset
+    targets : sequence of str, optional
+        Attribute names; the data set's own targets by default.
+    """
+    schema = dataset.schema
+    chosen = [schema.index(n) for n in targets] if targets else list(schema.target_indices)
+    keep = [
+        i
+        for i, attribute in enumerate(schema.attributes)
+        if i in chosen or (i not in schema.target_indices and attribute.kind != "string")
+    ]
+    restricted = Schema(
+        relation=schema.relation,
+        attributes=tuple(schema.attributes[i] for i in keep),
+        target_indices=tuple(keep.index(i) for i in sorted(chosen)),
+    )
+    return replace(
+        dataset,
+        schema=restricted,
+        values=dataset.values[:, np.asarray(keep, dtype=np.intp)],
+    )
