@@ -20,7 +20,7 @@ from sklearn.base import BaseEstimator
 from benchmark.catalogue import build_pipeline, get_spec
 from benchmark.dataset import Dataset, Schema
 from benchmark.errors import ConfigurationError
-from benchmark.metrics import expand_proba
+from benchmark.evaluation.metrics import expand_proba
 from benchmark.problem import feature_matrix, problem_from_dataset
 
 #: Libraries whose versions are recorded with a model.

@@ -22,10 +22,10 @@ from typing import Any
 
 import arff  # liac-arff
 
-from benchmark.arff import read_arff
-from benchmark.arff_reader import DateFormat
 from benchmark.dataset import Dataset
 from benchmark.errors import DataFormatError
+from benchmark.io.arff import read_arff
+from benchmark.io.arff_reader import DateFormat
 
 DEFAULT_FOLDER = Path(__file__).resolve().parents[1].parent / "shared" / "datasets"
 

@@ -24,11 +24,11 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmark.arff import read_arff
 from benchmark.catalogue import suite
-from benchmark.engine import Problem, run_tasks
-from benchmark.folds import make_folds
-from benchmark.leaderboard import build_leaderboard
+from benchmark.evaluation.leaderboard import build_leaderboard
+from benchmark.io.arff import read_arff
+from benchmark.run.engine import Problem, run_tasks
+from benchmark.run.folds import make_folds
 
 DATASETS = Path(__file__).resolve().parents[2] / "shared/datasets/uc3m-touch"
 

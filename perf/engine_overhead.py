@@ -24,10 +24,10 @@ from sklearn.metrics import cohen_kappa_score, make_scorer
 from sklearn.model_selection import cross_validate
 from threadpoolctl import threadpool_limits
 
-from benchmark.arff import read_arff
 from benchmark.catalogue import build_pipeline, get_spec
-from benchmark.engine import Problem, run_tasks
-from benchmark.folds import Fold, make_folds
+from benchmark.io.arff import read_arff
+from benchmark.run.engine import Problem, run_tasks
+from benchmark.run.folds import Fold, make_folds
 
 DATA = (
     Path(__file__).resolve().parents[2] / "shared/datasets/uc3m-touch/mini/gesture_and_place.arff"

@@ -32,8 +32,8 @@ from joblib import Parallel, delayed
 from sklearn.model_selection import KFold, StratifiedKFold
 from sklearn.multioutput import MultiOutputClassifier
 
-from benchmark.arff import read_arff
 from benchmark.catalogue import build_pipeline
+from benchmark.io.arff import read_arff
 from benchmark.multitarget import build_multitarget, multitarget_scores
 
 DATASETS = Path(__file__).resolve().parents[2] / "shared" / "datasets" / "uc3m-touch"

@@ -11,9 +11,9 @@ from app.cli.output import info, print_json, table
 from app.cli.state import get_state
 
 if TYPE_CHECKING:
-    from app.benchmarking import IndependentResult
+    from app.services.runs import IndependentResult
     from app.store.runs import RunInfo
-    from benchmark.leaderboard import Leaderboard
+    from benchmark.evaluation.leaderboard import Leaderboard
 
 # scikit-learn, the engine and Dask are imported by the commands that use them, so that
 # `touchbench datasets` and `--help` start at once.
@@ -187,7 +187,9 @@ def bench_command(
     A data set with several targets gets the multi-target configurations (META:BASE, e.g.
     bcc:rf) unless --target picks one target for the multi-class catalogue.
     """
-    from app.benchmarking import (
+    from app.cli.progress import TaskProgress
+    from app.reports.leaderboard import leaderboard_json
+    from app.services.runs import (
         RunOptions,
         default_classifiers,
         independent_runs,
@@ -196,8 +198,6 @@ def bench_command(
         run_leaderboard,
         start_run,
     )
-    from app.cli.progress import TaskProgress
-    from app.reports import leaderboard_json
     from app.store.datasets import find_dataset
 
     store = get_state(ctx).store
@@ -301,8 +301,13 @@ def leaderboard_command(
         raise typer.BadParameter(
             f"'{output_format}' is not one of {', '.join(FORMATS)}", param_hint="--format"
         )
-    from app.benchmarking import per_target_summary, run_leaderboard
-    from app.reports import leaderboard_csv, leaderboard_json, leaderboard_markdown, metric_columns
+    from app.reports.leaderboard import (
+        leaderboard_csv,
+        leaderboard_json,
+        leaderboard_markdown,
+        metric_columns,
+    )
+    from app.services.runs import per_target_summary, run_leaderboard
 
     store = get_state(ctx).store
     run, board = run_leaderboard(store, run_id, metric=metric, baseline=baseline)
@@ -314,7 +319,7 @@ def leaderboard_command(
     elif output_format == "markdown":
         sys.stdout.write(leaderboard_markdown(run, board, columns))
     elif output_format == "arff":
-        from app.results_export import write_results_arff
+        from app.reports.results_arff import write_results_arff
 
         write_results_arff(store, run, sys.stdout)
     else:
@@ -347,7 +352,7 @@ def _print_independent(result: IndependentResult, as_json: bool) -> None:
 
 
 def _print_leaderboard(run: RunInfo, board: Leaderboard) -> None:
-    from app.reports import leaderboard_header, leaderboard_rows, metric_columns
+    from app.reports.leaderboard import leaderboard_header, leaderboard_rows, metric_columns
 
     columns = metric_columns(run, board)
     table(

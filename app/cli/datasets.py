@@ -11,7 +11,7 @@ import typer
 
 from app.cli.output import info, print_json, table
 from app.cli.state import get_state
-from app.importing import import_file, parse_targets
+from app.services.datasets import import_file, parse_targets
 from app.store.datasets import (
     DatasetInfo,
     delete_dataset,
@@ -19,8 +19,8 @@ from app.store.datasets import (
     list_datasets,
     load_dataset,
 )
-from benchmark.arff import write_arff
 from benchmark.dataset import Dataset
+from benchmark.io.arff import write_arff
 
 JsonOption = Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")]
 DatasetArgument = Annotated[str, typer.Argument(metavar="DATASET", help="Data set name or id.")]

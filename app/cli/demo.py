@@ -28,8 +28,8 @@ def demo_command(
     Unless --db is given, the store is FOLDER/touchbench.db, so the demo never touches
     your own store.
     """
-    from app.demo import run_demo
-    from app.reports import leaderboard_header, leaderboard_rows, metric_columns
+    from app.reports.leaderboard import leaderboard_header, leaderboard_rows, metric_columns
+    from app.services.demo import run_demo
     from app.store.database import Store
 
     state = get_state(ctx)

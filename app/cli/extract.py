@@ -52,7 +52,7 @@ def extract_command(
     as_json: Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")] = False,
 ) -> None:
     """Detect touch events in recordings, extract features, and store them as a data set."""
-    from app.extraction import extract_dataset
+    from app.services.extraction import extract_dataset
     from app.store.datasets import add_dataset, dataset_digest
 
     result = extract_dataset(

@@ -9,11 +9,11 @@ import typer
 
 from app.cli.output import info, print_json, table
 from app.cli.state import get_state
-from app.importing import guess_format
+from app.services.datasets import guess_format
 from app.store.models import list_models
-from benchmark.arff import read_arff
-from benchmark.csvio import read_csv
 from benchmark.errors import DataFormatError
+from benchmark.io.arff import read_arff
+from benchmark.io.csv import read_csv
 
 JsonOption = Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")]
 
@@ -39,7 +39,7 @@ def train_command(
     as_json: JsonOption = False,
 ) -> None:
     """Fit a classifier on every instance of a data set and store the model."""
-    from app.modelling import train
+    from app.services.models import train
 
     model = train(
         get_state(ctx).store,
@@ -92,7 +92,7 @@ def predict_command(
     as_json: JsonOption = False,
 ) -> None:
     """Predict every instance of a file; attributes are matched to the model's by name."""
-    from app.modelling import load_model, predict
+    from app.services.models import load_model, predict
 
     model_info, model = load_model(get_state(ctx).store, model_ref)
     if not file.exists():

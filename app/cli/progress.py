@@ -8,7 +8,6 @@ from __future__ import annotations
 import sys
 from types import TracebackType
 
-from benchmark.engine import TaskKey, TaskResult
 from rich.console import Console
 from rich.progress import (
     BarColumn,
@@ -19,11 +18,12 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
-from app.benchmarking import Callbacks
+from app.services.runs import Callbacks
+from benchmark.results import TaskKey, TaskResult
 
 
 class TaskProgress:
-    """Callbacks for :mod:`app.benchmarking` that draw a bar; a context manager."""
+    """Callbacks for :mod:`app.services.runs` that draw a bar; a context manager."""
 
     def __init__(self, *, enabled: bool | None = None) -> None:
         self.enabled = sys.stderr.isatty() if enabled is None else enabled

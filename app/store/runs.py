@@ -20,7 +20,7 @@ from sqlalchemy.orm import Session
 from app.errors import NotFoundError
 from app.store.database import Store
 from app.store.tables import DatasetRow, FoldResultRow, RunRow, utcnow
-from benchmark.engine import TaskKey, TaskResult
+from benchmark.results import TaskKey, TaskResult
 
 #: Multi-target folds keep their per-target scores in the metrics column under this key.
 PER_TARGET = "per_target"

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 from sqlalchemy import create_engine, text
 
-from benchmark.arff import loads_arff
+from benchmark.io.arff import loads_arff
 from tests.app.cli_runner import run_cli
 from tests.app.synthetic import touch_arff
 

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from benchmark.arff import read_arff
+from benchmark.io.arff import read_arff
 from tests.app.cli_runner import run_cli
 
 TOUCH_ARFF = """% two targets, MEKA style

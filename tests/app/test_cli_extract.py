@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from app.simulation import write_labels, write_session
+from app.services.simulation import write_labels, write_session
 from tests.app.cli_runner import run_cli
 
 

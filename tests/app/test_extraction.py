@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import soundfile
 
-from app.extraction import extract_dataset, read_labels
+from app.services.extraction import extract_dataset, read_labels
 from benchmark.dataset import resolve_targets
 from benchmark.errors import DataFormatError
 from drivers.errors import DriverError

@@ -1,4 +1,4 @@
-"""Tests of benchmark.arff: reading and writing WEKA ARFF."""
+"""Tests of benchmark.io.arff: reading and writing WEKA ARFF."""
 
 from __future__ import annotations
 
@@ -10,10 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmark.arff import dumps_arff, loads_arff, read_arff, write_arff
-from benchmark.arff_reader import DateFormat
 from benchmark.dataset import Attribute, Dataset, Schema, resolve_targets
 from benchmark.errors import DataFormatError
+from benchmark.io.arff import dumps_arff, loads_arff, read_arff, write_arff
+from benchmark.io.arff_reader import DateFormat
 
 NAN = np.nan
 

@@ -1,4 +1,4 @@
-"""Tests of benchmark.csvio: reading CSV files into datasets."""
+"""Tests of benchmark.io.csv: reading CSV files into datasets."""
 
 from __future__ import annotations
 
@@ -7,9 +7,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmark.csvio import read_csv, sniff_delimiter
 from benchmark.dataset import Attribute
 from benchmark.errors import DataFormatError
+from benchmark.io.csv import read_csv, sniff_delimiter
 
 NAN = np.nan
 

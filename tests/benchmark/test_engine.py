@@ -14,9 +14,9 @@ import pytest
 from sklearn.base import BaseEstimator, ClassifierMixin
 
 from benchmark.catalogue import ClassifierSpec, get_spec
-from benchmark.engine import Problem, TaskKey, TaskResult, run_tasks
 from benchmark.errors import ConfigurationError
-from benchmark.folds import make_folds
+from benchmark.run.engine import Problem, TaskKey, TaskResult, run_tasks
+from benchmark.run.folds import make_folds
 
 # Deliberately misbehaving classifiers.  The engine's workers import them from this module.
 
@@ -236,7 +236,7 @@ def test_dask_local_cluster_runs_the_same_tasks(problem, folds) -> None:
 
 
 def test_an_unreachable_scheduler_is_a_configuration_error(problem, folds, monkeypatch) -> None:
-    monkeypatch.setattr("benchmark.dask_backend.CONNECT_TIMEOUT", "1s")
+    monkeypatch.setattr("benchmark.run.dask_backend.CONNECT_TIMEOUT", "1s")
     with pytest.raises(ConfigurationError, match="cannot reach the Dask scheduler"):
         run_tasks(problem, ["nb"], folds, scheduler="tcp://127.0.0.1:9")
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from benchmark.errors import ConfigurationError
-from benchmark.folds import make_folds
+from benchmark.run.folds import make_folds
 
 
 def check_partition(folds: list, n: int, n_repeats: int = 1) -> None:

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from benchmark.errors import ConfigurationError
-from benchmark.leaderboard import build_leaderboard
-from benchmark.significance import corrected_resampled_ttest
-from benchmark.task import TaskKey, TaskResult
+from benchmark.evaluation.leaderboard import build_leaderboard
+from benchmark.evaluation.significance import corrected_resampled_ttest
+from benchmark.results import TaskKey, TaskResult
 
 OFFSETS = np.linspace(-0.02, 0.02, 10)
 

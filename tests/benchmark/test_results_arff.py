@@ -9,13 +9,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmark.arff import dumps_arff, loads_arff, read_arff
 from benchmark.catalogue import CATALOGUE
 from benchmark.errors import ConfigurationError
-from benchmark.folds import make_folds
+from benchmark.evaluation.results_arff import RESULT_ATTRIBUTES, results_to_dataset, weka_measures
+from benchmark.io.arff import dumps_arff, loads_arff, read_arff
 from benchmark.problem import Problem
-from benchmark.results_arff import RESULT_ATTRIBUTES, results_to_dataset, weka_measures
-from benchmark.task import TaskContext, TaskKey, TaskResult, execute_task
+from benchmark.run.folds import make_folds
+from benchmark.run.task import TaskContext, TaskKey, TaskResult, execute_task
 
 
 @pytest.fixture(scope="module")

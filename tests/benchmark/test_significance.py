@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from benchmark.errors import ConfigurationError
-from benchmark.significance import corrected_resampled_ttest
+from benchmark.evaluation.significance import corrected_resampled_ttest
 
 
 def test_hand_computed_example() -> None:

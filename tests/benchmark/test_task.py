@@ -12,9 +12,9 @@ import pytest
 from sklearn.base import BaseEstimator, ClassifierMixin
 
 from benchmark.catalogue import CATALOGUE, get_spec
-from benchmark.folds import Fold, make_folds
 from benchmark.problem import Problem
-from benchmark.task import TaskContext, TaskKey, TaskResult, execute_task, pickled_size
+from benchmark.run.folds import Fold, make_folds
+from benchmark.run.task import TaskContext, TaskKey, TaskResult, execute_task, pickled_size
 
 
 class WarningClassifier(ClassifierMixin, BaseEstimator):

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from sklearn.model_selection import StratifiedKFold
 
-from benchmark.arff import read_arff
+from benchmark.io.arff import read_arff
 from benchmark.multitarget import build_multitarget, multitarget_scores
 
 SAMPLE = 600

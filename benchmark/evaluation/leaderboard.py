@@ -17,9 +17,9 @@ from typing import Any, Literal
 import numpy as np
 
 from benchmark.errors import ConfigurationError
-from benchmark.metrics import LOWER_IS_BETTER
-from benchmark.significance import corrected_resampled_ttest
-from benchmark.task import TaskResult
+from benchmark.evaluation.metrics import LOWER_IS_BETTER
+from benchmark.evaluation.significance import corrected_resampled_ttest
+from benchmark.results import TaskResult
 
 Mark = Literal["v", "*", ""]
 

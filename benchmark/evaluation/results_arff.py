@@ -21,7 +21,7 @@ import numpy as np
 from benchmark.catalogue import CATALOGUE, ClassifierSpec
 from benchmark.dataset import Attribute, Dataset, Schema
 from benchmark.errors import ConfigurationError
-from benchmark.task import TaskResult
+from benchmark.results import TaskResult
 
 RELATION = "InstanceResultListener"
 
@@ -129,7 +129,7 @@ def results_to_dataset(
     -------
     Dataset
         Relation ``InstanceResultListener``; write it with
-        :func:`benchmark.arff.write_arff`.
+        :func:`benchmark.io.arff.write_arff`.
 
     Raises
     ------

@@ -4,7 +4,7 @@ A worker is a fresh Python interpreter (``subprocess``, not ``multiprocessing``)
 started from anywhere (a multi-threaded service, a daemonic Dask worker), its BLAS and
 OpenMP thread counts are set through its environment before any library loads, and it can
 be killed outright (its whole process group) when a task overruns its time limit, native
-code included.  The run's :class:`~benchmark.task.TaskContext` is pickled once by the
+code included.  The run's :class:`~benchmark.run.task.TaskContext` is pickled once by the
 parent and sent to each worker once; afterwards each task costs one small message each
 way.
 
@@ -26,7 +26,8 @@ import time
 from multiprocessing.connection import Connection
 from typing import Any
 
-from benchmark.task import TaskKey, TaskResult, describe_exception, execute_task
+from benchmark.results import TaskKey, TaskResult
+from benchmark.run.task import describe_exception, execute_task
 
 #: Characters of a dead worker's stderr quoted in the error.
 STDERR_TAIL = 300
@@ -44,7 +45,7 @@ class Worker:
     Parameters
     ----------
     context : bytes
-        The pickled :class:`~benchmark.task.TaskContext`.
+        The pickled :class:`~benchmark.run.task.TaskContext`.
     threads : int
         OpenMP threads the worker may use; BLAS always gets one.  Parallelism comes from
         running several workers: the matrices of a fold are small, and BLAS or OpenMP
@@ -59,7 +60,7 @@ class Worker:
         command = [
             sys.executable,
             "-c",
-            "from benchmark.worker import serve; serve()",
+            "from benchmark.run.worker import serve; serve()",
             str(child_in),
             str(child_out),
         ]

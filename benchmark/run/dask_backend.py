@@ -1,7 +1,7 @@
 """Running the engine's tasks on an existing Dask distributed cluster.
 
-The run's pickled :class:`~benchmark.task.TaskContext` is scattered to every Dask worker
-once.  Each Dask worker thread keeps one :class:`~benchmark.worker.Worker` subprocess per
+The run's pickled :class:`~benchmark.run.task.TaskContext` is scattered to every Dask worker
+once.  Each Dask worker thread keeps one :class:`~benchmark.run.worker.Worker` subprocess per
 run (Dask worker processes are daemonic and may not fork ``multiprocessing`` children,
 but they may start subprocesses), so time limits and crash isolation work as they do
 locally.  The client keeps as many tasks in flight as the cluster has threads, so that
@@ -17,8 +17,9 @@ from collections import deque
 from collections.abc import Callable, Sequence
 
 from benchmark.errors import BenchmarkError, ConfigurationError
-from benchmark.task import TaskKey, TaskResult, failed_result
-from benchmark.worker import Worker, WorkerDiedError
+from benchmark.results import TaskKey, TaskResult
+from benchmark.run.task import failed_result
+from benchmark.run.worker import Worker, WorkerDiedError
 
 #: Seconds to wait for the scheduler to answer.
 CONNECT_TIMEOUT = "10s"

@@ -1,6 +1,6 @@
 """Writing a :class:`~benchmark.dataset.Dataset` as WEKA ARFF text.
 
-The output is what :mod:`benchmark.arff_reader` (and WEKA) reads back to the same
+The output is what :mod:`benchmark.io.arff_reader` (and WEKA) reads back to the same
 dataset: names and values are quoted only when WEKA's tokenizer would otherwise split or
 misread them, with the escapes the reader decodes; numbers use Python's shortest
 round-trip ``repr`` (``3`` rather than ``3.0``); a sparse dataset is written as sparse
@@ -17,9 +17,9 @@ from typing import TextIO
 
 import numpy as np
 
-from benchmark.arff_reader import DateFormat
 from benchmark.dataset import Attribute, Dataset, Schema, resolve_targets
 from benchmark.errors import ConfigurationError, DataFormatError
+from benchmark.io.arff_reader import DateFormat
 
 _NEEDS_QUOTES = re.compile(r"""[\x00-\x20,{}'"%\\\x7f]""")
 _TO_ESCAPE = re.compile(r"""[\x00-\x1f'"%\\\x7f]""")

@@ -22,9 +22,9 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmark.arff_reader import read_text_file
 from benchmark.dataset import Attribute, Dataset, Schema, resolve_targets
 from benchmark.errors import ConfigurationError, DataFormatError
+from benchmark.io.arff_reader import read_text_file
 
 MISSING = frozenset({"", "?", "NA", "NaN", "nan"})
 _DELIMITERS = (",", ";", "\t")

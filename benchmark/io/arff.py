@@ -8,7 +8,7 @@ are not supported.  ``loads_arff(dumps_arff(d))`` equals ``d``.
 
 from __future__ import annotations
 
-from benchmark.arff_reader import loads_arff, read_arff
-from benchmark.arff_writer import dumps_arff, write_arff
+from benchmark.io.arff_reader import loads_arff, read_arff
+from benchmark.io.arff_writer import dumps_arff, write_arff
 
 __all__ = ["dumps_arff", "loads_arff", "read_arff", "write_arff"]

@@ -6,10 +6,10 @@ from typing import TextIO
 
 from app.store.database import Store
 from app.store.runs import RunInfo, load_results
-from benchmark.arff import write_arff
 from benchmark.catalogue import CATALOGUE
 from benchmark.errors import ConfigurationError
-from benchmark.results_arff import results_to_dataset
+from benchmark.evaluation.results_arff import results_to_dataset
+from benchmark.io.arff import write_arff
 
 
 def write_results_arff(store: Store, run: RunInfo, stream: TextIO) -> None:

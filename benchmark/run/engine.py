@@ -1,9 +1,9 @@
 """The cross-validation engine: every classifier on every fold, in parallel, with time limits.
 
-Tasks (one classifier on one fold) run in worker processes (:mod:`benchmark.worker`) that
+Tasks (one classifier on one fold) run in worker processes (:mod:`benchmark.run.worker`) that
 each receive the run's data once.  Locally, ``jobs`` workers take tasks from one queue;
 with ``scheduler="tcp://host:port"`` the tasks go to a Dask distributed cluster, where each
-Dask worker thread keeps such a worker process (:mod:`benchmark.dask_backend`).
+Dask worker thread keeps such a worker process (:mod:`benchmark.run.dask_backend`).
 
 Why our own pool rather than joblib's: a task that overruns its time limit must be
 stopped, native code included, without losing the other workers or their data, and a
@@ -27,10 +27,11 @@ from multiprocessing.connection import wait
 
 from benchmark.catalogue import CATALOGUE, ClassifierSpec, unknown_classifier_message
 from benchmark.errors import BenchmarkError, ConfigurationError
-from benchmark.folds import Fold
 from benchmark.problem import Problem
-from benchmark.task import TaskContext, TaskKey, TaskResult, failed_result
-from benchmark.worker import Worker, WorkerDiedError
+from benchmark.results import TaskKey, TaskResult
+from benchmark.run.folds import Fold
+from benchmark.run.task import TaskContext, failed_result
+from benchmark.run.worker import Worker, WorkerDiedError
 
 __all__ = ["Problem", "TaskKey", "TaskResult", "available_cores", "plan_tasks", "run_tasks"]
 
@@ -62,7 +63,7 @@ def run_tasks(
     classifiers : sequence of str
         Classifier ids, run in this order (duplicates ignored).
     folds : sequence of Fold
-        The folds, shared by every classifier (:func:`benchmark.folds.make_folds`).
+        The folds, shared by every classifier (:func:`benchmark.run.folds.make_folds`).
     jobs : int
         Local worker processes; -1 for one per core.  Ignored with ``scheduler``.
     scheduler : str, optional
@@ -114,7 +115,7 @@ def run_tasks(
 
     started = on_start or _ignore
     if scheduler:
-        from benchmark.dask_backend import run_on_dask
+        from benchmark.run.dask_backend import run_on_dask
 
         run_on_dask(scheduler, context, tasks, timeout=timeout, on_start=started, on_result=deliver)
     else:

@@ -9,9 +9,9 @@ from typing import Literal
 from app.errors import AppError
 from app.store.database import Store
 from app.store.datasets import DatasetInfo, add_dataset, content_digest
-from benchmark.arff import loads_arff
-from benchmark.csvio import read_csv
 from benchmark.errors import DataFormatError
+from benchmark.io.arff import loads_arff
+from benchmark.io.csv import read_csv
 
 FileFormat = Literal["arff", "csv"]
 

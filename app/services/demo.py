@@ -11,15 +11,15 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from app.benchmarking import RunOptions, default_classifiers, run_leaderboard, start_run
-from app.extraction import extract_dataset
-from app.modelling import Predictions, load_model, predict, train
-from app.simulation import write_labels, write_session
+from app.services.extraction import extract_dataset
+from app.services.models import Predictions, load_model, predict, train
+from app.services.runs import RunOptions, default_classifiers, run_leaderboard, start_run
+from app.services.simulation import write_labels, write_session
 from app.store.database import Store
 from app.store.datasets import DatasetInfo, add_dataset, dataset_digest
 from app.store.runs import RunInfo
-from benchmark.arff import read_arff, write_arff
-from benchmark.leaderboard import Leaderboard
+from benchmark.evaluation.leaderboard import Leaderboard
+from benchmark.io.arff import read_arff, write_arff
 
 
 @dataclass

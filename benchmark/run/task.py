@@ -13,114 +13,18 @@ import time
 import traceback
 import warnings
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
-from typing import Any, Literal
+from dataclasses import dataclass
 
 import numpy as np
 
 from benchmark.catalogue import ClassifierSpec, build_pipeline
-from benchmark.folds import Fold
-from benchmark.metrics import confusion_matrix, expand_proba, multiclass_scores
+from benchmark.evaluation.metrics import confusion_matrix, expand_proba, multiclass_scores
 from benchmark.problem import Problem
-
-Status = Literal["ok", "error", "timeout"]
+from benchmark.results import Status, TaskKey, TaskResult
+from benchmark.run.folds import Fold
 
 #: At most this many distinct warnings are kept per task.
 MAX_WARNINGS = 5
-
-
-@dataclass(frozen=True, order=True)
-class TaskKey:
-    """Which classifier on which fold (0-based repeat and fold)."""
-
-    classifier: str
-    repeat: int
-    fold: int
-
-    def __str__(self) -> str:
-        return f"{self.classifier} (repeat {self.repeat + 1}, fold {self.fold + 1})"
-
-
-@dataclass
-class TaskResult:
-    """The outcome of one task.
-
-    Parameters
-    ----------
-    key : TaskKey
-    status : {"ok", "error", "timeout"}
-    error : str or None
-        ``"ExceptionType: message"`` (or what stopped the worker) unless ``ok``.
-    metrics : dict of str to float
-        Scores (:data:`benchmark.metrics.MULTICLASS_METRICS`, or the multi-target scores)
-        and costs: ``fit_time`` and ``predict_time`` (wall seconds), ``fit_cpu_time`` and
-        ``predict_cpu_time`` (CPU seconds of the worker process), ``model_size`` (bytes of
-        the pickled fitted model).  Empty unless ``ok``.
-    confusion : list or None
-        Multi-class: the (n_classes, n_classes) matrix, rows true.  Multi-target: one such
-        matrix per target.
-    n_train, n_test : int
-        Fold sizes.
-    warnings : list of str
-        Distinct warnings the classifier emitted (convergence...), at most five.
-    per_target : dict or None
-        Multi-target: scores per target name.
-    """
-
-    key: TaskKey
-    status: Status
-    error: str | None
-    metrics: dict[str, float]
-    confusion: list[Any] | None
-    n_train: int
-    n_test: int
-    warnings: list[str] = field(default_factory=list)
-    per_target: dict[str, dict[str, float]] | None = None
-
-    @property
-    def ok(self) -> bool:
-        return self.status == "ok"
-
-    def to_json(self) -> dict[str, Any]:
-        """JSON-ready data (NaN as ``null``); :meth:`from_json` restores it."""
-        return {
-            "classifier": self.key.classifier,
-            "repeat": self.key.repeat,
-            "fold": self.key.fold,
-            "status": self.status,
-            "error": self.error,
-            "metrics": {name: _json_number(v) for name, v in self.metrics.items()},
-            "confusion": self.confusion,
-            "n_train": self.n_train,
-            "n_test": self.n_test,
-            "warnings": list(self.warnings),
-            "per_target": None
-            if self.per_target is None
-            else {
-                target: {name: _json_number(v) for name, v in scores.items()}
-                for target, scores in self.per_target.items()
-            },
-        }
-
-    @classmethod
-    def from_json(cls, data: Mapping[str, Any]) -> TaskResult:
-        per_target = data.get("per_target")
-        return cls(
-            key=TaskKey(data["classifier"], int(data["repeat"]), int(data["fold"])),
-            status=data["status"],
-            error=data.get("error"),
-            metrics={name: _from_json_number(v) for name, v in data["metrics"].items()},
-            confusion=data.get("confusion"),
-            n_train=int(data["n_train"]),
-            n_test=int(data["n_test"]),
-            warnings=list(data.get("warnings", ())),
-            per_target=None
-            if per_target is None
-            else {
-                target: {name: _from_json_number(v) for name, v in scores.items()}
-                for target, scores in per_target.items()
-            },
-        )
 
 
 @dataclass(frozen=True, eq=False)
@@ -324,11 +228,3 @@ def _distinct_warnings(caught: Sequence[warnings.WarningMessage]) -> list[str]:
         if len(seen) == MAX_WARNINGS:
             break
     return seen
-
-
-def _json_number(value: float) -> float | None:
-    return None if value is None or math.isnan(value) else value
-
-
-def _from_json_number(value: float | None) -> float:
-    return math.nan if value is None else float(value)

@@ -9,7 +9,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from app.store.runs import RunInfo
-from benchmark.leaderboard import Leaderboard, LeaderboardRow
+from benchmark.evaluation.leaderboard import Leaderboard, LeaderboardRow
 
 #: Columns shown in tables, by kind of problem (the ranking metric always comes first).
 TABLE_METRICS = {

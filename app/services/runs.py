@@ -21,11 +21,11 @@ from app.store.runs import (
     set_status,
 )
 from benchmark.dataset import Dataset
-from benchmark.engine import Problem, TaskKey, TaskResult, run_tasks
 from benchmark.errors import ConfigurationError
-from benchmark.folds import Fold, make_folds
-from benchmark.leaderboard import Leaderboard, build_leaderboard
+from benchmark.evaluation.leaderboard import Leaderboard, build_leaderboard
 from benchmark.problem import problem_from_dataset, restrict_targets
+from benchmark.run.engine import Problem, TaskKey, TaskResult, run_tasks
+from benchmark.run.folds import Fold, make_folds
 
 
 @dataclass
