@@ -4,21 +4,29 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import sys
 from collections.abc import Iterable, Sequence
 from typing import Any
 
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
+
+from app.schemas.base import finite
 
 #: Pipes and files get a wide page: nobody wants a leaderboard wrapped at 80 columns.
 console = Console(highlight=False, soft_wrap=False, width=None if sys.stdout.isatty() else 160)
-err_console = Console(stderr=True, highlight=False)
+#: Messages are never wrapped: a command quoted in a message must stay pasteable.
+err_console = Console(stderr=True, highlight=False, soft_wrap=True)
+#: Longest text shown in a table cell; the rest is elided (``--json`` has it whole).
+MAX_CELL = 60
+_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]")
 
 
 def print_json(data: Any) -> None:
     """Only JSON on stdout: NaN and infinities become ``null``."""
-    sys.stdout.write(json.dumps(_finite(data), indent=2, default=str) + "\n")
+    sys.stdout.write(json.dumps(finite(data), indent=2, default=str) + "\n")
     sys.stdout.flush()
 
 
@@ -43,20 +51,17 @@ def table(
 
 
 def format_cell(value: Any) -> str:
+    """A value as a table shows it: numbers to 4 decimals, text made safe and short."""
     if value is None:
         return "-"
     if isinstance(value, float):
         if math.isnan(value):
             return "-"
         return f"{value:.4f}" if abs(value) < 1e5 else f"{value:.4g}"
-    return str(value)
+    return escape(printable(str(value)))
 
 
-def _finite(data: Any) -> Any:
-    if isinstance(data, float) and not math.isfinite(data):
-        return None
-    if isinstance(data, dict):
-        return {key: _finite(value) for key, value in data.items()}
-    if isinstance(data, list | tuple):
-        return [_finite(value) for value in data]
-    return data
+def printable(text: str, limit: int = MAX_CELL) -> str:
+    """``text`` with control characters shown as ``?`` and cut to ``limit`` characters."""
+    text = _CONTROL.sub("?", text)
+    return text if len(text) <= limit else text[: limit - 1] + "…"

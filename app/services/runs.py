@@ -348,5 +348,5 @@ def _execute(
     except BaseException:
         set_status(store, run.id, "interrupted")
         raise
-    set_status(store, run.id, "finished")
+    set_status(store, run.id, "done")
     return load_results(store, run.id)

@@ -85,6 +85,7 @@ def add_dataset(
     sha256: str,
     name: str | None = None,
     source_name: str | None = None,
+    extraction: dict[str, Any] | None = None,
 ) -> tuple[DatasetInfo, bool]:
     """Store a data set in one transaction, unless the same content is stored already.
 
@@ -98,6 +99,9 @@ def add_dataset(
         Unique name; by default the relation name (made unique with a numeric suffix).
     source_name : str, optional
         File name the data came from.
+    extraction : dict, optional
+        How the data set was extracted from recordings (JSON), kept so that models trained
+        on it can extract live features the same way.
 
     Returns
     -------
@@ -125,6 +129,7 @@ def add_dataset(
             sparse=dataset.sparse,
             source_name=source_name,
             sha256=sha256,
+            extraction=extraction,
         )
         session.add(row)
         session.flush()

@@ -98,7 +98,7 @@ def list_runs(store: Store) -> list[RunInfo]:
 
 def set_status(store: Store, run_id: int, status: str) -> None:
     with store.session() as session:
-        finished = utcnow() if status in ("finished", "failed") else None
+        finished = utcnow() if status in ("done", "failed", "cancelled") else None
         session.execute(
             update(RunRow).where(RunRow.id == run_id).values(status=status, finished_at=finished)
         )

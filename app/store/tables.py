@@ -49,6 +49,9 @@ class DatasetRow(Base):
     source_name: Mapped[str | None] = mapped_column(Text)
     sha256: Mapped[str] = mapped_column(String(64), index=True)
     created_at: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=utcnow)
+    #: How the data set was extracted from recordings (extractor, options, event detector),
+    #: so that models trained on it extract live features the same way; None if imported.
+    extraction: Mapped[dict[str, Any] | None] = mapped_column(JSON(none_as_null=True))
 
     instances: Mapped[list[InstanceRow]] = relationship(
         back_populates="dataset", cascade="all, delete-orphan", passive_deletes=True
@@ -83,9 +86,15 @@ class RunRow(Base):
     targets: Mapped[list[str]] = mapped_column(JSON)
     classifiers: Mapped[list[str]] = mapped_column(JSON)
     config: Mapped[dict[str, Any]] = mapped_column(JSON)
-    status: Mapped[str] = mapped_column(String(20), default="running")
+    status: Mapped[str] = mapped_column(String(20), default="queued")
     created_at: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=utcnow)
+    started_at: Mapped[datetime | None] = mapped_column(DateTime(timezone=True))
     finished_at: Mapped[datetime | None] = mapped_column(DateTime(timezone=True))
+    #: ``host:pid`` of the process executing the run, and when it last said it was alive.
+    owner: Mapped[str | None] = mapped_column(String(200))
+    heartbeat_at: Mapped[datetime | None] = mapped_column(DateTime(timezone=True))
+    error: Mapped[str | None] = mapped_column(Text)
+    cancel_requested: Mapped[bool] = mapped_column(default=False)
 
 
 class FoldResultRow(Base):
@@ -109,7 +118,9 @@ class FoldResultRow(Base):
 
 
 class ModelRow(Base):
-    """A trained model: pickled estimator bytes, checked by sha256 before loading."""
+    """A trained model: the estimator's artifact (``format`` says how it is serialised;
+    only formats that cannot run code are loaded), its schema, and how its features were
+    extracted."""
 
     __tablename__ = "models"
 
@@ -125,3 +136,23 @@ class ModelRow(Base):
     sha256: Mapped[str] = mapped_column(String(64))
     size_bytes: Mapped[int] = mapped_column(Integer)
     created_at: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=utcnow)
+    format: Mapped[str] = mapped_column(String(20), default="pickle")
+    extraction: Mapped[dict[str, Any] | None] = mapped_column(JSON(none_as_null=True))
+
+
+class JobRow(Base):
+    """Long work other than runs (extraction, training), queued for worker processes."""
+
+    __tablename__ = "jobs"
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    kind: Mapped[str] = mapped_column(String(20))
+    status: Mapped[str] = mapped_column(String(20), index=True, default="queued")
+    params: Mapped[dict[str, Any]] = mapped_column(JSON)
+    result: Mapped[dict[str, Any] | None] = mapped_column(JSON(none_as_null=True))
+    error: Mapped[str | None] = mapped_column(Text)
+    owner: Mapped[str | None] = mapped_column(String(200))
+    heartbeat_at: Mapped[datetime | None] = mapped_column(DateTime(timezone=True))
+    created_at: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=utcnow)
+    started_at: Mapped[datetime | None] = mapped_column(DateTime(timezone=True))
+    finished_at: Mapped[datetime | None] = mapped_column(DateTime(timezone=True))

@@ -84,7 +84,7 @@ def test_bench_json_leaderboard_and_stored_run(
     assert board["zeror"]["mark"] == "*"  # significantly worse than the best
     runs = run_cli(capsys, store_url, "runs", "--json").json()["runs"]
     assert [(r["id"], r["status"], r["tasks_done"], r["tasks"]) for r in runs] == [
-        (report["run_id"], "finished", 9, 9)
+        (report["run_id"], "done", 9, 9)
     ]
 
 

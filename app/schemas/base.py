@@ -1,0 +1,29 @@
+"""The base of every response model."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from pydantic import BaseModel, ConfigDict
+
+
+class Schema(BaseModel):
+    """A response model: JSON-ready (``to_json``), NaN and infinities as ``null``."""
+
+    model_config = ConfigDict(extra="forbid", ser_json_inf_nan="null")
+
+    def to_json(self) -> dict[str, Any]:
+        """The plain JSON object (what ``--json`` prints and the API answers)."""
+        return finite(self.model_dump(mode="json"))
+
+
+def finite(data: Any) -> Any:
+    """``data`` with every NaN or infinite float replaced by ``None``, recursively."""
+    if isinstance(data, float) and not math.isfinite(data):
+        return None
+    if isinstance(data, dict):
+        return {key: finite(value) for key, value in data.items()}
+    if isinstance(data, list | tuple):
+        return [finite(value) for value in data]
+    return data
