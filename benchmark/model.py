@@ -17,9 +17,10 @@ from typing import Any
 import numpy as np
 from sklearn.base import BaseEstimator
 
-from benchmark.catalogue import build_pipeline, get_spec
+from benchmark.catalogue import get_spec
 from benchmark.dataset import Dataset, Schema
 from benchmark.errors import ConfigurationError
+from benchmark.estimators import build_estimator
 from benchmark.evaluation.metrics import expand_proba
 from benchmark.problem import feature_matrix, problem_from_dataset
 
@@ -136,27 +137,11 @@ def fit_model(dataset: Dataset, classifier_id: str, *, random_state: int = 0) ->
             raise ConfigurationError(
                 f"target '{name}' has a single class in the training data; nothing to learn"
             )
-    estimator: Any
+    estimator = build_estimator(classifier_id, problem, random_state=random_state)
     if problem.kind == "multiclass":
-        spec = get_spec(classifier_id)
-        estimator = build_pipeline(
-            spec,
-            nominal_features=problem.nominal_features,
-            n_features=problem.n_features,
-            random_state=random_state,
-        )
         estimator.fit(problem.X, problem.Y[:, 0])
-        params: dict[str, Any] = dict(spec.params)
+        params: dict[str, Any] = dict(get_spec(classifier_id).params)
     else:
-        from benchmark.multitarget import build_multitarget
-
-        estimator = build_multitarget(
-            classifier_id,
-            nominal_features=problem.nominal_features,
-            n_features=problem.n_features,
-            random_state=random_state,
-            n_classes=problem.n_classes,
-        )
         estimator.fit(problem.X, problem.Y)
         params = {"config": classifier_id}
     params["random_state"] = random_state
