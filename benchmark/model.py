@@ -1,15 +1,15 @@
 """Models trained on a whole data set, and their serialisation.
 
 A :class:`TrainedModel` keeps the schema it was trained on, so that new instances can be
-checked and predicted with the labels of that schema.  Serialised models are plain pickles;
-:func:`loads_model` refuses bytes whose SHA-256 differs from the digest recorded when they
-were stored, because unpickling runs code.
+checked and predicted with the labels of that schema.  Serialised models are skops
+artifacts (:mod:`benchmark.artifacts`): loading one cannot run code, whoever wrote it;
+:func:`loads_model` also refuses bytes whose SHA-256 differs from the digest recorded when
+they were stored (damage in transit or in the store).
 """
 
 from __future__ import annotations
 
 import hashlib
-import pickle
 from dataclasses import dataclass, field
 from importlib import metadata
 from typing import Any
@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 from sklearn.base import BaseEstimator
 
+from benchmark.artifacts import dumps_artifact, loads_artifact
 from benchmark.catalogue import get_spec
 from benchmark.dataset import Dataset, Schema
 from benchmark.errors import ConfigurationError
@@ -154,8 +155,17 @@ def model_digest(data: bytes) -> str:
 
 
 def dumps_model(model: TrainedModel) -> bytes:
-    """Serialise a model (a pickle; store :func:`model_digest` of it beside it)."""
-    return pickle.dumps(model, protocol=pickle.HIGHEST_PROTOCOL)
+    """Serialise a model as an artifact that cannot run code when loaded (store
+    :func:`model_digest` of it beside it)."""
+    return dumps_artifact(
+        {
+            "classifier": model.classifier,
+            "params": model.params,
+            "schema": model.schema.to_json(),
+            "versions": model.versions,
+            "estimator": model.estimator,
+        }
+    )
 
 
 def loads_model(data: bytes, *, sha256: str) -> TrainedModel:
@@ -164,8 +174,8 @@ def loads_model(data: bytes, *, sha256: str) -> TrainedModel:
     Raises
     ------
     ConfigurationError
-        The digest differs (the bytes are not the ones stored, so they are not unpickled)
-        or the bytes are not a model.
+        The digest differs, the bytes are not a touchbench artifact, or they name types
+        outside the trusted packages (nothing is built from them then).
     """
     actual = model_digest(data)
     if actual != sha256.strip().lower():
@@ -173,13 +183,17 @@ def loads_model(data: bytes, *, sha256: str) -> TrainedModel:
             f"model bytes do not match their recorded sha256 ({sha256[:12]}..., got "
             f"{actual[:12]}...); refusing to load them"
         )
+    content = loads_artifact(data)
     try:
-        model = pickle.loads(data)
-    except Exception as exc:
-        raise ConfigurationError(f"the stored model cannot be loaded: {exc}") from None
-    if not isinstance(model, TrainedModel):
-        raise ConfigurationError(f"the stored bytes hold a {type(model).__name__}, not a model")
-    return model
+        return TrainedModel(
+            classifier=str(content["classifier"]),
+            params=dict(content["params"]),
+            schema=Schema.from_json(content["schema"]),
+            estimator=content["estimator"],
+            versions=dict(content.get("versions", {})),
+        )
+    except (KeyError, TypeError, ValueError) as exc:
+        raise ConfigurationError(f"the stored model is incomplete: {exc}") from None
 
 
 def _library_versions() -> dict[str, str]:

@@ -16,6 +16,7 @@ from app.cli import bench as bench_commands
 from app.cli import datasets as datasets_commands
 from app.cli import demo as demo_commands
 from app.cli import extract as extract_commands
+from app.cli import help as help_pages
 from app.cli import models as models_commands
 from app.cli.output import EXIT_FAILED, EXIT_INTERRUPTED, ExitWith
 from app.cli.state import CliState
@@ -24,6 +25,9 @@ from app.settings import get_settings
 
 EXIT_USAGE = 2
 EXIT_UNEXPECTED = EXIT_FAILED
+
+
+help_pages.install()
 
 app = typer.Typer(
     name="touchbench",

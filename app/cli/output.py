@@ -58,6 +58,11 @@ def info(message: str) -> None:
     err_console.print(message)
 
 
+def warn(message: str) -> None:
+    """Something changed or left out that the user should know of, on stderr."""
+    err_console.print(f"[yellow]warning:[/yellow] {escape(message)}")
+
+
 def table(
     title: str | None,
     columns: Sequence[str],
