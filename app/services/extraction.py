@@ -431,3 +431,64 @@ def _label(
         if file_name not in table.rows
     ]
     return keep, attributes, codes, warnings
+
+
+@dataclass
+class ExtractionSummary:
+    """What ``extract --json`` prints: the stored data set and the event counts."""
+
+    dataset: Any
+    created: bool
+    result: ExtractionResult
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "id": self.dataset.id,
+            "name": self.dataset.name,
+            "n_instances": self.dataset.n_instances,
+            "n_features": self.dataset.n_features,
+            "targets": self.dataset.targets,
+            "events_found": self.result.n_events,
+            "events_labelled": self.result.n_labelled,
+            "events_dropped": self.result.n_dropped,
+            "warnings": self.result.warnings,
+            "created": self.created,
+        }
+
+
+def extract_and_store(
+    store: Any,
+    recordings: Sequence[Path],
+    *,
+    labels: Path | None,
+    extractor: str,
+    events: str | None = None,
+    name: str | None = None,
+    samplerate: float | None = None,
+    segment: float | None = None,
+    options: Mapping[str, Any] | None = None,
+    topic: str | None = None,
+) -> ExtractionSummary:
+    """Extract a data set from recordings and store it (deduplicated by content)."""
+    from app.store.datasets import add_dataset, dataset_digest
+
+    result = extract_dataset(
+        recordings,
+        labels=labels,
+        extractor=extractor,
+        events=events,
+        name=name,
+        samplerate=samplerate,
+        segment=segment,
+        options=options,
+    )
+    data = result.dataset
+    info, created = add_dataset(
+        store,
+        data,
+        sha256=dataset_digest(data),
+        name=name,
+        source_name=", ".join(p.name for p in recordings[:3])
+        + (f" (+{len(recordings) - 3})" if len(recordings) > 3 else ""),
+    )
+    return ExtractionSummary(info, created, result)

@@ -12,7 +12,7 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -43,9 +43,11 @@ from app.store.runs import (
 )
 from benchmark.dataset import Dataset
 from benchmark.errors import ConfigurationError
-from benchmark.evaluation.leaderboard import Leaderboard, build_leaderboard
 from benchmark.problem import Problem, problem_from_dataset, restrict_targets
 from benchmark.results import TaskKey, TaskResult
+
+if TYPE_CHECKING:  # scipy.stats (significance) loads when a leaderboard is first built
+    from benchmark.evaluation.leaderboard import Leaderboard
 
 #: Metric a leaderboard is ranked by unless asked otherwise, per kind of run.
 DEFAULT_METRIC = {"multiclass": "f1_weighted", "multitarget": "hamming_score"}
@@ -369,6 +371,8 @@ def run_leaderboard(
     ConfigurationError
         The run has no result yet; an unknown metric or baseline.
     """
+    from benchmark.evaluation.leaderboard import build_leaderboard
+
     run = get_run(store, run_id)
     results = load_results(store, run.id)
     if not results:

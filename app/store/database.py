@@ -131,20 +131,19 @@ def _check_sqlite_file(path: Path, url: str) -> None:
         return
     if not path.is_file():
         raise AppError(f"cannot open the store at {url}: {path} is not a regular file")
-    with path.open("rb") as handle:
-        header = handle.read(16)
-    if header and header != b"SQLite format 3\x00":
-        raise AppError(f"cannot open the store at {url}: {path} is not a SQLite database")
-    if not header:
+    if path.stat().st_size == 0:
         return
     import sqlite3
 
-    # read-only: SQLite's WAL pragma must not touch another application's file either
+    # Through SQLite itself, read-only: opening and closing the file any other way would
+    # drop the POSIX locks this process's own connections hold on it (SQLite shares them
+    # between its connections), and SQLite's WAL pragma must not touch a foreign file.
     try:
         with contextlib.closing(sqlite3.connect(f"file:{path}?mode=ro", uri=True)) as peek:
             tables = {name for (name,) in peek.execute("SELECT name FROM sqlite_master")}
     except sqlite3.DatabaseError as error:
-        raise AppError(f"cannot open the store at {url}: {error}") from None
+        reason = "is not a SQLite database" if "not a database" in str(error) else str(error)
+        raise AppError(f"cannot open the store at {url}: {path} {reason}") from None
     if tables and "alembic_version" not in tables:
         shown = ", ".join(sorted(tables)[:5])
         raise AppError(
