@@ -25,7 +25,7 @@ import arff  # liac-arff
 from benchmark.dataset import Dataset
 from benchmark.errors import DataFormatError
 from benchmark.io.arff import read_arff
-from benchmark.io.arff_reader import DateFormat
+from benchmark.io.dates import DateFormat
 
 DEFAULT_FOLDER = Path(__file__).resolve().parents[1].parent / "shared" / "datasets"
 

@@ -24,7 +24,7 @@ import numpy as np
 
 from benchmark.dataset import Attribute, Dataset, Schema, resolve_targets
 from benchmark.errors import ConfigurationError, DataFormatError
-from benchmark.io.arff_reader import read_text_file
+from benchmark.io.textfile import read_text_file
 
 MISSING = frozenset({"", "?", "NA", "NaN", "nan"})
 _DELIMITERS = (",", ";", "\t")
