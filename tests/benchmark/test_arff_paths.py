@@ -180,16 +180,21 @@ def test_an_error_in_a_late_block_names_its_line(tmp_path: Path) -> None:
     path = tmp_path / "late.arff"
     path.write_text(NOMINAL_HEADER + "\n".join(rows) + "\n", encoding="utf-8")
     for parser in PARSERS:
-        with pytest.raises(DataFormatError, match="'oops' is not a number") as caught:
-            with open_arff(path, parser=parser, block_bytes=2048) as reader:
-                list(reader.blocks())
+        with (
+            pytest.raises(DataFormatError, match="'oops' is not a number") as caught,
+            open_arff(path, parser=parser, block_bytes=2048) as reader,
+        ):
+            list(reader.blocks())
         assert caught.value.line == NOMINAL_HEADER.count("\n") + 4322
         assert caught.value.attribute == "y"
 
 
 @pytest.mark.parametrize("encoding", ["utf-8", "latin-1", "utf-16"])
 def test_encodings_and_line_ends_stream_alike(tmp_path: Path, encoding: str) -> None:
-    header = "@relation caf\u00e9\r\n@attribute a {\u00e9t\u00e9,hiver}\r\n@attribute n numeric\r\n@data\r\n"
+    header = (
+        "@relation caf\u00e9\r\n@attribute a {\u00e9t\u00e9,hiver}\r\n"
+        "@attribute n numeric\r\n@data\r\n"
+    )
     summer = "\u00e9t\u00e9"
     body = "".join(f"{summer if i % 2 else 'hiver'},{i}\r\n" for i in range(2000))
     path = tmp_path / "encoded.arff"
