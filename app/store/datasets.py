@@ -487,9 +487,10 @@ class StoredInstances:
 
 @contextmanager
 def read_blocks(
-    store: Store, ref: str | int, *, rows: int = READ_BATCH
+    store: Store, ref: str | int, *, rows: int | None = None
 ) -> Iterator[StoredInstances]:
-    """A stored data set's values and weights, to read in blocks of ``rows`` instances::
+    """A stored data set's values and weights, to read in blocks of ``rows`` instances
+    (:data:`READ_BATCH` by default)::
 
     with read_blocks(store, "mini") as stored:
         for block in stored.blocks(): ...
@@ -507,7 +508,7 @@ def _value_batches(
     n_attributes: int,
     *,
     with_weights: bool,
-    rows: int = READ_BATCH,
+    rows: int | None = None,
 ) -> Iterator[InstanceBlock]:
     """Instances in order, ``rows`` at a time, through the driver's own cursor: SQLAlchemy's
     per-row processing and psycopg's text-format ``bytea`` would triple the load time."""
@@ -525,7 +526,7 @@ def _value_batches(
             f"SELECT {columns} FROM instances WHERE dataset_id = {marker} ORDER BY position",
             {"id": dataset_id} if style == "named" else (dataset_id,),
         )
-        while batch := cursor.fetchmany(rows):
+        while batch := cursor.fetchmany(rows or READ_BATCH):
             values = np.frombuffer(b"".join(bytes(r[0]) for r in batch), dtype=_LITTLE_F8)
             weights = None
             if with_weights and any(r[1] is not None for r in batch):
