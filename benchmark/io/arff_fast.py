@@ -129,11 +129,12 @@ def _plain_rows(block: bytes, n_columns: int) -> np.ndarray | None:
     without saying so; the rest (a line with too many fields, a field that is neither a
     number nor a label) makes pandas fail or :func:`read_plain_block` refuse the values.
     """
-    if any(byte in block for byte in _FORBIDDEN) or b"'?'" in block or b"''" in block:
-        return None
-    if b",," in block:
+    if any(byte in block for byte in _FORBIDDEN):
         return None
     data = np.frombuffer(block, dtype=np.uint8)
+    commas = data == _COMMA
+    if np.any(commas[1:] & commas[:-1]):
+        return None  # an empty field
     breaks = np.flatnonzero(data == _LF)
     crlf = b"\r" in block
     carriage_returns = int(np.count_nonzero(data == _CR)) if crlf else 0
@@ -156,7 +157,7 @@ def _plain_rows(block: bytes, n_columns: int) -> np.ndarray | None:
     first = non_blank[0]
     if block.count(b",", starts[first], ends[first]) != n_columns - 1:
         return None
-    if np.count_nonzero(data == _COMMA) != non_blank.size * (n_columns - 1):
+    if np.count_nonzero(commas) != non_blank.size * (n_columns - 1):
         return None
     if b"'" in block and not _quotes_enclose_fields(data, np.flatnonzero(data == _QUOTE), breaks):
         return None
@@ -164,10 +165,14 @@ def _plain_rows(block: bytes, n_columns: int) -> np.ndarray | None:
 
 
 def _quotes_enclose_fields(data: np.ndarray, quotes: np.ndarray, breaks: np.ndarray) -> bool:
-    """Whether the quotes pair up on each line, each pair enclosing one whole field."""
+    """Whether the quotes pair up on each line, each pair enclosing one whole field that is
+    neither empty nor ``?``."""
     if quotes.size % 2:
         return False
     opening, closing = quotes[0::2], quotes[1::2]
+    inside = closing - opening - 1
+    if np.any(inside == 0) or np.any((inside == 1) & (data[opening + 1] == ord("?"))):
+        return False
     before = data[np.maximum(opening - 1, 0)]
     if np.any((opening > 0) & (before != _COMMA) & (before != _LF)):
         return False

@@ -48,6 +48,9 @@ Parser = Literal["auto", "vectorised", "tokenizer"]
 #: Blocks smaller than this are split on commas rather than handed to pandas, whose import
 #: costs more than it saves on a small file.
 VECTORISED_MIN_BYTES = 1 << 20
+#: Files larger than this have their first bytes parsed as a header before they are read
+#: whole (a smaller file is read so fast that the reader may as well say what is wrong).
+EARLY_CHECK_BYTES = 8 << 20
 
 
 class ArffReader:
@@ -213,7 +216,8 @@ def open_arff(
             size = os.fstat(stream.fileno()).st_size
             head = stream.read(SNIFF_BYTES)
             sniff_text(head, source=source)
-            _check_header_start(head, source, whole=len(head) >= size)
+            if size > EARLY_CHECK_BYTES:
+                _check_header_start(head, source)
             stream.seek(0)
             scan = scan_file(stream, source=source, size=size, progress=progress)
             stream.seek(0)
@@ -226,10 +230,8 @@ def open_arff(
         )
 
 
-def _check_header_start(head: bytes, source: str, *, whole: bool) -> None:
+def _check_header_start(head: bytes, source: str) -> None:
     """Refuse a file whose first bytes already show a wrong header, before reading it all."""
-    if whole:
-        return  # the file is short: the reader will say what is wrong soon enough
     parser = HeaderParser(source)
     utf16 = head.startswith((b"\xff\xfe", b"\xfe\xff"))
     text = head.decode("utf-16" if utf16 else "utf-8", "replace")

@@ -238,7 +238,7 @@ def test_devices_pipes_and_binary_files_are_refused_before_they_are_read(
     with pytest.raises(DataFormatError, match="not a text file"):
         read_arff(wav)
     log = tmp_path / "log.arff"
-    log.write_text("2024-01-01 started\n" * 100_000, encoding="utf-8")
+    log.write_text("2024-01-01 started\n" * 500_000, encoding="utf-8")  # over 8 MB
     with pytest.raises(DataFormatError, match="no @relation") as caught:
         read_arff(log)
     assert caught.value.line == 1
