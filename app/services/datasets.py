@@ -14,13 +14,15 @@ from __future__ import annotations
 
 import contextlib
 import os
+import queue
 import stat
 import tempfile
+import threading
 import warnings
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Literal, TextIO
+from typing import Any, Literal, TextIO
 
 import numpy as np
 
@@ -244,7 +246,7 @@ class _CheckedInstances:
 
     def blocks(self) -> Iterator[InstanceBlock]:
         size = self.data.scan.size
-        for block in self.data.blocks():
+        for block in prefetched(self.data.blocks()):
             _refuse_infinite(block, self.schema, self.source, self.count)
             self.count += block.n_instances
             if self.progress is not None:
@@ -254,6 +256,51 @@ class _CheckedInstances:
             raise DataFormatError(
                 "no instances: the file has a header but no data rows", source=self.source
             )
+
+
+def prefetched(blocks: Iterator[InstanceBlock], depth: int = 2) -> Iterator[InstanceBlock]:
+    """``blocks``, read ahead by a thread while the caller stores the ones before.
+
+    Parsing (pandas' C parser) and inserting (the database driver) both release the GIL
+    for most of their work, so on two cores an import takes about the longer of the two
+    rather than their sum.  At most ``depth`` blocks wait; what the reader raises is
+    raised here, and the reader stops when the caller does.
+    """
+    ahead: queue.Queue[tuple[str, Any]] = queue.Queue(maxsize=depth)
+    stop = threading.Event()
+
+    def offer(kind: str, item: Any) -> bool:
+        """Queue an item unless the caller stopped; ``False`` if it did."""
+        while not stop.is_set():
+            try:
+                ahead.put((kind, item), timeout=0.1)
+                return True
+            except queue.Full:
+                continue
+        return False
+
+    def read() -> None:
+        try:
+            for block in blocks:
+                if not offer("block", block):
+                    return
+            offer("end", None)
+        except BaseException as error:  # handed to the caller, which raises it
+            offer("error", error)
+
+    reader = threading.Thread(target=read, name="import-reader", daemon=True)
+    reader.start()
+    try:
+        while True:
+            kind, item = ahead.get()
+            if kind == "end":
+                return
+            if kind == "error":
+                raise item
+            yield item
+    finally:
+        stop.set()
+        reader.join()
 
 
 def _refuse_infinite(block: InstanceBlock, schema: Schema, source: str, offset: int) -> None:
