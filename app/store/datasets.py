@@ -64,7 +64,10 @@ class DatasetInfo:
             targets=list(row.target_names),
             source_name=row.source_name,
             sha256=row.sha256,
-            created_at=row.created_at,
+            # SQLite gives back naive times; they were written in UTC.
+            created_at=row.created_at
+            if row.created_at.tzinfo is not None
+            else row.created_at.replace(tzinfo=UTC),
         )
 
     def to_json(self) -> dict[str, Any]:
