@@ -75,9 +75,7 @@ def import_command(
 ) -> None:
     """Import an ARFF or CSV file as a data set, named after the file.
 
-    Nothing is stored if the file has an error. A file whose content is stored already is
-    not stored twice: importing it again says so, and refuses if another --name or other
-    --targets are asked for (`touchbench rename` renames a data set).
+    Nothing is stored from a file with an error, and known content is never stored twice.
     """
     if file_format is not None and file_format not in ("arff", "csv"):
         raise typer.BadParameter(f"'{file_format}' is not arff or csv", param_hint="--format")

@@ -249,18 +249,18 @@ def test_values_that_read_as_infinite_are_kept_for_the_caller_to_judge() -> None
     assert math.isinf(dataset.values[0, 1]) and math.isinf(dataset.values[0, 2])
 
 
-@pytest.mark.shared
-@pytest.mark.parametrize(
-    "relative",
-    [
-        "uc3m-touch/mini/gesture_and_place.arff",
-        "uc3m-touch/maggie/gesture_and_place.arff",
-        "uc3m-touch/mini/weka_results_gesture.arff",
-        "uc3m-touch/mini/weka_results_place.arff",
-        "uc3m-touch/maggie/weka_results_gesture.arff",
-        "uc3m-touch/maggie/weka_results_place.arff",
-    ],
+REFERENCE_FILES = (
+    "uc3m-touch/mini/gesture_and_place.arff",
+    "uc3m-touch/maggie/gesture_and_place.arff",
+    "uc3m-touch/mini/weka_results_gesture.arff",
+    "uc3m-touch/mini/weka_results_place.arff",
+    "uc3m-touch/maggie/weka_results_gesture.arff",
+    "uc3m-touch/maggie/weka_results_place.arff",
 )
+
+
+@pytest.mark.shared
+@pytest.mark.parametrize("relative", REFERENCE_FILES)
 def test_every_reference_file_reads_alike(shared_datasets: Path, relative: str) -> None:
     path = shared_datasets / relative
     results = [outcome(lambda p=p: read_arff(path, parser=p)) for p in PARSERS]
@@ -268,14 +268,6 @@ def test_every_reference_file_reads_alike(shared_datasets: Path, relative: str) 
 
 
 @pytest.mark.shared
-def test_the_reference_files_are_found(shared_datasets: Path) -> None:
-    # The list above must cover every ARFF file of ../shared/datasets.
+def test_the_reference_files_are_all_compared(shared_datasets: Path) -> None:
     found = {str(p.relative_to(shared_datasets)) for p in shared_datasets.rglob("*.arff")}
-    assert found == {
-        "uc3m-touch/mini/gesture_and_place.arff",
-        "uc3m-touch/maggie/gesture_and_place.arff",
-        "uc3m-touch/mini/weka_results_gesture.arff",
-        "uc3m-touch/mini/weka_results_place.arff",
-        "uc3m-touch/maggie/weka_results_gesture.arff",
-        "uc3m-touch/maggie/weka_results_place.arff",
-    }
+    assert found == set(REFERENCE_FILES)
