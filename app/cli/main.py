@@ -70,7 +70,10 @@ def main(argv: list[str] | None = None) -> int:
     """Run the CLI; returns (and, as a console script, exits with) the status."""
     command = typer.main.get_command(app)
     try:
-        command.main(args=argv, prog_name="touchbench", standalone_mode=False)
+        status = command.main(args=argv, prog_name="touchbench", standalone_mode=False)
+        if status == 130:  # typer turns Ctrl-C into this status instead of raising
+            print("touchbench: interrupted", file=sys.stderr)
+            return _exit(130)
     except typer.Exit as done:
         return _exit(done.exit_code)
     except typer.Abort:

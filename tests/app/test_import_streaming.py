@@ -1,4 +1,5 @@
-"""Importing and exporting stream: a ~50 MB file goes through the CLI in bounded memory.
+"""Importing and exporting stream: a ~50 MB file goes through the CLI in bounded memory,
+and an import interrupted midway (Ctrl-C, ``kill -9``) leaves nothing in the store.
 
 Each command runs in its own process, which reports its own peak resident set (VmHWM
 from ``/proc``; ``ru_maxrss`` would include the memory of the test process it was forked
@@ -10,12 +11,20 @@ ten times its size.
 from __future__ import annotations
 
 import os
+import signal
+import sqlite3
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
 import pytest
+from sqlalchemy import func, select
+
+from app.store.database import Store
+from app.store.datasets import list_datasets
+from app.store.tables import InstanceRow
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 PEAK_BOUND_MB = 400
@@ -27,6 +36,15 @@ with open("/proc/self/status") as status:
     peak = next(line.split()[1] for line in status if line.startswith("VmHWM:"))
 print(f"peak-rss-kb {peak}", file=sys.stderr)
 sys.exit(code)
+"""
+
+# A shell that runs a command in the background starts it with Ctrl-C ignored, which
+# Python then keeps ignoring: the CLI is started as a terminal would start it.
+_CLI_WITH_CTRL_C = """
+import signal, sys
+signal.signal(signal.SIGINT, signal.default_int_handler)
+from app.cli.main import main
+sys.exit(main(sys.argv[1:]))
 """
 
 pytestmark = [
@@ -83,3 +101,52 @@ def test_a_50_mb_import_and_its_export_stay_in_bounded_memory(tmp_path: Path) ->
     with open(exported, "rb") as stream:
         lines = sum(block.count(b"\n") for block in iter(lambda: stream.read(1 << 20), b""))
     assert lines == 101 + 4 + rows  # header, blank lines, @relation, @data, rows
+
+
+@pytest.mark.parametrize("signal_number", [signal.SIGINT, signal.SIGKILL])
+def test_an_import_interrupted_midway_leaves_nothing_behind(
+    tmp_path: Path, signal_number: int
+) -> None:
+    source = tmp_path / "big.arff"
+    write_large_arff(source, 40)
+    store_path = tmp_path / "store.db"
+    db = f"sqlite:///{store_path}"
+    Store(db).dispose()  # migrated before the import starts
+    process = subprocess.Popen(
+        [sys.executable, "-c", _CLI_WITH_CTRL_C, "--db", db, "import", str(source)],
+        env={**os.environ, "PYTHONPATH": str(REPOSITORY)},
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    probe = sqlite3.connect(store_path, timeout=0, isolation_level=None)
+
+    def importing() -> bool:
+        """Whether a write transaction (the import's) holds the store."""
+        try:
+            probe.execute("BEGIN IMMEDIATE")
+        except sqlite3.OperationalError:
+            return True
+        probe.execute("ROLLBACK")
+        return False
+
+    deadline = time.monotonic() + 120
+    while not importing():
+        assert process.poll() is None, "the import ended before it could be interrupted"
+        assert time.monotonic() < deadline
+        time.sleep(0.01)
+    time.sleep(0.2)
+    assert process.poll() is None, "the import ended before it could be interrupted"
+    process.send_signal(signal_number)
+    _, err = process.communicate(timeout=120)
+    if signal_number == signal.SIGINT:
+        assert process.returncode == 130
+        assert err.strip().splitlines() == ["touchbench: interrupted"]
+    else:
+        assert process.returncode == -signal.SIGKILL
+    probe.close()
+    store = Store(db)
+    assert list_datasets(store) == []
+    with store.session() as session:
+        assert session.scalar(select(func.count()).select_from(InstanceRow)) == 0
+    store.dispose()
