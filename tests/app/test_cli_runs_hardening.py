@@ -85,9 +85,19 @@ def test_a_run_whose_every_task_fails_is_failed_and_says_why(
 ) -> None:
     _import(capsys, store_url, touch_arff(tmp_path / "t.arff"), "touch")
     result = run_cli(
-        capsys, store_url, "bench", "touch", "--target", "gesture", "-c", "rf,nb",
-        "--folds", "3", "--timeout", "0.001",
-    )  # fmt: skip
+        capsys,
+        store_url,
+        "bench",
+        "touch",
+        "--target",
+        "gesture",
+        "-c",
+        "rf,nb",
+        "--folds",
+        "3",
+        "--timeout",
+        "0.001",
+    )
     assert result.code == 1
     assert "run 1 failed: all 6 tasks failed" in result.err and "timed out" in result.err
     run = run_cli(capsys, store_url, "runs", "--json").json()["runs"][0]
@@ -158,9 +168,17 @@ def test_an_unreachable_scheduler_leaves_no_run(
     url = f"sqlite:///{tmp_path / 's.db'}"
     _import(capsys, url, touch_arff(tmp_path / "t.arff"), "touch")
     result = run_cli(
-        capsys, url, "bench", "touch", "--target", "gesture", "-c", "nb",
-        "--scheduler", "tcp://127.0.0.1:9",
-    )  # fmt: skip
+        capsys,
+        url,
+        "bench",
+        "touch",
+        "--target",
+        "gesture",
+        "-c",
+        "nb",
+        "--scheduler",
+        "tcp://127.0.0.1:9",
+    )
     assert result.code == 2 and "cannot reach the Dask scheduler" in result.err
     assert run_cli(capsys, url, "runs", "--json").json() == {"runs": []}
 
@@ -202,8 +220,12 @@ def test_listing_models_reads_no_artifact(
 ) -> None:
     _import(capsys, store_url, touch_arff(tmp_path / "t.arff"), "touch")
     for classifier in ("nb", "j48"):
-        assert run_cli(capsys, store_url, "train", "touch", "-c", classifier, "--target",
-                       "gesture").code == 0  # fmt: skip
+        assert (
+            run_cli(
+                capsys, store_url, "train", "touch", "-c", classifier, "--target", "gesture"
+            ).code
+            == 0
+        )
     store = Store(store_url)
     statements: list[str] = []
     event.listen(
@@ -314,10 +336,21 @@ def test_error_lines_are_not_wrapped(tmp_path: Path) -> None:
     long_name = "a" * 150
     environment = {**os.environ, "COLUMNS": "60"}
     done = subprocess.run(
-        [sys.executable, "-m", "app.cli.main", "--db", f"sqlite:///{tmp_path / 'w.db'}",
-         "show", long_name],
-        cwd=ROOT, env=environment, capture_output=True, text=True, timeout=60,
-    )  # fmt: skip
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "--db",
+            f"sqlite:///{tmp_path / 'w.db'}",
+            "show",
+            long_name,
+        ],
+        cwd=ROOT,
+        env=environment,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert done.returncode == 2
     assert len(done.stderr.strip().splitlines()) == 1, done.stderr
     assert json.dumps(done.stderr)  # printable

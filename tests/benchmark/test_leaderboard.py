@@ -135,5 +135,11 @@ def test_bad_requests(results: list[TaskResult], kwargs: dict, message: str) -> 
 def test_no_results_at_all() -> None:
     with pytest.raises(ConfigurationError, match="no results to rank"):
         build_leaderboard([])
-    with pytest.raises(ConfigurationError, match="unknown metric"):
-        build_leaderboard([failed("x", "error", "boom", 0)])
+    board = build_leaderboard(
+        [failed("x", "error", "boom", 0), failed("y", "timeout", "timed out", 0)]
+    )
+    assert board.baseline is None and board.summary == (0, 0, 0)
+    assert [(r.rank, r.classifier, r.n_failed, r.errors) for r in board.rows] == [
+        (1, "x", 1, ["boom"]),
+        (2, "y", 1, ["timed out"]),
+    ]

@@ -8,7 +8,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Annotated, Literal
 
-from fastapi import APIRouter, File, Form, UploadFile, status
+from fastapi import APIRouter, File, Form, Response, UploadFile, status
 from fastapi.responses import StreamingResponse
 
 from app.api.deps import ServiceDep, StoreDep
@@ -39,9 +39,15 @@ class RenameRequest(Schema):
     name: str
 
 
-@router.post("", status_code=status.HTTP_201_CREATED, response_model=ImportResult)
+@router.post(
+    "",
+    status_code=status.HTTP_201_CREATED,
+    response_model=ImportResult,
+    responses={200: {"model": ImportResult, "description": "The content was stored before."}},
+)
 def upload(
     service: ServiceDep,
+    response: Response,
     file: Annotated[UploadFile, File(description="An ARFF or CSV file.")],
     name: Annotated[str | None, Form(max_length=200)] = None,
     targets: Annotated[
@@ -59,7 +65,7 @@ def upload(
     service.settings.work_dir.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=service.settings.work_dir) as folder:
         path = save_upload(file, Path(folder), "upload.arff")
-        return import_file(
+        result = import_file(
             service.store,
             path,
             name=name,
@@ -67,6 +73,9 @@ def upload(
             file_format=format,
             source_name=path.name,
         )
+    if not result.created:
+        response.status_code = status.HTTP_200_OK
+    return result
 
 
 @router.get("", response_model=DatasetList)

@@ -42,9 +42,17 @@ class Server:
         port = self.url.rsplit(":", 1)[1]
         assert self.log is not None
         command = [
-            sys.executable, "-m", "app.cli.main", "--db", self.database_url, "serve",
-            "--port", port, "--log-level", "warning",
-        ]  # fmt: skip
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "--db",
+            self.database_url,
+            "serve",
+            "--port",
+            port,
+            "--log-level",
+            "warning",
+        ]
         self.process = subprocess.Popen(
             command,
             cwd=ROOT,
@@ -101,9 +109,7 @@ def finished(body: dict[str, Any]) -> bool:
     return body["status"] in {"done", "failed", "cancelled", "interrupted"}
 
 
-@pytest.fixture
-def make_server(store_url: str, tmp_path: Path) -> Iterator[Callable[..., Server]]:
-    """Builds (and at the end stops) services on the test's store."""
+def _servers(database_url: str, tmp_path: Path) -> Iterator[Callable[..., Server]]:
     servers: list[Server] = []
 
     def build(**settings: str) -> Server:
@@ -117,7 +123,7 @@ def make_server(store_url: str, tmp_path: Path) -> Iterator[Callable[..., Server
         environment.pop("TOUCHBENCH_DATABASE_URL", None)
         server = Server(
             url=f"http://127.0.0.1:{free_port()}",
-            database_url=store_url,
+            database_url=database_url,
             work_dir=tmp_path / "work",
             environment=environment,
             log=tmp_path / f"service-{len(servers)}.log",
@@ -129,6 +135,18 @@ def make_server(store_url: str, tmp_path: Path) -> Iterator[Callable[..., Server
     yield build
     for server in servers:
         server.stop()
+
+
+@pytest.fixture
+def make_server(store_url: str, tmp_path: Path) -> Iterator[Callable[..., Server]]:
+    """Builds (and at the end stops) services on the test's store (SQLite, PostgreSQL)."""
+    yield from _servers(store_url, tmp_path)
+
+
+@pytest.fixture
+def make_sqlite_server(tmp_path: Path) -> Iterator[Callable[..., Server]]:
+    """Builds services on a SQLite file of the test's own."""
+    yield from _servers(f"sqlite:///{tmp_path / 'touchbench.db'}", tmp_path)
 
 
 @pytest.fixture

@@ -26,16 +26,24 @@ def test_run_leaderboard_model_and_predictions_over_http(
 
     started = api.post(
         "/api/runs",
-        json={"dataset": "touch", "target": "gesture", "classifiers": ["nb", "zeror", "j48"],
-              "folds": 3, "seed": 1},
-    )  # fmt: skip
+        json={
+            "dataset": "touch",
+            "target": "gesture",
+            "classifiers": ["nb", "zeror", "j48"],
+            "folds": 3,
+            "seed": 1,
+        },
+    )
     assert started.status_code == 202, started.text
     assert started.json()["status"] == "queued"
     run_id = started.json()["id"]
     run = server.wait_for(f"/api/runs/{run_id}", finished)
     assert (run["status"], run["tasks_done"], run["tasks"], run["tasks_failed"]) == (
-        "done", 9, 9, 0,
-    )  # fmt: skip
+        "done",
+        9,
+        9,
+        0,
+    )
 
     board = api.get(f"/api/runs/{run_id}/leaderboard")
     assert board.status_code == 200
@@ -60,9 +68,13 @@ def test_run_leaderboard_model_and_predictions_over_http(
 
     predicted = api.post(
         f"/api/models/{model_id}/predict",
-        json={"instances": [{"f0": 0.0, "f1": 0.0, "f2": 0, "f3": 0, "mic": "left"},
-                            {"f0": 4.0, "f1": 2.0, "mic": "elbow"}]},
-    )  # fmt: skip
+        json={
+            "instances": [
+                {"f0": 0.0, "f1": 0.0, "f2": 0, "f3": 0, "mic": "left"},
+                {"f0": 4.0, "f1": 2.0, "mic": "elbow"},
+            ]
+        },
+    )
     assert predicted.status_code == 200, predicted.text
     report = predicted.json()
     assert report["model"] == "best" and len(report["predictions"]) == 2
@@ -115,9 +127,14 @@ def test_cancel_and_resume_over_http(
     api = server.client
     run_id = api.post(
         "/api/runs",
-        json={"dataset": "touch", "target": "gesture", "classifiers": ["mlp", "rf", "nb"],
-              "folds": 10, "repeats": 2},
-    ).json()["id"]  # fmt: skip
+        json={
+            "dataset": "touch",
+            "target": "gesture",
+            "classifiers": ["mlp", "rf", "nb"],
+            "folds": 10,
+            "repeats": 2,
+        },
+    ).json()["id"]
     server.wait_for(f"/api/runs/{run_id}", lambda body: body["tasks_done"] >= 1)
     cancelled = api.post(f"/api/runs/{run_id}/cancel")
     assert cancelled.status_code == 200
