@@ -17,6 +17,7 @@ from app.cli import datasets as datasets_commands
 from app.cli import demo as demo_commands
 from app.cli import extract as extract_commands
 from app.cli import models as models_commands
+from app.cli import reports as reports_commands
 from app.cli.state import CliState
 from app.errors import USER_ERRORS
 from app.settings import get_settings
@@ -64,6 +65,7 @@ bench_commands.register(app)
 models_commands.register(app)
 extract_commands.register(app)
 demo_commands.register(app)
+reports_commands.register(app)
 
 
 def main(argv: list[str] | None = None) -> int:

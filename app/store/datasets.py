@@ -155,6 +155,12 @@ def list_datasets(store: Store) -> list[DatasetInfo]:
         return [DatasetInfo.of(row) for row in rows]
 
 
+def load_schema(store: Store, ref: str | int) -> Schema:
+    """The stored data set's schema alone (attributes, labels, targets), without its rows."""
+    with store.session() as session:
+        return Schema.from_json(_row(session, ref).schema)
+
+
 def load_dataset(store: Store, ref: str | int) -> Dataset:
     """The stored data set, values as WEKA encodes them (see :mod:`benchmark.dataset`)."""
     with store.session() as session:

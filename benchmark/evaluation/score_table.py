@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Literal, cast
 
 import numpy as np
 
@@ -112,10 +112,7 @@ class ScoreTable:
         ConfigurationError
             An unknown policy.
         """
-        if policy not in MISSING_POLICIES:
-            raise ConfigurationError(
-                f"unknown missing-cell policy '{policy}' (use {', '.join(MISSING_POLICIES)})"
-            )
+        policy = missing_policy(policy)
         missing = self.missing_cells()
         holes = np.isnan(self.scores)
         if policy == "worst":
@@ -162,6 +159,15 @@ class CompletedTable:
     missing: list[MissingCell]
     dropped_classifiers: list[str] = field(default_factory=list)
     dropped_blocks: list[str] = field(default_factory=list)
+
+
+def missing_policy(name: str) -> MissingPolicy:
+    """``name`` as a :data:`MissingPolicy`; anything else is refused."""
+    if name not in MISSING_POLICIES:
+        raise ConfigurationError(
+            f"unknown missing-cell policy '{name}' (use {', '.join(MISSING_POLICIES)})"
+        )
+    return cast(MissingPolicy, name)
 
 
 def fold_label(repeat: int, fold: int) -> str:
