@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -271,7 +272,7 @@ def _print_comparison(comparison: Comparison) -> None:
                 i + 1,
                 name,
                 f"{rank:.3f}",
-                float(mean),
+                float(mean) if math.isfinite(mean) else None,  # inf: ranked worst where missing
                 "(control)" if name == ranks.control else f"{holm[name].adjusted_p_value:.4f}",
                 "*" if name in holm and holm[name].significant else "",
                 letters[name],

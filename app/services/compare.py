@@ -226,6 +226,12 @@ def compare_runs(
     completed = table.complete(missing, lower_is_better=lower)
     _check_enough(completed, missing)
     ranks = compare_classifiers(completed.table, lower_is_better=lower, alpha=alpha)
+    if ranks.friedman.iman_davenport_p_value > alpha:
+        notes.append(
+            f"Friedman's test (Iman-Davenport F) does not reject equal ranks at alpha {alpha} "
+            f"(p = {ranks.friedman.iman_davenport_p_value:.3g}): Demšar advises against reading "
+            "the post-hoc tests (Nemenyi, Holm) as significant"
+        )
     bayes = _pair(scores, shared, pair, rope, lower, notes) if pair else None
     return Comparison(
         runs=scores,

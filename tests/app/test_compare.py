@@ -84,6 +84,7 @@ def test_demsar_example_from_stored_runs(store: Store, tmp_path: Path) -> None:
     missing = comparison.completed.missing
     assert [(m.block, m.classifier) for m in missing] == [("d3 (gesture)", "svm")]
     assert comparison.completed.dropped_classifiers == ["svm"]
+    assert not any("does not reject" in note for note in comparison.notes)  # p = 0.02
 
     worst = compare_runs(store, runs, metric="roc_auc", missing="worst")
     assert worst.ranks.classifiers[-1] == "svm"
