@@ -9,8 +9,9 @@ from typing import Literal
 from app.errors import AppError
 from app.store.database import Store
 from app.store.datasets import DatasetInfo, add_dataset, content_digest
+from benchmark.dataset import Dataset
 from benchmark.errors import DataFormatError
-from benchmark.io.arff import loads_arff
+from benchmark.io.arff import loads_arff, read_arff
 from benchmark.io.csv import read_csv
 
 FileFormat = Literal["arff", "csv"]
@@ -62,3 +63,14 @@ def import_file(
     return add_dataset(
         store, dataset, sha256=content_digest(content), name=name, source_name=path.name
     )
+
+
+def read_data_file(path: Path, file_format: FileFormat | None = None) -> Dataset:
+    """An ARFF or CSV file read into memory (for prediction; nothing is stored)."""
+    if not path.exists():
+        raise DataFormatError("no such file", source=str(path))
+    if not path.is_file():
+        raise DataFormatError("is not a regular file", source=str(path))
+    if (file_format or guess_format(path)) == "csv":
+        return read_csv(path, targets=None)
+    return read_arff(path)

@@ -180,13 +180,14 @@ def run_view(store: Store, run_ref: int | str, *, metric: str | None = None) -> 
     for target in run.targets:
         attribute = schema.attributes[schema.index(target)]
         labels[target] = list(attribute.values)
+    results = load_results(store, run.id)
     per_target = None
     if run.kind == "multitarget":
-        summary = per_target_summary(store, run.id)
+        summary = per_target_summary(results)
         per_target = {
             r.classifier: summary[r.classifier] for r in board.rows if r.classifier in summary
         }
-    return RunView(run, board, load_results(store, run.id), labels, per_target)
+    return RunView(run, board, results, labels, per_target)
 
 
 def build_report(

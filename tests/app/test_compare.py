@@ -13,7 +13,7 @@ from app.schemas.compare import ComparisonOut
 from app.services.compare import compare_runs
 from app.store.database import Store
 from app.store.datasets import add_dataset, dataset_digest
-from app.store.runs import create_run, record_result, set_status
+from app.store.runs import create_run, finish_run, record_result
 from benchmark.errors import ConfigurationError
 from benchmark.io.arff import read_arff
 from benchmark.results import TaskKey, TaskResult
@@ -64,7 +64,7 @@ def stored_runs(
                         6,
                     ),
                 )
-        set_status(store, run.id, "done")
+        finish_run(store, run.id, "done")
         run_ids.append(run.id)
     return run_ids
 
