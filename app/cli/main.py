@@ -18,6 +18,7 @@ from app.cli import demo as demo_commands
 from app.cli import extract as extract_commands
 from app.cli import help as help_pages
 from app.cli import models as models_commands
+from app.cli import reports as reports_commands
 from app.cli import serve as serve_commands
 from app.cli.output import EXIT_FAILED, EXIT_INTERRUPTED, ExitWith
 from app.cli.state import CliState
@@ -88,6 +89,7 @@ models_commands.register(app)
 extract_commands.register(app)
 demo_commands.register(app)
 serve_commands.register(app)
+reports_commands.register(app)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,0 +1,86 @@
+"""The plots of runs and comparisons: what :mod:`app.reports.plots` draws, fed from the
+services' objects.  The CLI's ``plot`` and ``compare --plot``, the HTML report and a web
+page all draw through these, so a plot reads the same wherever it appears."""
+
+from __future__ import annotations
+
+from matplotlib.figure import Figure
+
+from app.reports import plots
+from app.services.compare import Comparison
+from app.services.report import RunView
+from benchmark.errors import ConfigurationError
+from benchmark.evaluation.metrics import LOWER_IS_BETTER
+
+#: The per-target score that ``targets`` plots show.
+PER_TARGET_METRIC = "accuracy"
+
+
+def cd_figure(comparison: Comparison) -> Figure:
+    """The critical-difference diagram of a comparison; its title says what the blocks are
+    (data sets, or one run's folds)."""
+    ranks = comparison.ranks
+    if comparison.blocks_are == "folds":
+        run = comparison.runs[0].run
+        blocks = f"run {run.id} ({run.dataset_name}), {ranks.n_blocks} folds as blocks"
+    else:
+        blocks = f"{ranks.n_blocks} data sets"
+    return plots.cd_diagram(
+        dict(zip(ranks.classifiers, ranks.average_ranks.tolist(), strict=True)),
+        ranks.critical_difference,
+        ranks.groups,
+        title=f"{comparison.metric}: average ranks over {blocks} (Nemenyi, alpha {ranks.alpha})",
+    )
+
+
+def folds_figure(view: RunView) -> Figure:
+    """Every fold's score of every classifier of a run."""
+    scores = view.fold_scores()
+    return plots.fold_strip_plot(
+        {name: scores.column(name) for name in scores.classifiers},
+        metric=view.metric,
+        lower_is_better=view.metric in LOWER_IS_BETTER,
+        title=view.title,
+    )
+
+
+def confusion_figure(view: RunView, classifier: str | None = None) -> Figure:
+    """A classifier's confusion matrices (default: the run's best), one panel per target."""
+    confusion = view.confusion(classifier or view.board.rows[0].classifier)
+    return plots.confusion_figure(
+        confusion.matrices, view.labels, title=f"{view.title}: {confusion.description}"
+    )
+
+
+def targets_figure(view: RunView) -> Figure:
+    """A multi-target run's accuracy on each target, per classifier."""
+    if view.per_target is None:
+        raise ConfigurationError(
+            f"run {view.run.id} is multi-class (one target): per-target plots need a "
+            "multi-target run"
+        )
+    return plots.per_target_figure(
+        {
+            classifier: {
+                target: scores[PER_TARGET_METRIC]
+                for target, scores in by_target.items()
+                if PER_TARGET_METRIC in scores
+            }
+            for classifier, by_target in view.per_target.items()
+        },
+        metric=PER_TARGET_METRIC,
+        title=f"{view.title}: {PER_TARGET_METRIC} per target",
+    )
+
+
+def classes_figure(view: RunView) -> Figure:
+    """Instances per class of each target of a run's data set."""
+    counts = view.class_counts()
+    if counts is None:
+        raise ConfigurationError(
+            f"run {view.run.id}: no classifier completed every fold of the first repeat, so "
+            "the class counts are unknown"
+        )
+    return plots.class_distribution_figure(
+        counts, title=f"{view.run.dataset_name}: instances per class in run {view.run.id}"
+    )

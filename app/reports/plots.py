@@ -1,0 +1,429 @@
+"""Plots of results, as matplotlib figures that render to SVG text (web pages, HTML
+reports) or PNG bytes.
+
+Every plot function takes plain numbers and labels, never the store, and returns a
+:class:`matplotlib.figure.Figure` built without pyplot (no global state, safe in a web
+server's threads).  :func:`svg_text` renders one with its text kept as text
+(``svg.fonttype: none``), so labels stay searchable and parseable and the file small, and
+with fixed ids and no date, so the same figure renders to the same bytes.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import os
+import secrets
+import textwrap
+from collections.abc import Callable, Mapping, Sequence
+from functools import wraps
+from pathlib import Path
+from typing import Any, ParamSpec
+
+import numpy as np
+from matplotlib import rc_context
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+from numpy.typing import ArrayLike
+
+from app.errors import AppError
+
+#: Output formats of :func:`save_figure`, by file suffix.
+FORMATS = ("svg", "png")
+#: Confusion matrices with more classes than this show colours without numbers.
+MAX_ANNOTATED_CLASSES = 15
+
+#: matplotlib settings of every plot, applied while it is built and while it is rendered.
+_RC: Any = {
+    "svg.fonttype": "none",
+    "svg.hashsalt": "touchbench",
+    "font.size": 9,
+    "axes.titlesize": 10,
+    "figure.dpi": 100,
+}
+_P = ParamSpec("_P")
+_METADATA_SVG = {"Date": None, "Creator": "touchbench"}
+_METADATA_PNG = {"Software": "touchbench"}
+_LINE = "#333333"
+_ACCENT = "#1f77b4"
+_MUTED = "#9ecae1"
+
+
+def _styled(build: Callable[_P, Figure]) -> Callable[_P, Figure]:
+    """Build the figure under the plots' matplotlib settings (fonts are set on creation)."""
+
+    @wraps(build)
+    def styled(*args: _P.args, **kwargs: _P.kwargs) -> Figure:
+        with rc_context(_RC):
+            return build(*args, **kwargs)
+
+    return styled
+
+
+@_styled
+def cd_diagram(
+    average_ranks: Mapping[str, float],
+    critical_difference: float,
+    groups: Sequence[Sequence[str]],
+    *,
+    title: str,
+) -> Figure:
+    """Demšar's critical-difference diagram.
+
+    Parameters
+    ----------
+    average_ranks : mapping of str to float
+        Average rank of each classifier (1 = best).
+    critical_difference : float
+        Nemenyi's CD, drawn as a bar of that length above the axis.
+    groups : sequence of sequence of str
+        Classifiers not significantly different from each other; each group is a thick
+        bar joining their ranks.
+    title : str
+
+    Returns
+    -------
+    Figure
+        Rank axis from 1 (left, best) to k; the better half of the classifiers labelled
+        on the left, the others on the right, each label ``"name (rank)"``.
+    """
+    names = sorted(average_ranks, key=lambda name: (average_ranks[name], name))
+    k = len(names)
+    if k < 2:
+        raise AppError(f"a critical-difference diagram needs at least 2 classifiers, got {k}")
+    left_side = names[: (k + 1) // 2]
+    right_side = names[(k + 1) // 2 :][::-1]
+    rows = max(len(left_side), len(right_side))
+    step = 0.32
+    group_space = 0.18 * (len(groups) + 1)
+    height = 1.3 + group_space * 0.9 + rows * step
+    figure = Figure(figsize=(9.0, height), layout=None)
+    title_share = 0.45 / height
+    ax = figure.add_axes((0.28, 0.0, 0.44, 1.0 - title_share))
+    ax.set_axis_off()
+    top, bottom = -0.9, group_space + rows * step + 0.1
+    ax.set_xlim(0.9, k + 0.1)
+    ax.set_ylim(bottom, top)
+    figure.suptitle(
+        textwrap.fill(title, width=int(figure.get_figwidth() * 13)), y=1.0 - 0.12 / height, va="top"
+    )
+    # the rank axis
+    ax.plot([1, k], [0, 0], color=_LINE, linewidth=1)
+    for tick in range(1, k + 1):
+        ax.plot([tick, tick], [0, -0.08], color=_LINE, linewidth=1)
+        ax.text(tick, -0.12, str(tick), ha="center", va="bottom")
+    # the critical difference
+    cd_end = 1 + critical_difference
+    ax.plot([1, min(cd_end, k)], [-0.55, -0.55], color=_LINE, linewidth=1.5)
+    for x in (1, min(cd_end, k)):
+        ax.plot([x, x], [-0.6, -0.5], color=_LINE, linewidth=1)
+    ax.text(1, -0.62, f"CD = {critical_difference:.3f}", ha="left", va="bottom")
+    # groups of classifiers the test does not tell apart
+    for g, group in enumerate(groups):
+        ranks = [average_ranks[name] for name in group]
+        y = 0.14 + 0.18 * g
+        ax.plot([min(ranks) - 0.03, max(ranks) + 0.03], [y, y], color=_LINE, linewidth=3)
+    # one elbow line and label per classifier
+    for side, anchor, align in ((left_side, 0.9, "right"), (right_side, k + 0.1, "left")):
+        for i, name in enumerate(side):
+            rank = average_ranks[name]
+            y = group_space + 0.1 + i * step
+            ax.plot([rank, rank, anchor], [0, y, y], color=_LINE, linewidth=0.8)
+            ax.text(
+                anchor + (-0.05 if align == "right" else 0.05),
+                y,
+                f"{name} ({rank:.2f})",
+                ha=align,
+                va="center",
+                clip_on=False,
+            )
+    return figure
+
+
+@_styled
+def fold_strip_plot(
+    scores: Mapping[str, ArrayLike],
+    *,
+    metric: str,
+    lower_is_better: bool = False,
+    title: str,
+) -> Figure:
+    """Every fold's score of every classifier, one row per classifier, best on top.
+
+    Parameters
+    ----------
+    scores : mapping of str to array-like of shape (n_folds,)
+        Per-fold scores of each classifier (NaN for a failed fold: left out, and counted
+        in the row label).
+    metric : str
+        The axis label.
+    lower_is_better : bool
+        The metric's direction, which orders the rows.
+    title : str
+
+    Returns
+    -------
+    Figure
+        Dots for folds (spread vertically so that equal scores stay visible), a bar for the
+        mean.
+    """
+    if not scores:
+        raise AppError("no classifier to plot")
+    columns = {name: np.asarray(values, dtype=np.float64) for name, values in scores.items()}
+
+    def key(name: str) -> tuple[bool, float, str]:
+        finite = columns[name][~np.isnan(columns[name])]
+        if finite.size == 0:
+            return (True, 0.0, name)
+        mean = float(finite.mean())
+        return (False, mean if lower_is_better else -mean, name)
+
+    names = sorted(columns, key=key)
+    figure = Figure(figsize=(7.5, 1.1 + 0.3 * len(names)), layout="constrained")
+    ax = figure.add_subplot()
+    jitter = np.random.default_rng(0)
+    labels = []
+    for row, name in enumerate(names):
+        values = columns[name]
+        finite = values[~np.isnan(values)]
+        failed = values.size - finite.size
+        labels.append(f"{name} ({failed} failed)" if failed else name)
+        if finite.size:
+            offsets = jitter.uniform(-0.18, 0.18, finite.size)
+            ax.scatter(finite, row + offsets, s=14, color=_ACCENT, alpha=0.75, linewidths=0)
+            ax.plot([finite.mean()] * 2, [row - 0.3, row + 0.3], color=_LINE, linewidth=1.5)
+    ax.set_yticks(range(len(names)), labels)
+    ax.set_ylim(len(names) - 0.5, -0.5)
+    direction = "lower is better" if lower_is_better else "higher is better"
+    ax.set_xlabel(f"{metric} per fold ({direction}; bar: mean)")
+    ax.grid(axis="x", color="#dddddd", linewidth=0.6)
+    ax.set_axisbelow(True)
+    ax.set_title(title, loc="left")
+    return figure
+
+
+@_styled
+def confusion_figure(
+    matrices: Mapping[str, np.ndarray],
+    labels: Mapping[str, Sequence[str]],
+    *,
+    title: str,
+) -> Figure:
+    """Confusion matrices normalised per row, one panel per target.
+
+    Parameters
+    ----------
+    matrices : mapping of str to ndarray of shape (n_classes, n_classes)
+        Counts per target (rows true, columns predicted), e.g. summed over folds.
+    labels : mapping of str to sequence of str
+        The class labels of each target, in code order (the schema's).
+    title : str
+
+    Returns
+    -------
+    Figure
+        Cells coloured by the share of the true class predicted as each class; with up to
+        :data:`MAX_ANNOTATED_CLASSES` classes each cell also shows the share and the count.
+        A class that never occurs shows an empty row.
+    """
+    if not matrices:
+        raise AppError("no confusion matrix to plot")
+    targets = list(matrices)
+    sizes = [len(labels[t]) for t in targets]
+    side = max(3.2, min(9.0, 0.55 * max(sizes) + 1.6))
+    figure = Figure(figsize=(side * len(targets), side + 0.5), layout="constrained")
+    axes = figure.subplots(1, len(targets), squeeze=False)[0]
+    image = None
+    for ax, target in zip(axes, targets, strict=True):
+        counts = np.asarray(matrices[target], dtype=np.float64)
+        names = list(labels[target])
+        if counts.shape != (len(names), len(names)):
+            raise AppError(
+                f"confusion matrix of '{target}' has shape {counts.shape} for {len(names)} labels"
+            )
+        totals = counts.sum(axis=1, keepdims=True)
+        shares = np.divide(counts, totals, out=np.full_like(counts, np.nan), where=totals > 0)
+        image = ax.imshow(shares, cmap="Blues", vmin=0.0, vmax=1.0)
+        ax.set_xticks(range(len(names)), names, rotation=45, ha="right", rotation_mode="anchor")
+        ax.set_yticks(range(len(names)), names)
+        ax.set_xlabel("predicted")
+        ax.set_ylabel("true")
+        if len(targets) > 1:
+            ax.set_title(target)
+        if len(names) <= MAX_ANNOTATED_CLASSES:
+            _annotate_cells(ax, shares, counts)
+    if image is not None:
+        figure.colorbar(image, ax=list(axes), shrink=0.8, label="share of the true class")
+    _suptitle(figure, title)
+    return figure
+
+
+@_styled
+def per_target_figure(
+    summary: Mapping[str, Mapping[str, tuple[float, float]]],
+    *,
+    metric: str,
+    title: str,
+) -> Figure:
+    """A multi-target run's score on each target, one panel per target.
+
+    Parameters
+    ----------
+    summary : mapping of str to mapping of str to (float, float)
+        classifier -> target -> (mean, standard deviation) of ``metric`` over folds
+        (NaN standard deviation: no error bar).
+    metric : str
+    title : str
+
+    Returns
+    -------
+    Figure
+        A dot per classifier at its mean, classifiers in the order given (a
+        leaderboard's), error bars one standard deviation.
+    """
+    classifiers = list(summary)
+    targets = list(dict.fromkeys(t for by_target in summary.values() for t in by_target))
+    if not classifiers or not targets:
+        raise AppError("no per-target scores to plot")
+    figure = Figure(
+        figsize=(3.4 * len(targets) + 1.5, 1.2 + 0.28 * len(classifiers)), layout="constrained"
+    )
+    axes = figure.subplots(1, len(targets), squeeze=False, sharey=True)[0]
+    rows = np.arange(len(classifiers))
+    for ax, target in zip(axes, targets, strict=True):
+        pairs = [summary[c].get(target, (math.nan, math.nan)) for c in classifiers]
+        means = np.array([m for m, _ in pairs], dtype=np.float64)
+        stds = np.nan_to_num(np.array([s for _, s in pairs], dtype=np.float64))
+        ax.errorbar(
+            means,
+            rows,
+            xerr=stds,
+            fmt="o",
+            color=_ACCENT,
+            ecolor=_LINE,
+            elinewidth=0.8,
+            capsize=2,
+            markersize=4,
+        )
+        ax.set_title(target)
+        ax.set_xlabel(metric)
+        ax.grid(axis="x", color="#dddddd", linewidth=0.6)
+        ax.set_axisbelow(True)
+    axes[0].set_yticks(rows, classifiers)
+    axes[0].set_ylim(len(classifiers) - 0.5, -0.5)
+    _suptitle(figure, title)
+    return figure
+
+
+@_styled
+def class_distribution_figure(counts: Mapping[str, Mapping[str, int]], *, title: str) -> Figure:
+    """How many instances each class has, one panel per target.
+
+    Parameters
+    ----------
+    counts : mapping of str to mapping of str to int
+        target -> label -> number of instances (labels in the schema's order).
+    title : str
+    """
+    targets = list(counts)
+    if not targets:
+        raise AppError("no class counts to plot")
+    most = max(len(counts[t]) for t in targets)
+    figure = Figure(figsize=(3.6 * len(targets) + 0.6, 1.2 + 0.3 * most), layout="constrained")
+    axes = figure.subplots(1, len(targets), squeeze=False)[0]
+    for ax, target in zip(axes, targets, strict=True):
+        names = list(counts[target])
+        values = [int(counts[target][name]) for name in names]
+        total = sum(values)
+        rows = np.arange(len(names))
+        ax.barh(rows, values, color=_MUTED, edgecolor=_ACCENT)
+        ax.set_yticks(rows, names)
+        ax.set_ylim(len(names) - 0.5, -0.5)
+        for row, value in zip(rows, values, strict=True):
+            share = f" ({value / total:.0%})" if total else ""
+            ax.text(value, row, f" {value}{share}", va="center", ha="left")
+        ax.set_xlim(0, max([*values, 1]) * 1.35)
+        ax.set_title(f"{target} ({total} instances)")
+        ax.set_xlabel("instances")
+    _suptitle(figure, title)
+    return figure
+
+
+def _suptitle(figure: Figure, title: str) -> None:
+    """A figure title wrapped to the figure's width (about 13 characters an inch at 9 pt)."""
+    width = int(figure.get_figwidth() * 13)
+    figure.suptitle(textwrap.fill(title, width=max(width, 20)))
+
+
+def svg_text(figure: Figure, *, inline: bool = False) -> str:
+    """The figure as SVG text.
+
+    Parameters
+    ----------
+    figure : Figure
+    inline : bool
+        Drop the XML declaration and DOCTYPE, for an ``<svg>`` element inside HTML.
+    """
+    buffer = io.StringIO()
+    with rc_context(_RC):
+        figure.savefig(buffer, format="svg", metadata=_METADATA_SVG)
+    text = buffer.getvalue()
+    if inline:
+        text = text[text.index("<svg") :]
+    return text
+
+
+def png_bytes(figure: Figure, *, dpi: int = 150) -> bytes:
+    """The figure as PNG."""
+    buffer = io.BytesIO()
+    with rc_context(_RC):
+        figure.savefig(buffer, format="png", dpi=dpi, metadata=_METADATA_PNG)
+    return buffer.getvalue()
+
+
+def figure_format(path: Path) -> str:
+    """``"svg"`` or ``"png"`` from the file's suffix; anything else is refused."""
+    suffix = path.suffix.lower().lstrip(".")
+    if suffix not in FORMATS:
+        raise AppError(
+            f"{path}: unknown plot format '{path.suffix or '(none)'}' (use a .svg or .png file)"
+        )
+    return suffix
+
+
+def save_figure(figure: Figure, path: Path) -> None:
+    """Write the figure to ``path`` (SVG or PNG by suffix) all at once: a temporary file
+    in the same folder is renamed over it, so nothing half-written is ever left."""
+    data = svg_text(figure).encode() if figure_format(path) == "svg" else png_bytes(figure)
+    write_atomically(path, data)
+
+
+def write_atomically(path: Path, data: bytes) -> None:
+    """Replace ``path`` with ``data`` by renaming a finished temporary file over it."""
+    folder = path.resolve().parent
+    if not folder.is_dir():
+        raise AppError(f"{path}: no such folder '{folder}'")
+    temporary = folder / f".{path.name}.{secrets.token_hex(6)}.tmp"
+    try:
+        with open(temporary, "xb") as out:  # open(), unlike mkstemp, honours the umask
+            out.write(data)
+        os.replace(temporary, path)
+    except BaseException:
+        temporary.unlink(missing_ok=True)
+        raise
+
+
+def _annotate_cells(ax: Axes, shares: np.ndarray, counts: np.ndarray) -> None:
+    for (row, column), share in np.ndenumerate(shares):
+        if math.isnan(share):
+            continue
+        colour = "white" if share > 0.6 else _LINE
+        ax.text(
+            column,
+            row,
+            f"{share:.2f}\n{int(counts[row, column])}",
+            ha="center",
+            va="center",
+            color=colour,
+            fontsize=7,
+        )

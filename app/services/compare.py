@@ -1,0 +1,325 @@
+"""Comparing classifiers across runs: Demšar's ranks, Friedman, Nemenyi and Holm, and the
+Bayesian view of two classifiers.
+
+Each run is one block (a data set with its targets) and each classifier's score on it is
+its mean over the run's successful folds.  A single run has no data sets to rank over, so
+its folds become the blocks, as autorank does for repeated measures; folds share training
+data, so that reading is descriptive and the result says so (``blocks_are == "folds"``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+
+from app.store.database import Store
+from app.store.runs import RunInfo, get_run, load_results
+from benchmark.errors import ConfigurationError
+from benchmark.evaluation.bayesian import (
+    DEFAULT_ROPE,
+    BayesianComparison,
+    correlated_ttest,
+    signed_rank_test,
+)
+from benchmark.evaluation.metrics import LOWER_IS_BETTER
+from benchmark.evaluation.score_table import (
+    CompletedTable,
+    MissingPolicy,
+    ScoreTable,
+    fold_score_table,
+)
+from benchmark.evaluation.statistics import RankComparison, compare_classifiers
+from benchmark.results import TaskResult
+
+BlockKind = Literal["datasets", "folds"]
+
+
+@dataclass(frozen=True)
+class RunScores:
+    """One run's scores on one metric.
+
+    Attributes
+    ----------
+    run : RunInfo
+    label : str
+        The run as a block: ``"dataset (target, ...)"``.
+    folds : ScoreTable
+        Per-fold scores, shape (n_folds, n_classifiers), NaN for failed folds.
+    test_train_ratio : float
+        Mean ``n_test / n_train`` of the run's folds.
+    """
+
+    run: RunInfo
+    label: str
+    folds: ScoreTable
+    test_train_ratio: float
+
+    def mean(self, classifier: str) -> float:
+        """Mean over the successful folds; NaN when there is none."""
+        column = self.folds.column(classifier)
+        finite = column[~np.isnan(column)]
+        return float(finite.mean()) if finite.size else math.nan
+
+
+@dataclass(frozen=True)
+class PairComparison:
+    """The Bayesian view of classifiers ``a`` and ``b``.
+
+    Attributes
+    ----------
+    a, b : str
+    per_run : list of (RunScores, BayesianComparison)
+        The correlated t-test on each run's paired folds.
+    across : BayesianComparison or None
+        The Bayesian signed-rank test over the runs' means (at least 2 runs).
+    """
+
+    a: str
+    b: str
+    per_run: list[tuple[RunScores, BayesianComparison]]
+    across: BayesianComparison | None
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """Classifiers compared over the blocks of one or more runs.
+
+    Attributes
+    ----------
+    runs : list of RunScores
+    metric : str
+    lower_is_better : bool
+    blocks_are : {"datasets", "folds"}
+    table : ScoreTable
+        Scores per block and shared classifier, missing cells as NaN.
+    completed : CompletedTable
+        The table the statistics ran on, and what the missing-cell policy did.
+    ranks : RankComparison
+    not_shared : list of str
+        Classifiers that some of the runs lack (left out).
+    pair : PairComparison or None
+    notes : list of str
+        What a reader should know (unfinished runs, folds as blocks...).
+    """
+
+    runs: list[RunScores]
+    metric: str
+    lower_is_better: bool
+    blocks_are: BlockKind
+    table: ScoreTable
+    completed: CompletedTable
+    ranks: RankComparison
+    not_shared: list[str] = field(default_factory=list)
+    pair: PairComparison | None = None
+    notes: list[str] = field(default_factory=list)
+
+
+def default_metric(kinds: Sequence[str]) -> str:
+    """The leaderboards' ranking metric for runs of these kinds."""
+    distinct = set(kinds)
+    if distinct == {"multiclass"}:
+        return "f1_weighted"
+    if distinct == {"multitarget"}:
+        return "hamming_score"
+    raise ConfigurationError(
+        "the runs mix multi-class and multi-target problems: give --metric (one every run has)"
+    )
+
+
+def run_scores(run: RunInfo, metric: str, results: Sequence[TaskResult]) -> RunScores:
+    """One run's per-fold scores on ``metric``."""
+    if not results:
+        raise ConfigurationError(f"run {run.id} has no results yet")
+    if not any(r.ok and metric in r.metrics for r in results):
+        available = sorted({name for r in results if r.ok for name in r.metrics})
+        raise ConfigurationError(
+            f"run {run.id} has no '{metric}' scores (metrics: {', '.join(available) or 'none'})"
+        )
+    ratios = [r.n_test / r.n_train for r in results if r.n_train > 0]
+    return RunScores(
+        run=run,
+        label=f"{run.dataset_name} ({', '.join(run.targets)})",
+        folds=fold_score_table(results, metric, classifiers=run.classifiers),
+        test_train_ratio=float(np.mean(ratios)) if ratios else 0.0,
+    )
+
+
+def compare_runs(
+    store: Store,
+    run_refs: Sequence[int | str],
+    *,
+    metric: str | None = None,
+    alpha: float = 0.05,
+    missing: MissingPolicy = "drop-classifier",
+    pair: tuple[str, str] | None = None,
+    rope: float = DEFAULT_ROPE,
+) -> Comparison:
+    """Rank the classifiers that all the runs share, and test their differences.
+
+    Parameters
+    ----------
+    store : Store
+    run_refs : sequence of int or str
+        Run ids: several runs (one per data set), or one run (its folds as blocks).
+    metric : str, optional
+        Default: the leaderboards' (weighted F1, or Hamming score for multi-target runs).
+    alpha : float
+        Significance level of the Nemenyi CD and Holm's procedure.
+    missing : {"drop-classifier", "drop-block", "worst"}
+        What to do with a classifier without a score on a block (see
+        :meth:`ScoreTable.complete`); the cells are reported whatever the choice.
+    pair : (str, str), optional
+        Two classifiers for the Bayesian view.
+    rope : float
+        Region of practical equivalence of the Bayesian tests, in the metric's units.
+
+    Raises
+    ------
+    NotFoundError
+        An unknown run.
+    ConfigurationError
+        No runs, a run given twice, two runs of the same data set and targets, a metric
+        some run lacks, fewer than 2 shared classifiers, an unknown pair.
+    """
+    if not run_refs:
+        raise ConfigurationError("give at least one run to compare")
+    runs = [get_run(store, ref) for ref in run_refs]
+    _check_distinct(runs)
+    metric = metric or default_metric([run.kind for run in runs])
+    lower = metric in LOWER_IS_BETTER
+    scores = [run_scores(run, metric, load_results(store, run.id)) for run in runs]
+    shared = [c for c in runs[0].classifiers if all(c in run.classifiers for run in runs[1:])]
+    not_shared = sorted({c for run in runs for c in run.classifiers} - set(shared))
+    if len(shared) < 2:
+        raise ConfigurationError(
+            f"the runs share {len(shared)} classifier(s) ({', '.join(shared) or 'none'}): "
+            "a comparison needs at least 2"
+        )
+    notes = [
+        f"run {run.id} is {run.status}: {run.n_results} of {run.n_tasks} tasks have results"
+        for run in runs
+        if run.status != "done"
+    ]
+    if len(runs) == 1:
+        blocks_are: BlockKind = "folds"
+        only = scores[0]
+        table = ScoreTable(
+            np.column_stack([only.folds.column(c) for c in shared]),
+            only.folds.blocks,
+            tuple(shared),
+        )
+        notes.append(
+            f"one run: its {len(table.blocks)} folds are the blocks; folds share training "
+            "data, so read the ranks as descriptive (Demšar's tests assume independent data sets)"
+        )
+    else:
+        blocks_are = "datasets"
+        table = ScoreTable(
+            np.array([[s.mean(c) for c in shared] for s in scores]),
+            tuple(s.label for s in scores),
+            tuple(shared),
+        )
+    completed = table.complete(missing, lower_is_better=lower)
+    _check_enough(completed, missing)
+    ranks = compare_classifiers(completed.table, lower_is_better=lower, alpha=alpha)
+    if ranks.friedman.iman_davenport_p_value > alpha:
+        notes.append(
+            f"Friedman's test (Iman-Davenport F) does not reject equal ranks at alpha {alpha} "
+            f"(p = {ranks.friedman.iman_davenport_p_value:.3g}): Demšar advises against reading "
+            "the post-hoc tests (Nemenyi, Holm) as significant"
+        )
+    bayes = _pair(scores, shared, pair, rope, lower, notes) if pair else None
+    return Comparison(
+        runs=scores,
+        metric=metric,
+        lower_is_better=lower,
+        blocks_are=blocks_are,
+        table=table,
+        completed=completed,
+        ranks=ranks,
+        not_shared=not_shared,
+        pair=bayes,
+        notes=notes,
+    )
+
+
+def _check_distinct(runs: Sequence[RunInfo]) -> None:
+    seen: dict[tuple[int, tuple[str, ...]], RunInfo] = {}
+    for run in runs:
+        key = (run.dataset_id, tuple(run.targets))
+        earlier = seen.get(key)
+        if earlier is not None:
+            if earlier.id == run.id:
+                raise ConfigurationError(f"run {run.id} is given twice")
+            raise ConfigurationError(
+                f"runs {earlier.id} and {run.id} both benchmark {run.dataset_name} "
+                f"({', '.join(run.targets)}): each data set must count once"
+            )
+        seen[key] = run
+
+
+def _check_enough(completed: CompletedTable, policy: str) -> None:
+    table = completed.table
+    if table.shape[1] >= 2 and table.shape[0] >= 2:
+        return
+    cells = ", ".join(f"{m.classifier} on {m.block}" for m in completed.missing[:4])
+    more = f" and {len(completed.missing) - 4} more" if len(completed.missing) > 4 else ""
+    raise ConfigurationError(
+        f"with --missing {policy}, {table.shape[1]} classifier(s) on {table.shape[0]} block(s) "
+        f"remain (missing scores: {cells}{more}); try another --missing policy"
+    )
+
+
+def _pair(
+    scores: Sequence[RunScores],
+    shared: Sequence[str],
+    pair: tuple[str, str],
+    rope: float,
+    lower: bool,
+    notes: list[str],
+) -> PairComparison:
+    a, b = pair
+    for name in pair:
+        if name not in shared:
+            raise ConfigurationError(
+                f"'{name}' is not a classifier every run has (shared: {', '.join(shared)})"
+            )
+    if a == b:
+        raise ConfigurationError(f"compare two different classifiers, not '{a}' with itself")
+    per_run = []
+    for run in scores:
+        x, y = run.folds.column(a), run.folds.column(b)
+        both = ~np.isnan(x) & ~np.isnan(y)
+        if both.sum() < 2:
+            notes.append(f"run {run.run.id}: fewer than 2 folds where both {a} and {b} succeeded")
+            continue
+        per_run.append(
+            (
+                run,
+                correlated_ttest(
+                    x[both],
+                    y[both],
+                    test_train_ratio=run.test_train_ratio,
+                    rope=rope,
+                    lower_is_better=lower,
+                ),
+            )
+        )
+    across = None
+    if len(scores) >= 2:
+        means = np.array([[s.mean(a), s.mean(b)] for s in scores])
+        usable = ~np.isnan(means).any(axis=1)
+        if usable.sum() < len(scores):
+            notes.append(
+                f"signed-rank test: {len(scores) - int(usable.sum())} run(s) left out where "
+                f"{a} or {b} has no score"
+            )
+        if usable.sum() >= 2:
+            across = signed_rank_test(
+                means[usable, 0], means[usable, 1], rope=rope, lower_is_better=lower
+            )
+    return PairComparison(a, b, per_run, across)

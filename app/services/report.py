@@ -1,0 +1,264 @@
+"""What the plots and the HTML report show of runs: leaderboards, per-fold scores, confusion
+matrices with the schema's labels, class counts, per-target scores, and the comparison
+across runs; plus the library versions behind them."""
+
+from __future__ import annotations
+
+import platform
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from importlib import metadata
+
+import numpy as np
+
+from app.services.compare import Comparison, compare_runs
+from app.services.runs import PerTargetSummary, per_target_summary, run_leaderboard
+from app.store.database import Store
+from app.store.datasets import load_schema
+from app.store.runs import RunInfo, load_results
+from benchmark.errors import BenchmarkError, ConfigurationError
+from benchmark.evaluation.leaderboard import Leaderboard
+from benchmark.evaluation.score_table import MissingPolicy, ScoreTable, fold_score_table
+from benchmark.results import TaskResult
+
+#: Distributions whose versions a report names.
+LIBRARIES = (
+    "touchbench",
+    "numpy",
+    "scipy",
+    "scikit-learn",
+    "xgboost",
+    "scikit-multilearn-ng",
+    "sqlalchemy",
+    "matplotlib",
+)
+
+
+@dataclass(frozen=True)
+class Confusion:
+    """A classifier's confusion matrices summed over its successful folds.
+
+    Attributes
+    ----------
+    classifier : str
+    matrices : dict of str to ndarray of shape (n_classes, n_classes)
+        One per target, rows true, columns predicted.
+    n_folds : int
+        Folds summed (over every repeat).
+    n_failed : int
+        Folds without a result to sum.
+    """
+
+    classifier: str
+    matrices: dict[str, np.ndarray]
+    n_folds: int
+    n_failed: int
+
+    @property
+    def description(self) -> str:
+        failed = f", {self.n_failed} failed" if self.n_failed else ""
+        return f"{self.classifier}, summed over {self.n_folds} folds{failed}"
+
+
+@dataclass(frozen=True)
+class RunView:
+    """One run as the plots and the report see it.
+
+    Attributes
+    ----------
+    run : RunInfo
+    board : Leaderboard
+    results : list of TaskResult
+    labels : dict of str to list of str
+        Class labels of each target, from the data set's schema.
+    per_target : dict or None
+        Multi-target runs: classifier -> target -> metric -> (mean, std), in leaderboard
+        order; ``None`` for multi-class runs.
+    """
+
+    run: RunInfo
+    board: Leaderboard
+    results: list[TaskResult]
+    labels: dict[str, list[str]]
+    per_target: PerTargetSummary | None = None
+
+    @property
+    def metric(self) -> str:
+        return self.board.metric
+
+    @property
+    def title(self) -> str:
+        return f"run {self.run.id}: {self.run.dataset_name} ({', '.join(self.run.targets)})"
+
+    def fold_scores(self) -> ScoreTable:
+        """Per-fold scores on the leaderboard's metric, best classifier first."""
+        return fold_score_table(
+            self.results, self.metric, classifiers=[row.classifier for row in self.board.rows]
+        )
+
+    def confusion(self, classifier: str) -> Confusion:
+        """``classifier``'s confusion matrices summed over its successful folds."""
+        if classifier not in self.run.classifiers:
+            raise ConfigurationError(
+                f"run {self.run.id} has no classifier '{classifier}' "
+                f"(classifiers: {', '.join(self.run.classifiers)})"
+            )
+        mine = [r for r in self.results if r.key.classifier == classifier]
+        ok = [r for r in mine if r.ok and r.confusion is not None]
+        if not ok:
+            raise ConfigurationError(
+                f"'{classifier}' has no successful fold in run {self.run.id}: no confusion matrix"
+            )
+        return Confusion(classifier, _sum_confusions(self.run, ok), len(ok), len(mine) - len(ok))
+
+    def class_counts(self) -> dict[str, dict[str, int]] | None:
+        """Instances per class of each target, as the run's first repeat tested them.
+
+        Every instance is tested once per repeat of k-fold cross-validation, so the row
+        sums of a classifier's confusion matrices over the folds of repeat 1 count the
+        classes of the instances the run used.  ``None`` when no classifier completed every
+        fold of repeat 1.
+        """
+        first = {r.key.fold for r in self.results if r.key.repeat == 0}
+        for row in self.board.rows:
+            done = [
+                r
+                for r in self.results
+                if r.key.classifier == row.classifier
+                and r.key.repeat == 0
+                and r.ok
+                and r.confusion is not None
+            ]
+            if {r.key.fold for r in done} == first:
+                matrices = _sum_confusions(self.run, done)
+                return {
+                    target: {
+                        label: int(count)
+                        for label, count in zip(
+                            self.labels[target], matrix.sum(axis=1), strict=True
+                        )
+                    }
+                    for target, matrix in matrices.items()
+                }
+        return None
+
+
+@dataclass(frozen=True)
+class Report:
+    """Everything an HTML report of some runs shows.
+
+    Attributes
+    ----------
+    views : list of RunView
+    comparison : Comparison or None
+        Across the runs (two or more), when it can be made.
+    comparison_note : str or None
+        Why there is no comparison across runs, if there could have been one.
+    fold_ranks : dict of int to Comparison or str
+        Per run id: its classifiers ranked over its folds, or why that cannot be done.
+    confusions : int
+        How many of each run's best classifiers get a confusion matrix.
+    versions : dict of str to str
+    created_at : datetime
+    """
+
+    views: list[RunView]
+    comparison: Comparison | None
+    comparison_note: str | None
+    fold_ranks: dict[int, Comparison | str]
+    confusions: int
+    versions: dict[str, str]
+    created_at: datetime = field(default_factory=lambda: datetime.now(UTC))
+
+
+def run_view(store: Store, run_ref: int | str, *, metric: str | None = None) -> RunView:
+    """A run with its leaderboard, results and class labels."""
+    run, board = run_leaderboard(store, run_ref, metric=metric)
+    _, schema, _ = load_schema(store, run.dataset_id)
+    labels = {}
+    for target in run.targets:
+        attribute = schema.attributes[schema.index(target)]
+        labels[target] = list(attribute.values)
+    results = load_results(store, run.id)
+    per_target = None
+    if run.kind == "multitarget":
+        summary = per_target_summary(results)
+        per_target = {
+            r.classifier: summary[r.classifier] for r in board.rows if r.classifier in summary
+        }
+    return RunView(run, board, results, labels, per_target)
+
+
+def build_report(
+    store: Store,
+    run_refs: Sequence[int | str],
+    *,
+    metric: str | None = None,
+    alpha: float = 0.05,
+    missing: MissingPolicy = "drop-classifier",
+    confusions: int = 5,
+    on_run: Callable[[RunInfo], None] = lambda run: None,
+) -> Report:
+    """Gather what a report of ``run_refs`` shows.
+
+    Parameters
+    ----------
+    store : Store
+    run_refs : sequence of int or str
+    metric : str, optional
+        Ranking metric; default each run's leaderboard default.
+    alpha : float
+        Significance level of the comparisons.
+    missing : {"drop-classifier", "drop-block", "worst"}
+        Missing-cell policy of the comparison across runs.
+    confusions : int
+        Confusion matrices for this many of each run's best classifiers (>= 0).
+    on_run : callable
+        Called with each run as it is gathered (progress).
+    """
+    if not run_refs:
+        raise ConfigurationError("give at least one run to report")
+    if confusions < 0:
+        raise ConfigurationError(f"--confusions must be >= 0, got {confusions}")
+    views = []
+    fold_ranks: dict[int, Comparison | str] = {}
+    for ref in run_refs:
+        view = run_view(store, ref, metric=metric)
+        try:
+            fold_ranks[view.run.id] = compare_runs(
+                store, [view.run.id], metric=view.metric, alpha=alpha, missing=missing
+            )
+        except BenchmarkError as error:
+            fold_ranks[view.run.id] = str(error)
+        on_run(view.run)
+        views.append(view)
+    comparison, note = None, None
+    if len(views) >= 2:
+        try:
+            comparison = compare_runs(store, run_refs, metric=metric, alpha=alpha, missing=missing)
+        except BenchmarkError as error:  # the report stands without it; it says why
+            note = str(error)
+    return Report(views, comparison, note, fold_ranks, confusions, library_versions())
+
+
+def library_versions() -> dict[str, str]:
+    """Python's and the main libraries' versions in this environment."""
+    versions = {"python": platform.python_version()}
+    for name in LIBRARIES:
+        try:
+            versions[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            versions[name] = "not installed"
+    return versions
+
+
+def _sum_confusions(run: RunInfo, results: Sequence[TaskResult]) -> dict[str, np.ndarray]:
+    """Per-target sums of the results' confusion matrices."""
+    sums: dict[str, np.ndarray] = {}
+    for result in results:
+        matrices = result.confusion if run.kind == "multitarget" else [result.confusion]
+        for target, matrix in zip(run.targets, matrices or [], strict=True):
+            counts = np.asarray(matrix, dtype=np.int64)
+            sums[target] = sums[target] + counts if target in sums else counts
+    return sums
