@@ -26,6 +26,7 @@ from app.schemas.runs import (
 )
 from app.store.database import Store
 from app.store.datasets import find_dataset, load_dataset
+from app.store.ownership import process_owner
 from app.store.runs import (
     HEARTBEAT_INTERVAL,
     RunInfo,
@@ -35,7 +36,6 @@ from app.store.runs import (
     get_run,
     heartbeat,
     load_results,
-    process_owner,
     record_result,
 )
 from app.store.runs import (

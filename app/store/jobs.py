@@ -11,7 +11,7 @@ from sqlalchemy import select, update
 from app.errors import NotFoundError
 from app.schemas.jobs import JobSchema
 from app.store.database import Store
-from app.store.runs import owner_alive, process_owner
+from app.store.ownership import mark_lost, process_owner
 from app.store.tables import JobRow, utcnow
 
 
@@ -74,22 +74,13 @@ def finish_job(
 def mark_lost_jobs(store: Store) -> list[int]:
     """Jobs left ``running`` by a process that died become ``interrupted``; their ids."""
     with store.session() as session:
-        running = session.execute(
-            select(JobRow.id, JobRow.owner, JobRow.heartbeat_at).where(JobRow.status == "running")
-        ).all()
-        lost = [job_id for job_id, owner, beat in running if not owner_alive(owner, beat)]
-        if lost:
-            session.execute(
-                update(JobRow)
-                .where(JobRow.id.in_(lost))
-                .values(
-                    status="interrupted",
-                    error="the worker process stopped before the job ended",
-                    finished_at=utcnow(),
-                )
-                .execution_options(synchronize_session=False)
-            )
-    return lost
+        return mark_lost(
+            session,
+            JobRow,
+            status="interrupted",
+            error="the worker process stopped before the job ended",
+            finished_at=utcnow(),
+        )
 
 
 def _row(session: Any, job_id: int | str) -> JobRow:

@@ -10,11 +10,9 @@ already recorded, so a resumed run never duplicates rows.
 
 from __future__ import annotations
 
-import os
-import socket
 from collections.abc import Sequence
 from dataclasses import dataclass
-from datetime import datetime, timedelta
+from datetime import datetime
 from typing import Any
 
 from sqlalchemy import case, func, insert, select, update
@@ -25,6 +23,7 @@ from sqlalchemy.orm import Session
 from app.errors import AppError, NotFoundError
 from app.schemas.runs import FINAL_STATUSES, RunSchema, RunStatus
 from app.store.database import Store
+from app.store.ownership import aware, mark_lost, owner_alive, process_owner
 from app.store.tables import DatasetRow, FoldResultRow, RunRow, utcnow
 from benchmark.results import TaskKey, TaskResult
 
@@ -32,39 +31,6 @@ from benchmark.results import TaskKey, TaskResult
 PER_TARGET = "per_target"
 #: Seconds between heartbeats of the process executing a run.
 HEARTBEAT_INTERVAL = 5.0
-#: A running run whose heartbeat is older than this has lost its process.
-STALE_AFTER = 30.0
-
-
-def process_owner(pid: int | None = None) -> str:
-    """``host:pid@start`` of this process (or of ``pid`` on this host), as it is written in
-    a run it executes; the start time tells a live owner from a later process that reuses
-    its pid."""
-    pid = os.getpid() if pid is None else pid
-    return f"{socket.gethostname()}:{pid}@{_start_ticks(pid)}"
-
-
-def owner_alive(owner: str | None, heartbeat_at: datetime | None) -> bool:
-    """Whether the process ``owner`` still runs: looked up directly when it is on this host,
-    judged by its heartbeat otherwise."""
-    if not owner:
-        return False
-    host, _, rest = owner.partition(":")
-    pid_text, _, start = rest.partition("@")
-    if host == socket.gethostname() and pid_text.isdigit():
-        return start == _start_ticks(int(pid_text)) != ""
-    if heartbeat_at is None:
-        return False
-    return utcnow() - _aware(heartbeat_at) < timedelta(seconds=STALE_AFTER)
-
-
-def _start_ticks(pid: int) -> str:
-    """The start time of process ``pid`` in clock ticks since boot; '' if it does not exist."""
-    try:
-        with open(f"/proc/{pid}/stat") as stat:
-            return stat.read().rsplit(")", 1)[1].split()[19]
-    except (OSError, IndexError):
-        return ""
 
 
 @dataclass(frozen=True)
@@ -178,7 +144,7 @@ def claim_run(store: Store, run_id: int, *, owner: str | None = None) -> RunInfo
             and row.owner != owner
             and owner_alive(row.owner, row.heartbeat_at)
         ):
-            seconds = (now - _aware(row.heartbeat_at)).total_seconds() if row.heartbeat_at else 0
+            seconds = (now - aware(row.heartbeat_at)).total_seconds() if row.heartbeat_at else 0
             raise AppError(
                 f"run {row.id} is being executed by {row.owner} (heard from {seconds:.0f} s "
                 f"ago); wait for it to end or cancel it with `touchbench cancel {row.id}`"
@@ -259,17 +225,7 @@ def request_cancel(store: Store, run_id: int | str) -> RunInfo:
 def mark_lost_runs(store: Store) -> list[int]:
     """Runs left ``running`` by a process that died become ``interrupted``; their ids."""
     with store.session() as session:
-        running = session.execute(
-            select(RunRow.id, RunRow.owner, RunRow.heartbeat_at).where(RunRow.status == "running")
-        ).all()
-        ids = [run_id for run_id, owner, beat in running if not owner_alive(owner, beat)]
-        if ids:
-            session.execute(
-                update(RunRow)
-                .where(RunRow.id.in_(ids))
-                .values(status="interrupted", owner=None, heartbeat_at=None)
-            )
-    return ids
+        return mark_lost(session, RunRow, status="interrupted", owner=None, heartbeat_at=None)
 
 
 def record_result(store: Store, run_id: int, result: TaskResult) -> None:
@@ -403,8 +359,3 @@ def _infos(session: Session, rows: Sequence[RunRow]) -> list[RunInfo]:
         )
         for row in rows
     ]
-
-
-def _aware(moment: datetime) -> datetime:
-    """SQLite hands timestamps back without their time zone: they are UTC."""
-    return moment if moment.tzinfo is not None else moment.replace(tzinfo=utcnow().tzinfo)

@@ -1,0 +1,240 @@
+"""The service side by side with in-process work: prediction latency and throughput over HTTP
+against the same model's in-process ``predict_proba``, and a run submitted over HTTP against
+the same run from the CLI.
+
+    .venv/bin/python perf/serve.py [--requests 400] [--seconds 10] [--run-classifiers nb,j48,rf]
+
+Uses Mini (``../shared/datasets``) when present, else a synthetic data set of the same
+shape. Prints a table of figures and ratios; nothing here is asserted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import socket
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+import httpx
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+MINI = ROOT.parent / "shared" / "datasets" / "uc3m-touch" / "mini" / "gesture_and_place.arff"
+sys.path.insert(0, str(ROOT))
+
+
+def percentile(values: list[float], q: float) -> float:
+    return float(np.percentile(np.array(values) * 1000.0, q))
+
+
+def free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+def data_file(folder: Path) -> Path:
+    if MINI.exists():
+        return MINI
+    from tests.app.synthetic import touch_arff
+
+    return touch_arff(folder / "synthetic.arff", n=2777)
+
+
+def start_service(db: str, folder: Path) -> tuple[subprocess.Popen[bytes], str]:
+    port = free_port()
+    environment = {
+        **os.environ,
+        "PYTHONPATH": str(ROOT),
+        "TOUCHBENCH_WORK_DIR": str(folder / "work"),
+        "TOUCHBENCH_JOB_WORKERS": "1",
+    }
+    command = [
+        sys.executable,
+        "-m",
+        "app.cli.main",
+        "--db",
+        db,
+        "serve",
+        "--port",
+        str(port),
+        "--log-level",
+        "warning",
+    ]
+    process = subprocess.Popen(command, cwd=ROOT, env=environment)
+    url = f"http://127.0.0.1:{port}"
+    for _ in range(600):
+        try:
+            if httpx.get(f"{url}/healthz", timeout=1).status_code == 200:
+                return process, url
+        except httpx.HTTPError:
+            time.sleep(0.2)
+    raise SystemExit("the service did not start")
+
+
+def latency(url: str, model: str, record: dict[str, object], n: int) -> list[float]:
+    times = []
+    with httpx.Client(base_url=url, timeout=60) as client:
+        for _ in range(20):  # warm-up: load the model into the cache, open the connection
+            client.post(f"/api/models/{model}/predict", json={"instances": [record]})
+        for _ in range(n):
+            start = time.perf_counter()
+            response = client.post(f"/api/models/{model}/predict", json={"instances": [record]})
+            times.append(time.perf_counter() - start)
+            assert response.status_code == 200, response.text
+    return times
+
+
+def in_process(trained: object, X: np.ndarray, n: int) -> list[float]:
+    times = []
+    for _ in range(20):
+        trained.predict_proba(X)  # type: ignore[attr-defined]
+    for _ in range(n):
+        start = time.perf_counter()
+        trained.predict_proba(X)  # type: ignore[attr-defined]
+        times.append(time.perf_counter() - start)
+    return times
+
+
+def throughput(
+    url: str, model: str, record: dict[str, object], clients: int, seconds: float
+) -> float:
+    done = 0
+    lock = threading.Lock()
+    stop = time.monotonic() + seconds
+
+    def worker() -> None:
+        nonlocal done
+        with httpx.Client(base_url=url, timeout=60) as client:
+            while time.monotonic() < stop:
+                response = client.post(f"/api/models/{model}/predict", json={"instances": [record]})
+                assert response.status_code == 200
+                with lock:
+                    done += 1
+
+    threads = [threading.Thread(target=worker) for _ in range(clients)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    return done / seconds
+
+
+def run_over_http(url: str, request: dict[str, object]) -> float:
+    with httpx.Client(base_url=url, timeout=60) as client:
+        start = time.perf_counter()
+        run_id = client.post("/api/runs", json=request).json()["id"]
+        while client.get(f"/api/runs/{run_id}").json()["status"] in ("queued", "running"):
+            time.sleep(0.2)
+        return time.perf_counter() - start
+
+
+def run_from_cli(db: str, request: dict[str, object]) -> float:
+    command = [
+        sys.executable,
+        "-m",
+        "app.cli.main",
+        "--db",
+        db,
+        "bench",
+        str(request["dataset"]),
+        "--target",
+        str(request["target"]),
+        "-c",
+        ",".join(request["classifiers"]),  # type: ignore[arg-type]
+        "--folds",
+        str(request["folds"]),
+        "--json",
+    ]
+    start = time.perf_counter()
+    subprocess.run(command, cwd=ROOT, check=True, stdout=subprocess.DEVNULL)
+    return time.perf_counter() - start
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--requests", type=int, default=400)
+    parser.add_argument("--seconds", type=float, default=10.0)
+    parser.add_argument("--run-classifiers", default="nb,j48,logistic,rf")
+    args = parser.parse_args()
+
+    from app.services.datasets import import_file
+    from app.services.models import align_features, load_model, train
+    from app.store.database import Store
+    from benchmark.io import read_arff
+
+    folder = Path(tempfile.mkdtemp(prefix="touchbench-serve-perf-"))
+    db = f"sqlite:///{folder / 'perf.db'}"
+    store = Store(db)
+    source = data_file(folder)
+    imported = import_file(store, source, name="mini")
+    for classifier in ("logistic", "rf"):
+        train(store, "mini", classifier, targets=["gesture"], name=f"mini-{classifier}")
+    data = read_arff(source)
+    process, url = start_service(db, folder)
+    rows = []
+    try:
+        for classifier in ("logistic", "rf"):
+            info, trained = load_model(store, f"mini-{classifier}")
+            X = align_features(trained.schema, data)[:1]
+            record = {
+                attribute.name: (float(value) if np.isfinite(value) else None)
+                for attribute, value in zip(trained.schema.features, X[0], strict=True)
+            }
+            http_times = latency(url, info.name, record, args.requests)
+            local_times = in_process(trained, X, args.requests)
+            overhead = percentile(http_times, 50) - percentile(local_times, 50)
+            rows.append(
+                (
+                    f"{classifier} one instance: HTTP p50 / p99 (ms)",
+                    f"{percentile(http_times, 50):.2f} / {percentile(http_times, 99):.2f}",
+                    f"in-process {percentile(local_times, 50):.2f} / "
+                    f"{percentile(local_times, 99):.2f}",
+                    f"overhead p50 {overhead:.2f} ms",
+                )
+            )
+            local_rate = 1.0 / statistics.mean(local_times)
+            for clients in (8, 32):
+                rate = throughput(url, info.name, record, clients, args.seconds)
+                rows.append(
+                    (
+                        f"{classifier} throughput, {clients} clients (req/s)",
+                        f"{rate:.0f}",
+                        f"in-process {local_rate:.0f}",
+                        f"ratio {rate / local_rate:.2f}",
+                    )
+                )
+        request = {
+            "dataset": "mini",
+            "target": "gesture",
+            "classifiers": args.run_classifiers.split(","),
+            "folds": 10,
+        }
+        http_seconds = run_over_http(url, request)
+        cli_seconds = run_from_cli(db, request)
+        rows.append(
+            (
+                f"run {args.run_classifiers} x 10 folds (s)",
+                f"HTTP {http_seconds:.1f}",
+                f"CLI {cli_seconds:.1f}",
+                f"ratio {http_seconds / cli_seconds:.3f}",
+            )
+        )
+    finally:
+        process.terminate()
+        process.wait(timeout=30)
+        store.dispose()
+    print(f"data: {source} ({imported.n_instances} instances); load {os.getloadavg()[0]:.1f}")
+    width = max(len(row[0]) for row in rows)
+    for row in rows:
+        print(f"{row[0]:<{width}}  {row[1]:>16}  {row[2]:>22}  {row[3]}")
+
+
+if __name__ == "__main__":
+    main()
