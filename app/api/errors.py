@@ -90,7 +90,8 @@ def install(app: FastAPI) -> None:
         )
 
     async def too_large(request: Request, error: Exception) -> JSONResponse:
-        return JSONResponse(error_body("UploadTooLarge", str(error), "body"), status_code=413)
+        cause = _caused_by(error, UploadTooLarge) or error
+        return JSONResponse(error_body("UploadTooLarge", str(cause), "body"), status_code=413)
 
     async def invalid(request: Request, error: Exception) -> JSONResponse:
         assert isinstance(error, RequestValidationError)
@@ -105,6 +106,8 @@ def install(app: FastAPI) -> None:
 
     async def http_error(request: Request, error: Exception) -> JSONResponse:
         assert isinstance(error, StarletteHTTPException)
+        if _caused_by(error, UploadTooLarge):  # FastAPI wraps errors met reading a form
+            return await too_large(request, error)
         headers = getattr(error, "headers", None)
         return JSONResponse(
             error_body(_http_kind(error.status_code), str(error.detail)),
@@ -125,6 +128,16 @@ def install(app: FastAPI) -> None:
     app.add_exception_handler(RequestValidationError, invalid)
     app.add_exception_handler(StarletteHTTPException, http_error)
     app.add_exception_handler(Exception, unexpected)
+
+
+def _caused_by(error: BaseException, kind: type[BaseException]) -> BaseException | None:
+    """``error`` or the first exception of ``kind`` in its chain of causes."""
+    seen: BaseException | None = error
+    while seen is not None:
+        if isinstance(seen, kind):
+            return seen
+        seen = seen.__cause__ or seen.__context__
+    return None
 
 
 def _http_kind(status: int) -> str:

@@ -131,10 +131,15 @@ def test_uploads_over_the_limit_are_refused_while_streaming(
     assert response.status_code == 413
     assert response.json()["error"]["type"] == "UploadTooLarge"
 
-    def chunks() -> Iterator[bytes]:
+    def chunks() -> Iterator[bytes]:  # a valid multipart body, sent without a length
+        yield (
+            b'--x\r\nContent-Disposition: form-data; name="recordings"; filename="big.wav"'
+            b"\r\nContent-Type: application/octet-stream\r\n\r\n"
+        )
         with big.open("rb") as handle:
             while block := handle.read(65536):
                 yield block
+        yield b"\r\n--x--\r\n"
 
     streamed = server.client.post(
         "/api/datasets/recordings",
