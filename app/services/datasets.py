@@ -114,7 +114,8 @@ def import_file(
         By default from the file name's ending.
     source_name : str, optional
         The name the user knows the file by (an upload's file name, when ``path`` is a
-        temporary copy): it names the data set and is kept as its source.
+        temporary copy): it names the data set, is kept as its source, and is what error
+        messages call the file.
     progress : callable, optional
         Called with (what is being done, bytes done, bytes in all).
 
@@ -137,11 +138,12 @@ def import_file(
         check_name(name, kind="dataset")
     chosen = file_format or guess_format(Path(shown))
     notes: list[str] = []
-    with _open_data(path, chosen, targets, Path(shown).stem, progress, notes) as data:
-        _check_schema(data.schema, str(path), notes)
+    label = source_name or str(path)  # what messages call the file
+    with _open_data(path, label, chosen, targets, Path(shown).stem, progress, notes) as data:
+        _check_schema(data.schema, label, notes)
         existing = stored.stored_digest(store, data.scan.sha256)
         if existing is None:
-            checked = _CheckedInstances(data, str(path), progress)
+            checked = _CheckedInstances(data, label, progress)
             info, created = stored.add_dataset_stream(
                 store,
                 checked,
@@ -182,6 +184,7 @@ class _Opened:
 @contextlib.contextmanager
 def _open_data(
     path: Path,
+    label: str,
     file_format: FileFormat,
     targets: int | Sequence[str] | None,
     stem: str,
@@ -193,15 +196,14 @@ def _open_data(
             progress("checking", done, total)
 
     if file_format == "arff":
-        with open_arff(path, targets=targets, progress=scanned) as reader:
+        with open_arff(path, targets=targets, progress=scanned, source=label) as reader:
             yield _Opened(reader.scan, reader)
         return
-    source = check_regular_file(path)
-    with open_binary(source) as stream:
-        scan = scan_file(stream, source=source, size=os.fstat(stream.fileno()).st_size)
+    with open_binary(check_regular_file(path)) as stream:
+        scan = scan_file(stream, source=label, size=os.fstat(stream.fileno()).st_size)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", DataWarning)
-        dataset = read_csv(path, targets=targets, relation=stem)
+        dataset = read_csv(path, targets=targets, relation=stem, source=label)
     notes += [str(w.message) for w in caught if issubclass(w.category, DataWarning)]
     yield _Opened(scan, DatasetInMemory(dataset))
 

@@ -184,6 +184,7 @@ def open_arff(
     parser: Parser = "auto",
     block_bytes: int = BLOCK_BYTES,
     progress: Progress | None = None,
+    source: str | None = None,
 ) -> Iterator[ArffReader]:
     """An ARFF file opened for reading in blocks.
 
@@ -199,6 +200,9 @@ def open_arff(
         As in :class:`ArffReader`.
     progress : callable, optional
         Called with (bytes read, file size) while the file is scanned.
+    source : str, optional
+        The name messages give the file (an upload's name when ``path`` is a temporary
+        copy); ``path`` by default.
 
     Yields
     ------
@@ -210,8 +214,9 @@ def open_arff(
         If the file does not exist, is not a regular file, is not text, or its header
         is wrong.
     """
-    source = check_regular_file(path)
-    with open_binary(source) as stream:
+    named = check_regular_file(path)
+    source = source or named
+    with open_binary(named) as stream:
         try:
             size = os.fstat(stream.fileno()).st_size
             head = stream.read(SNIFF_BYTES)

@@ -150,6 +150,7 @@ def read_csv(
     *,
     targets: int | Sequence[str] | None = None,
     relation: str | None = None,
+    source: str | None = None,
 ) -> Dataset:
     """Read a CSV file whose first row names the columns.
 
@@ -162,6 +163,9 @@ def read_csv(
         the last column.
     relation : str, optional
         The relation name; the file name without its extension by default.
+    source : str, optional
+        The name messages give the file (an upload's name when ``path`` is a temporary
+        copy); ``path`` by default.
 
     Returns
     -------
@@ -180,7 +184,8 @@ def read_csv(
     DataWarning
         When a column is nominal because of a few words among numbers.
     """
-    text, source = read_text_file(path)
+    text, named = read_text_file(path)
+    source = source or named
     records = _records(text, sniff_delimiter(text), source)
     if not records:
         raise DataFormatError("empty file", source=source)

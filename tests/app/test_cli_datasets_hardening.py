@@ -14,6 +14,7 @@ from app.services import datasets as dataset_service
 from app.store import datasets as store_datasets
 from app.store.database import Store
 from app.store.tables import RunRow
+from benchmark.errors import DataFormatError
 from benchmark.io.arff import read_arff
 from tests.app.cli_runner import CliResult, run_cli
 from tests.app.test_cli_datasets import TOUCH_ARFF, write
@@ -348,3 +349,21 @@ def test_help_shows_plain_metavars_and_the_rename_command(
         assert all("<bool>" not in line for line in json_line)
     listing = run_cli(capsys, db, "--help")
     assert "rename" in listing.out
+
+
+def test_an_upload_is_named_and_reported_by_its_own_file_name(
+    store_url: str, tmp_path: Path
+) -> None:
+    store = Store(store_url)
+    temporary = write(tmp_path, "upload-1a2b3c.tmp", TOUCH_ARFF)
+    result = dataset_service.import_file(store, temporary, source_name="robot arm.arff")
+    assert (result.name, result.created) == ("robot_arm", True)
+    assert dataset_service.list_datasets(store)[0].source == "robot arm.arff"
+    broken = write(tmp_path, "upload-4d5e6f.tmp", TOUCH_ARFF.replace("0.75", "oops"))
+    with pytest.raises(DataFormatError) as caught:
+        dataset_service.import_file(store, broken, source_name="bad.arff")
+    assert str(caught.value).startswith("bad.arff:12: attribute 'energy'")
+    csv = write(tmp_path, "upload-7a8b9c.tmp", "a,b\n1,x\n2,y,3\n")
+    with pytest.raises(DataFormatError, match=r"^bad\.csv:3: "):
+        dataset_service.import_file(store, csv, source_name="bad.csv")
+    store.dispose()

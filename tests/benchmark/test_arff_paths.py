@@ -271,3 +271,12 @@ def test_every_reference_file_reads_alike(shared_datasets: Path, relative: str) 
 def test_the_reference_files_are_all_compared(shared_datasets: Path) -> None:
     found = {str(p.relative_to(shared_datasets)) for p in shared_datasets.rglob("*.arff")}
     assert found == set(REFERENCE_FILES)
+
+
+def test_pandas_before_3_1_is_asked_for_pythons_own_float_conversion() -> None:
+    from benchmark.io.arff_fast import _exact_floats
+
+    assert _exact_floats("2.2.3") == {"float_precision": "round_trip"}
+    assert _exact_floats("3.0.6") == {"float_precision": "round_trip"}
+    assert _exact_floats("3.1.1") == {}
+    assert _exact_floats("4.0.0.dev0+12.gabc") == {}
