@@ -8,9 +8,9 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-from sqlalchemy import Engine, create_engine, event, text
+from sqlalchemy import Engine, create_engine, event, inspect, text
 from sqlalchemy.engine import make_url
-from sqlalchemy.exc import ArgumentError, DatabaseError, OperationalError, ProgrammingError
+from sqlalchemy.exc import ArgumentError, DatabaseError, OperationalError
 from sqlalchemy.orm import Session, sessionmaker
 
 from app.errors import AppError
@@ -40,7 +40,9 @@ class Store:
         """Bring the schema to the newest revision (a no-op when it is there).
 
         The revision is read with one query; Alembic is imported only when a migration is
-        due, which keeps every CLI command's start-up short.
+        due, which keeps every CLI command's start-up short.  Processes that open a new
+        store at the same moment migrate it one at a time: PostgreSQL through an advisory
+        lock, SQLite through its write lock taken before the revision is read again.
         """
         try:
             revision = self.revision()
@@ -54,6 +56,9 @@ class Store:
             config = Config()
             config.set_main_option("script_location", str(MIGRATIONS))
             with self.engine.begin() as connection:
+                _lock_for_migration(connection)
+                if _revision(connection) == HEAD_REVISION:
+                    return  # another process migrated it while this one waited
                 config.attributes["connection"] = connection
                 command.upgrade(config, "head")
         except (OperationalError, DatabaseError) as error:
@@ -78,14 +83,7 @@ class Store:
     def revision(self) -> str | None:
         """The schema revision the store is at, ``None`` for an empty database."""
         with self.engine.connect() as connection:
-            try:
-                return connection.execute(
-                    text("SELECT version_num FROM alembic_version")
-                ).scalar_one_or_none()
-            except (OperationalError, ProgrammingError) as error:
-                if "alembic_version" in str(error):
-                    return None
-                raise
+            return _revision(connection)
 
     @contextmanager
     def session(self) -> Iterator[Session]:
@@ -95,6 +93,31 @@ class Store:
 
     def dispose(self) -> None:
         self.engine.dispose()
+
+
+#: Key of the PostgreSQL advisory lock held while a store is migrated.
+_MIGRATION_LOCK = 0x746F7563  # "touc"
+
+
+def _revision(connection: Any) -> str | None:
+    if not inspect(connection).has_table("alembic_version"):
+        return None
+    value = connection.execute(text("SELECT version_num FROM alembic_version")).scalar()
+    return None if value is None else str(value)
+
+
+def _lock_for_migration(connection: Any) -> None:
+    """Hold, until the transaction ends, a lock that other migrating processes wait for."""
+    if connection.dialect.name == "postgresql":
+        connection.execute(text(f"SELECT pg_advisory_xact_lock({_MIGRATION_LOCK})"))
+    elif connection.dialect.name == "sqlite":
+        # a write that takes SQLite's lock at once; rolled back with the rest on failure
+        connection.execute(
+            text(
+                "CREATE TABLE IF NOT EXISTS alembic_version "
+                "(version_num VARCHAR(32) NOT NULL PRIMARY KEY)"
+            )
+        )
 
 
 def _normalise(url: str) -> str:

@@ -354,3 +354,22 @@ def test_error_lines_are_not_wrapped(tmp_path: Path) -> None:
     assert done.returncode == 2
     assert len(done.stderr.strip().splitlines()) == 1, done.stderr
     assert json.dumps(done.stderr)  # printable
+
+
+def test_processes_opening_a_new_store_at_once_migrate_it_once(store_url: str) -> None:
+    environment = {**os.environ, "PYTHONPATH": str(ROOT)}
+    processes = [
+        subprocess.Popen(
+            [sys.executable, "-m", "app.cli.main", "--db", store_url, "datasets", "--json"],
+            cwd=ROOT,
+            env=environment,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        for _ in range(4)
+    ]
+    results = [(p.wait(120), *p.communicate()) for p in processes]
+    assert [code for code, _, _ in results] == [0, 0, 0, 0], results
+    assert all(json.loads(out) == {"datasets": []} for _, out, _ in results)
+    assert _scalar(store_url, "SELECT count(*) FROM alembic_version") == 1
