@@ -3,15 +3,24 @@
 from __future__ import annotations
 
 import math
+from datetime import UTC, datetime
 from typing import Any
 
-from pydantic import BaseModel, ConfigDict
+from pydantic import BaseModel, ConfigDict, field_validator
 
 
 class Schema(BaseModel):
-    """A response model: JSON-ready (``to_json``), NaN and infinities as ``null``."""
+    """A response model: JSON-ready (``to_json``), NaN and infinities as ``null``, every
+    time with its zone (the store keeps UTC; SQLite hands it back without the zone)."""
 
     model_config = ConfigDict(extra="forbid", ser_json_inf_nan="null")
+
+    @field_validator("*", mode="after")
+    @classmethod
+    def _utc(cls, value: Any) -> Any:
+        if isinstance(value, datetime) and value.tzinfo is None:
+            return value.replace(tzinfo=UTC)
+        return value
 
     def to_json(self) -> dict[str, Any]:
         """The plain JSON object (what ``--json`` prints and the API answers)."""

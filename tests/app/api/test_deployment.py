@@ -96,7 +96,11 @@ def dask_cluster(tmp_path: Path) -> Iterator[str]:
     log = (tmp_path / "dask.log").open("wb")
     processes = [
         subprocess.Popen(
-            scheduler_command, stdout=log, stderr=subprocess.STDOUT, start_new_session=True
+            scheduler_command,
+            env=environment,
+            stdout=log,
+            stderr=subprocess.STDOUT,
+            start_new_session=True,
         ),
     ]
     time.sleep(1.0)
