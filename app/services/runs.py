@@ -17,13 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from app.errors import AppError
-from app.schemas.runs import (
-    LeaderboardRowSchema,
-    LeaderboardSchema,
-    MarkSummary,
-    MetricValue,
-    RunStatus,
-)
+from app.schemas.runs import LeaderboardRowSchema, LeaderboardSchema, MarkSummary, RunStatus
 from app.store.database import Store
 from app.store.datasets import find_dataset, load_dataset
 from app.store.ownership import process_owner
@@ -394,40 +388,24 @@ def leaderboard_schema(
     (multi-target rows carry ``metrics.per_target``)."""
     run, board = run_leaderboard(store, run_id, metric=metric, baseline=baseline)
     per_target = per_target_summary(load_results(store, run.id))
-    rows = []
-    for row in board.rows:
-        metrics: dict[str, Any] = {
-            name: MetricValue(mean=mean, std=std) for name, (mean, std) in row.metrics.items()
-        }
-        if per_target.get(row.classifier):
-            metrics["per_target"] = {
-                target: {
-                    name: MetricValue(mean=mean, std=std) for name, (mean, std) in scores.items()
-                }
-                for target, scores in per_target[row.classifier].items()
+    data = board.to_json()
+    for row in data["leaderboard"]:
+        targets = per_target.get(row["classifier"])
+        if targets:
+            row["metrics"]["per_target"] = {
+                target: {name: {"mean": mean, "std": std} for name, (mean, std) in scores.items()}
+                for target, scores in targets.items()
             }
-        rows.append(
-            LeaderboardRowSchema(
-                rank=row.rank,
-                classifier=row.classifier,
-                mark=row.mark,
-                metrics=metrics,
-                n_ok=row.n_ok,
-                n_failed=row.n_failed,
-                errors=row.errors,
-            )
-        )
-    better, same, worse = board.summary
     report = LeaderboardSchema(
         run_id=run.id,
         dataset=run.dataset_name,
         kind=run.kind,
         targets=run.targets,
         status=run.status,
-        metric=board.metric,
-        baseline=board.baseline,
-        summary=MarkSummary(better=better, same=same, worse=worse),
-        leaderboard=rows,
+        metric=data["metric"],
+        baseline=data["baseline"],
+        summary=MarkSummary(**data["summary"]),
+        leaderboard=[LeaderboardRowSchema(**row) for row in data["leaderboard"]],
     )
     return run, board, report
 
