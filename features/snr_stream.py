@@ -16,9 +16,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from features._checks import as_positive_int, as_samplerate
+from features.framing import frame
 from features.history import History
 from features.snr import SnrTrack, Touch, follow_floor, tracking_windows
-from features.framing import frame
 from features.temporal import rms
 
 

@@ -49,8 +49,8 @@ class Window(Extractor):
         onsets = np.array([event.onset for event in detection.events], dtype=np.int64)
         fits = onsets + length <= n_samples
         warnings = [
-            f"event at {(onset + detection.origin) / samplerate:.3f} s leaves fewer than {length} samples before "
-            "the end of the recording and was left out"
+            f"event at {(onset + detection.origin) / samplerate:.3f} s leaves fewer than "
+            f"{length} samples before the end of the recording and was left out"
             for onset in onsets[~fits]
         ]
         onsets = onsets[fits]
