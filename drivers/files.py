@@ -55,7 +55,7 @@ def read_recording(path: str | Path, *, samplerate: float | None = None) -> Reco
     if path.is_dir():
         raise DriverError(f"{path}: is a folder, not a recording")
     if samplerate is not None:
-        samplerate = _check_rate(samplerate, path, "the given samplerate")
+        samplerate = check_rate(samplerate, path, "the given samplerate")
     suffix = path.suffix.lower()
     if suffix == ".npy":
         samples, rate = _read_npy(path), samplerate
@@ -70,7 +70,7 @@ def read_recording(path: str | Path, *, samplerate: float | None = None) -> Reco
     return _finish(samples, rate, path)
 
 
-def _check_rate(rate: float, path: Path, what: str) -> float:
+def check_rate(rate: float, path: Path, what: str) -> float:
     try:
         value = float(rate)
     except (TypeError, ValueError):
@@ -98,7 +98,7 @@ def _read_audio(path: Path, samplerate: float | None) -> tuple[np.ndarray, float
         data, rate = soundfile.read(str(path), dtype="float64", always_2d=True)
     except (soundfile.LibsndfileError, RuntimeError, TypeError) as error:
         raise DriverError(f"{path}: cannot read as audio: {error}") from None
-    rate = _check_rate(rate, path, "the file's sample rate")
+    rate = check_rate(rate, path, "the file's sample rate")
     if samplerate is not None and abs(samplerate - rate) > 1e-6:
         raise DriverError(
             f"{path}: the file is sampled at {rate:g} Hz, but samplerate={samplerate:g} was given"

@@ -133,7 +133,7 @@ class SnrEvents(EventStream):
         """Merge ended touches into events as in the whole-recording detector; an event is
         final once no touch still going on overlaps it, or once it reaches max_event."""
         assert self.track is not None
-        events = []
+        events: list[Event] = []
         while True:
             cut = self._cut
             self._ended.sort(key=lambda t: (max(t.first_window, cut), t.channel))

@@ -23,7 +23,7 @@ class History:
     """
 
     def __init__(self, n_rows: int, dtype: type = np.float64) -> None:
-        self._buffer = np.zeros((n_rows, 1024), dtype=dtype)
+        self._buffer: np.ndarray = np.zeros((n_rows, 1024), dtype=dtype)
         self._first = 0  # buffer column of absolute column ``start``
         self.start = 0
         self.stop = 0

@@ -84,7 +84,7 @@ class Recipe:
         return cls(
             extractor=extractor,
             events=kind,
-            extractor_options=dict(make_extractor(extractor, mine).params),
+            extractor_options=dict(make_extractor(extractor, _given(mine)).params),
             event_options=resolve_options(
                 EVENT_KINDS[kind].options, detector, owner=f"events '{kind}'"
             ),
@@ -93,7 +93,7 @@ class Recipe:
         )
 
     def make_extractor(self) -> Extractor:
-        return make_extractor(self.extractor, self.extractor_options)
+        return make_extractor(self.extractor, _given(self.extractor_options))
 
     def open(self, *, samplerate: float, n_channels: int) -> FeatureStream:
         """A :class:`FeatureStream` for a stream of ``n_channels`` at ``samplerate`` Hz."""
@@ -127,12 +127,17 @@ class Recipe:
                 str(data["extractor"]),
                 events=str(data["events"]),
                 segment=data.get("segment"),
-                options={**data.get("extractor_options", {}), **data.get("event_options", {})},
+                options=_given({**data["extractor_options"], **data["event_options"]}),
                 max_event=data.get("max_event"),
             )
         except (KeyError, TypeError, AttributeError) as error:
             raise FeatureError(f"not an extraction recipe: {error!r}") from None
         return recipe
+
+
+def _given(options: Mapping[str, Any]) -> dict[str, Any]:
+    """Options without the unset ones (``None`` stands for the default)."""
+    return {key: value for key, value in options.items() if value is not None}
 
 
 def _plain(options: Mapping[str, Any]) -> dict[str, Any]:
