@@ -325,22 +325,41 @@ class DbscanEvents(EventStream):
         return self._cluster(final=final)
 
     def _cluster(self, *, final: bool) -> list[Event]:
-        """Cluster the runs no later detection can reach; cut a group that grows too long."""
-        open_channels = np.flatnonzero(self._open >= 0)
-        starts = [begin for _, begin, _ in self._runs] + [int(self._open[c]) for c in open_channels]
-        if not starts:
-            return []
-        if not final:
-            last_stop = max((end for _, _, end in self._runs), default=self._filtered_until)
-            reachable = self._filtered_until - (last_stop - 1) <= self.radius
-            if open_channels.size or reachable:
-                if self._filtered_until - min(starts) < self.max_samples:
-                    return []
+        """Cluster the runs no later detection can reach; cut a group at max_event."""
+        events: list[Event] = []
+        while True:
+            open_channels = np.flatnonzero(self._open >= 0)
+            starts = [begin for _, begin, _ in self._runs]
+            starts += [int(self._open[c]) for c in open_channels]
+            if not starts:
+                return events
+            cut = min(starts) + self.max_samples
+            if cut < self._filtered_until:
                 self._cut_warning(min(starts))
-                for c in open_channels:  # they go on as new runs from here
-                    self._runs.append((int(c), int(self._open[c]), self._filtered_until))
-                    self._open[c] = self._filtered_until
-        found, self._runs = self._runs, []
+                events += self._flush_before(cut)
+                continue
+            if not final:
+                last_stop = max((end for _, _, end in self._runs), default=self._filtered_until)
+                reachable = self._filtered_until - (last_stop - 1) <= self.radius
+                if open_channels.size or reachable:
+                    return events
+            return events + self._flush_before(self._filtered_until + 1)
+
+    def _flush_before(self, cut: int) -> list[Event]:
+        """Cluster the runs (or their parts) before sample ``cut``; the rest goes on."""
+        found, kept = [], []
+        for channel, begin, end in self._runs:
+            if begin >= cut:
+                kept.append((channel, begin, end))
+                continue
+            found.append((channel, begin, min(end, cut)))
+            if end > cut:
+                kept.append((channel, cut, end))
+        for channel in np.flatnonzero(self._open >= 0):
+            if self._open[channel] < cut:
+                found.append((int(channel), int(self._open[channel]), cut))
+                self._open[channel] = cut
+        self._runs = kept
         ordered = sorted(found)  # by channel, then start: the whole-recording order
         return dbscan_events(
             np.array([r[0] for r in ordered], dtype=np.int64),
