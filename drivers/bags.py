@@ -196,7 +196,8 @@ class RosbagSource(Source):
                         f"{data.size} bytes, not whole {self.sample_format} frames of "
                         f"{self.n_channels} channels"
                     )
-                samples = data.view(dtype).reshape(-1, self.n_channels).T / scale
+                frames = data.view(dtype).reshape(-1, self.n_channels)
+                samples = np.ascontiguousarray(frames.T, dtype=np.float64) / scale
                 yield Block(samples, self.start_time + position / self.samplerate)
                 position += samples.shape[1]
         except DriverError:

@@ -159,7 +159,8 @@ class SoundDeviceSource(Source):
             with self._lock:
                 self.overflows += 1
         try:
-            self._queue.put_nowait((data.T.astype(np.float64), time.perf_counter()))
+            block = np.ascontiguousarray(data.T, dtype=np.float64)
+            self._queue.put_nowait((block, time.perf_counter()))
         except queue.Full:
             with self._lock:
                 self.overflows += 1

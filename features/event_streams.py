@@ -53,6 +53,7 @@ class EventStream(ABC):
 
     def feed(self, block: np.ndarray) -> list[Event]:
         """The events that became final with ``block`` (n_channels, n)."""
+        block = np.ascontiguousarray(block, dtype=np.float64)
         self.position += block.shape[1]
         return self._feed(block)
 

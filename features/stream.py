@@ -86,7 +86,8 @@ class FeatureStream:
         Instances
             Spans in samples from the start of the stream; warnings of the events.
         """
-        block = as_signal(block, name="block", min_samples=0)
+        # C order: sums over a window then run in the order of the whole-recording functions.
+        block = np.ascontiguousarray(as_signal(block, name="block", min_samples=0))
         if block.ndim != 2 or block.shape[0] != self.n_channels:
             raise FeatureError(
                 f"a block must have shape ({self.n_channels}, n_samples), got {block.shape}"

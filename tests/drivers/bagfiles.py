@@ -33,7 +33,7 @@ def write_audio_bag(
     coding_format: str = "wave",
     stamped: bool = False,
     message_samples: int = 1024,
-    topic: str = "/audio/audio",
+    topic: str | None = "/audio/audio",
     info_topic: str | None = "/audio/audio_info",
     audio_delay: float = 0.25,
     extra_topic: bool = True,
@@ -60,7 +60,7 @@ def write_audio_bag(
         plugin = StoragePlugin.MCAP if path.suffix == ".mcap" else StoragePlugin.SQLITE3
         writer = Writer(path.with_suffix(""), version=9, storage_plugin=plugin)
     with writer as bag:  # type: ignore[attr-defined]
-        audio = bag.add_connection(topic, data_type, typestore=store)
+        audio = None if topic is None else bag.add_connection(topic, data_type, typestore=store)
         if extra_topic:
             status = bag.add_connection("/status", "std_msgs/msg/String", typestore=store)
             bag.write(
@@ -81,7 +81,7 @@ def write_audio_bag(
             )
             bag.write(info, start + 1, serialize(message, "audio_common_msgs/msg/AudioInfo"))
         first = start + round(audio_delay * 1e9)
-        for begin in range(0, samples.shape[1], message_samples):
+        for begin in range(0, samples.shape[1] if audio is not None else 0, message_samples):
             chunk = encode(samples[:, begin : begin + message_samples], sample_format)
             payload = types["audio_common_msgs/msg/AudioData"](data=chunk)
             stamp = first + round(begin / samplerate * 1e9)
@@ -105,4 +105,30 @@ def write_audio_bag(
             database.execute(
                 "DELETE FROM message_definitions WHERE topic_type LIKE 'audio_common_msgs/%'"
             )
+    return folder
+
+
+def write_other_audio_bag(path: Path) -> Path:
+    """A ROS 2 .mcap bag whose topic /audio has a type named
+    ``audio_common_msgs/msg/AudioData`` but another package's definition."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    store.register(get_types_from_msg(OTHER_AUDIO_DATA, "audio_common_msgs/msg/AudioData"))
+    kind = store.types["audio_common_msgs/msg/AudioData"]
+    folder = path.with_suffix("")
+    with Writer(folder, version=9, storage_plugin=StoragePlugin.MCAP) as bag:
+        audio = bag.add_connection("/audio", "audio_common_msgs/msg/AudioData", typestore=store)
+        empty = {
+            name: np.zeros(0, dtype=dtype)
+            for name, dtype in (
+                ("float32_data", np.float32),
+                ("int32_data", np.int32),
+                ("int8_data", np.int8),
+                ("uint8_data", np.uint8),
+            )
+        }
+        message = kind(int16_data=np.zeros(512, dtype=np.int16), **empty)
+        bag.write(audio, 1, store.serialize_cdr(message, "audio_common_msgs/msg/AudioData"))
     return folder
