@@ -26,6 +26,8 @@ from drivers.errors import DriverError
 from drivers.source import Block, Source
 
 _END = None
+#: sample format -> full scale
+_SCALES = {"int16": 32768.0, "int32": 2147483648.0, "float32": 1.0}
 
 
 @dataclass(frozen=True)
@@ -110,6 +112,9 @@ class SoundDeviceSource(Source):
         Audio the queue holds before blocks are dropped (and counted).
     seconds : float, optional
         Stop after this much audio; run until closed otherwise.
+    sample_format : {"int16", "int32", "float32"}
+        What PortAudio delivers (scaled to full scale -1 to 1 here); 16-bit by default,
+        the format every sound card has.
     """
 
     def __init__(
@@ -121,7 +126,13 @@ class SoundDeviceSource(Source):
         block_length: int = 1024,
         queue_seconds: float = 5.0,
         seconds: float | None = None,
+        sample_format: str = "int16",
     ) -> None:
+        if sample_format not in _SCALES:
+            raise DriverError(
+                f"sample_format must be one of {', '.join(_SCALES)}, got '{sample_format}'"
+            )
+        self.sample_format = sample_format
         sd = portaudio()
         found = find_device(device)
         self.device = found
@@ -138,7 +149,7 @@ class SoundDeviceSource(Source):
                     device=found.index,
                     channels=self.n_channels,
                     samplerate=self.samplerate,
-                    dtype="float32",
+                    dtype=sample_format,
                 )
         except sd.PortAudioError as error:
             raise DriverError(
@@ -159,7 +170,7 @@ class SoundDeviceSource(Source):
             with self._lock:
                 self.overflows += 1
         try:
-            block = np.ascontiguousarray(data.T, dtype=np.float64)
+            block = np.ascontiguousarray(data.T, dtype=np.float64) / _SCALES[self.sample_format]
             self._queue.put_nowait((block, time.perf_counter()))
         except queue.Full:
             with self._lock:
@@ -173,7 +184,7 @@ class SoundDeviceSource(Source):
                     channels=self.n_channels,
                     samplerate=self.samplerate,
                     blocksize=self.block_length,
-                    dtype="float32",
+                    dtype=self.sample_format,
                     callback=self._callback,
                 )
                 self._stream.start()

@@ -84,12 +84,9 @@ def record_command(
         labels=targets,
         on_touch=show,
     )
-    if take.overflows:
-        info(f"[yellow]warning:[/yellow] {take.overflows} block(s) were lost (overflow)")
-    summary = (
-        f"{take.path}: {take.seconds:.2f} s, {take.touches} touch(es) detected, "
-        f"labelled in {take.labels}"
-    )
+    lost = f", {take.overflows} block(s) LOST to overflow" if take.overflows else ""
+    where = f", labelled in {take.labels}" if targets else ""
+    summary = f"{take.path}: {take.seconds:.2f} s, {take.touches} touch(es) detected{lost}{where}"
     if take.interrupted and seconds is not None:
         raise AppError(f"interrupted by Ctrl-C; the take so far is kept: {summary}")
     info(summary)
@@ -157,29 +154,47 @@ def live_command(
         float | None, typer.Option("--seconds", min=0.01, help="Stop after this much audio.")
     ] = None,
     topic: Annotated[str | None, typer.Option("--topic", help="Audio topic of a bag.")] = None,
+    channels: Annotated[
+        int | None,
+        typer.Option("--channels", min=1, help="Device channels (default: the model's)."),
+    ] = None,
+    samplerate: Annotated[
+        float | None,
+        typer.Option("--samplerate", help="Device rate in Hz (default: the model's)."),
+    ] = None,
     as_json: Annotated[
         bool, typer.Option("--json", help="One JSON object per touch on stdout (JSON lines).")
     ] = False,
 ) -> None:
     """Predict every touch of a live stream with a model: its own event detection and
     extractor run on the stream, and each touch is printed as soon as it ends."""
-    from app.services.live import open_live
+    from app.services.live import LiveSession, load_live_model
     from drivers.replay import FileReplaySource
     from drivers.sound import SoundDeviceSource
     from drivers.source import Source
 
     if (device is None) == (replay is None):
         raise AppError("give exactly one of --device DEV or --replay FILE")
-    store = get_state(ctx).store
+    info_, trained, extraction = load_live_model(get_state(ctx).store, model)
     source: Source
     if replay is not None:
         source = FileReplaySource(replay, realtime=realtime, topic=topic, block_length=1024)
     else:
         assert device is not None
-        source = SoundDeviceSource(device, seconds=seconds)
+        recipe = extraction or {}
+        source = SoundDeviceSource(
+            device,
+            samplerate=samplerate or recipe.get("samplerate"),
+            channels=channels or recipe.get("n_channels"),
+            seconds=seconds,
+        )
     with source:
-        session = open_live(
-            store, model, samplerate=source.samplerate, n_channels=source.n_channels
+        session = LiveSession(
+            info_,
+            trained,
+            samplerate=source.samplerate,
+            n_channels=source.n_channels,
+            extraction=extraction,
         )
         shown = 0
         try:

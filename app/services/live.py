@@ -221,15 +221,19 @@ def model_extraction(store: Store, model_id: int) -> dict[str, Any] | None:
         return dict(dataset.extraction) if dataset is not None and dataset.extraction else None
 
 
-def open_live(store: Store, ref: str | int, *, samplerate: float, n_channels: int) -> LiveSession:
-    """A :class:`LiveSession` of the stored model ``ref`` (name or id)."""
+def load_live_model(
+    store: Store, ref: str | int
+) -> tuple[Any, TrainedModel, dict[str, Any] | None]:
+    """A stored model (name or id), its artifact checked, and its extraction recipe."""
     from app.services.models import load_model
 
     info, model = load_model(store, ref)
+    return info, model, model_extraction(store, info.id)
+
+
+def open_live(store: Store, ref: str | int, *, samplerate: float, n_channels: int) -> LiveSession:
+    """A :class:`LiveSession` of the stored model ``ref`` (name or id)."""
+    info, model, extraction = load_live_model(store, ref)
     return LiveSession(
-        info,
-        model,
-        samplerate=samplerate,
-        n_channels=n_channels,
-        extraction=model_extraction(store, info.id),
+        info, model, samplerate=samplerate, n_channels=n_channels, extraction=extraction
     )
