@@ -356,10 +356,10 @@ class DbscanEvents(EventStream):
             found.append((channel, begin, min(end, cut)))
             if end > cut:
                 kept.append((channel, cut, end))
-        for channel in np.flatnonzero(self._open >= 0):
-            if self._open[channel] < cut:
-                found.append((int(channel), int(self._open[channel]), cut))
-                self._open[channel] = cut
+        for going in np.flatnonzero(self._open >= 0):
+            if self._open[going] < cut:
+                found.append((int(going), int(self._open[going]), cut))
+                self._open[going] = cut
         self._runs = kept
         ordered = sorted(found)  # by channel, then start: the whole-recording order
         return dbscan_events(
