@@ -159,22 +159,27 @@ class SoundDeviceSource(Source):
             ) from None
         depth = max(2, round(queue_seconds * self.samplerate / block_length))
         self._queue: queue.Queue[tuple[np.ndarray, float] | None] = queue.Queue(maxsize=depth)
-        self.overflows = 0
-        self._captured = 0
+        self.dropped = 0  # blocks the consumer was too slow for (queue full)
+        self.xruns = 0  # callbacks whose input PortAudio reports as overflowed
         self._lock = threading.Lock()
         self._stream: Any = None
         self._sd = sd
 
+    @property
+    def overflows(self) -> int:  # type: ignore[override]
+        """Blocks lost: dropped from a full queue, or reported lost by PortAudio."""
+        return self.dropped + self.xruns
+
     def _callback(self, data: np.ndarray, frames: int, when: Any, status: Any) -> None:
         if status.input_overflow:
             with self._lock:
-                self.overflows += 1
+                self.xruns += 1
         try:
             block = np.ascontiguousarray(data.T, dtype=np.float64) / _SCALES[self.sample_format]
             self._queue.put_nowait((block, time.perf_counter()))
         except queue.Full:
             with self._lock:
-                self.overflows += 1
+                self.dropped += 1
 
     def _open(self) -> None:
         try:
