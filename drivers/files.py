@@ -58,7 +58,7 @@ def read_recording(path: str | Path, *, samplerate: float | None = None) -> Reco
         samplerate = check_rate(samplerate, path, "the given samplerate")
     suffix = path.suffix.lower()
     if suffix == ".npy":
-        samples, rate = _read_npy(path), samplerate
+        samples, rate = np.asarray(open_npy(path), dtype=np.float64), samplerate
     elif suffix in _CSV_SUFFIXES:
         samples, rate = _read_csv(path, samplerate)
     else:
@@ -106,9 +106,10 @@ def _read_audio(path: Path, samplerate: float | None) -> tuple[np.ndarray, float
     return data.T, rate
 
 
-def _read_npy(path: Path) -> np.ndarray:
+def open_npy(path: Path) -> np.ndarray:
+    """A ``.npy`` recording memory-mapped, shape (n_channels, n_samples), values as stored."""
     try:
-        data = np.load(path, allow_pickle=False)
+        data = np.load(path, mmap_mode="r", allow_pickle=False)
     except (OSError, ValueError) as error:
         raise DriverError(f"{path}: cannot read as a .npy array: {error}") from None
     if data.dtype.kind not in "biuf":
@@ -119,7 +120,7 @@ def _read_npy(path: Path) -> np.ndarray:
         raise DriverError(
             f"{path}: must be 1-D (samples) or 2-D (channels, samples), got shape {data.shape}"
         )
-    return data.astype(np.float64)
+    return data
 
 
 def _read_csv(path: Path, samplerate: float | None) -> tuple[np.ndarray, float | None]:

@@ -18,7 +18,7 @@ import numpy as np
 import soundfile
 
 from drivers.errors import DriverError
-from drivers.files import check_rate, read_recording
+from drivers.files import check_rate, open_npy, read_recording
 from drivers.source import Block, RecordingSource, Source, check_finite, paced
 
 CSV_SUFFIXES = frozenset({".csv", ".tsv", ".txt"})
@@ -88,7 +88,7 @@ class FileReplaySource(Source):
             self._inner = RecordingSource(recording, block_length=block_length)
             rate, self.n_channels = recording.samplerate, recording.n_channels
         elif self.path.suffix.lower() == ".npy":
-            self._array = _open_npy(self.path)
+            self._array = open_npy(self.path)
             rate, self.n_channels = samplerate, self._array.shape[0]
         else:
             self._audio = _open_audio(self.path)
@@ -158,19 +158,3 @@ def _open_audio(path: Path) -> soundfile.SoundFile:
         raise DriverError(
             f"{path}: not a recording touchbench can read ({error}); it reads {FORMATS}"
         ) from None
-
-
-def _open_npy(path: Path) -> np.ndarray:
-    try:
-        data = np.load(path, mmap_mode="r", allow_pickle=False)
-    except (OSError, ValueError) as error:
-        raise DriverError(f"{path}: cannot read as a .npy array: {error}") from None
-    if data.dtype.kind not in "biuf":
-        raise DriverError(f"{path}: holds {data.dtype} values, not numbers")
-    if data.ndim == 1:
-        data = data[np.newaxis, :]
-    if data.ndim != 2:
-        raise DriverError(
-            f"{path}: must be 1-D (samples) or 2-D (channels, samples), got shape {data.shape}"
-        )
-    return data

@@ -9,6 +9,7 @@ from typing import Annotated
 
 import typer
 
+from app.cli.extract import key_values
 from app.cli.output import info, print_json, table
 from app.cli.state import get_state
 from app.errors import AppError
@@ -93,14 +94,10 @@ def record_command(
 
 
 def _labels(pairs: list[str]) -> dict[str, str]:
-    labels: dict[str, str] = {}
-    for pair in pairs:
-        target, sep, value = pair.partition("=")
-        if not sep or not target.strip() or not value.strip():
-            raise AppError(f"--label must be TARGET=VALUE, got '{pair}'")
-        if target.strip().lower() in ("file", "start", "end"):
+    labels = key_values(pairs, "--label", "TARGET=VALUE")
+    for target in labels:
+        if target.lower() in ("file", "start", "end"):
             raise AppError(f"--label: '{target}' is a column of the labels file, not a target")
-        labels[target.strip()] = value.strip()
     return labels
 
 

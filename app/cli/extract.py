@@ -85,7 +85,7 @@ def extract_command(
             name=name,
             samplerate=samplerate,
             segment=segment,
-            options=_options(option or []),
+            options=key_values(option or [], "--option"),
             topic=topic,
             max_event=max_event,
             on_progress=reading.update,
@@ -115,14 +115,15 @@ def extract_command(
     )
 
 
-def _options(pairs: list[str]) -> dict[str, str]:
-    options: dict[str, str] = {}
+def key_values(pairs: list[str], option: str, what: str = "KEY=VALUE") -> dict[str, str]:
+    """``["a=1", "b=2"]`` as ``{"a": "1", "b": "2"}``; AppError naming ``option`` if not."""
+    found: dict[str, str] = {}
     for pair in pairs:
         key, sep, value = pair.partition("=")
-        if not sep or not key.strip():
-            raise AppError(f"--option must be KEY=VALUE, got '{pair}'")
-        options[key.strip()] = value.strip()
-    return options
+        if not sep or not key.strip() or not value.strip():
+            raise AppError(f"{option} must be {what}, got '{pair}'")
+        found[key.strip()] = value.strip()
+    return found
 
 
 class _Reading:
