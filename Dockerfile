@@ -1,3 +1,4 @@
+# One image for the API, the Dask scheduler and the Dask workers (docker-compose.yml).
 FROM python:3.11-slim-bookworm
 RUN apt-get update \
     && DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends \
@@ -10,6 +11,9 @@ COPY benchmark ./benchmark
 COPY features ./features
 COPY drivers ./drivers
 RUN pip install --no-cache-dir .
-WORKDIR /data
-ENTRYPOINT []
+RUN useradd --create-home touchbench && mkdir -p /var/lib/touchbench \
+    && chown touchbench /var/lib/touchbench
+USER touchbench
+WORKDIR /var/lib/touchbench
+EXPOSE 8000 8786
 CMD ["touchbench", "--help"]

@@ -15,5 +15,9 @@ class NotFoundError(AppError):
     """A dataset, run or model that the store does not have."""
 
 
+class ConflictError(AppError):
+    """The request clashes with the store's state: a name taken, a run already running."""
+
+
 #: Exceptions that mean the user's input is wrong: exit status 2 on the CLI, 4xx on the API.
 USER_ERRORS: tuple[type[Exception], ...] = (AppError, BenchmarkError, FeatureError, DriverError)

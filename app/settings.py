@@ -2,26 +2,59 @@
 
 from __future__ import annotations
 
+import tempfile
 from functools import lru_cache
+from pathlib import Path
 
+from pydantic import Field, SecretStr
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
 DEFAULT_DATABASE_URL = "sqlite:///touchbench.db"
 
 
 class Settings(BaseSettings):
-    """Every setting of the CLI and the service.
+    """Every setting of the CLI and the service (``TOUCHBENCH_`` + the name, upper case).
 
     Attributes
     ----------
     database_url : str
-        SQLAlchemy URL of the store (``TOUCHBENCH_DATABASE_URL``); SQLite in the current
-        directory by default.
+        SQLAlchemy URL of the store; SQLite in the current directory by default.
+    api_key : SecretStr or None
+        When set, every request but ``GET /healthz`` and the OpenAPI document needs it in
+        the ``X-API-Key`` header. Unset, the service listens on loopback only.
+    max_upload_mb : float
+        Largest upload (data set, recording session, file to predict), enforced while the
+        body streams in.
+    job_workers : int
+        Jobs (runs, extractions, trainings) one service process carries out at once, each in
+        a worker process of its own.
+    run_jobs : int
+        Engine worker processes per run.
+    dask_scheduler : str or None
+        ``tcp://host:port`` of a Dask scheduler: runs' tasks go there instead.
+    resume_on_start : bool
+        Put runs interrupted by a crash back in the queue when the service starts.
+    work_dir : Path
+        Where uploaded recording sessions wait for their extraction job.
+    model_cache : int
+        Loaded models kept in memory per service process for predictions.
     """
 
     model_config = SettingsConfigDict(env_prefix="TOUCHBENCH_", extra="ignore")
 
     database_url: str = DEFAULT_DATABASE_URL
+    api_key: SecretStr | None = None
+    max_upload_mb: float = Field(default=200.0, gt=0)
+    job_workers: int = Field(default=1, ge=1)
+    run_jobs: int = Field(default=1, ge=1)
+    dask_scheduler: str | None = None
+    resume_on_start: bool = False
+    work_dir: Path = Field(default_factory=lambda: Path(tempfile.gettempdir()) / "touchbench")
+    model_cache: int = Field(default=8, ge=1)
+
+    @property
+    def max_upload_bytes(self) -> int:
+        return int(self.max_upload_mb * 2**20)
 
 
 @lru_cache(maxsize=1)

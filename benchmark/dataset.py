@@ -10,7 +10,7 @@ engine's ``X`` and ``Y`` without copying the schema around.
 from __future__ import annotations
 
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
@@ -246,6 +246,73 @@ class Dataset:
         mine = np.ones(self.n_instances) if self.weights is None else self.weights
         theirs = np.ones(other.n_instances) if other.weights is None else other.weights
         return bool(np.array_equal(mine, theirs))
+
+
+@dataclass(frozen=True)
+class InstanceBlock:
+    """Consecutive instances of a data set, as readers and the store hand them on.
+
+    Parameters
+    ----------
+    values : ndarray of shape (n_instances, n_attributes), float64
+        Encoded as in :class:`Dataset`.
+    weights : ndarray of shape (n_instances,) or None
+        Instance weights; ``None`` means all 1.
+    groups : ndarray of shape (n_instances,) or None
+        Recording/session ids, as in :class:`Dataset`.
+    meta : list of dict or None
+        Per-instance provenance, as in :class:`Dataset`.
+    lines : ndarray of shape (n_instances,) or None
+        The 1-based line of the file each instance was read from, for messages.
+    """
+
+    values: np.ndarray
+    weights: np.ndarray | None = None
+    groups: np.ndarray | None = None
+    meta: list[dict[str, Any]] | None = None
+    lines: np.ndarray | None = None
+
+    @property
+    def n_instances(self) -> int:
+        return int(self.values.shape[0])
+
+
+def dataset_blocks(dataset: Dataset, rows: int) -> Iterator[InstanceBlock]:
+    """The instances of ``dataset`` in blocks of at most ``rows``."""
+    for start in range(0, dataset.n_instances, rows):
+        part = slice(start, start + rows)
+        yield InstanceBlock(
+            dataset.values[part],
+            weights=None if dataset.weights is None else dataset.weights[part],
+            groups=None if dataset.groups is None else dataset.groups[part],
+            meta=None if dataset.meta is None else dataset.meta[part],
+        )
+
+
+def join_blocks(schema: Schema, blocks: Iterable[InstanceBlock], *, sparse: bool) -> Dataset:
+    """One data set of ``blocks`` in order (weights, groups and meta kept where any has them)."""
+    parts = list(blocks)
+    n = sum(part.n_instances for part in parts)
+    values = np.empty((n, schema.n_attributes))
+    weights = np.ones(n) if any(part.weights is not None for part in parts) else None
+    groups = (
+        np.full(n, None, dtype=object) if any(part.groups is not None for part in parts) else None
+    )
+    meta: list[dict[str, Any]] | None = None
+    if any(part.meta is not None for part in parts):
+        meta = [{} for _ in range(n)]
+    start = 0
+    for part in parts:
+        stop = start + part.n_instances
+        values[start:stop] = part.values
+        if weights is not None and part.weights is not None:
+            weights[start:stop] = part.weights
+        if groups is not None and part.groups is not None:
+            groups[start:stop] = part.groups
+        if meta is not None and part.meta is not None:
+            meta[start:stop] = part.meta
+        start = stop
+    return Dataset(schema, values, weights=weights, groups=groups, meta=meta, sparse=sparse)
 
 
 def meka_target_count(relation: str) -> int | None:

@@ -60,3 +60,11 @@ class ConfigurationError(BenchmarkError):
 
     Examples: an unknown classifier or target, more folds than the smallest class allows.
     """
+
+
+class DataWarning(UserWarning):
+    """A data file read as it stands, with a choice the user should hear about.
+
+    Example: a CSV column typed nominal because of a few words among numbers.  Callers
+    that import data show these warnings as notes.
+    """

@@ -1,15 +1,15 @@
 """Models trained on a whole data set, and their serialisation.
 
 A :class:`TrainedModel` keeps the schema it was trained on, so that new instances can be
-checked and predicted with the labels of that schema.  Serialised models are plain pickles;
-:func:`loads_model` refuses bytes whose SHA-256 differs from the digest recorded when they
-were stored, because unpickling runs code.
+checked and predicted with the labels of that schema.  Serialised models are skops
+artifacts (:mod:`benchmark.artifacts`): loading one cannot run code, whoever wrote it;
+:func:`loads_model` also refuses bytes whose SHA-256 differs from the digest recorded when
+they were stored (damage in transit or in the store).
 """
 
 from __future__ import annotations
 
 import hashlib
-import pickle
 from dataclasses import dataclass, field
 from importlib import metadata
 from typing import Any
@@ -17,9 +17,11 @@ from typing import Any
 import numpy as np
 from sklearn.base import BaseEstimator
 
-from benchmark.catalogue import build_pipeline, get_spec
+from benchmark.artifacts import dumps_artifact, loads_artifact
+from benchmark.catalogue import get_spec
 from benchmark.dataset import Dataset, Schema
 from benchmark.errors import ConfigurationError
+from benchmark.estimators import build_estimator
 from benchmark.evaluation.metrics import expand_proba
 from benchmark.problem import feature_matrix, problem_from_dataset
 
@@ -136,27 +138,11 @@ def fit_model(dataset: Dataset, classifier_id: str, *, random_state: int = 0) ->
             raise ConfigurationError(
                 f"target '{name}' has a single class in the training data; nothing to learn"
             )
-    estimator: Any
+    estimator = build_estimator(classifier_id, problem, random_state=random_state)
     if problem.kind == "multiclass":
-        spec = get_spec(classifier_id)
-        estimator = build_pipeline(
-            spec,
-            nominal_features=problem.nominal_features,
-            n_features=problem.n_features,
-            random_state=random_state,
-        )
         estimator.fit(problem.X, problem.Y[:, 0])
-        params: dict[str, Any] = dict(spec.params)
+        params: dict[str, Any] = dict(get_spec(classifier_id).params)
     else:
-        from benchmark.multitarget import build_multitarget
-
-        estimator = build_multitarget(
-            classifier_id,
-            nominal_features=problem.nominal_features,
-            n_features=problem.n_features,
-            random_state=random_state,
-            n_classes=problem.n_classes,
-        )
         estimator.fit(problem.X, problem.Y)
         params = {"config": classifier_id}
     params["random_state"] = random_state
@@ -169,8 +155,17 @@ def model_digest(data: bytes) -> str:
 
 
 def dumps_model(model: TrainedModel) -> bytes:
-    """Serialise a model (a pickle; store :func:`model_digest` of it beside it)."""
-    return pickle.dumps(model, protocol=pickle.HIGHEST_PROTOCOL)
+    """Serialise a model as an artifact that cannot run code when loaded (store
+    :func:`model_digest` of it beside it)."""
+    return dumps_artifact(
+        {
+            "classifier": model.classifier,
+            "params": model.params,
+            "schema": model.schema.to_json(),
+            "versions": model.versions,
+            "estimator": model.estimator,
+        }
+    )
 
 
 def loads_model(data: bytes, *, sha256: str) -> TrainedModel:
@@ -179,8 +174,8 @@ def loads_model(data: bytes, *, sha256: str) -> TrainedModel:
     Raises
     ------
     ConfigurationError
-        The digest differs (the bytes are not the ones stored, so they are not unpickled)
-        or the bytes are not a model.
+        The digest differs, the bytes are not a touchbench artifact, or they name types
+        outside the trusted packages (nothing is built from them then).
     """
     actual = model_digest(data)
     if actual != sha256.strip().lower():
@@ -188,13 +183,17 @@ def loads_model(data: bytes, *, sha256: str) -> TrainedModel:
             f"model bytes do not match their recorded sha256 ({sha256[:12]}..., got "
             f"{actual[:12]}...); refusing to load them"
         )
+    content = loads_artifact(data)
     try:
-        model = pickle.loads(data)
-    except Exception as exc:
-        raise ConfigurationError(f"the stored model cannot be loaded: {exc}") from None
-    if not isinstance(model, TrainedModel):
-        raise ConfigurationError(f"the stored bytes hold a {type(model).__name__}, not a model")
-    return model
+        return TrainedModel(
+            classifier=str(content["classifier"]),
+            params=dict(content["params"]),
+            schema=Schema.from_json(content["schema"]),
+            estimator=content["estimator"],
+            versions=dict(content.get("versions", {})),
+        )
+    except (KeyError, TypeError, ValueError) as exc:
+        raise ConfigurationError(f"the stored model is incomplete: {exc}") from None
 
 
 def _library_versions() -> dict[str, str]:

@@ -7,11 +7,12 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from app.cli.output import info, print_json, table
+from app.cli.output import EXIT_FAILED, EXIT_INTERRUPTED, ExitWith, info, print_json, table
 from app.cli.state import get_state
 
 if TYPE_CHECKING:
     from app.services.runs import IndependentResult
+    from app.store.database import Store
     from app.store.runs import RunInfo
     from benchmark.evaluation.leaderboard import Leaderboard
 
@@ -27,6 +28,7 @@ def register(app: typer.Typer) -> None:
     app.command("bench")(bench_command)
     app.command("runs")(runs_command)
     app.command("leaderboard")(leaderboard_command)
+    app.command("cancel")(cancel_command)
 
 
 def classifiers_command(
@@ -138,11 +140,16 @@ def _print_multitarget(suite_name: str | None, as_json: bool) -> None:
 def bench_command(
     ctx: typer.Context,
     dataset: Annotated[
-        str | None, typer.Argument(metavar="DATASET", help="Data set name or id.")
+        str | None,
+        typer.Argument(metavar="DATASET", help="Data set name or id.", show_default=False),
     ] = None,
     target: Annotated[
         str | None,
-        typer.Option("--target", help="Benchmark this one target with the multi-class catalogue."),
+        typer.Option(
+            "--target",
+            metavar="NAME",
+            help="Benchmark this one target with the multi-class catalogue.",
+        ),
     ] = None,
     classifiers: Annotated[
         str | None,
@@ -150,25 +157,61 @@ def bench_command(
     ] = None,
     suite_name: Annotated[
         str | None,
-        typer.Option("--suite", help="fast, default or all (default: default)."),
+        typer.Option("--suite", metavar="NAME", help="fast, default or all (default: default)."),
     ] = None,
-    folds: Annotated[int, typer.Option("--folds", "-k", min=2, help="Folds per repeat.")] = 10,
-    repeats: Annotated[int, typer.Option("--repeats", "-r", min=1, help="Repeats of k-fold.")] = 1,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of folds and classifiers.")] = 0,
-    jobs: Annotated[int, typer.Option("--jobs", "-j", min=1, help="Parallel local workers.")] = 1,
+    folds: Annotated[
+        int, typer.Option("--folds", "-k", min=2, metavar="K", help="Folds per repeat.")
+    ] = 10,
+    repeats: Annotated[
+        int, typer.Option("--repeats", "-r", min=1, metavar="R", help="Repeats of k-fold.")
+    ] = 1,
+    seed: Annotated[
+        int, typer.Option("--seed", metavar="S", help="Seed of folds and classifiers.")
+    ] = 0,
+    jobs: Annotated[
+        int,
+        typer.Option(
+            "--jobs",
+            "-j",
+            min=1,
+            metavar="N",
+            help="Parallel local worker processes (at most one per core unless --oversubscribe).",
+        ),
+    ] = 1,
+    oversubscribe: Annotated[
+        bool,
+        typer.Option("--oversubscribe", help="Allow more --jobs than this machine has cores."),
+    ] = False,
     scheduler: Annotated[
         str | None,
         typer.Option("--scheduler", metavar="tcp://HOST:PORT", help="Run on a Dask cluster."),
     ] = None,
     timeout: Annotated[
-        float, typer.Option("--timeout", min=0.0, help="Seconds per task before it is stopped.")
+        float,
+        typer.Option(
+            "--timeout", min=0.0, metavar="SECONDS", help="Seconds per task before it is stopped."
+        ),
     ] = 600.0,
-    metric: Annotated[str | None, typer.Option("--metric", help="Rank by this metric.")] = None,
+    max_memory: Annotated[
+        float | None,
+        typer.Option(
+            "--max-memory",
+            min=1.0,
+            metavar="MB",
+            help="Megabytes one task may allocate (beyond its copy of the data) before it fails.",
+            show_default=False,
+        ),
+    ] = None,
+    metric: Annotated[
+        str | None, typer.Option("--metric", metavar="NAME", help="Rank by this metric.")
+    ] = None,
     baseline: Annotated[
-        str | None, typer.Option("--baseline", help="Classifier the t-test compares against.")
+        str | None,
+        typer.Option("--baseline", metavar="ID", help="Classifier the t-test compares against."),
     ] = None,
     resume: Annotated[
-        int | None, typer.Option("--resume", metavar="RUN", help="Finish an interrupted run.")
+        int | None,
+        typer.Option("--resume", metavar="RUN", help="Finish an interrupted run.", min=1),
     ] = None,
     independent: Annotated[
         bool,
@@ -185,81 +228,145 @@ def bench_command(
     """Cross-validate classifiers on a data set; every finished fold is stored at once.
 
     A data set with several targets gets the multi-target configurations (META:BASE, e.g.
-    bcc:rf) unless --target picks one target for the multi-class catalogue.
+    bcc:rf) unless --target picks one target for the multi-class catalogue. Ctrl-C keeps
+    every finished fold: `touchbench bench --resume RUN` carries out the rest.
     """
     from app.cli.progress import TaskProgress
-    from app.reports.leaderboard import leaderboard_json
     from app.services.runs import (
+        RunCancelled,
         RunOptions,
-        default_classifiers,
+        create_run,
+        execute_run,
         independent_runs,
-        per_target_summary,
-        resume_run,
-        run_leaderboard,
-        start_run,
     )
-    from app.store.datasets import find_dataset
 
     store = get_state(ctx).store
+    jobs = _check_jobs(jobs, oversubscribe)
+    if scheduler is not None:
+        from benchmark.run.dask_backend import connect
+
+        connect(scheduler).close()  # fail before a run exists, not after
+    if resume is not None and dataset is not None:
+        raise typer.BadParameter("give either DATASET or --resume RUN, not both")
+    if resume is None and dataset is None:
+        raise typer.BadParameter("missing DATASET (or --resume RUN)")
+    if classifiers and suite_name:
+        raise typer.BadParameter("give --classifiers or --suite, not both")
+    if independent and target:
+        raise typer.BadParameter("--independent benchmarks every target; drop --target")
+    ids = [c.strip() for c in classifiers.split(",") if c.strip()] if classifiers else None
+    options = RunOptions(
+        folds=folds, repeats=repeats, seed=seed, timeout=timeout or None, max_memory_mb=max_memory
+    )
     progress = TaskProgress(enabled=False if as_json else None)
-    with progress:
-        if resume is not None:
-            if dataset is not None:
-                raise typer.BadParameter("give either DATASET or --resume RUN, not both")
-            run, _ = resume_run(
-                store, resume, jobs=jobs, scheduler=scheduler, callbacks=progress.callbacks()
-            )
-        else:
-            if dataset is None:
-                raise typer.BadParameter("missing DATASET (or --resume RUN)")
-            if classifiers and suite_name:
-                raise typer.BadParameter("give --classifiers or --suite, not both")
-            if independent and target:
-                raise typer.BadParameter("--independent benchmarks every target; drop --target")
-            if classifiers:
-                ids = [c.strip() for c in classifiers.split(",") if c.strip()]
-            else:
-                n_targets = (
-                    1 if (target or independent) else len(find_dataset(store, dataset).targets)
-                )
-                ids = default_classifiers(n_targets, suite_name or "default")
-            options = RunOptions(folds=folds, repeats=repeats, seed=seed, timeout=timeout or None)
-            if independent:
-                result = independent_runs(
-                    store,
-                    dataset,
-                    ids,
-                    options=options,
-                    jobs=jobs,
-                    scheduler=scheduler,
-                    callbacks=progress.callbacks(),
-                )
-                _print_independent(result, as_json)
-                return
-            run, _ = start_run(
+    if independent:
+        assert dataset is not None
+        with progress:
+            result = independent_runs(
                 store,
                 dataset,
                 ids,
-                targets=[target] if target else None,
+                suite=suite_name,
                 options=options,
                 jobs=jobs,
                 scheduler=scheduler,
                 callbacks=progress.callbacks(),
             )
-    run, board = run_leaderboard(store, run.id, metric=metric, baseline=baseline)
+        _print_independent(result, as_json)
+        return
+    if resume is not None:
+        run_id = resume
+    else:
+        assert dataset is not None
+        run_id = create_run(
+            store,
+            dataset,
+            ids,
+            suite=suite_name,
+            targets=[target] if target else None,
+            options=options,
+            on_warning=progress.note,
+        ).id
+    try:
+        with progress:
+            run = execute_run(
+                store, run_id, jobs=jobs, scheduler=scheduler, callbacks=progress.callbacks()
+            )
+    except KeyboardInterrupt:
+        raise ExitWith(_kept_message(store, run_id, "interrupted"), EXIT_INTERRUPTED) from None
+    except RunCancelled as cancelled:
+        raise ExitWith(_kept_message(store, cancelled.run.id, "cancelled"), EXIT_FAILED) from None
+    _print_run_report(store, run.id, metric, baseline, as_json)
+    if run.status == "failed":
+        raise ExitWith(
+            f"run {run.id} failed: {run.error} (`touchbench leaderboard {run.id}` lists why)",
+            EXIT_FAILED,
+        )
+
+
+def cancel_command(
+    ctx: typer.Context,
+    run_id: Annotated[
+        int, typer.Argument(metavar="RUN", help="Run id (see `touchbench runs`).", min=1)
+    ],
+    as_json: JsonOption = False,
+) -> None:
+    """Cancel a run: a queued run at once, a running one as soon as its process hears of it."""
+    from app.store.runs import request_cancel
+
+    run = request_cancel(get_state(ctx).store, run_id)
     if as_json:
-        print_json(leaderboard_json(run, board, per_target_summary(store, run.id)))
+        print_json(run.to_json())
+        return
+    if run.status == "cancelled":
+        info(f"run {run.id} cancelled ({run.n_results}/{run.n_tasks} tasks kept)")
+    else:
+        info(f"asked {run.owner} to stop run {run.id}; it ends within a few seconds")
+
+
+def _check_jobs(jobs: int, oversubscribe: bool) -> int:
+    from benchmark.run.engine import available_cores
+
+    cores = available_cores()
+    if jobs > cores and not oversubscribe:
+        raise typer.BadParameter(
+            f"{jobs} jobs but this machine has {cores} core(s); each job is a process with "
+            "its own copy of the data (add --oversubscribe to run more anyway)",
+            param_hint="--jobs",
+        )
+    return jobs
+
+
+def _kept_message(store: Store, run_id: int, what: str) -> str:
+    from app.store.runs import get_run
+
+    run = get_run(store, run_id)
+    return (
+        f"run {run.id} {what}: {run.n_results} of {run.n_tasks} tasks are stored; "
+        f"`touchbench bench --resume {run.id}` carries out the rest"
+    )
+
+
+def _print_run_report(
+    store: Store, run_id: int, metric: str | None, baseline: str | None, as_json: bool
+) -> None:
+    from app.services.runs import leaderboard_schema
+
+    run, board, report = leaderboard_schema(store, run_id, metric=metric, baseline=baseline)
+    if as_json:
+        print_json(report.to_json())
         return
     _print_leaderboard(run, board)
 
 
 def runs_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
-    """List benchmark runs."""
+    """List benchmark runs with their status and progress."""
+    from app.schemas.runs import RunList
     from app.store.runs import list_runs
 
     runs = list_runs(get_state(ctx).store)
     if as_json:
-        print_json({"runs": [run.to_json() for run in runs]})
+        print_json(RunList(runs=[run.schema() for run in runs]).to_json())
         return
     if not runs:
         info("no runs yet: `touchbench bench DATASET` starts one")
@@ -273,7 +380,8 @@ def runs_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
                 run.dataset_name,
                 ", ".join(run.targets),
                 len(run.classifiers),
-                f"{run.n_results}/{run.n_tasks}",
+                f"{run.n_results}/{run.n_tasks}"
+                + (f" ({run.n_failed} failed)" if run.n_failed else ""),
                 run.status,
                 run.created_at.strftime("%Y-%m-%d %H:%M"),
             )
@@ -284,13 +392,21 @@ def runs_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
 
 def leaderboard_command(
     ctx: typer.Context,
-    run_id: Annotated[int, typer.Argument(metavar="RUN", help="Run id (see `touchbench runs`).")],
-    metric: Annotated[str | None, typer.Option("--metric", help="Rank by this metric.")] = None,
+    run_id: Annotated[
+        int, typer.Argument(metavar="RUN", help="Run id (see `touchbench runs`).", min=1)
+    ],
+    metric: Annotated[
+        str | None, typer.Option("--metric", metavar="NAME", help="Rank by this metric.")
+    ] = None,
     baseline: Annotated[
-        str | None, typer.Option("--baseline", help="Classifier the t-test compares against.")
+        str | None,
+        typer.Option("--baseline", metavar="ID", help="Classifier the t-test compares against."),
     ] = None,
     output_format: Annotated[
-        str, typer.Option("--format", "-f", help="table, json, csv, markdown or arff.")
+        str,
+        typer.Option(
+            "--format", "-f", metavar="FORMAT", help="table, json, csv, markdown or arff."
+        ),
     ] = "table",
     as_json: JsonOption = False,
 ) -> None:
@@ -303,17 +419,16 @@ def leaderboard_command(
         )
     from app.reports.leaderboard import (
         leaderboard_csv,
-        leaderboard_json,
         leaderboard_markdown,
         metric_columns,
     )
-    from app.services.runs import per_target_summary, run_leaderboard
+    from app.services.runs import leaderboard_schema
 
     store = get_state(ctx).store
-    run, board = run_leaderboard(store, run_id, metric=metric, baseline=baseline)
+    run, board, report = leaderboard_schema(store, run_id, metric=metric, baseline=baseline)
     columns = metric_columns(run, board)
     if output_format == "json":
-        print_json(leaderboard_json(run, board, per_target_summary(store, run.id)))
+        print_json(report.to_json())
     elif output_format == "csv":
         sys.stdout.write(leaderboard_csv(board, columns))
     elif output_format == "markdown":
@@ -361,6 +476,9 @@ def _print_leaderboard(run: RunInfo, board: Leaderboard) -> None:
         leaderboard_header(board, columns),
         leaderboard_rows(board, columns),
     )
+    if board.baseline is None:
+        info(f"no task of run {run.id} succeeded; the notes say why")
+        return
     v, same, worse = board.summary
     info(
         f"marks against {board.baseline}: v significantly better, * significantly worse "

@@ -172,7 +172,8 @@ def live_command(
 
     if (device is None) == (replay is None):
         raise AppError("give exactly one of --device DEV or --replay FILE")
-    info_, trained, extraction = load_live_model(get_state(ctx).store, model)
+    model_info, trained = load_live_model(get_state(ctx).store, model)
+    extraction = model_info.extraction
     source: Source
     if replay is not None:
         source = FileReplaySource(replay, realtime=realtime, topic=topic, block_length=1024)
@@ -187,7 +188,7 @@ def live_command(
         )
     with source:
         session = LiveSession(
-            info_,
+            model_info,
             trained,
             samplerate=source.samplerate,
             n_channels=source.n_channels,

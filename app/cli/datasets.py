@@ -1,29 +1,35 @@
-"""Commands for data sets: import, datasets, show, export, delete."""
+"""Commands for data sets: import, datasets, show, export, rename, delete."""
 
 from __future__ import annotations
 
+import os
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated
 
-import numpy as np
 import typer
+from rich.console import Console
+from rich.progress import BarColumn, DownloadColumn, Progress, TextColumn, TimeRemainingColumn
 
 from app.cli.output import info, print_json, table
 from app.cli.state import get_state
-from app.services.datasets import import_file, parse_targets
-from app.store.datasets import (
-    DatasetInfo,
-    delete_dataset,
-    find_dataset,
-    list_datasets,
-    load_dataset,
+from app.errors import AppError
+from app.schemas.datasets import (
+    AttributeDescription,
+    DatasetDescription,
+    DatasetList,
+    ImportResult,
 )
-from benchmark.dataset import Dataset
-from benchmark.io.arff import write_arff
+from app.services import datasets as service
+from app.services.datasets import ImportProgress
+from app.store.database import Store
 
-JsonOption = Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")]
-DatasetArgument = Annotated[str, typer.Argument(metavar="DATASET", help="Data set name or id.")]
+JsonOption = Annotated[bool, typer.Option("--json", metavar="", help="Print only JSON on stdout.")]
+DatasetArgument = Annotated[
+    str, typer.Argument(metavar="DATASET", help="Data set name or id.", show_default=False)
+]
 
 
 def register(app: typer.Typer) -> None:
@@ -31,14 +37,22 @@ def register(app: typer.Typer) -> None:
     app.command("datasets")(datasets_command)
     app.command("show")(show_command)
     app.command("export")(export_command)
+    app.command("rename")(rename_command)
     app.command("delete")(delete_command)
 
 
 def import_command(
     ctx: typer.Context,
-    file: Annotated[Path, typer.Argument(help="ARFF or CSV file.", show_default=False)],
+    file: Annotated[
+        Path, typer.Argument(metavar="FILE", help="ARFF or CSV file.", show_default=False)
+    ],
     name: Annotated[
-        str | None, typer.Option("--name", help="Name in the store (default: the relation).")
+        str | None,
+        typer.Option(
+            "--name",
+            metavar="NAME",
+            help="Name in the store (default: the file name without its ending).",
+        ),
     ] = None,
     targets: Annotated[
         str | None,
@@ -59,33 +73,58 @@ def import_command(
     ] = None,
     as_json: JsonOption = False,
 ) -> None:
-    """Import an ARFF or CSV file as a data set (nothing is stored if the file has an error)."""
+    """Import an ARFF or CSV file as a data set, named after the file.
+
+    Nothing is stored from a file with an error, and known content is never stored twice.
+    """
     if file_format is not None and file_format not in ("arff", "csv"):
         raise typer.BadParameter(f"'{file_format}' is not arff or csv", param_hint="--format")
     store = get_state(ctx).store
-    dataset_info, created = import_file(
-        store,
-        file,
-        name=name,
-        targets=parse_targets(targets),
-        file_format=file_format,  # type: ignore[arg-type]
-    )
-    if as_json:
-        print_json({**_summary(dataset_info), "created": created})
-        return
-    if not created:
-        info(
-            f"{file} is already stored as dataset {dataset_info.id} '{dataset_info.name}'; "
-            "nothing imported"
+    with _import_progress(enabled=not as_json and sys.stderr.isatty()) as progress:
+        result = service.import_file(
+            store,
+            file,
+            name=name,
+            targets=service.parse_targets(targets),
+            file_format=file_format,  # type: ignore[arg-type]  # checked above
+            progress=progress,
         )
-    _print_summary(dataset_info)
+    if as_json:
+        print_json(result.to_json())
+        return
+    for note in result.notes:
+        info(f"note: {note}")
+    _print_summary(result)
+
+
+@contextmanager
+def _import_progress(*, enabled: bool) -> Iterator[ImportProgress | None]:
+    """A byte-count progress bar on stderr (a terminal only), as an import callback."""
+    if not enabled:
+        yield None
+        return
+    bar = Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        DownloadColumn(),
+        TimeRemainingColumn(),
+        console=Console(stderr=True),
+        transient=True,
+    )
+    task = bar.add_task("checking", total=None)
+
+    def update(what: str, done: int, total: int) -> None:
+        bar.update(task, description=what, completed=done, total=total)
+
+    with bar:
+        yield update
 
 
 def datasets_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
     """List the data sets in the store."""
-    rows = list_datasets(get_state(ctx).store)
+    rows = service.list_datasets(get_state(ctx).store)
     if as_json:
-        print_json({"datasets": [row.to_json() for row in rows]})
+        print_json(DatasetList(datasets=rows).to_json())
         return
     if not rows:
         info("no datasets yet: `touchbench import FILE` adds one")
@@ -100,7 +139,7 @@ def datasets_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
                 row.n_instances,
                 row.n_features,
                 ", ".join(row.targets),
-                row.source_name,
+                row.source,
                 row.created_at.strftime("%Y-%m-%d %H:%M"),
             )
             for row in rows
@@ -111,31 +150,21 @@ def datasets_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
 
 def show_command(ctx: typer.Context, dataset: DatasetArgument, as_json: JsonOption = False) -> None:
     """Show a data set's schema, class distribution per target and missing values."""
-    store = get_state(ctx).store
-    dataset_info = find_dataset(store, dataset)
-    data = load_dataset(store, dataset_info.id)
-    description = describe(dataset_info, data)
+    description = service.describe_dataset(get_state(ctx).store, dataset)
     if as_json:
-        print_json(description)
+        print_json(description.to_json())
         return
-    _print_summary(dataset_info)
+    _print_summary(description)
     table(
         "attributes",
         ["#", "name", "role", "type", "labels / range", "missing"],
         [
-            (
-                i + 1,
-                a["name"],
-                a["role"],
-                a["kind"],
-                _labels_or_range(a),
-                a["missing"],
-            )
-            for i, a in enumerate(description["attributes"])
+            (i + 1, a.name, a.role, a.kind, _labels_or_range(a), a.missing)
+            for i, a in enumerate(description.attributes)
         ],
         justify=["right", "left", "left", "left", "left", "right"],
     )
-    for target, counts in description["class_distribution"].items():
+    for target, counts in description.class_distribution.items():
         total = sum(counts.values()) or 1
         table(
             f"class distribution of {target}",
@@ -143,103 +172,86 @@ def show_command(ctx: typer.Context, dataset: DatasetArgument, as_json: JsonOpti
             [(label, n, f"{100 * n / total:.1f} %") for label, n in counts.items()],
             justify=["left", "right", "right"],
         )
-    info(f"missing values: {description['missing_values']}")
+    for note in description.notes:
+        info(f"note: {note}")
+    info(f"missing values: {description.missing_values}")
 
 
 def export_command(
     ctx: typer.Context,
     dataset: DatasetArgument,
     output: Annotated[
-        Path | None, typer.Option("-o", "--output", help="File to write (default: stdout).")
+        Path | None,
+        typer.Option("-o", "--output", metavar="FILE", help="File to write (default: stdout)."),
     ] = None,
+    force: Annotated[
+        bool, typer.Option("--force", metavar="", help="Replace FILE if it exists.")
+    ] = False,
 ) -> None:
-    """Write a data set back as ARFF (the relation keeps MEKA's -C header for its targets)."""
+    """Write a data set back as ARFF (the relation keeps MEKA's -C header for its targets).
+
+    A file is written whole or not at all; an existing file is replaced only with --force.
+    """
     store = get_state(ctx).store
-    data = load_dataset(store, find_dataset(store, dataset).id)
     if output is None:
-        write_arff(data, sys.stdout)
+        _export_to_stdout(store, dataset)
         return
-    write_arff(data, output)
-    info(f"wrote {data.n_instances} instances to {output}")
+    count = service.export_to_file(store, dataset, output, force=force)
+    info(f"wrote {count} instances to {output}")
+
+
+def _export_to_stdout(store: Store, dataset: str) -> None:
+    try:
+        service.export_dataset(store, dataset, sys.stdout)
+        sys.stdout.flush()
+    except BrokenPipeError:
+        # The reader went away (`export mini | head`): not an error, and nothing more to say.
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except OSError as error:
+        raise AppError(f"cannot write to the standard output: {error.strerror}") from None
+
+
+def rename_command(
+    ctx: typer.Context,
+    dataset: DatasetArgument,
+    new_name: Annotated[
+        str, typer.Argument(metavar="NEW", help="The new name.", show_default=False)
+    ],
+) -> None:
+    """Give a data set another name."""
+    renamed = service.rename_dataset(get_state(ctx).store, dataset, new_name)
+    info(f"renamed dataset {renamed.id} '{renamed.previous_name}' to '{renamed.name}'")
 
 
 def delete_command(ctx: typer.Context, dataset: DatasetArgument) -> None:
-    """Delete a data set with its instances, runs and results."""
-    gone = delete_dataset(get_state(ctx).store, dataset)
+    """Delete a data set with its instances, runs and results (not while a run uses it)."""
+    gone = service.delete_dataset(get_state(ctx).store, dataset)
     info(f"deleted dataset {gone.id} '{gone.name}' ({gone.n_instances} instances)")
 
 
-def describe(dataset_info: DatasetInfo, data: Dataset) -> dict[str, Any]:
-    """Schema, per-attribute missing counts and ranges, class distribution per target."""
-    schema = data.schema
-    targets = set(schema.target_indices)
-    missing = np.isnan(data.values).sum(axis=0)
-    attributes = []
-    for i, attribute in enumerate(schema.attributes):
-        column = data.values[:, i]
-        entry: dict[str, Any] = {
-            "name": attribute.name,
-            "kind": attribute.kind,
-            "role": "target" if i in targets else "feature",
-            "missing": int(missing[i]),
-        }
-        if attribute.kind == "nominal":
-            entry["values"] = list(attribute.values)
-        elif attribute.kind == "numeric" and np.isfinite(column).any():
-            entry["min"] = float(np.nanmin(column))
-            entry["max"] = float(np.nanmax(column))
-        attributes.append(entry)
-    distribution: dict[str, dict[str, int]] = {}
-    for i in schema.target_indices:
-        attribute = schema.attributes[i]
-        if attribute.kind != "nominal":
-            continue
-        codes = data.values[:, i]
-        counts = np.bincount(codes[~np.isnan(codes)].astype(int), minlength=len(attribute.values))
-        distribution[attribute.name] = {
-            label: int(n) for label, n in zip(attribute.values, counts, strict=True)
-        }
-    return {
-        **_summary(dataset_info),
-        "relation": schema.relation,
-        "attributes": attributes,
-        "class_distribution": distribution,
-        "missing_values": int(missing.sum()),
-    }
-
-
-def _summary(dataset_info: DatasetInfo) -> dict[str, Any]:
-    return {
-        "id": dataset_info.id,
-        "name": dataset_info.name,
-        "n_instances": dataset_info.n_instances,
-        "n_features": dataset_info.n_features,
-        "targets": dataset_info.targets,
-    }
-
-
-def _print_summary(dataset_info: DatasetInfo) -> None:
+def _print_summary(result: ImportResult | DatasetDescription) -> None:
     table(
         None,
         ["id", "name", "instances", "features", "targets"],
         [
             (
-                dataset_info.id,
-                dataset_info.name,
-                dataset_info.n_instances,
-                dataset_info.n_features,
-                ", ".join(dataset_info.targets),
+                result.id,
+                result.name,
+                result.n_instances,
+                result.n_features,
+                ", ".join(result.targets),
             )
         ],
         justify=["right", "left", "right", "right", "left"],
     )
 
 
-def _labels_or_range(attribute: dict[str, Any]) -> str:
-    if "values" in attribute:
-        labels = attribute["values"]
-        shown = ", ".join(labels[:6])
-        return shown + (f", ... ({len(labels)})" if len(labels) > 6 else "")
-    if "min" in attribute:
-        return f"{attribute['min']:.4g} .. {attribute['max']:.4g}"
+def _labels_or_range(attribute: AttributeDescription) -> str:
+    if attribute.values is not None:
+        shown = ", ".join(attribute.values[:6])
+        more = len(attribute.values) - 6
+        return shown + (f", ... ({len(attribute.values)})" if more > 0 else "")
+    if attribute.min is not None and attribute.max is not None:
+        return f"{attribute.min:.4g} .. {attribute.max:.4g}"
     return ""

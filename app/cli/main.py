@@ -17,13 +17,19 @@ from app.cli import capture as capture_commands
 from app.cli import datasets as datasets_commands
 from app.cli import demo as demo_commands
 from app.cli import extract as extract_commands
+from app.cli import help as help_pages
 from app.cli import models as models_commands
+from app.cli import serve as serve_commands
+from app.cli.output import EXIT_FAILED, EXIT_INTERRUPTED, ExitWith
 from app.cli.state import CliState
 from app.errors import USER_ERRORS
 from app.settings import get_settings
 
 EXIT_USAGE = 2
-EXIT_UNEXPECTED = 1
+EXIT_UNEXPECTED = EXIT_FAILED
+
+
+help_pages.install()
 
 app = typer.Typer(
     name="touchbench",
@@ -38,6 +44,14 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
     context_settings={"help_option_names": ["-h", "--help"]},
 )
+
+
+def _print_version(value: bool) -> None:
+    if value:
+        from importlib import metadata
+
+        print(f"touchbench {metadata.version('touchbench')}")
+        raise typer.Exit()
 
 
 @app.callback()
@@ -56,6 +70,15 @@ def root(
             show_default=False,
         ),
     ] = None,
+    version: Annotated[
+        bool,
+        typer.Option(
+            "--version",
+            callback=_print_version,
+            is_eager=True,
+            help="Print touchbench's version and exit.",
+        ),
+    ] = False,
 ) -> None:
     ctx.obj = CliState(database_url=db or get_settings().database_url)
 
@@ -65,6 +88,7 @@ bench_commands.register(app)
 models_commands.register(app)
 extract_commands.register(app)
 demo_commands.register(app)
+serve_commands.register(app)
 capture_commands.register(app)
 
 
@@ -72,12 +96,15 @@ def main(argv: list[str] | None = None) -> int:
     """Run the CLI; returns (and, as a console script, exits with) the status."""
     command = typer.main.get_command(app)
     try:
-        command.main(args=argv, prog_name="touchbench", standalone_mode=False)
+        returned = command.main(args=argv, prog_name="touchbench", standalone_mode=False)
     except typer.Exit as done:
         return _exit(done.exit_code)
+    except ExitWith as outcome:
+        print(f"touchbench: {outcome}", file=sys.stderr)
+        return outcome.exit_code
     except typer.Abort:
         print("touchbench: interrupted", file=sys.stderr)
-        return _exit(130)
+        return EXIT_INTERRUPTED
     except typer.TyperException as error:  # typer's (vendored click's) usage errors
         context = getattr(error, "ctx", None)
         hint = f" (see '{context.command_path} --help')" if context is not None else ""
@@ -89,7 +116,7 @@ def main(argv: list[str] | None = None) -> int:
         return _exit(EXIT_USAGE)
     except KeyboardInterrupt:
         print("touchbench: interrupted", file=sys.stderr)
-        return _exit(130)
+        return EXIT_INTERRUPTED
     except Exception as error:  # anything else is a bug: say so in one line, trace on request
         if os.environ.get("TOUCHBENCH_DEBUG"):
             traceback.print_exc()
@@ -99,7 +126,9 @@ def main(argv: list[str] | None = None) -> int:
             file=sys.stderr,
         )
         return _exit(EXIT_UNEXPECTED)
-    return _exit(0)
+    if returned == EXIT_INTERRUPTED:  # typer turned a Ctrl-C into this status, silently
+        print("touchbench: interrupted", file=sys.stderr)
+    return returned if isinstance(returned, int) else 0
 
 
 def _exit(code: int | None) -> int:

@@ -7,13 +7,9 @@ from typing import Annotated
 
 import typer
 
-from app.cli.output import info, print_json, table
+from app.cli.output import info, print_json, table, warn
 from app.cli.state import get_state
-from app.services.datasets import guess_format
 from app.store.models import list_models
-from benchmark.errors import DataFormatError
-from benchmark.io.arff import read_arff
-from benchmark.io.csv import read_csv
 
 JsonOption = Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")]
 
@@ -22,20 +18,33 @@ def register(app: typer.Typer) -> None:
     app.command("train")(train_command)
     app.command("models")(models_command)
     app.command("predict")(predict_command)
+    app.command("delete-model")(delete_model_command)
 
 
 def train_command(
     ctx: typer.Context,
-    dataset: Annotated[str, typer.Argument(metavar="DATASET", help="Data set name or id.")],
+    dataset: Annotated[
+        str, typer.Argument(metavar="DATASET", help="Data set name or id.", show_default=False)
+    ],
     classifier: Annotated[
         str,
-        typer.Option("--classifier", "-c", help="Classifier id (see `touchbench classifiers`)."),
+        typer.Option(
+            "--classifier",
+            "-c",
+            metavar="ID",
+            help="Classifier id (see `touchbench classifiers`).",
+            show_default=False,
+        ),
     ],
     target: Annotated[
-        str | None, typer.Option("--target", help="Train for this one target only.")
+        str | None,
+        typer.Option("--target", metavar="NAME", help="Train for this one target only."),
     ] = None,
-    name: Annotated[str | None, typer.Option("--name", help="Model name.")] = None,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of the classifier.")] = 0,
+    name: Annotated[
+        str | None,
+        typer.Option("--name", metavar="NAME", help="Model name (default: DATASET-CLASSIFIER)."),
+    ] = None,
+    seed: Annotated[int, typer.Option("--seed", metavar="S", help="Seed of the classifier.")] = 0,
     as_json: JsonOption = False,
 ) -> None:
     """Fit a classifier on every instance of a data set and store the model."""
@@ -59,17 +68,19 @@ def train_command(
 
 
 def models_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
-    """List trained models."""
+    """List trained models (artifacts are not read)."""
+    from app.schemas.models import ModelList
+
     models = list_models(get_state(ctx).store)
     if as_json:
-        print_json({"models": [m.to_json() for m in models]})
+        print_json(ModelList(models=[m.to_schema() for m in models]).to_json())
         return
     if not models:
         info("no models yet: `touchbench train DATASET --classifier ID` makes one")
         return
     table(
         None,
-        ["id", "name", "classifier", "dataset", "targets", "bytes", "trained"],
+        ["id", "name", "classifier", "dataset", "targets", "bytes", "live", "trained"],
         [
             (
                 m.id,
@@ -78,6 +89,7 @@ def models_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
                 m.dataset_name,
                 ", ".join(m.targets),
                 f"{m.size_bytes:,}",
+                "✓" if m.extraction else "",
                 m.created_at.strftime("%Y-%m-%d %H:%M"),
             )
             for m in models
@@ -87,47 +99,61 @@ def models_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
 
 def predict_command(
     ctx: typer.Context,
-    model_ref: Annotated[str, typer.Argument(metavar="MODEL", help="Model name or id.")],
-    file: Annotated[Path, typer.Argument(help="ARFF or CSV file with the model's attributes.")],
+    model_ref: Annotated[
+        str, typer.Argument(metavar="MODEL", help="Model name or id.", show_default=False)
+    ],
+    file: Annotated[
+        Path,
+        typer.Argument(
+            metavar="FILE",
+            help="ARFF or CSV file with the model's attributes (matched by name).",
+            show_default=False,
+        ),
+    ],
     as_json: JsonOption = False,
 ) -> None:
     """Predict every instance of a file; attributes are matched to the model's by name."""
-    from app.services.models import load_model, predict
+    from app.services.models import predict_file
 
-    model_info, model = load_model(get_state(ctx).store, model_ref)
-    if not file.exists():
-        raise DataFormatError("no such file", source=str(file))
-    data = read_csv(file, targets=None) if guess_format(file) == "csv" else read_arff(file)
-    predictions = predict(model, data, source=str(file))
+    report = predict_file(get_state(ctx).store, model_ref, file)
     if as_json:
-        print_json(
-            {
-                "model": model_info.name,
-                "targets": model_info.targets,
-                "predictions": predictions.to_json(),
-                "accuracy": predictions.accuracy,
-            }
-        )
+        print_json(report.to_json())
         return
-    rows = predictions.to_json()
-    columns = ["#", *model_info.targets]
-    if predictions.probabilities is not None:
-        columns += [f"p({t})" for t in model_info.targets]
+    rows = [row.model_dump() for row in report.predictions]
+    columns = ["#", *report.targets]
+    with_probabilities = bool(rows) and rows[0].get("probabilities") is not None
+    if with_probabilities:
+        columns += [f"p({t})" for t in report.targets]
     table(
-        f"{len(rows)} predictions by {model_info.name}",
+        f"{len(rows)} predictions by {report.model}",
         columns,
         [
             (
                 row["instance"],
-                *(row[t] for t in model_info.targets),
+                *(row[t] for t in report.targets),
                 *(
                     f"{row['probabilities'][t][row[t]]:.3f}"
-                    for t in model_info.targets
-                    if "probabilities" in row
+                    for t in report.targets
+                    if with_probabilities
                 ),
             )
             for row in rows
         ],
     )
-    for target, accuracy in predictions.accuracy.items():
+    for warning in report.warnings:
+        warn(warning)
+    for target, accuracy in report.accuracy.items():
         info(f"accuracy on {target} (the file carries the true labels): {accuracy:.4f}")
+
+
+def delete_model_command(
+    ctx: typer.Context,
+    model_ref: Annotated[
+        str, typer.Argument(metavar="MODEL", help="Model name or id.", show_default=False)
+    ],
+) -> None:
+    """Delete a trained model."""
+    from app.store.models import delete_model
+
+    gone = delete_model(get_state(ctx).store, model_ref)
+    info(f"deleted model {gone.id} '{gone.name}'")

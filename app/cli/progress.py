@@ -9,6 +9,7 @@ import sys
 from types import TracebackType
 
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import (
     BarColumn,
     MofNCompleteColumn,
@@ -60,6 +61,7 @@ class TaskProgress:
             on_start=self.start,
             on_result=self.finish,
             on_warning=self.warn,
+            on_note=self.note,
         )
 
     def plan(self, total: int, done: int) -> None:
@@ -80,4 +82,11 @@ class TaskProgress:
         self._progress.advance(self._task)
 
     def warn(self, message: str) -> None:
-        self._progress.console.print(f"[yellow]warning:[/yellow] {message}", highlight=False)
+        """Something the user should look at (a failed task...)."""
+        self._progress.console.print(
+            f"[yellow]warning:[/yellow] {escape(message)}", highlight=False, soft_wrap=True
+        )
+
+    def note(self, message: str) -> None:
+        """A routine adjustment worth knowing (fewer folds, how folds are stratified...)."""
+        self._progress.console.print(f"note: {escape(message)}", highlight=False, soft_wrap=True)

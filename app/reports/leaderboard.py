@@ -1,11 +1,12 @@
-"""Leaderboards as people and programs read them: JSON, CSV, Markdown, WEKA results ARFF."""
+"""Leaderboards as people and other tools read them: table rows, CSV and Markdown (the JSON
+report is :func:`app.services.runs.leaderboard_schema`)."""
 
 from __future__ import annotations
 
 import csv
 import io
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from typing import Any
 
 from app.store.runs import RunInfo
@@ -22,58 +23,6 @@ def metric_columns(run: RunInfo, board: Leaderboard) -> list[str]:
     columns = [board.metric] + [m for m in TABLE_METRICS.get(run.kind, []) if m != board.metric]
     available = {name for row in board.rows for name in row.metrics}
     return [c for c in columns if c in available or c == board.metric]
-
-
-def leaderboard_json(
-    run: RunInfo,
-    board: Leaderboard,
-    per_target: Mapping[str, Mapping[str, Mapping[str, tuple[float, float]]]] | None = None,
-) -> dict[str, Any]:
-    """The report of a run; multi-target rows carry ``metrics.per_target`` when given."""
-    rows = [row_json(row) for row in board.rows]
-    for row in rows:
-        targets = (per_target or {}).get(row["classifier"])
-        if targets:
-            row["metrics"]["per_target"] = {
-                target: {
-                    name: {"mean": _finite(mean), "std": _finite(std)}
-                    for name, (mean, std) in scores.items()
-                }
-                for target, scores in targets.items()
-            }
-    return {
-        "run_id": run.id,
-        "dataset": run.dataset_name,
-        "kind": run.kind,
-        "targets": run.targets,
-        "metric": board.metric,
-        "baseline": board.baseline,
-        "summary": {
-            "better": board.summary[0],
-            "same": board.summary[1],
-            "worse": board.summary[2],
-        },
-        "leaderboard": rows,
-    }
-
-
-def row_json(row: LeaderboardRow) -> dict[str, Any]:
-    metrics: dict[str, Any] = {}
-    for name, value in row.metrics.items():
-        if name == "per_target" and isinstance(value, dict):
-            metrics[name] = value
-        else:
-            mean, std = value
-            metrics[name] = {"mean": _finite(mean), "std": _finite(std)}
-    return {
-        "rank": row.rank,
-        "classifier": row.classifier,
-        "mark": row.mark,
-        "metrics": metrics,
-        "n_ok": row.n_ok,
-        "n_failed": row.n_failed,
-        "errors": row.errors,
-    }
 
 
 def leaderboard_header(board: Leaderboard, columns: Sequence[str]) -> list[str]:
@@ -112,10 +61,15 @@ def leaderboard_csv(board: Leaderboard, columns: Sequence[str]) -> str:
 
 
 def leaderboard_markdown(run: RunInfo, board: Leaderboard, columns: Sequence[str]) -> str:
+    marks = (
+        f"marks against {board.baseline} (corrected resampled t-test, alpha 0.05): "
+        "v better, * worse."
+        if board.baseline
+        else f"no task succeeded (run {run.status})."
+    )
     lines = [
         f"Run {run.id} on {run.dataset_name} ({', '.join(run.targets)}), ranked by "
-        f"{board.metric}; marks against {board.baseline} (corrected resampled t-test, "
-        "alpha 0.05): v better, * worse.",
+        f"{board.metric}; {marks}",
         "",
         "| rank | classifier | | " + " | ".join(columns) + " |",
         "|---:|---|:-:|" + "---:|" * len(columns),
@@ -139,7 +93,3 @@ def _mean_std(value: tuple[float, float]) -> str:
     if std is None or (isinstance(std, float) and math.isnan(std)):
         return f"{mean:.4f}"
     return f"{mean:.4f} ±{std:.3f}"
-
-
-def _finite(value: Any) -> Any:
-    return None if isinstance(value, float) and not math.isfinite(value) else value

@@ -18,7 +18,7 @@ import numpy as np
 
 from app.errors import AppError
 from app.store.database import Store
-from app.store.tables import DatasetRow, ModelRow
+from app.store.models import ModelInfo
 from benchmark.model import TrainedModel
 from features.errors import FeatureError
 from features.extractors import Instances
@@ -64,9 +64,9 @@ class LiveSession:
 
     Parameters
     ----------
-    model_info : object
-        The stored model's description; its ``name`` is used in messages and its
-        ``extraction`` (when it has one) is the recipe.
+    model_info : ModelInfo
+        The stored model's description: its ``name`` for messages, its ``extraction``
+        for the recipe.
     model : TrainedModel
         The fitted model.
     samplerate : float
@@ -85,17 +85,15 @@ class LiveSession:
 
     def __init__(
         self,
-        model_info: Any,
+        model_info: ModelInfo,
         model: TrainedModel,
         *,
         samplerate: float,
         n_channels: int,
         extraction: Mapping[str, Any] | None = None,
     ) -> None:
-        name = getattr(model_info, "name", "model")
-        recipe_json = (
-            extraction if extraction is not None else getattr(model_info, "extraction", None)
-        )
+        name = model_info.name
+        recipe_json = extraction if extraction is not None else model_info.extraction
         if not recipe_json:
             raise AppError(
                 f"model '{name}' was trained on a data set imported from a file, not extracted "
@@ -203,37 +201,15 @@ class LiveSession:
         return out
 
 
-def model_extraction(store: Store, model_id: int) -> dict[str, Any] | None:
-    """The extraction recipe of a stored model: its own, else its data set's.
-
-    The data set's is read while training does not yet copy the recipe into the model
-    row; a model of an imported data set has none.
-    """
-    with store.session() as session:
-        row = session.get(ModelRow, model_id)
-        if row is None:
-            return None
-        if row.extraction:
-            return dict(row.extraction)
-        if row.dataset_id is None:
-            return None
-        dataset = session.get(DatasetRow, row.dataset_id)
-        return dict(dataset.extraction) if dataset is not None and dataset.extraction else None
-
-
-def load_live_model(
-    store: Store, ref: str | int
-) -> tuple[Any, TrainedModel, dict[str, Any] | None]:
-    """A stored model (name or id), its artifact checked, and its extraction recipe."""
+def load_live_model(store: Store, ref: str | int) -> tuple[ModelInfo, TrainedModel]:
+    """A stored model (name or id) with its artifact checked; ``info.extraction`` is the
+    recipe of the data set it was trained on (None for an imported one)."""
     from app.services.models import load_model
 
-    info, model = load_model(store, ref)
-    return info, model, model_extraction(store, info.id)
+    return load_model(store, ref)
 
 
 def open_live(store: Store, ref: str | int, *, samplerate: float, n_channels: int) -> LiveSession:
     """A :class:`LiveSession` of the stored model ``ref`` (name or id)."""
-    info, model, extraction = load_live_model(store, ref)
-    return LiveSession(
-        info, model, samplerate=samplerate, n_channels=n_channels, extraction=extraction
-    )
+    info, model = load_live_model(store, ref)
+    return LiveSession(info, model, samplerate=samplerate, n_channels=n_channels)

@@ -3,16 +3,21 @@
 A model keeps the schema it was trained on; a file to predict is matched to it by
 attribute name (order and extra attributes do not matter, nominal labels are matched by
 text), so a model trained on a public ARFF file accepts what the extractor produces live.
+Whatever had to be changed on the way (a label the model never saw) is reported as a
+warning that says where.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from app.errors import AppError
+from app.schemas.models import PredictionReport, PredictionRow
 from app.store.database import Store
 from app.store.datasets import find_dataset, load_dataset
 from app.store.models import ModelInfo, load_artifact, save_model
@@ -20,6 +25,9 @@ from benchmark.dataset import Attribute, Dataset, Schema
 from benchmark.errors import DataFormatError
 from benchmark.model import TrainedModel, dumps_model, fit_model, loads_model
 from benchmark.problem import restrict_targets
+
+#: Labels quoted in one warning at most.
+MAX_QUOTED = 5
 
 
 def train(
@@ -49,8 +57,28 @@ def train(
     )
 
 
+def train_best(store: Store, run_id: int | str, *, name: str | None = None) -> ModelInfo:
+    """Train the best classifier of a finished run on its whole data set and targets."""
+    from app.services.runs import run_leaderboard
+
+    run, board = run_leaderboard(store, run_id)
+    if board.baseline is None:
+        raise AppError(f"run {run.id} has no successful classifier to train")
+    best = board.rows[0].classifier
+    return train(
+        store,
+        str(run.dataset_id),
+        best,
+        targets=run.config.get("targets_given"),
+        name=name,
+        seed=int(run.config.get("seed", 0)),
+        run_id=run.id,
+    )
+
+
 def load_model(store: Store, ref: str | int) -> tuple[ModelInfo, TrainedModel]:
-    """A stored model, its bytes checked against their sha256 before they are unpickled."""
+    """A stored model; its bytes are checked against their sha256 and loaded only as an
+    artifact that cannot run code (:mod:`benchmark.artifacts`)."""
     info, artifact = load_artifact(store, ref)
     return info, loads_model(artifact, sha256=info.sha256)
 
@@ -68,12 +96,25 @@ class Predictions:
         Target name -> the labels in the column order of ``probabilities``.
     accuracy : dict of str to float
         Per target, where the file carries the true labels.
+    warnings : list of str
+        What was changed on the way, and where (labels the model never saw).
     """
 
     labels: dict[str, list[str]]
     probabilities: dict[str, np.ndarray] | None
     class_labels: dict[str, list[str]]
     accuracy: dict[str, float]
+    warnings: list[str] = field(default_factory=list)
+
+    def report(self, model: ModelInfo) -> PredictionReport:
+        """The report ``predict --json`` prints and the API answers."""
+        return PredictionReport(
+            model=model.name,
+            targets=model.targets,
+            predictions=[PredictionRow(**row) for row in self.to_json()],
+            accuracy=self.accuracy,
+            warnings=self.warnings,
+        )
 
     def to_json(self) -> list[dict[str, Any]]:
         n = len(next(iter(self.labels.values()))) if self.labels else 0
@@ -96,7 +137,8 @@ class Predictions:
 
 def predict(model: TrainedModel, data: Dataset, *, source: str = "input") -> Predictions:
     """Predict every instance of ``data`` whose attributes match the model's by name."""
-    X = align_features(model.schema, data, source=source)
+    warnings: list[str] = []
+    X = align_features(model.schema, data, source=source, warnings=warnings)
     codes = np.asarray(model.predict(X)).reshape(X.shape[0], -1)
     targets = model.schema.targets
     labels = {t.name: [t.values[int(c)] for c in codes[:, j]] for j, t in enumerate(targets)}
@@ -110,24 +152,125 @@ def predict(model: TrainedModel, data: Dataset, *, source: str = "input") -> Pre
     accuracy = {}
     for t in targets:
         truth = _true_labels(t, data)
-        if truth is not None:
-            known = [i for i, label in enumerate(truth) if label is not None]
-            if known:
-                hits = sum(labels[t.name][i] == truth[i] for i in known)
-                accuracy[t.name] = hits / len(known)
+        if truth is None:
+            continue
+        known = [i for i, label in enumerate(truth) if label is not None]
+        if not known:
+            continue
+        accuracy[t.name] = sum(labels[t.name][i] == truth[i] for i in known) / len(known)
+        foreign = [str(truth[i]) for i in known if truth[i] not in t.values]
+        if foreign:
+            warnings.append(
+                f"{source}: target '{t.name}': {len(foreign)} instance(s) carry labels the "
+                f"model cannot predict ({_quoted(foreign)}); they count as misses in the accuracy"
+            )
     return Predictions(
         labels=labels,
         probabilities=probabilities,
         class_labels={t.name: list(t.values) for t in targets},
         accuracy=accuracy,
+        warnings=warnings,
     )
 
 
-def align_features(schema: Schema, data: Dataset, *, source: str = "input") -> np.ndarray:
+def predict_file(store: Store, model_ref: str | int, path: Path) -> PredictionReport:
+    """Predict every instance of an ARFF or CSV file (attributes matched by name)."""
+    from app.services.datasets import read_data_file
+
+    info, model = load_model(store, model_ref)
+    data = read_data_file(path)
+    return predict(model, data, source=path.name).report(info)
+
+
+def predict_records(
+    store: Store, model_ref: str | int, records: Sequence[Mapping[str, Any]]
+) -> PredictionReport:
+    """Predict instances given as attribute -> value mappings (the API's JSON body).
+
+    Numeric attributes take numbers, nominal ones their labels as text; a missing key or
+    ``null`` is a missing value.
+    """
+    info, model = load_model(store, model_ref)
+    data = dataset_from_records(model.schema, records)
+    return predict(model, data, source="instances").report(info)
+
+
+def dataset_from_records(schema: Schema, records: Sequence[Mapping[str, Any]]) -> Dataset:
+    """A data set with ``schema``'s features (no targets) from JSON-like records.
+
+    Numeric attributes take numbers; nominal ones take their labels as text (a label the
+    model never saw is kept, so that :func:`align_features` can say so); a missing key or
+    ``null`` is a missing value.
+
+    Raises
+    ------
+    DataFormatError
+        A value of the wrong kind, naming the instance and attribute; records that share
+        no attribute with the model.
+    """
+    features = schema.features
+    given = {key for record in records for key in record}
+    if given and not given & {a.name for a in features}:
+        raise DataFormatError(
+            f"none of the attributes given are the model's ({_quoted(sorted(given))}); the "
+            f"model needs {_quoted([a.name for a in features])}",
+            source="instances",
+        )
+    columns = []
+    attributes = []
+    for attribute in features:
+        cells = [record.get(attribute.name) for record in records]
+        if attribute.kind == "nominal":
+            labels = list(attribute.values)
+            codes = []
+            for i, cell in enumerate(cells):
+                if cell is None:
+                    codes.append(np.nan)
+                    continue
+                if isinstance(cell, bool) or not isinstance(cell, str | int):
+                    raise DataFormatError(
+                        f"instance {i + 1}: expects a label ({_quoted(labels)}), got {cell!r}",
+                        source="instances",
+                        attribute=attribute.name,
+                    )
+                if str(cell) not in labels:
+                    labels.append(str(cell))
+                codes.append(float(labels.index(str(cell))))
+            attributes.append(Attribute(attribute.name, "nominal", values=tuple(labels)))
+            columns.append(np.array(codes, dtype=np.float64))
+            continue
+        numbers = []
+        for i, cell in enumerate(cells):
+            if cell is not None and (
+                isinstance(cell, bool)
+                or not isinstance(cell, int | float)
+                or not np.isfinite(float(cell))
+            ):
+                raise DataFormatError(
+                    f"instance {i + 1}: expects a finite number, got {cell!r}",
+                    source="instances",
+                    attribute=attribute.name,
+                )
+            numbers.append(np.nan if cell is None else float(cell))
+        attributes.append(attribute)
+        columns.append(np.array(numbers, dtype=np.float64))
+    values = np.column_stack(columns) if columns else np.empty((len(records), 0))
+    out_schema = Schema(relation="instances", attributes=tuple(attributes), target_indices=())
+    return Dataset(schema=out_schema, values=values, name="instances")
+
+
+def align_features(
+    schema: Schema,
+    data: Dataset,
+    *,
+    source: str = "input",
+    warnings: list[str] | None = None,
+) -> np.ndarray:
     """The model's feature matrix from ``data``, shape (n_instances, n_model_features).
 
     Columns are found by name; nominal codes are translated label by label; a label the
-    model never saw becomes missing (NaN), which every pipeline imputes.
+    model never saw becomes missing (NaN), which every pipeline imputes, and is reported
+    in ``warnings``.
     """
     by_name = {a.name: i for i, a in enumerate(data.schema.attributes)}
     missing = [a.name for a in schema.features if a.name not in by_name]
@@ -142,11 +285,17 @@ def align_features(schema: Schema, data: Dataset, *, source: str = "input") -> n
     for attribute in schema.features:
         theirs = data.schema.attributes[by_name[attribute.name]]
         column = data.values[:, by_name[attribute.name]]
-        columns.append(_translate(attribute, theirs, column, source))
+        columns.append(_translate(attribute, theirs, column, source, warnings))
     return np.column_stack(columns) if columns else np.empty((data.n_instances, 0))
 
 
-def _translate(mine: Attribute, theirs: Attribute, column: np.ndarray, source: str) -> np.ndarray:
+def _translate(
+    mine: Attribute,
+    theirs: Attribute,
+    column: np.ndarray,
+    source: str,
+    warnings: list[str] | None,
+) -> np.ndarray:
     if mine.kind == "nominal":
         if theirs.kind != "nominal":
             raise DataFormatError(
@@ -155,12 +304,20 @@ def _translate(mine: Attribute, theirs: Attribute, column: np.ndarray, source: s
                 attribute=mine.name,
             )
         lookup = np.array(
-            [mine.values.index(v) if v in mine.values else np.nan for v in theirs.values]
-            or [np.nan]
+            [mine.values.index(v) if v in mine.values else -1.0 for v in theirs.values] or [-1.0]
         )
         out = np.full(column.shape, np.nan)
         known = ~np.isnan(column)
         out[known] = lookup[column[known].astype(int)]
+        unseen = out < 0
+        if unseen.any():
+            labels = [theirs.values[int(code)] for code in column[unseen]]
+            if warnings is not None:
+                warnings.append(
+                    f"{source}: attribute '{mine.name}': {int(unseen.sum())} instance(s) have "
+                    f"labels the model never saw ({_quoted(labels)}); treated as missing values"
+                )
+            out[unseen] = np.nan
         return out
     if theirs.kind not in ("numeric", "date") and mine.kind == "numeric":
         raise DataFormatError(
@@ -178,6 +335,12 @@ def _true_labels(target: Attribute, data: Dataset) -> list[str | None] | None:
         return None
     column = data.values[:, names.index(target.name)]
     return [theirs.label(v) for v in column]
+
+
+def _quoted(labels: Sequence[str]) -> str:
+    distinct = list(dict.fromkeys(labels))
+    shown = ", ".join(f"'{label}'" for label in distinct[:MAX_QUOTED])
+    return shown + (f", ... ({len(distinct)} in all)" if len(distinct) > MAX_QUOTED else "")
 
 
 def _jsonable(params: dict[str, Any]) -> dict[str, Any]:

@@ -1,41 +1,77 @@
-"""Benchmark runs end to end: a stored data set -> a problem -> folds -> the engine, each
-finished task written to the store as it arrives; resume; leaderboards from the store."""
+"""Benchmark runs: created (checked, stored ``queued``), executed (by the CLI at once, or by a
+service worker later), resumed, cancelled; their leaderboards read from the store.
+
+:func:`create_run` validates everything that can be validated before any work is done (the
+data set, its targets, the classifier ids, the folds) and stores the run; :func:`execute_run`
+claims it, carries out the tasks that have no result yet while a heartbeat tells other
+processes it is alive (and hears a cancel request), and writes the final status.
+"""
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from app.errors import AppError
+from app.schemas.runs import (
+    LeaderboardRowSchema,
+    LeaderboardSchema,
+    MarkSummary,
+    MetricValue,
+    RunStatus,
+)
 from app.store.database import Store
 from app.store.datasets import find_dataset, load_dataset
 from app.store.runs import (
+    HEARTBEAT_INTERVAL,
     RunInfo,
-    create_run,
+    claim_run,
+    finish_run,
     finished_keys,
     get_run,
+    heartbeat,
     load_results,
+    process_owner,
     record_result,
-    set_status,
+)
+from app.store.runs import (
+    create_run as store_run,
 )
 from benchmark.dataset import Dataset
 from benchmark.errors import ConfigurationError
-from benchmark.evaluation.leaderboard import Leaderboard, build_leaderboard
-from benchmark.problem import problem_from_dataset, restrict_targets
-from benchmark.run.engine import Problem, TaskKey, TaskResult, run_tasks
-from benchmark.run.folds import Fold, make_folds
+from benchmark.problem import Problem, problem_from_dataset, restrict_targets
+from benchmark.results import TaskKey, TaskResult
+
+if TYPE_CHECKING:  # scipy.stats (significance) loads when a leaderboard is first built
+    from benchmark.evaluation.leaderboard import Leaderboard
+
+#: Metric a leaderboard is ranked by unless asked otherwise, per kind of run.
+DEFAULT_METRIC = {"multiclass": "f1_weighted", "multitarget": "hamming_score"}
 
 
 @dataclass
 class RunOptions:
-    """How to cross-validate: the same options a resumed run gets back from the store."""
+    """How to cross-validate: the same options a resumed run gets back from the store.
+
+    Attributes
+    ----------
+    folds, repeats, seed : int
+        k of k-fold, repetitions of the whole partition, seed of folds and classifiers.
+    timeout : float or None
+        Seconds one task may take before its worker process is killed.
+    max_memory_mb : float or None
+        Megabytes one task may allocate beyond its worker's copy of the data.
+    """
 
     folds: int = 10
     repeats: int = 1
     seed: int = 0
     timeout: float | None = 600.0
+    max_memory_mb: float | None = None
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -43,7 +79,18 @@ class RunOptions:
             "repeats": self.repeats,
             "seed": self.seed,
             "timeout": self.timeout,
+            "max_memory_mb": self.max_memory_mb,
         }
+
+    @classmethod
+    def from_config(cls, config: dict[str, Any]) -> RunOptions:
+        return cls(
+            folds=int(config.get("folds_requested", config["folds"])),
+            repeats=int(config["repeats"]),
+            seed=int(config["seed"]),
+            timeout=config.get("timeout"),
+            max_memory_mb=config.get("max_memory_mb"),
+        )
 
 
 @dataclass
@@ -54,6 +101,7 @@ class Callbacks:
     on_start: Callable[[TaskKey], None] = lambda key: None
     on_result: Callable[[TaskResult], None] = lambda result: None
     on_warning: Callable[[str], None] = lambda message: None
+    on_note: Callable[[str], None] = lambda message: None
 
 
 @dataclass
@@ -61,6 +109,14 @@ class PreparedProblem:
     problem: Problem
     target_names: list[str]
     warnings: list[str] = field(default_factory=list)
+
+
+class RunCancelled(Exception):  # noqa: N818 (an outcome, not an error)
+    """The run was cancelled while it executed; its finished tasks are kept."""
+
+    def __init__(self, run: RunInfo) -> None:
+        super().__init__(f"run {run.id} was cancelled")
+        self.run = run
 
 
 def prepare_problem(dataset: Dataset, targets: Sequence[str] | None = None) -> PreparedProblem:
@@ -100,66 +156,196 @@ def default_classifiers(n_targets: int, suite_name: str = "default") -> list[str
 
 def check_classifiers(problem: Problem, classifiers: Sequence[str]) -> None:
     """Refuse, before a run exists, ids that are unknown or do not fit the problem."""
-    from benchmark.catalogue import get_spec
-    from benchmark.multitarget import META_METHODS, check_targets
+    from benchmark.estimators import check_classifier
 
     if not classifiers:
         raise ConfigurationError("no classifiers to run")
-    names = ", ".join(problem.target_names)
     for classifier in classifiers:
-        is_meta = ":" in classifier or classifier.lower() in META_METHODS
-        if problem.kind == "multitarget" and not is_meta:
-            get_spec(classifier)
-            raise ConfigurationError(
-                f"'{classifier}' is a multi-class classifier and the data set has "
-                f"{len(problem.target_names)} targets ({names}): use --target NAME for one "
-                f"target, or a multi-target configuration such as bcc:{classifier}"
-            )
-        if is_meta:
-            check_targets(classifier, problem.n_classes, problem.target_names)
-        else:
-            get_spec(classifier)
+        check_classifier(classifier, problem)
 
 
-def start_run(
+def create_run(
     store: Store,
     dataset_ref: str,
-    classifiers: Sequence[str],
+    classifiers: Sequence[str] | None = None,
     *,
+    suite: str | None = None,
     targets: Sequence[str] | None = None,
     options: RunOptions | None = None,
-    jobs: int = 1,
-    scheduler: str | None = None,
-    callbacks: Callbacks | None = None,
-) -> tuple[RunInfo, list[TaskResult]]:
-    """Create a run in the store and carry it out."""
+    on_warning: Callable[[str], None] | None = None,
+) -> RunInfo:
+    """Check a benchmark request and store it as a ``queued`` run.
+
+    Parameters
+    ----------
+    store : Store
+    dataset_ref : str
+        Data set name or id.
+    classifiers : sequence of str, optional
+        Classifier ids; default: the suite's (``default`` unless ``suite`` says).
+    suite : str, optional
+        ``fast``, ``default`` or ``all``; not together with ``classifiers``.
+    targets : sequence of str, optional
+        Targets to classify (one: the multi-class catalogue); default the data set's own.
+    options : RunOptions, optional
+    on_warning : callable, optional
+        Hears adjustments made (fewer folds than asked, unstratified folds, ...).
+
+    Raises
+    ------
+    ConfigurationError, AppError
+        Anything that would make the run fail at once: unknown data set, target or
+        classifier, a target with one class, impossible folds.
+    """
+    if classifiers and suite:
+        raise ConfigurationError("give classifiers or a suite, not both")
     options = options or RunOptions()
-    callbacks = callbacks or Callbacks()
+    _check_options(options)
     info = find_dataset(store, dataset_ref)
     prepared = prepare_problem(load_dataset(store, info.id), targets)
-    check_classifiers(prepared.problem, classifiers)
-    folds, fold_warnings = _folds(prepared, options)
+    ids = list(dict.fromkeys(classifiers or ())) or default_classifiers(
+        len(prepared.target_names), suite or "default"
+    )
+    check_classifiers(prepared.problem, ids)
+    folds, fold_notes = _folds(prepared, options)
     effective = max(f.fold for f in folds) + 1
     config = {
         **options.to_json(),
         "folds": effective,
         "folds_requested": options.folds,
         "targets_given": list(targets) if targets else None,
-        "n_tasks": len(classifiers) * len(folds),
+        "suite": None if classifiers else (suite or "default"),
+        "n_tasks": len(ids) * len(folds),
         "n_instances": int(prepared.problem.X.shape[0]),
+        "grouped": prepared.problem.groups is not None,
     }
-    run = create_run(
+    run = store_run(
         store,
         dataset_id=info.id,
         kind=prepared.problem.kind,
         targets=prepared.target_names,
-        classifiers=list(classifiers),
+        classifiers=ids,
         config=config,
     )
-    for message in prepared.warnings + fold_warnings:
-        callbacks.on_warning(message)
-    results = _execute(store, run, prepared, folds, options, jobs, scheduler, callbacks)
-    return get_run(store, run.id), results
+    if on_warning is not None:
+        for message in prepared.warnings + fold_notes:
+            on_warning(message)
+    return run
+
+
+def execute_run(
+    store: Store,
+    run_id: int | str,
+    *,
+    jobs: int = 1,
+    scheduler: str | None = None,
+    callbacks: Callbacks | None = None,
+) -> RunInfo:
+    """Carry out every task of a run that has no result yet, then record how it ended.
+
+    The run is claimed first (another live process executing it is refused); a heartbeat
+    thread tells other processes this one is alive and stops the engine when a cancel is
+    requested.
+
+    Returns
+    -------
+    RunInfo
+        Status ``done``, or ``failed`` when every task failed.
+
+    Raises
+    ------
+    RunCancelled
+        A cancel request stopped the run (status ``cancelled``).
+    KeyboardInterrupt
+        Passed on after the run is marked ``interrupted``.
+    AppError
+        Another process executes the run.
+    """
+    callbacks = callbacks or Callbacks()
+    run = get_run(store, run_id)
+    if run.status == "done" and run.n_results >= run.n_tasks:
+        return run
+    owner = process_owner()
+    run = claim_run(store, run.id, owner=owner)
+    stop = threading.Event()
+    beat = _Heartbeat(store, run.id, owner, stop)
+    try:
+        options = RunOptions.from_config(run.config)
+        prepared = prepare_problem(
+            load_dataset(store, run.dataset_id), run.config.get("targets_given")
+        )
+        folds, _ = _folds(prepared, options)
+        done = finished_keys(store, run.id)
+        callbacks.on_plan(len(run.classifiers) * len(folds), len(done))
+
+        def persist(result: TaskResult) -> None:
+            record_result(store, run.id, result)
+            callbacks.on_result(result)
+
+        from benchmark.run.engine import RunStopped, run_tasks
+
+        beat.start()
+        try:
+            run_tasks(
+                prepared.problem,
+                run.classifiers,
+                folds,
+                jobs=jobs,
+                scheduler=scheduler,
+                timeout=options.timeout,
+                random_state=options.seed,
+                skip=done,
+                on_start=callbacks.on_start,
+                on_result=persist,
+                max_memory=_bytes(options.max_memory_mb),
+                stop=stop.is_set,
+            )
+        except RunStopped:
+            finish_run(store, run.id, "cancelled")
+            raise RunCancelled(get_run(store, run.id)) from None
+    except (KeyboardInterrupt, SystemExit):
+        finish_run(store, run.id, "interrupted")
+        raise
+    except RunCancelled:
+        raise
+    except (ConfigurationError, AppError) as error:
+        finish_run(store, run.id, "failed", error=str(error))
+        raise
+    except BaseException as error:
+        finish_run(store, run.id, "interrupted", error=f"{type(error).__name__}: {error}")
+        raise
+    finally:
+        beat.stop()
+    status, error_text = _outcome(load_results(store, run.id))
+    finish_run(store, run.id, status, error=error_text)
+    return get_run(store, run.id)
+
+
+def start_run(
+    store: Store,
+    dataset_ref: str,
+    classifiers: Sequence[str] | None = None,
+    *,
+    suite: str | None = None,
+    targets: Sequence[str] | None = None,
+    options: RunOptions | None = None,
+    jobs: int = 1,
+    scheduler: str | None = None,
+    callbacks: Callbacks | None = None,
+) -> tuple[RunInfo, list[TaskResult]]:
+    """Create a run and carry it out at once (the CLI's ``bench``)."""
+    callbacks = callbacks or Callbacks()
+    run = create_run(
+        store,
+        dataset_ref,
+        classifiers,
+        suite=suite,
+        targets=targets,
+        options=options,
+        on_warning=callbacks.on_note,
+    )
+    run = execute_run(store, run.id, jobs=jobs, scheduler=scheduler, callbacks=callbacks)
+    return run, load_results(store, run.id)
 
 
 def resume_run(
@@ -171,36 +357,85 @@ def resume_run(
     callbacks: Callbacks | None = None,
 ) -> tuple[RunInfo, list[TaskResult]]:
     """Finish a run that was interrupted: only the tasks without a result are carried out."""
-    callbacks = callbacks or Callbacks()
-    run = get_run(store, run_id)
-    config = run.config
-    options = RunOptions(
-        folds=config["folds"],
-        repeats=config["repeats"],
-        seed=config["seed"],
-        timeout=config["timeout"],
-    )
-    prepared = prepare_problem(load_dataset(store, run.dataset_id), config.get("targets_given"))
-    folds, _ = _folds(prepared, options)
-    results = _execute(store, run, prepared, folds, options, jobs, scheduler, callbacks)
-    return get_run(store, run.id), results
+    run = execute_run(store, run_id, jobs=jobs, scheduler=scheduler, callbacks=callbacks)
+    return run, load_results(store, run.id)
 
 
 def run_leaderboard(
     store: Store, run_id: int | str, *, metric: str | None = None, baseline: str | None = None
 ) -> tuple[RunInfo, Leaderboard]:
+    """A run's leaderboard from its stored results.
+
+    Raises
+    ------
+    ConfigurationError
+        The run has no result yet; an unknown metric or baseline.
+    """
+    from benchmark.evaluation.leaderboard import build_leaderboard
+
     run = get_run(store, run_id)
     results = load_results(store, run.id)
     if not results:
-        raise ConfigurationError(f"run {run.id} has no results yet (resume it with --resume)")
-    default_metric = "f1_weighted" if run.kind == "multiclass" else "hamming_score"
-    return run, build_leaderboard(results, metric=metric or default_metric, baseline=baseline)
+        hint = (
+            "it is still running"
+            if run.status == "running"
+            else f"it is {run.status}; `touchbench bench --resume {run.id}` carries it out"
+        )
+        raise ConfigurationError(f"run {run.id} has no results yet ({hint})")
+    return run, build_leaderboard(
+        results, metric=metric or DEFAULT_METRIC.get(run.kind, "f1_weighted"), baseline=baseline
+    )
+
+
+def leaderboard_schema(
+    store: Store, run_id: int | str, *, metric: str | None = None, baseline: str | None = None
+) -> tuple[RunInfo, Leaderboard, LeaderboardSchema]:
+    """A run's leaderboard, and the report ``leaderboard --json`` prints and the API serves
+    (multi-target rows carry ``metrics.per_target``)."""
+    run, board = run_leaderboard(store, run_id, metric=metric, baseline=baseline)
+    per_target = per_target_summary(load_results(store, run.id))
+    rows = []
+    for row in board.rows:
+        metrics: dict[str, Any] = {
+            name: MetricValue(mean=mean, std=std) for name, (mean, std) in row.metrics.items()
+        }
+        if per_target.get(row.classifier):
+            metrics["per_target"] = {
+                target: {
+                    name: MetricValue(mean=mean, std=std) for name, (mean, std) in scores.items()
+                }
+                for target, scores in per_target[row.classifier].items()
+            }
+        rows.append(
+            LeaderboardRowSchema(
+                rank=row.rank,
+                classifier=row.classifier,
+                mark=row.mark,
+                metrics=metrics,
+                n_ok=row.n_ok,
+                n_failed=row.n_failed,
+                errors=row.errors,
+            )
+        )
+    better, same, worse = board.summary
+    report = LeaderboardSchema(
+        run_id=run.id,
+        dataset=run.dataset_name,
+        kind=run.kind,
+        targets=run.targets,
+        status=run.status,
+        metric=board.metric,
+        baseline=board.baseline,
+        summary=MarkSummary(better=better, same=same, worse=worse),
+        leaderboard=rows,
+    )
+    return run, board, report
 
 
 PerTargetSummary = dict[str, dict[str, dict[str, tuple[float, float]]]]
 
 
-def per_target_summary(store: Store, run_id: int) -> PerTargetSummary:
+def per_target_summary(results: Sequence[TaskResult]) -> PerTargetSummary:
     """Mean and standard deviation over folds of each target's scores, per classifier.
 
     Returns
@@ -209,7 +444,7 @@ def per_target_summary(store: Store, run_id: int) -> PerTargetSummary:
         classifier -> target -> metric (accuracy, f1_weighted, ...) -> (mean, std).
     """
     collected: dict[str, dict[str, dict[str, list[float]]]] = {}
-    for result in load_results(store, run_id):
+    for result in results:
         if result.status != "ok" or not result.per_target:
             continue
         by_target = collected.setdefault(result.key.classifier, {})
@@ -266,8 +501,9 @@ class IndependentResult:
 def independent_runs(
     store: Store,
     dataset_ref: str,
-    classifiers: Sequence[str],
+    classifiers: Sequence[str] | None = None,
     *,
+    suite: str | None = None,
     options: RunOptions | None = None,
     jobs: int = 1,
     scheduler: str | None = None,
@@ -287,6 +523,7 @@ def independent_runs(
             store,
             str(info.id),
             classifiers,
+            suite=suite,
             targets=[target],
             options=options,
             jobs=jobs,
@@ -303,50 +540,78 @@ def independent_runs(
     return IndependentResult(runs, product)
 
 
-def _folds(prepared: PreparedProblem, options: RunOptions) -> tuple[list[Fold], list[str]]:
-    return make_folds(
-        prepared.problem.Y,
-        n_folds=options.folds,
-        n_repeats=options.repeats,
-        seed=options.seed,
-        groups=prepared.problem.groups,
-        target_names=prepared.target_names,
-    )
+class _Heartbeat:
+    """A thread that keeps a run's heartbeat and sets ``stop`` on a cancel request."""
+
+    def __init__(self, store: Store, run_id: int, owner: str, stop: threading.Event) -> None:
+        self._store = store
+        self._run_id = run_id
+        self._owner = owner
+        self._stop = stop
+        self._done = threading.Event()
+        self._thread = threading.Thread(target=self._beat, daemon=True, name="run-heartbeat")
+
+    def start(self) -> None:
+        self._thread.start()
+
+    def stop(self) -> None:
+        self._done.set()
+        if self._thread.is_alive():
+            self._thread.join(timeout=HEARTBEAT_INTERVAL * 2)
+
+    def _beat(self) -> None:
+        while not self._done.wait(HEARTBEAT_INTERVAL):
+            try:
+                if heartbeat(self._store, self._run_id, self._owner):
+                    self._stop.set()
+            except Exception:  # a busy store: try again at the next beat
+                continue
 
 
-def _execute(
-    store: Store,
-    run: RunInfo,
-    prepared: PreparedProblem,
-    folds: list[Fold],
-    options: RunOptions,
-    jobs: int,
-    scheduler: str | None,
-    callbacks: Callbacks,
-) -> list[TaskResult]:
-    done = finished_keys(store, run.id)
-    callbacks.on_plan(len(run.classifiers) * len(folds), len(done))
+def _outcome(results: Sequence[TaskResult]) -> tuple[RunStatus, str | None]:
+    """``done``, or ``failed`` with a one-line reason when no task succeeded."""
+    if any(result.ok for result in results):
+        return "done", None
+    if not results:
+        return "failed", "no task was carried out"
+    reasons: dict[str, int] = {}
+    for result in results:
+        reason = (result.error or result.status).split(" (at ", 1)[0]
+        reasons[reason] = reasons.get(reason, 0) + 1
+    common = max(reasons, key=lambda reason: reasons[reason])
+    return "failed", (f"all {len(results)} tasks failed; most often ({reasons[common]}x): {common}")
 
-    def persist(result: TaskResult) -> None:
-        record_result(store, run.id, result)
-        callbacks.on_result(result)
 
-    set_status(store, run.id, "running")
-    try:
-        run_tasks(
-            prepared.problem,
-            run.classifiers,
-            folds,
-            jobs=jobs,
-            scheduler=scheduler,
-            timeout=options.timeout,
-            random_state=options.seed,
-            skip=done,
-            on_start=callbacks.on_start,
-            on_result=persist,
+def _check_options(options: RunOptions) -> None:
+    if options.folds < 2:
+        raise ConfigurationError(f"folds must be at least 2, got {options.folds}")
+    if options.repeats < 1:
+        raise ConfigurationError(f"repeats must be at least 1, got {options.repeats}")
+    if options.timeout is not None and not options.timeout > 0:
+        raise ConfigurationError(
+            f"timeout must be a positive number of seconds, got {options.timeout}"
         )
-    except BaseException:
-        set_status(store, run.id, "interrupted")
-        raise
-    set_status(store, run.id, "done")
-    return load_results(store, run.id)
+    if options.max_memory_mb is not None and not options.max_memory_mb > 0:
+        raise ConfigurationError(
+            f"max_memory must be a positive number of megabytes, got {options.max_memory_mb}"
+        )
+
+
+def _bytes(megabytes: float | None) -> int | None:
+    return None if megabytes is None else int(megabytes * 2**20)
+
+
+def _folds(prepared: PreparedProblem, options: RunOptions) -> tuple[list[Any], list[str]]:
+    from benchmark.run.folds import make_folds
+
+    try:
+        return make_folds(
+            prepared.problem.Y,
+            n_folds=options.folds,
+            n_repeats=options.repeats,
+            seed=options.seed,
+            groups=prepared.problem.groups,
+            target_names=prepared.target_names,
+        )
+    except ValueError as error:  # scikit-learn's splitters on data too small to split
+        raise ConfigurationError(f"cannot make {options.folds} folds: {error}") from None

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -9,7 +10,7 @@ from typing import Any
 
 from sqlalchemy import Engine, create_engine, event, text
 from sqlalchemy.engine import make_url
-from sqlalchemy.exc import ArgumentError, OperationalError, ProgrammingError
+from sqlalchemy.exc import ArgumentError, DatabaseError, OperationalError, ProgrammingError
 from sqlalchemy.orm import Session, sessionmaker
 
 from app.errors import AppError
@@ -42,8 +43,11 @@ class Store:
         due, which keeps every CLI command's start-up short.
         """
         try:
-            if self.revision() == HEAD_REVISION:
+            revision = self.revision()
+            if revision == HEAD_REVISION:
                 return
+            if revision is None:
+                self._refuse_foreign_database()
             from alembic import command
             from alembic.config import Config
 
@@ -52,11 +56,24 @@ class Store:
             with self.engine.begin() as connection:
                 config.attributes["connection"] = connection
                 command.upgrade(config, "head")
-        except OperationalError as error:
+        except (OperationalError, DatabaseError) as error:
             raise AppError(
                 f"cannot open the store at {self.engine.url.render_as_string()}: "
                 f"{_first_line(error.orig)}"
             ) from None
+
+    def _refuse_foreign_database(self) -> None:
+        """An unversioned database that holds tables belongs to someone else: never write."""
+        from sqlalchemy import inspect
+
+        tables = sorted(inspect(self.engine).get_table_names())
+        if tables:
+            shown = ", ".join(tables[:5]) + (f", ... ({len(tables)})" if len(tables) > 5 else "")
+            raise AppError(
+                f"{self.engine.url.render_as_string()} holds another application's tables "
+                f"({shown}) and no touchbench store; touchbench will not write into it: give "
+                "--db a new file or an empty database"
+            )
 
     def revision(self) -> str | None:
         """The schema revision the store is at, ``None`` for an empty database."""
@@ -94,8 +111,8 @@ def _create_engine(url: str) -> Engine:
     options: dict[str, Any] = {}
     if parsed.get_backend_name() == "sqlite":
         database = parsed.database or ""
-        if database and database != ":memory:" and not Path(database).parent.exists():
-            raise AppError(f"cannot open the store at {url}: folder does not exist")
+        if database and database != ":memory:":
+            _check_sqlite_file(Path(database), url)
         options["connect_args"] = {"timeout": 30}
     try:
         engine = create_engine(url, **options)
@@ -106,8 +123,38 @@ def _create_engine(url: str) -> Engine:
     return engine
 
 
+def _check_sqlite_file(path: Path, url: str) -> None:
+    """Refuse a path that cannot hold a SQLite store before SQLite touches it."""
+    if not path.parent.is_dir():
+        raise AppError(f"cannot open the store at {url}: folder {path.parent} does not exist")
+    if not path.exists():
+        return
+    if not path.is_file():
+        raise AppError(f"cannot open the store at {url}: {path} is not a regular file")
+    if path.stat().st_size == 0:
+        return
+    import sqlite3
+
+    # Through SQLite itself, read-only: opening and closing the file any other way would
+    # drop the POSIX locks this process's own connections hold on it (SQLite shares them
+    # between its connections), and SQLite's WAL pragma must not touch a foreign file.
+    try:
+        with contextlib.closing(sqlite3.connect(f"file:{path}?mode=ro", uri=True)) as peek:
+            tables = {name for (name,) in peek.execute("SELECT name FROM sqlite_master")}
+    except sqlite3.DatabaseError as error:
+        reason = "is not a SQLite database" if "not a database" in str(error) else str(error)
+        raise AppError(f"cannot open the store at {url}: {path} {reason}") from None
+    if tables and "alembic_version" not in tables:
+        shown = ", ".join(sorted(tables)[:5])
+        raise AppError(
+            f"{path} is another application's SQLite database (tables: {shown}); touchbench "
+            "will not write into it: give --db a new file"
+        )
+
+
 def _sqlite_pragmas(dbapi_connection: Any, _record: Any) -> None:
     cursor = dbapi_connection.cursor()
+    cursor.execute("PRAGMA busy_timeout=30000")
     cursor.execute("PRAGMA journal_mode=WAL")
     cursor.execute("PRAGMA foreign_keys=ON")
     cursor.execute("PRAGMA synchronous=NORMAL")

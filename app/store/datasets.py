@@ -1,27 +1,42 @@
-"""Data sets in the store: add (one transaction, deduplicated by content), look up by name
-or id, load into a :class:`benchmark.dataset.Dataset`, list and delete."""
+"""Data sets in the store: add (one transaction, streamed, deduplicated by content), look
+up by name or id, load whole or in blocks, rename and delete.
+
+Instances go in and out through the database driver's own bulk paths (SQLite's
+``executemany``, PostgreSQL's binary ``COPY``) in blocks, so that importing or exporting a
+data set of any size keeps memory flat; SQLAlchemy's per-row processing would take most of
+the time.  An import is one transaction: interrupted (Ctrl-C, ``kill -9``) or failed, it
+leaves nothing behind.
+"""
 
 from __future__ import annotations
 
 import hashlib
 import json
-import re
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
-from datetime import datetime
-from typing import Any
+from datetime import UTC, datetime, timedelta
+from typing import Any, Protocol
 
 import numpy as np
-from sqlalchemy import delete, insert, select
+from sqlalchemy import delete, insert, select, update
+from sqlalchemy.exc import IntegrityError, OperationalError
 from sqlalchemy.orm import Session
 
 from app.errors import AppError
 from app.store.database import Store
-from app.store.naming import find_row, free_name
-from app.store.tables import DatasetRow, InstanceRow
-from benchmark.dataset import Dataset, Schema
+from app.store.naming import check_name, default_name, find_row, free_name, shorten
+from app.store.tables import DatasetRow, InstanceRow, RunRow
+from benchmark.dataset import Dataset, InstanceBlock, Schema, dataset_blocks
 
 _LITTLE_F8 = np.dtype("<f8")
 _INSERT_BATCH = 5000
+#: Rows fetched at a time when instances are read back.
+READ_BATCH = 5000
+#: A queued or running run whose process said it was alive this recently holds its data set.
+LIVE_RUN = timedelta(seconds=60)
+_PGCOPY_HEADER = b"PGCOPY\n\xff\r\n\x00" + bytes(8)
+_PGCOPY_TRAILER = b"\xff\xff"
 
 
 @dataclass(frozen=True)
@@ -49,7 +64,10 @@ class DatasetInfo:
             targets=list(row.target_names),
             source_name=row.source_name,
             sha256=row.sha256,
-            created_at=row.created_at,
+            # SQLite gives back naive times; they were written in UTC.
+            created_at=row.created_at
+            if row.created_at.tzinfo is not None
+            else row.created_at.replace(tzinfo=UTC),
         )
 
     def to_json(self) -> dict[str, Any]:
@@ -64,6 +82,41 @@ class DatasetInfo:
             "sha256": self.sha256,
             "created_at": self.created_at.isoformat(),
         }
+
+
+class InstanceSource(Protocol):
+    """Instances that come block by block, such as an :class:`~benchmark.io.arff.ArffReader`.
+
+    ``schema`` and ``sparse`` are final once ``blocks()`` is exhausted (a reader's string
+    tables grow as it reads).
+    """
+
+    @property
+    def schema(self) -> Schema: ...
+
+    @property
+    def sparse(self) -> bool: ...
+
+    def blocks(self) -> Iterator[InstanceBlock]: ...
+
+
+@dataclass
+class DatasetInMemory:
+    """A :class:`~benchmark.dataset.Dataset` as an :class:`InstanceSource`."""
+
+    dataset: Dataset
+    rows: int | None = None  # instances per block; default _INSERT_BATCH
+
+    @property
+    def schema(self) -> Schema:
+        return self.dataset.schema
+
+    @property
+    def sparse(self) -> bool:
+        return self.dataset.sparse
+
+    def blocks(self) -> Iterator[InstanceBlock]:
+        return dataset_blocks(self.dataset, self.rows or _INSERT_BATCH)
 
 
 def content_digest(content: bytes) -> str:
@@ -87,60 +140,294 @@ def add_dataset(
     source_name: str | None = None,
     extraction: dict[str, Any] | None = None,
 ) -> tuple[DatasetInfo, bool]:
-    """Store a data set in one transaction, unless the same content is stored already.
+    """Store a data set held in memory (see :func:`add_dataset_stream`).
+
+    By default it is named after its relation (MEKA's options dropped), made unique with a
+    numeric suffix.
+    """
+    return add_dataset_stream(
+        store,
+        DatasetInMemory(dataset),
+        sha256=sha256,
+        name=name,
+        default=default_name(dataset.schema.relation.split(":", 1)[0].strip()),
+        source_name=source_name,
+        extraction=extraction,
+    )
+
+
+def add_dataset_stream(
+    store: Store,
+    source: InstanceSource,
+    *,
+    sha256: str,
+    name: str | None = None,
+    default: str = "dataset",
+    source_name: str | None = None,
+    extraction: dict[str, Any] | None = None,
+    on_block: Callable[[InstanceBlock], None] | None = None,
+) -> tuple[DatasetInfo, bool]:
+    """Store instances as they come, in one transaction, unless the same content is stored.
+
+    The data set's row is written first (so that a name taken meanwhile by another
+    process shows at once), then each block of instances as ``source`` yields it, then
+    the final schema and count.
 
     Parameters
     ----------
     store : Store
-    dataset : Dataset
+    source : InstanceSource
+        The schema and the blocks of instances; blocks are read only if the content is new.
     sha256 : str
-        Digest of the content (:func:`content_digest` of the file's bytes).
+        Digest of the content (of the file's bytes for an import).
     name : str, optional
-        Unique name; by default the relation name (made unique with a numeric suffix).
+        The name; it must be free (see :func:`~app.store.naming.check_name`).
+    default : str
+        The name when ``name`` is not given, made unique with a numeric suffix.
     source_name : str, optional
         File name the data came from.
     extraction : dict, optional
         How the data set was extracted from recordings (JSON), kept so that models trained
         on it can extract live features the same way.
+    on_block : callable, optional
+        Called with each block before it is stored; what it raises undoes the import.
 
     Returns
     -------
     info : DatasetInfo
     created : bool
         ``False`` when the content was already stored and ``info`` is that data set.
+
+    Raises
+    ------
+    AppError
+        If ``name`` is invalid or taken (also by an import that committed meanwhile), or
+        the store stayed locked by another writer.
     """
-    with store.session() as session:
-        existing = session.scalars(
-            select(DatasetRow).where(DatasetRow.sha256 == sha256).order_by(DatasetRow.id)
-        ).first()
-        if existing is not None:
-            return DatasetInfo.of(existing), False
-        if name is not None:
-            _check_name(session, name)
-        else:
-            name = free_name(session, DatasetRow, default_name(dataset.schema.relation))
-        row = DatasetRow(
-            name=name,
-            relation=dataset.schema.relation,
-            schema=dataset.schema.to_json(),
-            target_names=list(dataset.schema.target_names),
-            n_instances=dataset.n_instances,
-            n_attributes=dataset.schema.n_attributes,
-            sparse=dataset.sparse,
-            source_name=source_name,
-            sha256=sha256,
-            extraction=extraction,
+    if name is not None:
+        check_name(name, kind="dataset")
+    for _attempt in range(3):
+        try:
+            with store.session() as session:
+                existing = find_by_digest(session, sha256)
+                if existing is not None:
+                    return existing, False
+                chosen = name if name is not None else free_name(session, DatasetRow, default)
+                if name is not None:
+                    _refuse_taken(session, name)
+                row = _insert_row(session, source.schema, chosen, sha256, source_name, extraction)
+                count = _insert_blocks(session, row.id, source.blocks(), on_block)
+                schema = source.schema
+                session.execute(
+                    update(DatasetRow)
+                    .where(DatasetRow.id == row.id)
+                    .values(
+                        schema=schema.to_json(),
+                        n_instances=count,
+                        sparse=source.sparse,
+                    )
+                )
+                session.refresh(row)
+                return DatasetInfo.of(row), True
+        except _NameTakenError as taken:
+            if name is not None:
+                raise AppError(_taken_message(store, taken.name)) from None
+            # Another process took the default name meanwhile: choose again.
+        except OperationalError as error:
+            raise _busy_or_raise(error) from None
+    raise AppError(f"could not find a free name for the dataset after '{default}' (busy store)")
+
+
+class _NameTakenError(Exception):
+    def __init__(self, name: str) -> None:
+        self.name = name
+
+
+def _insert_row(
+    session: Session,
+    schema: Schema,
+    name: str,
+    sha256: str,
+    source_name: str | None,
+    extraction: dict[str, Any] | None,
+) -> DatasetRow:
+    row = DatasetRow(
+        name=name,
+        relation=schema.relation,
+        schema=schema.to_json(),
+        target_names=list(schema.target_names),
+        n_instances=0,
+        n_attributes=schema.n_attributes,
+        sparse=False,
+        source_name=source_name,
+        sha256=sha256,
+        extraction=extraction,
+    )
+    session.add(row)
+    try:
+        session.flush()  # waits for a concurrent import of the same name to end
+    except IntegrityError:
+        raise _NameTakenError(name) from None
+    return row
+
+
+def _refuse_taken(session: Session, name: str) -> None:
+    clash = session.scalars(select(DatasetRow).where(DatasetRow.name == name)).first()
+    if clash is not None:
+        raise AppError(
+            f"a dataset named '{shorten(name)}' already exists (id {clash.id}); choose another name"
         )
-        session.add(row)
-        session.flush()
-        _insert_instances(session, row.id, dataset)
-        return DatasetInfo.of(row), True
 
 
-def default_name(relation: str) -> str:
-    """A data set name from a relation: MEKA's options dropped, unsafe characters folded."""
-    base = relation.split(":", 1)[0].strip() or "dataset"
-    return re.sub(r"[^\w.-]+", "_", base).strip("_") or "dataset"
+def _taken_message(store: Store, name: str) -> str:
+    with store.session() as session:
+        clash = session.scalars(select(DatasetRow).where(DatasetRow.name == name)).first()
+    where = f" (id {clash.id})" if clash is not None else ""
+    return f"a dataset named '{shorten(name)}' already exists{where}; choose another name"
+
+
+def _busy_or_raise(error: OperationalError) -> Exception:
+    if "locked" in str(error.orig):
+        return AppError(
+            "the store is busy: another process kept it locked for writing (an import?); "
+            "try again when it is done"
+        )
+    return error
+
+
+def find_by_digest(session: Session, sha256: str) -> DatasetInfo | None:
+    """The first data set stored with content digest ``sha256``, if any."""
+    row = session.scalars(
+        select(DatasetRow).where(DatasetRow.sha256 == sha256).order_by(DatasetRow.id)
+    ).first()
+    return None if row is None else DatasetInfo.of(row)
+
+
+def stored_digest(store: Store, sha256: str) -> DatasetInfo | None:
+    """The first data set stored with content digest ``sha256``, if any."""
+    with store.session() as session:
+        return find_by_digest(session, sha256)
+
+
+def _insert_blocks(
+    session: Session,
+    dataset_id: int,
+    blocks: Iterable[InstanceBlock],
+    on_block: Callable[[InstanceBlock], None] | None,
+) -> int:
+    """Insert every block's instances; the number inserted."""
+    connection = session.connection()
+    bulk = _copy_block if connection.dialect.name == "postgresql" else _executemany_block
+    position = 0
+    for block in blocks:
+        if on_block is not None:
+            on_block(block)
+        _write_block(session, dataset_id, position, block, bulk)
+        position += block.n_instances
+    return position
+
+
+def _write_block(
+    session: Session,
+    dataset_id: int,
+    start: int,
+    block: InstanceBlock,
+    bulk: Callable[[Session, int, int, InstanceBlock], None],
+) -> None:
+    """Insert one block: in bulk, or through SQLAlchemy when it has groups or metadata."""
+    if block.groups is not None or block.meta is not None:
+        _orm_block(session, dataset_id, start, block)
+    else:
+        bulk(session, dataset_id, start, block)
+
+
+def _rows_bytes(block: InstanceBlock) -> np.ndarray:
+    values = np.ascontiguousarray(block.values, dtype=_LITTLE_F8)
+    return values.view(np.dtype((np.void, values.shape[1] * 8))).ravel()
+
+
+def _executemany_block(session: Session, dataset_id: int, start: int, block: InstanceBlock) -> None:
+    n, width = block.n_instances, block.values.shape[1] * 8
+    data = np.ascontiguousarray(block.values, dtype=_LITTLE_F8).tobytes()
+    weights = [None] * n if block.weights is None else block.weights.tolist()
+    cursor = _dbapi(session).cursor()
+    try:
+        cursor.executemany(
+            "INSERT INTO instances (dataset_id, position, data, weight) VALUES (?, ?, ?, ?)",
+            zip(
+                [dataset_id] * n,
+                range(start, start + n),
+                [data[i : i + width] for i in range(0, n * width, width)],
+                weights,
+                strict=True,
+            ),
+        )
+    finally:
+        cursor.close()
+
+
+def _copy_block(session: Session, dataset_id: int, start: int, block: InstanceBlock) -> None:
+    """One binary ``COPY`` of a block, its tuples laid out by numpy."""
+    n, width = block.n_instances, block.values.shape[1] * 8
+    fields = [
+        ("count", ">i2"),
+        ("id_size", ">i4"),
+        ("id", ">i4"),
+        ("position_size", ">i4"),
+        ("position", ">i4"),
+        ("data_size", ">i4"),
+        ("data", f"V{width}"),
+    ]
+    if block.weights is not None:
+        fields += [("weight_size", ">i4"), ("weight", ">f8")]
+    tuples = np.empty(n, dtype=np.dtype(fields))
+    tuples["count"] = 3 if block.weights is None else 4
+    tuples["id_size"] = tuples["position_size"] = 4
+    tuples["id"] = dataset_id
+    tuples["position"] = np.arange(start, start + n)
+    tuples["data_size"] = width
+    tuples["data"] = _rows_bytes(block)
+    columns = "dataset_id, position, data"
+    if block.weights is not None:
+        tuples["weight_size"] = 8
+        tuples["weight"] = block.weights
+        columns += ", weight"
+    cursor = _dbapi(session).cursor()
+    try:
+        with cursor.copy(f"COPY instances ({columns}) FROM STDIN (FORMAT BINARY)") as copy:
+            copy.write(_PGCOPY_HEADER)
+            copy.write(tuples.tobytes())
+            copy.write(_PGCOPY_TRAILER)
+    finally:
+        cursor.close()
+
+
+def _orm_block(session: Session, dataset_id: int, start: int, block: InstanceBlock) -> None:
+    """Instances with groups or metadata (extracted data sets), through SQLAlchemy."""
+    values = np.ascontiguousarray(block.values, dtype=_LITTLE_F8)
+    weights, groups, metas = block.weights, block.groups, block.meta
+    for first in range(0, block.n_instances, _INSERT_BATCH):
+        stop = min(first + _INSERT_BATCH, block.n_instances)
+        session.execute(
+            insert(InstanceRow),
+            [
+                {
+                    "dataset_id": dataset_id,
+                    "position": start + i,
+                    "data": values[i].tobytes(),
+                    "weight": None if weights is None else float(weights[i]),
+                    "group_id": None if groups is None else str(groups[i]),
+                    "meta": None if metas is None else metas[i],
+                }
+                for i in range(first, stop)
+            ],
+        )
+
+
+def _dbapi(session: Session) -> Any:
+    dbapi = session.connection().connection.dbapi_connection
+    assert dbapi is not None
+    return dbapi
 
 
 def find_dataset(store: Store, ref: str | int) -> DatasetInfo:
@@ -155,19 +442,27 @@ def list_datasets(store: Store) -> list[DatasetInfo]:
         return [DatasetInfo.of(row) for row in rows]
 
 
+def load_schema(store: Store, ref: str | int) -> tuple[DatasetInfo, Schema, bool]:
+    """A stored data set's listing, schema and whether it was read from sparse rows."""
+    with store.session() as session:
+        row = _row(session, ref)
+        return DatasetInfo.of(row), Schema.from_json(row.schema), row.sparse
+
+
 def load_dataset(store: Store, ref: str | int) -> Dataset:
     """The stored data set, values as WEKA encodes them (see :mod:`benchmark.dataset`)."""
     with store.session() as session:
         row = _row(session, ref)
         schema = Schema.from_json(row.schema)
-        blobs = _instance_blobs(session, row.id)
-        values = np.frombuffer(b"".join(blobs), dtype=_LITTLE_F8).reshape(
-            len(blobs), schema.n_attributes
-        )
-        weights, groups, meta = _instance_extras(session, row.id, len(blobs))
+        values = np.empty((row.n_instances, schema.n_attributes))
+        count = 0
+        for block in _value_batches(session, row.id, schema.n_attributes, with_weights=False):
+            values[count : count + block.n_instances] = block.values
+            count += block.n_instances
+        weights, groups, meta = _instance_extras(session, row.id, count)
         return Dataset(
             schema=schema,
-            values=values.copy(),
+            values=values[:count],
             weights=weights,
             groups=groups,
             meta=meta,
@@ -176,57 +471,70 @@ def load_dataset(store: Store, ref: str | int) -> Dataset:
         )
 
 
-def delete_dataset(store: Store, ref: str | int) -> DatasetInfo:
-    """Remove a data set with its instances (and, by cascade, its runs)."""
+@dataclass
+class StoredInstances:
+    """A stored data set read back in blocks (an :class:`InstanceSource`).
+
+    Made by :func:`read_blocks`; the blocks come from one query, so they are consistent
+    with each other even if the data set changes meanwhile.
+    """
+
+    info: DatasetInfo
+    schema: Schema
+    sparse: bool
+    _blocks: Iterator[InstanceBlock]
+
+    def blocks(self) -> Iterator[InstanceBlock]:
+        return self._blocks
+
+
+@contextmanager
+def read_blocks(
+    store: Store, ref: str | int, *, rows: int | None = None
+) -> Iterator[StoredInstances]:
+    """A stored data set's values and weights, to read in blocks of ``rows`` instances
+    (:data:`READ_BATCH` by default)::
+
+    with read_blocks(store, "mini") as stored:
+        for block in stored.blocks(): ...
+    """
     with store.session() as session:
         row = _row(session, ref)
-        info = DatasetInfo.of(row)
-        session.execute(delete(InstanceRow).where(InstanceRow.dataset_id == row.id))
-        session.delete(row)
-        return info
+        schema = Schema.from_json(row.schema)
+        batches = _value_batches(session, row.id, schema.n_attributes, with_weights=True, rows=rows)
+        yield StoredInstances(DatasetInfo.of(row), schema, row.sparse, batches)
 
 
-def _insert_instances(session: Session, dataset_id: int, dataset: Dataset) -> None:
-    values = np.ascontiguousarray(dataset.values, dtype=_LITTLE_F8)
-    n = dataset.n_instances
-    weights = dataset.weights
-    groups = dataset.groups
-    metas = dataset.meta
-    for start in range(0, n, _INSERT_BATCH):
-        stop = min(start + _INSERT_BATCH, n)
-        session.execute(
-            insert(InstanceRow),
-            [
-                {
-                    "dataset_id": dataset_id,
-                    "position": i,
-                    "data": values[i].tobytes(),
-                    "weight": None if weights is None else float(weights[i]),
-                    "group_id": None if groups is None else str(groups[i]),
-                    "meta": None if metas is None else metas[i],
-                }
-                for i in range(start, stop)
-            ],
-        )
-
-
-def _instance_blobs(session: Session, dataset_id: int) -> list[bytes]:
-    """Every instance's bytes in order, through the driver's own cursor: SQLAlchemy's
+def _value_batches(
+    session: Session,
+    dataset_id: int,
+    n_attributes: int,
+    *,
+    with_weights: bool,
+    rows: int | None = None,
+) -> Iterator[InstanceBlock]:
+    """Instances in order, ``rows`` at a time, through the driver's own cursor: SQLAlchemy's
     per-row processing and psycopg's text-format ``bytea`` would triple the load time."""
     connection = session.connection()
-    dbapi = connection.connection.dbapi_connection
-    assert dbapi is not None
+    dbapi = _dbapi(session)
     style = connection.dialect.paramstyle
     marker = {"qmark": "?", "numeric": ":1", "named": ":id"}.get(style, "%s")
+    postgresql = connection.dialect.driver == "psycopg"
     cursor = (
-        dbapi.cursor(binary=True) if connection.dialect.driver == "psycopg" else (dbapi.cursor())
+        dbapi.cursor(name=f"instances_{dataset_id}", binary=True) if postgresql else dbapi.cursor()
     )
+    columns = "data, weight" if with_weights else "data"
     try:
         cursor.execute(
-            f"SELECT data FROM instances WHERE dataset_id = {marker} ORDER BY position",
+            f"SELECT {columns} FROM instances WHERE dataset_id = {marker} ORDER BY position",
             {"id": dataset_id} if style == "named" else (dataset_id,),
         )
-        return [bytes(blob) for (blob,) in cursor.fetchall()]
+        while batch := cursor.fetchmany(rows or READ_BATCH):
+            values = np.frombuffer(b"".join(bytes(r[0]) for r in batch), dtype=_LITTLE_F8)
+            weights = None
+            if with_weights and any(r[1] is not None for r in batch):
+                weights = np.array([1.0 if r[1] is None else r[1] for r in batch])
+            yield InstanceBlock(values.reshape(len(batch), n_attributes), weights=weights)
     finally:
         cursor.close()
 
@@ -263,19 +571,80 @@ def _instance_extras(
     return weights, groups, meta
 
 
-def _check_name(session: Session, name: str) -> None:
-    if not name.strip():
-        raise AppError("a dataset name cannot be empty")
-    if name.isdigit():
-        raise AppError(f"a dataset name cannot be a number ('{name}' would read as an id)")
-    clash = session.scalars(select(DatasetRow).where(DatasetRow.name == name)).first()
-    if clash is not None:
-        raise AppError(
-            f"a dataset named '{name}' already exists (id {clash.id}); choose another --name"
-        )
+def rename_dataset(store: Store, ref: str | int, new_name: str) -> tuple[DatasetInfo, str]:
+    """Give a data set another name; returns its listing and the name it had.
+
+    Raises
+    ------
+    AppError
+        If the name is invalid or another data set has it.
+    """
+    check_name(new_name, kind="dataset")
+    try:
+        with store.session() as session:
+            row = _row(session, ref)
+            old = row.name
+            if new_name != old:
+                _refuse_taken(session, new_name)
+                row.name = new_name
+                try:
+                    session.flush()
+                except IntegrityError:
+                    raise _NameTakenError(new_name) from None
+            return DatasetInfo.of(row), old
+    except _NameTakenError as taken:
+        raise AppError(_taken_message(store, taken.name)) from None
 
 
-def _row(session: Session, ref: str | int) -> DatasetRow:
-    return find_row(
+def delete_dataset(store: Store, ref: str | int) -> DatasetInfo:
+    """Remove a data set with its instances (and, by cascade, its runs).
+
+    Raises
+    ------
+    AppError
+        If a run on it is queued or running (its process alive in the last
+        :data:`LIVE_RUN`): the run must be cancelled first.
+    """
+    with store.session() as session:
+        row = _row(session, ref, lock=True)
+        info = DatasetInfo.of(row)
+        live = _live_run(session, row.id)
+        if live is not None:
+            run_id, status = live
+            raise AppError(
+                f"dataset '{shorten(info.name)}' is in use by run {run_id} ({status}); "
+                f"cancel it first (`touchbench cancel {run_id}`) or wait for it to end"
+            )
+        session.execute(delete(InstanceRow).where(InstanceRow.dataset_id == row.id))
+        session.delete(row)
+        return info
+
+
+def _live_run(session: Session, dataset_id: int) -> tuple[int, str] | None:
+    """A queued or running run on the data set whose process is alive, if any."""
+    runs = session.execute(
+        select(RunRow.id, RunRow.status, RunRow.heartbeat_at)
+        .where(RunRow.dataset_id == dataset_id)
+        .where(RunRow.status.in_(("queued", "running")))
+        .order_by(RunRow.id)
+    ).all()
+    now = datetime.now(UTC)
+    for run_id, status, heartbeat in runs:
+        if heartbeat is None:
+            if status == "queued":
+                return run_id, status
+            continue
+        if heartbeat.tzinfo is None:  # SQLite keeps naive UTC times
+            heartbeat = heartbeat.replace(tzinfo=UTC)
+        if now - heartbeat < LIVE_RUN:
+            return run_id, status
+    return None
+
+
+def _row(session: Session, ref: str | int, *, lock: bool = False) -> DatasetRow:
+    row = find_row(
         session, DatasetRow, ref, kind="dataset", hint="the store has none; import one first"
     )
+    if lock:
+        session.refresh(row, with_for_update=True)
+    return row

@@ -1,5 +1,10 @@
-"""Trained models in the store: the artifact's bytes with their sha256, the schema the
-model expects, the classifier and its parameters, and the data set and run it came from."""
+"""Trained models in the store: the artifact's bytes with their sha256 and format, the schema
+the model expects, the classifier and its parameters, the data set and run it came from,
+and how that data set was extracted from recordings.
+
+Listings never read an artifact (the column is deferred); :func:`load_artifact` reads one,
+and only a format that cannot run code when loaded (``skops``) is handed out.
+"""
 
 from __future__ import annotations
 
@@ -9,13 +14,18 @@ from dataclasses import dataclass
 from datetime import datetime
 from typing import Any
 
-from sqlalchemy import select
+from sqlalchemy import delete, select, update
+from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session
 
 from app.errors import AppError
+from app.schemas.models import ModelSchema
 from app.store.database import Store
 from app.store.naming import find_row, free_name
 from app.store.tables import DatasetRow, ModelRow
+
+#: The only artifact format that is loaded (see :mod:`benchmark.artifacts`).
+SAFE_FORMAT = "skops"
 
 
 @dataclass(frozen=True)
@@ -32,20 +42,37 @@ class ModelInfo:
     size_bytes: int
     created_at: datetime
     schema: dict[str, Any]
+    format: str = SAFE_FORMAT
+    extraction: dict[str, Any] | None = None
+
+    @property
+    def feature_names(self) -> list[str]:
+        targets = set(self.schema.get("target_indices", ()))
+        return [
+            attribute["name"]
+            for i, attribute in enumerate(self.schema.get("attributes", ()))
+            if i not in targets
+        ]
+
+    def to_schema(self) -> ModelSchema:
+        return ModelSchema(
+            id=self.id,
+            name=self.name,
+            classifier=self.classifier,
+            targets=self.targets,
+            dataset=self.dataset_name,
+            dataset_id=self.dataset_id,
+            run_id=self.run_id,
+            sha256=self.sha256,
+            size_bytes=self.size_bytes,
+            format=self.format,
+            created_at=self.created_at,
+            features=self.feature_names,
+            extraction=self.extraction,
+        )
 
     def to_json(self) -> dict[str, Any]:
-        return {
-            "id": self.id,
-            "name": self.name,
-            "classifier": self.classifier,
-            "targets": self.targets,
-            "dataset": self.dataset_name,
-            "dataset_id": self.dataset_id,
-            "run_id": self.run_id,
-            "sha256": self.sha256,
-            "size_bytes": self.size_bytes,
-            "created_at": self.created_at.isoformat(),
-        }
+        return self.to_schema().to_json()
 
 
 def save_model(
@@ -60,45 +87,105 @@ def save_model(
     run_id: int | None = None,
     name: str | None = None,
 ) -> ModelInfo:
-    """Store a model's artifact; its name defaults to ``DATASET-CLASSIFIER[-N]``."""
-    with store.session() as session:
-        dataset_name = (
-            session.scalar(select(DatasetRow.name).where(DatasetRow.id == dataset_id))
-            if dataset_id is not None
-            else None
-        )
-        if name is None:
-            name = free_name(session, ModelRow, f"{dataset_name or 'model'}-{classifier}")
-        elif session.scalars(select(ModelRow).where(ModelRow.name == name)).first() is not None:
-            raise AppError(f"a model named '{name}' already exists; choose another --name")
-        row = ModelRow(
-            name=name,
-            dataset_id=dataset_id,
-            run_id=run_id,
-            classifier=classifier,
-            params=params,
-            schema=schema,
-            targets=list(targets),
-            artifact=artifact,
-            sha256=hashlib.sha256(artifact).hexdigest(),
-            size_bytes=len(artifact),
-        )
-        session.add(row)
-        session.flush()
-        return _info(session, row)
+    """Store a model's artifact; its name defaults to ``DATASET-CLASSIFIER[-N]``.
+
+    The data set's extraction recipe (if it was extracted from recordings) is copied to
+    the model, so that live prediction extracts features as training did.
+    """
+    if name is not None:
+        check_model_name(name)
+    try:
+        with store.session() as session:
+            dataset = session.get(DatasetRow, dataset_id) if dataset_id is not None else None
+            if name is None:
+                base = f"{dataset.name if dataset else 'model'}-{classifier}"
+                name = free_name(session, ModelRow, base)
+            elif session.scalars(select(ModelRow.id).where(ModelRow.name == name)).first():
+                raise AppError(f"a model named '{name}' already exists; choose another --name")
+            row = ModelRow(
+                name=name,
+                dataset_id=dataset_id,
+                run_id=run_id,
+                classifier=classifier,
+                params=params,
+                schema=schema,
+                targets=list(targets),
+                artifact=artifact,
+                sha256=hashlib.sha256(artifact).hexdigest(),
+                size_bytes=len(artifact),
+                format=SAFE_FORMAT,
+                extraction=dataset.extraction if dataset is not None else None,
+            )
+            session.add(row)
+            session.flush()
+            return _info(session, row)
+    except IntegrityError:  # another process took the name between our check and insert
+        raise AppError(f"a model named '{name}' already exists; choose another --name") from None
+
+
+def check_model_name(name: str) -> None:
+    """Refuse names that cannot be told from ids or do not print."""
+    if not name.strip():
+        raise AppError("a model name cannot be empty")
+    if name.isdigit():
+        raise AppError(f"a model name cannot be a number ('{name}' would read as an id)")
+    if len(name) > 200:
+        raise AppError(f"a model name has at most 200 characters, got {len(name)}")
+    if any(not character.isprintable() for character in name):
+        raise AppError("a model name cannot contain control characters")
 
 
 def list_models(store: Store) -> list[ModelInfo]:
+    """Every model, without reading any artifact."""
     with store.session() as session:
-        rows = session.scalars(select(ModelRow).order_by(ModelRow.id))
-        return [_info(session, row) for row in rows]
+        rows = list(session.scalars(select(ModelRow).order_by(ModelRow.id)))
+        names = _dataset_names(session, rows)
+        return [_info(session, row, names) for row in rows]
+
+
+def get_model(store: Store, ref: str | int) -> ModelInfo:
+    """A model's description (its artifact is not read)."""
+    with store.session() as session:
+        return _info(session, _row(session, ref))
 
 
 def load_artifact(store: Store, ref: str | int) -> tuple[ModelInfo, bytes]:
-    """A model's description and artifact bytes (check them with the sha256 before use)."""
+    """A model's description and artifact bytes (check them with the sha256 before use).
+
+    Raises
+    ------
+    AppError
+        The artifact is in a format that could run code when loaded (models stored by
+        touchbench before 0.2 were pickles).
+    """
     with store.session() as session:
         row = _row(session, ref)
-        return _info(session, row), bytes(row.artifact)
+        info = _info(session, row)
+        if row.format != SAFE_FORMAT:
+            raise AppError(
+                f"model '{row.name}' is stored as a {row.format}, a format that can run code "
+                f"when loaded; train it again (`touchbench train ... --name {row.name}-2`)"
+            )
+        return info, bytes(row.artifact)
+
+
+def delete_model(store: Store, ref: str | int) -> ModelInfo:
+    with store.session() as session:
+        row = _row(session, ref)
+        info = _info(session, row)
+        session.execute(delete(ModelRow).where(ModelRow.id == row.id))
+        return info
+
+
+def rename_model(store: Store, ref: str | int, new_name: str) -> ModelInfo:
+    check_model_name(new_name)
+    try:
+        with store.session() as session:
+            row = _row(session, ref)
+            session.execute(update(ModelRow).where(ModelRow.id == row.id).values(name=new_name))
+    except IntegrityError:
+        raise AppError(f"a model named '{new_name}' already exists") from None
+    return get_model(store, new_name)
 
 
 def _row(session: Session, ref: str | int) -> ModelRow:
@@ -107,12 +194,18 @@ def _row(session: Session, ref: str | int) -> ModelRow:
     )
 
 
-def _info(session: Session, row: ModelRow) -> ModelInfo:
-    dataset_name = (
-        session.scalar(select(DatasetRow.name).where(DatasetRow.id == row.dataset_id))
-        if row.dataset_id is not None
-        else None
+def _dataset_names(session: Session, rows: Sequence[ModelRow]) -> dict[int, str]:
+    ids = {row.dataset_id for row in rows if row.dataset_id is not None}
+    if not ids:
+        return {}
+    return dict(
+        session.execute(select(DatasetRow.id, DatasetRow.name).where(DatasetRow.id.in_(ids))).all()
     )
+
+
+def _info(session: Session, row: ModelRow, names: dict[int, str] | None = None) -> ModelInfo:
+    if names is None:
+        names = _dataset_names(session, [row])
     return ModelInfo(
         id=row.id,
         name=row.name,
@@ -120,10 +213,12 @@ def _info(session: Session, row: ModelRow) -> ModelInfo:
         params=dict(row.params),
         targets=list(row.targets),
         dataset_id=row.dataset_id,
-        dataset_name=dataset_name,
+        dataset_name=names.get(row.dataset_id) if row.dataset_id is not None else None,
         run_id=row.run_id,
         sha256=row.sha256,
         size_bytes=row.size_bytes,
         created_at=row.created_at,
         schema=dict(row.schema),
+        format=row.format,
+        extraction=row.extraction,
     )

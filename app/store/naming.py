@@ -1,13 +1,22 @@
-"""Rows that users address by name or by numeric id, and names made unique."""
+"""Rows that users address by name or by numeric id: lookup, name rules, unique names."""
 
 from __future__ import annotations
 
+import re
 from typing import Any, Protocol, TypeVar
 
-from sqlalchemy import select
+from sqlalchemy import func, select
 from sqlalchemy.orm import InstrumentedAttribute, Session
 
-from app.errors import NotFoundError
+from app.errors import AppError, NotFoundError
+
+#: The longest name the store keeps (the ``name`` columns are ``String(200)``).
+MAX_NAME = 200
+#: Names listed in a "no such ..." message, and the characters shown of each.
+_NAMES_SHOWN = 10
+_NAME_SHOWN = 40
+_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]")
+_UNSAFE = re.compile(r"[^\w.-]+")
 
 
 class Named(Protocol):
@@ -24,18 +33,62 @@ def find_row(session: Session, model: type[RowT], ref: str | int, *, kind: str, 
     Raises
     ------
     NotFoundError
-        Naming the known rows (the first ten), or ``hint`` when there are none.
+        Naming the known rows (the first ten, each shortened), or ``hint`` when there
+        are none.
     """
     text = str(ref)
     name_column: InstrumentedAttribute[str] = model.name
     row = session.scalars(select(model).where(name_column == text)).first()
-    if row is None and text.isdigit():
+    if row is None and text.isdigit() and len(text) < 10:
         row = session.get(model, int(text))
     if row is None:
-        names = session.scalars(select(name_column).order_by(model.id)).all()
-        known = ", ".join(names[:10]) if names else hint
-        raise NotFoundError(f"no {kind} '{text}' ({kind}s: {known})")
+        names = session.scalars(select(name_column).order_by(model.id).limit(_NAMES_SHOWN)).all()
+        if names:
+            total = session.scalar(select(func.count()).select_from(model)) or 0
+            known = ", ".join(shorten(name) for name in names)
+            if total > len(names):
+                known += f", ... ({total} in all)"
+        else:
+            known = hint
+        raise NotFoundError(f"no {kind} '{shorten(text)}' ({kind}s: {known})")
     return row
+
+
+def check_name(name: str, *, kind: str) -> str:
+    """``name`` if it can name a ``kind`` (a new one, or a renamed one).
+
+    A name is not empty, has at most :data:`MAX_NAME` characters, no control characters,
+    no spaces at its ends, and is not a number (a number is read as an id).
+
+    Raises
+    ------
+    AppError
+        Saying which rule the name breaks.
+    """
+    if not name.strip():
+        raise AppError(f"a {kind} name cannot be empty")
+    if len(name) > MAX_NAME:
+        raise AppError(
+            f"a {kind} name has at most {MAX_NAME} characters; '{shorten(name)}' has {len(name)}"
+        )
+    control = _CONTROL.search(name)
+    if control is not None:
+        raise AppError(
+            f"a {kind} name cannot hold control characters: '{shorten(name)}' has "
+            f"{control.group()!r} at position {control.start() + 1}"
+        )
+    if name != name.strip():
+        raise AppError(f"a {kind} name cannot start or end with spaces: '{name}'")
+    if name.isdigit():
+        raise AppError(f"a {kind} name cannot be a number ('{name}' would read as an id)")
+    return name
+
+
+def default_name(text: str, *, fallback: str = "dataset") -> str:
+    """A valid name made from ``text`` (a file stem, a relation): unsafe characters folded
+    to ``_``, cut to leave room for a numeric suffix, a number given a ``fallback-`` prefix."""
+    base = _UNSAFE.sub("_", text).strip("_")[: MAX_NAME - 10] or fallback
+    return f"{fallback}-{base}" if base.isdigit() else base
 
 
 def free_name(session: Session, model: type[Named], base: str) -> str:
@@ -48,3 +101,9 @@ def free_name(session: Session, model: type[Named], base: str) -> str:
     while f"{base}-{suffix}" in taken:
         suffix += 1
     return f"{base}-{suffix}"
+
+
+def shorten(text: str, limit: int = _NAME_SHOWN) -> str:
+    """``text`` for a message: control characters as ``?``, cut to ``limit`` characters."""
+    text = _CONTROL.sub("?", text)
+    return text if len(text) <= limit else text[: limit - 1] + "…"

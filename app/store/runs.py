@@ -1,29 +1,70 @@
 """Benchmark runs and their per-fold results in the store.
 
-The engine reports each finished task through a callback; :func:`record_result` writes it
-at once in its own transaction, and ignores a task that is already recorded, so a resumed
-run never duplicates rows.
+A run is created ``queued``; the process that executes it *claims* it (status ``running``,
+its ``host:pid`` as owner) and keeps a heartbeat while it works, so that any other process
+(a second service, the CLI) can tell a live run from one whose process died, and refuse to
+execute a run twice.  The engine reports each finished task through a callback;
+:func:`record_result` writes it at once in its own transaction and ignores a task that is
+already recorded, so a resumed run never duplicates rows.
 """
 
 from __future__ import annotations
 
+import os
+import socket
 from collections.abc import Sequence
 from dataclasses import dataclass
-from datetime import datetime
+from datetime import datetime, timedelta
 from typing import Any
 
-from sqlalchemy import func, insert, select, update
+from sqlalchemy import case, func, insert, select, update
 from sqlalchemy.dialects.postgresql import insert as postgresql_insert
 from sqlalchemy.dialects.sqlite import insert as sqlite_insert
 from sqlalchemy.orm import Session
 
-from app.errors import NotFoundError
+from app.errors import AppError, NotFoundError
+from app.schemas.runs import FINAL_STATUSES, RunSchema, RunStatus
 from app.store.database import Store
 from app.store.tables import DatasetRow, FoldResultRow, RunRow, utcnow
 from benchmark.results import TaskKey, TaskResult
 
 #: Multi-target folds keep their per-target scores in the metrics column under this key.
 PER_TARGET = "per_target"
+#: Seconds between heartbeats of the process executing a run.
+HEARTBEAT_INTERVAL = 5.0
+#: A running run whose heartbeat is older than this has lost its process.
+STALE_AFTER = 30.0
+
+
+def process_owner(pid: int | None = None) -> str:
+    """``host:pid@start`` of this process (or of ``pid`` on this host), as it is written in
+    a run it executes; the start time tells a live owner from a later process that reuses
+    its pid."""
+    pid = os.getpid() if pid is None else pid
+    return f"{socket.gethostname()}:{pid}@{_start_ticks(pid)}"
+
+
+def owner_alive(owner: str | None, heartbeat_at: datetime | None) -> bool:
+    """Whether the process ``owner`` still runs: looked up directly when it is on this host,
+    judged by its heartbeat otherwise."""
+    if not owner:
+        return False
+    host, _, rest = owner.partition(":")
+    pid_text, _, start = rest.partition("@")
+    if host == socket.gethostname() and pid_text.isdigit():
+        return start == _start_ticks(int(pid_text)) != ""
+    if heartbeat_at is None:
+        return False
+    return utcnow() - _aware(heartbeat_at) < timedelta(seconds=STALE_AFTER)
+
+
+def _start_ticks(pid: int) -> str:
+    """The start time of process ``pid`` in clock ticks since boot; '' if it does not exist."""
+    try:
+        with open(f"/proc/{pid}/stat") as stat:
+            return stat.read().rsplit(")", 1)[1].split()[19]
+    except (OSError, IndexError):
+        return ""
 
 
 @dataclass(frozen=True)
@@ -37,30 +78,47 @@ class RunInfo:
     targets: list[str]
     classifiers: list[str]
     config: dict[str, Any]
-    status: str
+    status: RunStatus
     created_at: datetime
     finished_at: datetime | None
     n_results: int
+    n_failed: int = 0
+    started_at: datetime | None = None
+    owner: str | None = None
+    heartbeat_at: datetime | None = None
+    error: str | None = None
+    cancel_requested: bool = False
 
     @property
     def n_tasks(self) -> int:
         return int(self.config.get("n_tasks", 0))
 
+    def is_alive(self) -> bool:
+        """Whether a live process is executing the run."""
+        return self.status == "running" and owner_alive(self.owner, self.heartbeat_at)
+
+    def schema(self) -> RunSchema:
+        return RunSchema(
+            id=self.id,
+            dataset=self.dataset_name,
+            dataset_id=self.dataset_id,
+            kind=self.kind,
+            targets=self.targets,
+            classifiers=self.classifiers,
+            config=self.config,
+            status=self.status,
+            created_at=self.created_at,
+            started_at=self.started_at,
+            finished_at=self.finished_at,
+            tasks_done=self.n_results,
+            tasks=self.n_tasks,
+            tasks_failed=self.n_failed,
+            error=self.error,
+            owner=self.owner,
+        )
+
     def to_json(self) -> dict[str, Any]:
-        return {
-            "id": self.id,
-            "dataset": self.dataset_name,
-            "dataset_id": self.dataset_id,
-            "kind": self.kind,
-            "targets": self.targets,
-            "classifiers": self.classifiers,
-            "config": self.config,
-            "status": self.status,
-            "created_at": self.created_at.isoformat(),
-            "finished_at": self.finished_at.isoformat() if self.finished_at else None,
-            "tasks_done": self.n_results,
-            "tasks": self.n_tasks,
-        }
+        return self.schema().to_json()
 
 
 def create_run(
@@ -72,6 +130,7 @@ def create_run(
     classifiers: Sequence[str],
     config: dict[str, Any],
 ) -> RunInfo:
+    """A new run, ``queued``."""
     with store.session() as session:
         row = RunRow(
             dataset_id=dataset_id,
@@ -79,29 +138,138 @@ def create_run(
             targets=list(targets),
             classifiers=list(classifiers),
             config=config,
-            status="running",
+            status="queued",
         )
         session.add(row)
         session.flush()
-        return _info(session, row)
+        return _infos(session, [row])[0]
 
 
 def get_run(store: Store, run_id: int | str) -> RunInfo:
     with store.session() as session:
-        return _info(session, _row(session, run_id))
+        return _infos(session, [_row(session, run_id)])[0]
 
 
-def list_runs(store: Store) -> list[RunInfo]:
+def list_runs(store: Store, *, status: str | None = None) -> list[RunInfo]:
     with store.session() as session:
-        return [_info(session, row) for row in session.scalars(select(RunRow).order_by(RunRow.id))]
+        query = select(RunRow).order_by(RunRow.id)
+        if status is not None:
+            query = query.where(RunRow.status == status)
+        return _infos(session, list(session.scalars(query)))
 
 
-def set_status(store: Store, run_id: int, status: str) -> None:
+def claim_run(store: Store, run_id: int, *, owner: str | None = None) -> RunInfo:
+    """Make this process the one executing ``run_id``: status ``running``, owner, heartbeat.
+
+    A run that another live process executes is refused; a ``running`` run whose process
+    died (kill -9, a crash, a lost machine) is taken over.
+
+    Raises
+    ------
+    AppError
+        Another process is executing the run.
+    """
+    owner = owner or process_owner()
+    now = utcnow()
     with store.session() as session:
-        finished = utcnow() if status in ("done", "failed", "cancelled") else None
+        row = _row(session, run_id)
+        if (
+            row.status == "running"
+            and row.owner != owner
+            and owner_alive(row.owner, row.heartbeat_at)
+        ):
+            seconds = (now - _aware(row.heartbeat_at)).total_seconds() if row.heartbeat_at else 0
+            raise AppError(
+                f"run {row.id} is being executed by {row.owner} (heard from {seconds:.0f} s "
+                f"ago); wait for it to end or cancel it with `touchbench cancel {row.id}`"
+            )
+        same_owner = RunRow.owner.is_(None) if row.owner is None else RunRow.owner == row.owner
+        claimed = session.execute(
+            update(RunRow)
+            .where(RunRow.id == row.id, RunRow.status == row.status, same_owner)
+            .values(
+                status="running",
+                owner=owner,
+                heartbeat_at=now,
+                started_at=func.coalesce(RunRow.started_at, now),
+                finished_at=None,
+                error=None,
+                cancel_requested=False,
+            )
+            .execution_options(synchronize_session=False)
+        ).rowcount  # type: ignore[attr-defined]  # an UPDATE gives a CursorResult
+        if not claimed:
+            raise AppError(f"run {row.id} was just taken up by another process; try again")
+    return get_run(store, run_id)
+
+
+def heartbeat(store: Store, run_id: int, owner: str) -> bool:
+    """Say that ``owner`` still executes the run; returns whether a cancel was requested
+    (or the run was taken away from this owner)."""
+    with store.session() as session:
         session.execute(
-            update(RunRow).where(RunRow.id == run_id).values(status=status, finished_at=finished)
+            update(RunRow)
+            .where(RunRow.id == run_id, RunRow.owner == owner, RunRow.status == "running")
+            .values(heartbeat_at=utcnow())
         )
+        row = session.execute(
+            select(RunRow.cancel_requested, RunRow.owner, RunRow.status).where(RunRow.id == run_id)
+        ).one_or_none()
+    if row is None:
+        return True
+    cancel, current_owner, status = row
+    return bool(cancel) or current_owner != owner or status != "running"
+
+
+def finish_run(store: Store, run_id: int, status: RunStatus, *, error: str | None = None) -> None:
+    """Leave a run in ``status`` (``finished_at`` set for final ones), its owner released."""
+    with store.session() as session:
+        session.execute(
+            update(RunRow)
+            .where(RunRow.id == run_id)
+            .values(
+                status=status,
+                error=error,
+                finished_at=utcnow() if status in FINAL_STATUSES else None,
+                heartbeat_at=None,
+                owner=None,
+            )
+        )
+
+
+def request_cancel(store: Store, run_id: int | str) -> RunInfo:
+    """Cancel a run: at once if nobody executes it, else by asking its process to stop.
+
+    Raises
+    ------
+    AppError
+        The run is already over.
+    """
+    run = get_run(store, run_id)
+    if run.status in ("done", "failed", "cancelled"):
+        raise AppError(f"run {run.id} is already {run.status}; nothing to cancel")
+    if run.is_alive():
+        with store.session() as session:
+            session.execute(update(RunRow).where(RunRow.id == run.id).values(cancel_requested=True))
+    else:
+        finish_run(store, run.id, "cancelled")
+    return get_run(store, run.id)
+
+
+def mark_lost_runs(store: Store) -> list[int]:
+    """Runs left ``running`` by a process that died become ``interrupted``; their ids."""
+    with store.session() as session:
+        running = session.execute(
+            select(RunRow.id, RunRow.owner, RunRow.heartbeat_at).where(RunRow.status == "running")
+        ).all()
+        ids = [run_id for run_id, owner, beat in running if not owner_alive(owner, beat)]
+        if ids:
+            session.execute(
+                update(RunRow)
+                .where(RunRow.id.in_(ids))
+                .values(status="interrupted", owner=None, heartbeat_at=None)
+            )
+    return ids
 
 
 def record_result(store: Store, run_id: int, result: TaskResult) -> None:
@@ -180,29 +348,63 @@ def _keys(session: Session, run_id: int) -> set[tuple[str, int, int]]:
 
 def _row(session: Session, run_id: int | str) -> RunRow:
     text = str(run_id)
-    row = session.get(RunRow, int(text)) if text.isdigit() else None
+    row = session.get(RunRow, int(text)) if text.isdigit() and len(text) < 12 else None
     if row is None:
         last = session.scalar(select(func.max(RunRow.id)))
         known = f"runs are 1..{last}" if last else "the store has no runs yet"
-        raise NotFoundError(f"no run '{text}' ({known}; `touchbench runs` lists them)")
+        shown = text if len(text) <= 40 else text[:39] + "…"
+        raise NotFoundError(f"no run '{shown}' ({known}; `touchbench runs` lists them)")
     return row
 
 
-def _info(session: Session, row: RunRow) -> RunInfo:
-    dataset_name = session.scalar(select(DatasetRow.name).where(DatasetRow.id == row.dataset_id))
-    n_results = session.scalar(
-        select(func.count()).select_from(FoldResultRow).where(FoldResultRow.run_id == row.id)
+def _infos(session: Session, rows: Sequence[RunRow]) -> list[RunInfo]:
+    """Descriptions of ``rows`` with two queries in all (names, result counts)."""
+    if not rows:
+        return []
+    ids = [row.id for row in rows]
+    names = dict(
+        session.execute(
+            select(DatasetRow.id, DatasetRow.name).where(
+                DatasetRow.id.in_({row.dataset_id for row in rows})
+            )
+        ).all()
     )
-    return RunInfo(
-        id=row.id,
-        dataset_id=row.dataset_id,
-        dataset_name=dataset_name or "?",
-        kind=row.kind,
-        targets=list(row.targets),
-        classifiers=list(row.classifiers),
-        config=dict(row.config),
-        status=row.status,
-        created_at=row.created_at,
-        finished_at=row.finished_at,
-        n_results=n_results or 0,
-    )
+    counts = {
+        run_id: (int(total), int(failed or 0))
+        for run_id, total, failed in session.execute(
+            select(
+                FoldResultRow.run_id,
+                func.count(),
+                func.sum(case((FoldResultRow.status != "ok", 1), else_=0)),
+            )
+            .where(FoldResultRow.run_id.in_(ids))
+            .group_by(FoldResultRow.run_id)
+        ).all()
+    }
+    return [
+        RunInfo(
+            id=row.id,
+            dataset_id=row.dataset_id,
+            dataset_name=names.get(row.dataset_id, "?"),
+            kind=row.kind,
+            targets=list(row.targets),
+            classifiers=list(row.classifiers),
+            config=dict(row.config),
+            status=row.status,  # type: ignore[arg-type]  # a RunStatus literal in the column
+            created_at=row.created_at,
+            finished_at=row.finished_at,
+            n_results=counts.get(row.id, (0, 0))[0],
+            n_failed=counts.get(row.id, (0, 0))[1],
+            started_at=row.started_at,
+            owner=row.owner,
+            heartbeat_at=row.heartbeat_at,
+            error=row.error,
+            cancel_requested=bool(row.cancel_requested),
+        )
+        for row in rows
+    ]
+
+
+def _aware(moment: datetime) -> datetime:
+    """SQLite hands timestamps back without their time zone: they are UTC."""
+    return moment if moment.tzinfo is not None else moment.replace(tzinfo=utcnow().tzinfo)

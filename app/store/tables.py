@@ -132,11 +132,11 @@ class ModelRow(Base):
     params: Mapped[dict[str, Any]] = mapped_column(JSON)
     schema: Mapped[dict[str, Any]] = mapped_column(JSON)
     targets: Mapped[list[str]] = mapped_column(JSON)
-    artifact: Mapped[bytes] = mapped_column(LargeBinary)
+    artifact: Mapped[bytes] = mapped_column(LargeBinary, deferred=True)
     sha256: Mapped[str] = mapped_column(String(64))
     size_bytes: Mapped[int] = mapped_column(Integer)
     created_at: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=utcnow)
-    format: Mapped[str] = mapped_column(String(20), default="pickle")
+    format: Mapped[str] = mapped_column(String(20), default="skops")
     extraction: Mapped[dict[str, Any] | None] = mapped_column(JSON(none_as_null=True))
 
 

@@ -78,8 +78,8 @@ class Leaderboard:
     ----------
     metric : str
         The ranking metric.
-    baseline : str
-        The classifier the marks compare against.
+    baseline : str or None
+        The classifier the marks compare against; ``None`` when no task succeeded.
     rows : list of LeaderboardRow
         Best first.
     summary : (int, int, int)
@@ -91,7 +91,7 @@ class Leaderboard:
     """
 
     metric: str
-    baseline: str
+    baseline: str | None
     rows: list[LeaderboardRow]
     summary: tuple[int, int, int]
     alpha: float = 0.05
@@ -141,12 +141,22 @@ def build_leaderboard(
     ConfigurationError
         No results, a metric no result has, a baseline not in the run or without a
         successful fold.
+
+    Notes
+    -----
+    When no task succeeded, every classifier is listed unranked with its failures and the
+    leaderboard has no baseline: a failed run still says why it failed.
     """
     if not results:
         raise ConfigurationError("no results to rank")
     by_classifier: dict[str, list[TaskResult]] = defaultdict(list)
     for result in results:
         by_classifier[result.key.classifier].append(result)
+    if not any(result.ok for result in results):
+        failed = [_summarise(c, rs, []) for c, rs in sorted(by_classifier.items())]
+        for position, row in enumerate(failed, start=1):
+            row.rank = position
+        return Leaderboard(metric, None, failed, (0, 0, 0), alpha)
     available = sorted({name for r in results if r.ok for name in r.metrics})
     if metric not in available:
         raise ConfigurationError(

@@ -3,12 +3,21 @@
 Everything WEKA's ``ArffLoader`` reads is read: dense and sparse rows, instance weights,
 numeric, nominal, string and date attributes, missing values, quotes with escapes,
 comments, and MEKA's ``-C`` target option in the relation name.  Relational attributes
-are not supported.  ``loads_arff(dumps_arff(d))`` equals ``d``.
+are not supported.  ``loads_arff(dumps_arff(d))`` equals ``d``.  Large files stream:
+:func:`open_arff` reads blocks of instances, :class:`ArffWriter` writes them.
 """
 
 from __future__ import annotations
 
-from benchmark.io.arff_reader import loads_arff, read_arff
-from benchmark.io.arff_writer import dumps_arff, write_arff
+from benchmark.io.arff_reader import ArffReader, loads_arff, open_arff, read_arff
+from benchmark.io.arff_writer import ArffWriter, dumps_arff, write_arff
 
-__all__ = ["dumps_arff", "loads_arff", "read_arff", "write_arff"]
+__all__ = [
+    "ArffReader",
+    "ArffWriter",
+    "dumps_arff",
+    "loads_arff",
+    "open_arff",
+    "read_arff",
+    "write_arff",
+]

@@ -9,6 +9,7 @@ rows; instance weights other than 1 follow their row as ``{w}``.
 
 from __future__ import annotations
 
+import io
 import math
 import os
 import re
@@ -19,7 +20,7 @@ import numpy as np
 
 from benchmark.dataset import Attribute, Dataset, Schema, resolve_targets
 from benchmark.errors import ConfigurationError, DataFormatError
-from benchmark.io.arff_reader import DateFormat
+from benchmark.io.dates import DateFormat
 
 _NEEDS_QUOTES = re.compile(r"""[\x00-\x20,{}'"%\\\x7f]""")
 _TO_ESCAPE = re.compile(r"""[\x00-\x1f'"%\\\x7f]""")
@@ -111,17 +112,17 @@ def relation_for(schema: Schema) -> str:
     return f"{schema.relation} {option}"
 
 
-def _check_codes(dataset: Dataset) -> None:
+def _check_codes(attributes: tuple[Attribute, ...], values: np.ndarray, offset: int) -> None:
     """Raise DataFormatError if a nominal or string column holds an invalid code."""
-    for j, attribute in enumerate(dataset.schema.attributes):
+    for j, attribute in enumerate(attributes):
         if attribute.kind not in ("nominal", "string"):
             continue
-        column = dataset.values[:, j]
+        column = values[:, j]
         present = ~np.isnan(column)
         codes = column[present]
         bad = (codes != np.floor(codes)) | (codes < 0) | (codes >= len(attribute.values))
         if bad.any():
-            row = int(np.flatnonzero(present)[np.argmax(bad)])
+            row = offset + int(np.flatnonzero(present)[np.argmax(bad)])
             raise DataFormatError(
                 f"row {row} holds {format_number(float(codes[np.argmax(bad)]))}, which is not "
                 f"the code of any of its {len(attribute.values)} {attribute.kind} values",
@@ -153,30 +154,81 @@ def _cell_formatter(attribute: Attribute) -> Callable[[float], str]:
     return label_text
 
 
-def _data_lines(dataset: Dataset) -> list[str]:
-    attributes = dataset.schema.attributes
-    formatters = [_cell_formatter(attribute) for attribute in attributes]
-    values = dataset.values
-    if dataset.sparse:
-        written = (values != 0) | np.isnan(values)
-        # Strings are always written: an omitted one would mean "string number 0".
-        written[:, [a.kind == "string" for a in attributes]] = True
-        lines = []
-        for row, mask in zip(values.tolist(), written, strict=True):
-            cells = (f"{j} {formatters[j](row[j])}" for j in np.flatnonzero(mask).tolist())
-            lines.append("{" + ",".join(cells) + "}")
-    else:
+class ArffWriter:
+    """Writes ARFF text block by block: the header, then instances as they come.
+
+    Memory stays that of one block, whatever the data set's size.
+
+    Parameters
+    ----------
+    stream : text stream
+        Where the text goes.
+    schema : Schema
+        Attributes, targets (written as MEKA's ``-C`` where needed, see
+        :func:`relation_for`) and string tables.
+    sparse : bool
+        Whether rows are written sparse (``{index value, ...}``, zeros left out).
+    """
+
+    def __init__(self, stream: TextIO, schema: Schema, *, sparse: bool = False) -> None:
+        self.stream = stream
+        self.schema = schema
+        self.sparse = sparse
+        self.rows_written = 0
+        self._formatters = [_cell_formatter(attribute) for attribute in schema.attributes]
+        self._strings = np.array([a.kind == "string" for a in schema.attributes], dtype=bool)
+
+    def write_header(self) -> None:
+        """Write ``@relation``, the attributes and ``@data``."""
+        lines = [f"@relation {quote(relation_for(self.schema))}", ""]
+        lines += [_attribute_line(attribute) for attribute in self.schema.attributes]
+        lines += ["", "@data"]
+        self.stream.write("\n".join(lines) + "\n")
+
+    def write_block(self, values: np.ndarray, weights: np.ndarray | None = None) -> None:
+        """Write instances.
+
+        Parameters
+        ----------
+        values : ndarray of shape (n, n_attributes)
+            Encoded as in :class:`~benchmark.dataset.Dataset`.
+        weights : ndarray of shape (n,) or None
+            Instance weights; those other than 1 follow their row as ``{w}``.
+
+        Raises
+        ------
+        DataFormatError
+            If a nominal or string column holds a code with no value, or a date is
+            outside the years 1 to 9999 (nothing of the block is written then).
+        """
+        _check_codes(self.schema.attributes, values, self.rows_written)
+        lines = self._sparse_lines(values) if self.sparse else self._dense_lines(values)
+        if weights is not None:
+            for i in np.flatnonzero(weights != 1).tolist():
+                lines[i] += ",{" + format_number(float(weights[i])) + "}"
+        if lines:
+            self.stream.write("\n".join(lines) + "\n")
+        self.rows_written += values.shape[0]
+
+    def _dense_lines(self, values: np.ndarray) -> list[str]:
         columns = [
             _number_texts(values[:, j])
             if formatter is format_number
             else list(map(formatter, values[:, j].tolist()))
-            for j, formatter in enumerate(formatters)
+            for j, formatter in enumerate(self._formatters)
         ]
-        lines = list(map(",".join, zip(*columns, strict=True))) if columns else []
-    if dataset.weights is not None:
-        for i in np.flatnonzero(dataset.weights != 1).tolist():
-            lines[i] += ",{" + format_number(float(dataset.weights[i])) + "}"
-    return lines
+        return list(map(",".join, zip(*columns, strict=True))) if columns else []
+
+    def _sparse_lines(self, values: np.ndarray) -> list[str]:
+        written = (values != 0) | np.isnan(values)
+        # Strings are always written: an omitted one would mean "string number 0".
+        written[:, self._strings] = True
+        formatters = self._formatters
+        lines = []
+        for row, mask in zip(values.tolist(), written, strict=True):
+            cells = (f"{j} {formatters[j](row[j])}" for j in np.flatnonzero(mask).tolist())
+            lines.append("{" + ",".join(cells) + "}")
+        return lines
 
 
 def dumps_arff(dataset: Dataset) -> str:
@@ -198,16 +250,18 @@ def dumps_arff(dataset: Dataset) -> str:
         If a nominal or string column holds a code with no value, or a date is outside
         the years 1 to 9999.
     """
-    _check_codes(dataset)
-    lines = [f"@relation {quote(relation_for(dataset.schema))}", ""]
-    lines += [_attribute_line(attribute) for attribute in dataset.schema.attributes]
-    lines += ["", "@data"]
-    lines += _data_lines(dataset)
-    return "\n".join(lines) + "\n"
+    stream = io.StringIO()
+    writer = ArffWriter(stream, dataset.schema, sparse=dataset.sparse)
+    writer.write_header()
+    writer.write_block(dataset.values, dataset.weights)
+    return stream.getvalue()
 
 
 def write_arff(dataset: Dataset, path_or_stream: str | os.PathLike[str] | TextIO) -> None:
     """Write the dataset as an ARFF file (UTF-8, ``\\n`` line ends).
+
+    The text is made whole before anything is written; :class:`ArffWriter` writes a
+    large data set block by block instead.
 
     Parameters
     ----------
@@ -219,7 +273,7 @@ def write_arff(dataset: Dataset, path_or_stream: str | os.PathLike[str] | TextIO
     Raises
     ------
     DataFormatError
-        As :func:`dumps_arff`.
+        As :func:`dumps_arff`; nothing is written then.
     """
     text = dumps_arff(dataset)
     if isinstance(path_or_stream, str | os.PathLike):

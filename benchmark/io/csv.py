@@ -6,9 +6,11 @@ quotes is doubled; quoted cells may hold line breaks).  Cells are stripped of su
 whitespace; empty cells, ``?``, ``NA``, ``NaN`` and ``nan`` are missing.
 
 A column is numeric when every non-missing cell is a number, otherwise nominal with its
-labels in order of first appearance.  One exception makes class labels usable: a target
-column whose cells are all integers (``0``, ``1``, ``2``...) is nominal, with its labels
-sorted by value, since a classifier needs a nominal target.
+labels in order of first appearance; when most of a nominal column's cells are numbers, a
+:class:`~benchmark.errors.DataWarning` names the words that made it nominal (a stray word
+in a column of measurements is more likely a typo than a label).  One exception makes
+class labels usable: a target column whose cells are all integers (``0``, ``1``, ``2``...)
+is nominal, with its labels sorted by value, since a classifier needs a nominal target.
 """
 
 from __future__ import annotations
@@ -17,14 +19,15 @@ import csv
 import io
 import os
 import re
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
 from benchmark.dataset import Attribute, Dataset, Schema, resolve_targets
-from benchmark.errors import ConfigurationError, DataFormatError
-from benchmark.io.arff_reader import read_text_file
+from benchmark.errors import ConfigurationError, DataFormatError, DataWarning
+from benchmark.io.textfile import read_text_file
 
 MISSING = frozenset({"", "?", "NA", "NaN", "nan"})
 _DELIMITERS = (",", ";", "\t")
@@ -106,11 +109,16 @@ def _is_number(text: str) -> bool:
     return True
 
 
-def _column(name: str, cells: list[str], *, is_target: bool) -> tuple[Attribute, np.ndarray]:
+def _column(
+    name: str, cells: list[str], lines: list[int], *, is_target: bool, source: str
+) -> tuple[Attribute, np.ndarray]:
     """The attribute and codes, shape (n_rows,), of one column of stripped cells."""
     present = [cell for cell in cells if cell not in MISSING]
+    words = [i for i, cell in enumerate(cells) if cell not in MISSING and not _is_number(cell)]
     labels: list[str]
-    if all(_is_number(cell) for cell in present):
+    if words and len(words) < len(present) - len(words):
+        _warn_stray_words(name, cells, lines, words, len(present) - len(words), source)
+    if not words:
         if not (is_target and present and all(_INTEGER.fullmatch(c) for c in present)):
             numbers = [np.nan if cell in MISSING else float(cell) for cell in cells]
             return Attribute(name, "numeric", (), "numeric"), np.array(numbers, dtype=np.float64)
@@ -120,6 +128,21 @@ def _column(name: str, cells: list[str], *, is_target: bool) -> tuple[Attribute,
     codes = {label: float(i) for i, label in enumerate(labels)}
     values = np.array([codes.get(cell, np.nan) for cell in cells], dtype=np.float64)
     return Attribute(name, "nominal", tuple(labels), "nominal"), values
+
+
+def _warn_stray_words(
+    name: str, cells: list[str], lines: list[int], words: list[int], numbers: int, source: str
+) -> None:
+    shown = ", ".join(f"'{cells[i]}' (line {lines[i]})" for i in words[:3])
+    more = f" and {len(words) - 3} more" if len(words) > 3 else ""
+    warnings.warn(
+        DataWarning(
+            f"{source}: column '{name}' is nominal because of {shown}{more}, while its other "
+            f"{numbers} cells are numbers; if these are typos, fix them or write ? for a "
+            "missing value"
+        ),
+        stacklevel=4,
+    )
 
 
 def read_csv(
@@ -151,6 +174,11 @@ def read_csv(
         If the file is missing, empty, has no header, duplicate or empty column names,
         rows with another number of cells than the header, or unknown targets; the
         error names the file and the line.
+
+    Warns
+    -----
+    DataWarning
+        When a column is nominal because of a few words among numbers.
     """
     text, source = read_text_file(path)
     records = _records(text, sniff_delimiter(text), source)
@@ -171,10 +199,11 @@ def read_csv(
                 line=line,
             )
     attributes = []
+    lines = [line for line, _ in rows]
     values = np.empty((len(rows), len(names)))
     for j, name in enumerate(names):
         cells = [row[j] for _, row in rows]
-        attribute, codes = _column(name, cells, is_target=j in target_indices)
+        attribute, codes = _column(name, cells, lines, is_target=j in target_indices, source=source)
         attributes.append(attribute)
         values[:, j] = codes
     name = Path(source).stem if relation is None else relation

@@ -11,10 +11,13 @@ locally.  The client keeps as many tasks in flight as the cluster has threads, s
 from __future__ import annotations
 
 import contextlib
+import re
 import threading
+import time
 import uuid
 from collections import deque
 from collections.abc import Callable, Sequence
+from typing import Any
 
 from benchmark.errors import BenchmarkError, ConfigurationError
 from benchmark.results import TaskKey, TaskResult
@@ -23,9 +26,49 @@ from benchmark.run.worker import Worker, WorkerDiedError
 
 #: Seconds to wait for the scheduler to answer.
 CONNECT_TIMEOUT = "10s"
+_ADDRESS = re.compile(
+    r"(?P<protocol>(?:tcp|tls)://)?(?P<host>\[[0-9a-fA-F:]+\]|[\w.-]+):(?P<port>\d{1,5})"
+)
 
 _LOCAL_WORKERS: dict[tuple[str, int], Worker] = {}
 _LOCAL_LOCK = threading.Lock()
+
+
+def check_scheduler_address(address: str) -> str:
+    """``address`` if it reads as a Dask scheduler address (``tcp://host:port``).
+
+    Raises
+    ------
+    ConfigurationError
+        Anything else, before any connection is tried.
+    """
+    match = _ADDRESS.fullmatch(address.strip())
+    if match is None or not 0 < int(match["port"]) < 65536:
+        raise ConfigurationError(
+            f"'{address}' is not a Dask scheduler address (expected tcp://HOST:PORT, e.g. "
+            "tcp://10.0.0.5:8786)"
+        )
+    return f"{match['protocol'] or 'tcp://'}{match['host']}:{match['port']}"
+
+
+def connect(address: str) -> Any:
+    """A Dask client of the scheduler at ``address``.
+
+    Raises
+    ------
+    ConfigurationError
+        A malformed address, or no scheduler answers within :data:`CONNECT_TIMEOUT`.
+    """
+    from distributed import Client
+
+    address = check_scheduler_address(address)
+    try:
+        return Client(address, timeout=CONNECT_TIMEOUT, set_as_default=False)
+    except (OSError, TimeoutError, ValueError) as exc:
+        reason = str(exc).splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise ConfigurationError(
+            f"cannot reach the Dask scheduler at {address}: {reason}"
+        ) from None
 
 
 def run_on_dask(
@@ -36,6 +79,8 @@ def run_on_dask(
     timeout: float | None,
     on_start: Callable[[TaskKey], None],
     on_result: Callable[[TaskResult], None],
+    max_memory: int | None = None,
+    stop: Callable[[], bool] | None = None,
 ) -> None:
     """Run ``tasks`` on the cluster at ``scheduler``, reporting each result as it arrives.
 
@@ -43,13 +88,14 @@ def run_on_dask(
     ------
     ConfigurationError
         The scheduler cannot be reached.
+    RunStopped
+        ``stop`` returned true (the tasks in flight are cancelled).
     """
-    from distributed import Client, Future, as_completed
+    from distributed import Future, as_completed
 
-    try:
-        client = Client(scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False)
-    except (OSError, TimeoutError, ValueError) as exc:
-        raise ConfigurationError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
+    from benchmark.run.engine import STOP_POLL, RunStopped
+
+    client = connect(scheduler)
     token = uuid.uuid4().hex
     try:
         [data] = client.scatter([context], broadcast=True, hash=False)
@@ -66,6 +112,7 @@ def run_on_dask(
                 token,
                 key,
                 timeout,
+                max_memory,
                 pure=False,
                 key=f"touchbench-{token}-{key}",
             )
@@ -73,29 +120,43 @@ def run_on_dask(
             return future
 
         running = as_completed([submit() for _ in range(min(slots, len(queue)))], loop=client.loop)
-        for future in running:
-            try:
-                result = future.result()
-            except BenchmarkError:
-                raise
-            except Exception as exc:
-                result = failed_result(keys[future], "error", f"Dask: {exc}", None)
-            on_result(result)
-            if queue:
-                running.add(submit())
+        while not running.is_empty():
+            if stop is not None and stop():
+                client.cancel(list(keys))
+                raise RunStopped
+            if not running.has_ready():
+                time.sleep(STOP_POLL / 5 if stop is not None else 0.01)
+                continue
+            for future in running.next_batch(block=False):
+                key = keys.pop(future)
+                try:
+                    result = future.result()
+                except BenchmarkError:
+                    raise
+                except Exception as exc:
+                    result = failed_result(key, "error", f"Dask: {exc}", None)
+                on_result(result)
+                if queue:
+                    running.add(submit())
     finally:
         with contextlib.suppress(Exception):
             client.run(release_remote_workers, token)
         client.close()
 
 
-def run_remote_task(context: bytes, token: str, key: TaskKey, timeout: float | None) -> TaskResult:
+def run_remote_task(
+    context: bytes,
+    token: str,
+    key: TaskKey,
+    timeout: float | None,
+    max_memory: int | None = None,
+) -> TaskResult:
     """Run one task on this Dask worker through the calling thread's worker process."""
     slot = (token, threading.get_ident())
     with _LOCAL_LOCK:
         worker = _LOCAL_WORKERS.get(slot)
         if worker is None or worker.process.poll() is not None:
-            worker = Worker(context)
+            worker = Worker(context, max_memory=max_memory)
             _LOCAL_WORKERS[slot] = worker
     try:
         while not worker.ready:

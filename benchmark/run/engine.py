@@ -25,18 +25,35 @@ from collections import deque
 from collections.abc import Callable, Collection, Mapping, Sequence
 from multiprocessing.connection import wait
 
-from benchmark.catalogue import CATALOGUE, ClassifierSpec, unknown_classifier_message
+from benchmark.catalogue import ClassifierSpec
 from benchmark.errors import BenchmarkError, ConfigurationError
+from benchmark.estimators import check_classifier
 from benchmark.problem import Problem
 from benchmark.results import TaskKey, TaskResult
 from benchmark.run.folds import Fold
 from benchmark.run.task import TaskContext, failed_result
 from benchmark.run.worker import Worker, WorkerDiedError
 
-__all__ = ["Problem", "TaskKey", "TaskResult", "available_cores", "plan_tasks", "run_tasks"]
+__all__ = [
+    "Problem",
+    "RunStopped",
+    "TaskKey",
+    "TaskResult",
+    "available_cores",
+    "plan_tasks",
+    "run_tasks",
+]
 
 ResultCallback = Callable[[TaskResult], None]
 StartCallback = Callable[[TaskKey], None]
+StopCheck = Callable[[], bool]
+
+#: Seconds between checks of ``stop`` while tasks run.
+STOP_POLL = 0.5
+
+
+class RunStopped(Exception):  # noqa: N818 (a signal, not an error)
+    """``stop`` asked the engine to end the run early; finished tasks were reported."""
 
 
 def run_tasks(
@@ -52,6 +69,8 @@ def run_tasks(
     on_start: StartCallback | None = None,
     on_result: ResultCallback | None = None,
     extra_specs: Mapping[str, ClassifierSpec] | None = None,
+    max_memory: int | None = None,
+    stop: StopCheck | None = None,
 ) -> list[TaskResult]:
     """Cross-validate classifiers on a problem.
 
@@ -81,6 +100,12 @@ def run_tasks(
     extra_specs : mapping of str to ClassifierSpec, optional
         Multi-class classifiers that are not in the catalogue (they win over catalogue
         entries of the same id).  Their factories must be importable by the workers.
+    max_memory : int, optional
+        Bytes of memory one task may allocate beyond its worker's copy of the data; a task
+        that needs more fails with an ``error`` result saying so.
+    stop : callable, optional
+        Checked about twice a second; when it returns true, running tasks are killed and
+        :class:`RunStopped` is raised (the results reported so far stand).
 
     Returns
     -------
@@ -92,12 +117,16 @@ def run_tasks(
     Raises
     ------
     ConfigurationError
-        Unknown classifier ids, no folds, impossible ``jobs`` or ``timeout``, an
-        unreachable scheduler.
+        Unknown classifier ids, no folds, impossible ``jobs``, ``timeout`` or
+        ``max_memory``, an unreachable scheduler.
+    RunStopped
+        ``stop`` returned true.
     """
     specs, tasks = plan_tasks(problem, classifiers, folds, skip=skip, extra_specs=extra_specs)
     if timeout is not None and not timeout > 0:
         raise ConfigurationError(f"timeout must be a positive number of seconds, got {timeout}")
+    if max_memory is not None and max_memory <= 0:
+        raise ConfigurationError(f"max_memory must be a positive number of bytes, got {max_memory}")
     if not tasks:
         return []
     context = pickle.dumps(
@@ -109,6 +138,11 @@ def run_tasks(
     def deliver(result: TaskResult) -> None:
         if result.status != "ok":
             result.n_train, result.n_test = sizes[(result.key.repeat, result.key.fold)]
+            if max_memory is not None and _looks_out_of_memory(result.error):
+                result.error = (
+                    f"exceeded the memory limit of {max_memory / 2**20:g} MB per task "
+                    f"({result.error})"
+                )
         results[result.key] = result
         if on_result is not None:
             on_result(result)
@@ -117,9 +151,19 @@ def run_tasks(
     if scheduler:
         from benchmark.run.dask_backend import run_on_dask
 
-        run_on_dask(scheduler, context, tasks, timeout=timeout, on_start=started, on_result=deliver)
+        run_on_dask(
+            scheduler,
+            context,
+            tasks,
+            timeout=timeout,
+            on_start=started,
+            on_result=deliver,
+            max_memory=max_memory,
+            stop=stop,
+        )
     else:
-        _run_local(context, tasks, _worker_count(jobs, len(tasks)), timeout, started, deliver)
+        pool = _LocalPool(context, _worker_count(jobs, len(tasks)), max_memory)
+        pool.run(tasks, timeout, started, deliver, stop)
     return [results[key] for key in tasks if key in results]
 
 
@@ -146,22 +190,10 @@ def plan_tasks(
     if not folds:
         raise ConfigurationError("no folds to run the classifiers on")
     specs: dict[str, ClassifierSpec] = {}
-    if problem.kind == "multiclass":
-        known = {**CATALOGUE, **(extra_specs or {})}
-        for classifier in ids:
-            if classifier not in known:
-                raise ConfigurationError(unknown_classifier_message(classifier, known))
-            specs[classifier] = known[classifier]
-    else:
-        from benchmark.multitarget import build_multitarget
-
-        for classifier in ids:
-            build_multitarget(
-                classifier,
-                nominal_features=problem.nominal_features,
-                n_features=problem.n_features,
-                n_classes=problem.n_classes,
-            )
+    for classifier in ids:
+        spec = check_classifier(classifier, problem, extra_specs)
+        if spec is not None:
+            specs[classifier] = spec
     done = set(skip)
     tasks = [
         key
@@ -188,46 +220,61 @@ def _worker_count(jobs: int, n_tasks: int) -> int:
     return min(jobs, n_tasks)
 
 
-def _run_local(
-    context: bytes,
-    tasks: Sequence[TaskKey],
-    n_workers: int,
-    timeout: float | None,
-    on_start: StartCallback,
-    deliver: ResultCallback,
-) -> None:
-    """Run ``tasks`` on ``n_workers`` local worker processes, one task each at a time.
+class _LocalPool:
+    """``n_workers`` local worker processes, one task each at a time.
 
     A worker that dies or overruns its task's time limit is replaced while tasks remain.
     """
-    queue = deque(tasks)
-    pool = [Worker(context) for _ in range(n_workers)]
-    try:
-        while queue or any(w.task is not None for w in pool):
+
+    def __init__(self, context: bytes, n_workers: int, max_memory: int | None) -> None:
+        self.context = context
+        self.n_workers = n_workers
+        self.max_memory = max_memory
+
+    def _spawn(self) -> Worker:
+        return Worker(self.context, max_memory=self.max_memory)
+
+    def run(
+        self,
+        tasks: Sequence[TaskKey],
+        timeout: float | None,
+        on_start: StartCallback,
+        deliver: ResultCallback,
+        stop: StopCheck | None,
+    ) -> None:
+        queue = deque(tasks)
+        pool = [self._spawn() for _ in range(self.n_workers)]
+        try:
+            while queue or any(w.task is not None for w in pool):
+                if stop is not None and stop():
+                    raise RunStopped
+                for worker in pool:
+                    if worker.ready and worker.task is None and queue:
+                        key = queue.popleft()
+                        on_start(key)
+                        worker.submit(key, timeout)
+                wait_for = _time_left(pool)
+                if stop is not None:
+                    wait_for = STOP_POLL if wait_for is None else min(wait_for, STOP_POLL)
+                arrived = wait([w.connection for w in pool], timeout=wait_for)
+                survivors = []
+                for worker in pool:
+                    alive = worker.connection not in arrived or _take_message(worker, deliver)
+                    task = worker.task
+                    if alive and task is not None and _past_deadline(worker):
+                        worker.kill()
+                        deliver(failed_result(task, "timeout", _timeout_message(timeout), None))
+                        alive = False
+                    if alive:
+                        survivors.append(worker)
+                        continue
+                    worker.close()
+                    if queue:
+                        survivors.append(self._spawn())
+                pool = survivors
+        finally:
             for worker in pool:
-                if worker.ready and worker.task is None and queue:
-                    key = queue.popleft()
-                    on_start(key)
-                    worker.submit(key, timeout)
-            arrived = wait([w.connection for w in pool], timeout=_time_left(pool))
-            survivors = []
-            for worker in pool:
-                alive = worker.connection not in arrived or _take_message(worker, deliver)
-                task = worker.task
-                if alive and task is not None and _past_deadline(worker):
-                    worker.kill()
-                    deliver(failed_result(task, "timeout", _timeout_message(timeout), None))
-                    alive = False
-                if alive:
-                    survivors.append(worker)
-                    continue
                 worker.close()
-                if queue:
-                    survivors.append(Worker(context))
-            pool = survivors
-    finally:
-        for worker in pool:
-            worker.close()
 
 
 def _take_message(worker: Worker, deliver: ResultCallback) -> bool:
@@ -264,3 +311,8 @@ def _timeout_message(timeout: float | None) -> str:
 
 def _ignore(key: TaskKey) -> None:
     return None
+
+
+def _looks_out_of_memory(error: str | None) -> bool:
+    text = error or ""
+    return "MemoryError" in text or "SIGSEGV" in text or "SIGABRT" in text or "bad_alloc" in text

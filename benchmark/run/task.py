@@ -17,7 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from benchmark.catalogue import ClassifierSpec, build_pipeline
+from benchmark.catalogue import ClassifierSpec
+from benchmark.estimators import build_estimator
 from benchmark.evaluation.metrics import confusion_matrix, expand_proba, multiclass_scores
 from benchmark.problem import Problem
 from benchmark.results import Status, TaskKey, TaskResult
@@ -97,11 +98,8 @@ def describe_exception(exc: BaseException) -> str:
 def _run_multiclass(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResult:
     problem = context.problem
     n_classes = problem.n_classes[0]
-    model = build_pipeline(
-        context.specs[key.classifier],
-        nominal_features=problem.nominal_features,
-        n_features=problem.n_features,
-        random_state=context.random_state,
+    model = build_estimator(
+        key.classifier, problem, random_state=context.random_state, extra_specs=context.specs
     )
     y = problem.Y[:, 0]
     timer = _Timer()
@@ -119,16 +117,10 @@ def _run_multiclass(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResul
 
 
 def _run_multitarget(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResult:
-    from benchmark.multitarget import build_multitarget, multitarget_scores
+    from benchmark.multitarget import multitarget_scores
 
     problem = context.problem
-    model = build_multitarget(
-        key.classifier,
-        nominal_features=problem.nominal_features,
-        n_features=problem.n_features,
-        random_state=context.random_state,
-        n_classes=problem.n_classes,
-    )
+    model = build_estimator(key.classifier, problem, random_state=context.random_state)
     timer = _Timer()
     model.fit(problem.X[fold.train], problem.Y[fold.train])
     fit_time, fit_cpu = timer.lap()

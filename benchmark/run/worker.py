@@ -51,9 +51,13 @@ class Worker:
         running several workers: the matrices of a fold are small, and BLAS or OpenMP
         threads that spin-wait for cores other processes hold slow fits down many times
         (a logistic regression 100x, histogram boosting 5x on a busy 2-core machine).
+    max_memory : int, optional
+        Bytes of data memory each task may allocate on top of what the worker holds once
+        the run's data is loaded (``RLIMIT_DATA``); a task that needs more fails with an
+        out-of-memory error instead of taking the machine down.
     """
 
-    def __init__(self, context: bytes, *, threads: int = 1) -> None:
+    def __init__(self, context: bytes, *, threads: int = 1, max_memory: int | None = None) -> None:
         parent_in, child_out = os.pipe()
         child_in, parent_out = os.pipe()
         self._stderr = tempfile.TemporaryFile()  # noqa: SIM115 (open for the worker's life)
@@ -63,6 +67,7 @@ class Worker:
             "from benchmark.run.worker import serve; serve()",
             str(child_in),
             str(child_out),
+            str(max_memory or 0),
         ]
         try:
             self.process = subprocess.Popen(
@@ -187,6 +192,18 @@ def _worker_environment(threads: int) -> dict[str, str]:
     return environment
 
 
+def _limit_data_memory(extra: int) -> None:
+    """Allow this process ``extra`` bytes of data memory beyond what it uses now."""
+    import resource
+
+    in_use = 0
+    with contextlib.suppress(OSError, ValueError), open("/proc/self/status") as status:
+        for line in status:
+            if line.startswith("VmData:"):
+                in_use = int(line.split()[1]) * 1024
+    resource.setrlimit(resource.RLIMIT_DATA, (in_use + extra, in_use + extra))
+
+
 def serve() -> None:
     """The worker's main loop: load the context, then run tasks until told to stop."""
     threading.Thread(target=_exit_with_parent, args=(os.getppid(),), daemon=True).start()
@@ -199,6 +216,9 @@ def serve() -> None:
     except Exception as exc:
         outbox.send(("broken", f"cannot load the run's data: {describe_exception(exc)}"))
         return
+    limit = int(sys.argv[3]) if len(sys.argv) > 3 else 0
+    if limit > 0:
+        _limit_data_memory(limit)
     outbox.send(("ready", os.getpid()))
     while True:
         try:

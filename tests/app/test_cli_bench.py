@@ -14,6 +14,8 @@ from pathlib import Path
 import pytest
 from sqlalchemy import create_engine, text
 
+from app.store.database import Store
+from app.store.datasets import add_dataset, dataset_digest
 from benchmark.io.arff import loads_arff
 from tests.app.cli_runner import run_cli
 from tests.app.synthetic import touch_arff
@@ -57,7 +59,7 @@ def test_classifiers_lists_at_least_fifty_with_capabilities(
 def test_bench_json_leaderboard_and_stored_run(
     capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
 ) -> None:
-    imported(capsys, store_url, touch_arff(tmp_path / "t.arff"))
+    imported(capsys, store_url, touch_arff(tmp_path / "touch.arff"))
     result = run_cli(
         capsys,
         store_url,
@@ -91,7 +93,7 @@ def test_bench_json_leaderboard_and_stored_run(
 def test_leaderboard_formats(
     capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
 ) -> None:
-    imported(capsys, store_url, touch_arff(tmp_path / "t.arff"))
+    imported(capsys, store_url, touch_arff(tmp_path / "touch.arff"))
     run_id = run_cli(
         capsys,
         store_url,
@@ -139,7 +141,7 @@ def test_bad_benchmark_requests_exit_2(
     store_url: str,
     tmp_path: Path,
 ) -> None:
-    imported(capsys, store_url, touch_arff(tmp_path / "t.arff", n=30))
+    imported(capsys, store_url, touch_arff(tmp_path / "touch.arff", n=30))
     base = ["bench", "touch", "--target", "gesture", "--classifiers", "zeror"]
     if "--target" in args:
         base = ["bench", "touch", "--classifiers", "zeror"]
@@ -154,7 +156,7 @@ def test_bad_benchmark_requests_exit_2(
 def test_too_many_folds_fall_back_with_a_warning(
     capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
 ) -> None:
-    imported(capsys, store_url, touch_arff(tmp_path / "t.arff", n=30))
+    imported(capsys, store_url, touch_arff(tmp_path / "touch.arff", n=30))
     result = run_cli(
         capsys,
         store_url,
@@ -177,7 +179,9 @@ def test_too_many_folds_fall_back_with_a_warning(
 def test_one_class_target_and_unknown_run_exit_2(
     capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
 ) -> None:
-    imported(capsys, store_url, touch_arff(tmp_path / "t.arff", one_class=True, with_place=False))
+    imported(
+        capsys, store_url, touch_arff(tmp_path / "touch.arff", one_class=True, with_place=False)
+    )
     one = run_cli(capsys, store_url, "bench", "touch", "--classifiers", "zeror")
     assert one.code == 2 and "single class" in one.err
     unknown = run_cli(capsys, store_url, "leaderboard", "999")
@@ -200,7 +204,7 @@ def _count(url: str, sql: str) -> int:
 def test_a_killed_run_resumes_without_repeating_or_duplicating(
     capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
 ) -> None:
-    imported(capsys, store_url, touch_arff(tmp_path / "t.arff", n=300))
+    imported(capsys, store_url, touch_arff(tmp_path / "touch.arff", n=300))
     command = [
         sys.executable,
         "-m",
@@ -249,9 +253,11 @@ def test_a_killed_run_resumes_without_repeating_or_duplicating(
 def test_an_empty_dataset_cannot_be_benchmarked(
     capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
 ) -> None:
-    empty = tmp_path / "empty.arff"
-    empty.write_text("@relation e\n@attribute a numeric\n@attribute c {x,y}\n@data\n")
-    assert run_cli(capsys, store_url, "import", str(empty)).code == 0
+    # `import` refuses a file without instances, so the empty data set is stored directly.
+    store = Store(store_url)
+    empty = loads_arff("@relation e\n@attribute a numeric\n@attribute c {x,y}\n@data\n")
+    add_dataset(store, empty, sha256=dataset_digest(empty))
+    store.dispose()
     result = run_cli(capsys, store_url, "bench", "e", "-c", "zeror")
     assert result.code == 2 and "dataset 'e' has no instances" in result.err
     assert run_cli(capsys, store_url, "runs", "--json").json() == {"runs": []}

@@ -77,7 +77,7 @@ def test_targets_option_overrides_the_header(
 def test_show_describes_schema_classes_and_missing_values(
     capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
 ) -> None:
-    run_cli(capsys, store_url, "import", str(write(tmp_path, "t.arff", TOUCH_ARFF)))
+    run_cli(capsys, store_url, "import", str(write(tmp_path, "touch.arff", TOUCH_ARFF)))
     shown = run_cli(capsys, store_url, "show", "touch", "--json").json()
     assert shown["class_distribution"] == {
         "gesture": {"tap": 2, "slap": 1, "soft stroke": 1},
@@ -94,7 +94,7 @@ def test_show_describes_schema_classes_and_missing_values(
 def test_export_then_reimport_gives_identical_data(
     capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
 ) -> None:
-    source = write(tmp_path, "t.arff", TOUCH_ARFF)
+    source = write(tmp_path, "touch.arff", TOUCH_ARFF)
     run_cli(capsys, store_url, "import", str(source))
     exported = tmp_path / "out.arff"
     assert run_cli(capsys, store_url, "export", "touch", "-o", str(exported)).code == 0
@@ -108,7 +108,7 @@ def test_export_then_reimport_gives_identical_data(
 def test_delete_removes_the_dataset(
     capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
 ) -> None:
-    run_cli(capsys, store_url, "import", str(write(tmp_path, "t.arff", TOUCH_ARFF)))
+    run_cli(capsys, store_url, "import", str(write(tmp_path, "touch.arff", TOUCH_ARFF)))
     assert run_cli(capsys, store_url, "delete", "touch").code == 0
     assert run_cli(capsys, store_url, "datasets", "--json").json() == {"datasets": []}
     missing = run_cli(capsys, store_url, "show", "touch")

@@ -13,7 +13,7 @@ from tests.app.synthetic import touch_arff
 
 @pytest.fixture
 def trained(capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path) -> Path:
-    path = touch_arff(tmp_path / "t.arff", n=120)
+    path = touch_arff(tmp_path / "touch.arff", n=120)
     assert run_cli(capsys, store_url, "import", str(path)).code == 0
     result = run_cli(
         capsys,

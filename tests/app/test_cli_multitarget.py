@@ -12,7 +12,7 @@ from tests.app.synthetic import touch_arff
 
 @pytest.fixture
 def two_targets(capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path) -> Path:
-    path = touch_arff(tmp_path / "t.arff", n=120)
+    path = touch_arff(tmp_path / "touch.arff", n=120)
     assert run_cli(capsys, store_url, "import", str(path)).code == 0
     return path
 
@@ -100,7 +100,7 @@ def test_multi_target_bad_input_exits_2(
 ) -> None:
     single = touch_arff(tmp_path / "single.arff", with_place=False, seed=5)
     assert run_cli(capsys, store_url, "import", str(single), "--name", "single").code == 0
-    numeric = tmp_path / "numeric.arff"
+    numeric = tmp_path / "n.arff"
     numeric.write_text(
         "@relation 'n: -C 2'\n@attribute a numeric\n@attribute b numeric\n"
         "@attribute x numeric\n@data\n1,2,3\n2,3,4\n",

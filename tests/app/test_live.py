@@ -11,7 +11,7 @@ import soundfile
 
 from app.errors import AppError
 from app.services.extraction import extract_and_store, extract_dataset
-from app.services.live import LiveSession, model_extraction, open_live
+from app.services.live import LiveSession, open_live
 from app.services.models import load_model, predict, train
 from app.services.simulation import write_labels, write_session
 from app.store.database import Store
@@ -62,7 +62,7 @@ def test_the_recipe_travels_with_the_data_set_to_the_model(
 ) -> None:
     name, _ = trained
     info, _ = load_model(store, name)
-    recipe = model_extraction(store, info.id)
+    recipe = info.extraction
     assert recipe is not None
     assert (recipe["extractor"], recipe["events"], recipe["n_channels"]) == ("uc3m-audio", "snr", 3)
     assert recipe["samplerate"] == 44100.0 and recipe["event_options"]["hangover"] == 0.5
@@ -128,8 +128,7 @@ def test_live_session_takes_a_recipe_given_explicitly(
 ) -> None:
     name, unseen = trained
     info, model = load_model(store, name)
-    recipe = model_extraction(store, info.id)
-    session = LiveSession(info, model, samplerate=44100.0, n_channels=3, extraction=recipe)
+    session = LiveSession(info, model, samplerate=44100.0, n_channels=3, extraction=info.extraction)
     samples, _ = soundfile.read(unseen, always_2d=True)
     touches = session.feed(samples.T, 10.0) + session.finish()
     assert len(touches) == 6 and touches[0].start > 10.0

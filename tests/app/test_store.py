@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pytest
 from sqlalchemy import func, select
@@ -111,16 +113,16 @@ def test_a_failure_while_importing_leaves_nothing_behind(
     store: Store, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setattr(store_datasets, "_INSERT_BATCH", 2)
-    real_insert = store_datasets.insert
+    real_write = store_datasets._write_block
     calls = {"n": 0}
 
-    def failing_insert(table: object) -> object:
+    def failing_write(*args: Any) -> None:
         calls["n"] += 1
         if calls["n"] == 3:
             raise RuntimeError("disk full")
-        return real_insert(table)  # type: ignore[arg-type]
+        real_write(*args)
 
-    monkeypatch.setattr(store_datasets, "insert", failing_insert)
+    monkeypatch.setattr(store_datasets, "_write_block", failing_write)
     with pytest.raises(RuntimeError, match="disk full"):
         add_dataset(store, small_dataset(), sha256="f" * 64)
     assert calls["n"] == 3

@@ -13,7 +13,7 @@ import pytest
 from benchmark.dataset import Attribute, Dataset, Schema, resolve_targets
 from benchmark.errors import DataFormatError
 from benchmark.io.arff import dumps_arff, loads_arff, read_arff, write_arff
-from benchmark.io.arff_reader import DateFormat
+from benchmark.io.dates import DateFormat
 
 NAN = np.nan
 

@@ -53,6 +53,19 @@ class MemoryHogClassifier(ClassifierMixin, BaseEstimator):
         return self
 
 
+class GreedyClassifier(ClassifierMixin, BaseEstimator):
+    """Allocates and touches 300 MB in its fit (no limit of its own)."""
+
+    def fit(self, X: np.ndarray, y: np.ndarray) -> GreedyClassifier:
+        block = np.ones(300 * 2**20 // 8)
+        self.total_ = float(block.sum())
+        self.classes_ = np.unique(y)
+        return self
+
+    def predict(self, X: np.ndarray) -> np.ndarray:
+        return np.full(len(X), self.classes_[0])
+
+
 class SelfKillingClassifier(ClassifierMixin, BaseEstimator):
     """Dies as the kernel's out-of-memory killer would kill it."""
 
@@ -275,3 +288,43 @@ def test_workers_do_not_outlive_a_killed_run(tmp_path: Path) -> None:
         time.sleep(0.2)
     os.kill(worker, signal.SIGKILL)
     pytest.fail("the worker was still running 10 s after its parent was killed")
+
+
+def test_a_task_over_the_memory_limit_fails_alone(problem, folds) -> None:
+    specs = {"greedy": stand_in("greedy", GreedyClassifier)}
+    limited = run_tasks(
+        problem, ["greedy", "nb"], folds[:2], extra_specs=specs, max_memory=100 * 2**20
+    )
+    greedy = [r for r in limited if r.key.classifier == "greedy"]
+    assert [r.status for r in greedy] == ["error", "error"]
+    assert all(str(r.error).startswith("exceeded the memory limit of 100 MB") for r in greedy)
+    assert [r.status for r in limited if r.key.classifier == "nb"] == ["ok", "ok"]
+    unlimited = run_tasks(problem, ["greedy"], folds[:1], extra_specs=specs)
+    assert unlimited[0].status == "ok"
+
+
+def test_stop_ends_the_run_and_keeps_what_finished(problem, folds, tmp_path: Path) -> None:
+    from benchmark.run.engine import RunStopped
+
+    specs = {"sleeper": stand_in("sleeper", SleepingClassifier, pid_file=str(tmp_path / "pid"))}
+    reported: list[TaskResult] = []
+    with pytest.raises(RunStopped):
+        run_tasks(
+            problem,
+            ["nb", "sleeper"],
+            folds,
+            extra_specs=specs,
+            on_result=reported.append,
+            stop=lambda: (tmp_path / "pid").exists(),
+        )
+    assert [r.key.classifier for r in reported] == ["nb"] * 3
+    sleeper_pid = int((tmp_path / "pid").read_text())
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline:
+        try:
+            os.kill(sleeper_pid, 0)
+        except ProcessLookupError:
+            break
+        time.sleep(0.1)
+    with pytest.raises(ProcessLookupError):
+        os.kill(sleeper_pid, 0)

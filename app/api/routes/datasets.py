@@ -1,0 +1,170 @@
+"""Data sets: upload (ARFF or CSV), list, describe, download as ARFF, rename, delete."""
+
+from __future__ import annotations
+
+import contextlib
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Annotated, Literal
+
+from fastapi import APIRouter, File, Form, UploadFile, status
+from fastapi.responses import StreamingResponse
+
+from app.api.deps import ServiceDep, StoreDep
+from app.api.uploads import save_upload
+from app.schemas.base import Schema
+from app.schemas.datasets import (
+    DatasetDescription,
+    DatasetList,
+    DatasetSummary,
+    ImportResult,
+    RenameResult,
+)
+from app.services.datasets import (
+    delete_dataset,
+    describe_dataset,
+    export_dataset,
+    import_file,
+    list_datasets,
+    parse_targets,
+    rename_dataset,
+)
+from app.store.database import Store
+
+router = APIRouter(prefix="/api/datasets", tags=["datasets"])
+
+
+class RenameRequest(Schema):
+    name: str
+
+
+@router.post("", status_code=status.HTTP_201_CREATED, response_model=ImportResult)
+def upload(
+    service: ServiceDep,
+    file: Annotated[UploadFile, File(description="An ARFF or CSV file.")],
+    name: Annotated[str | None, Form(max_length=200)] = None,
+    targets: Annotated[
+        str | None,
+        Form(
+            max_length=2000,
+            description="N first attributes, -N last ones, or comma-separated names "
+            "(default: MEKA's -C header, else the last attribute).",
+        ),
+    ] = None,
+    format: Annotated[Literal["arff", "csv"] | None, Form()] = None,
+) -> ImportResult:
+    """Import an uploaded file as a data set (what ``touchbench import --json`` prints);
+    nothing is stored if the file has an error."""
+    service.settings.work_dir.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(dir=service.settings.work_dir) as folder:
+        path = save_upload(file, Path(folder), "upload.arff")
+        return import_file(
+            service.store,
+            path,
+            name=name,
+            targets=parse_targets(targets),
+            file_format=format,
+            source_name=path.name,
+        )
+
+
+@router.get("", response_model=DatasetList)
+def datasets(store: StoreDep) -> DatasetList:
+    return DatasetList(datasets=list_datasets(store))
+
+
+@router.get("/{dataset}", response_model=DatasetDescription)
+def dataset(dataset: str, store: StoreDep) -> DatasetDescription:
+    """Schema, class distribution per target and missing values (``touchbench show``)."""
+    return describe_dataset(store, dataset)
+
+
+@router.get(
+    "/{dataset}/arff",
+    response_class=StreamingResponse,
+    responses={200: {"content": {"text/plain": {}}}},
+)
+def arff(dataset: str, store: StoreDep) -> StreamingResponse:
+    """The data set as ARFF (MEKA's -C header for several targets), streamed."""
+    summary = next(
+        (d for d in list_datasets(store) if d.name == dataset or str(d.id) == dataset), None
+    )
+    if summary is None:
+        describe_dataset(store, dataset)  # raises the 404 with the usual message
+    assert summary is not None
+    return StreamingResponse(
+        _arff_lines(store, dataset),
+        media_type="text/plain; charset=utf-8",
+        headers={"Content-Disposition": f'attachment; filename="{summary.name}.arff"'},
+    )
+
+
+@router.post("/{dataset}/rename", response_model=RenameResult)
+def rename(dataset: str, body: RenameRequest, store: StoreDep) -> RenameResult:
+    return rename_dataset(store, dataset, body.name)
+
+
+@router.delete("/{dataset}", response_model=DatasetSummary)
+def remove(dataset: str, store: StoreDep) -> DatasetSummary:
+    """Delete a data set with its runs (refused while a run on it is going)."""
+    return delete_dataset(store, dataset)
+
+
+class _Abandoned(Exception):  # noqa: N818 (the client went away)
+    pass
+
+
+def _arff_lines(store: Store, dataset: str) -> Iterator[bytes]:
+    """The export in chunks of about 64 kB, written by a thread through a bounded queue, so
+    that memory stays flat whatever the size and a client that goes away stops the export."""
+    import queue
+    import threading
+
+    chunks: queue.Queue[bytes | None] = queue.Queue(maxsize=8)
+    abandoned = threading.Event()
+
+    class _Pipe:
+        def __init__(self) -> None:
+            self.parts: list[str] = []
+            self.size = 0
+
+        def write(self, text: str) -> int:
+            self.parts.append(text)
+            self.size += len(text)
+            if self.size >= 1 << 16:
+                self.flush()
+            return len(text)
+
+        def flush(self) -> None:
+            if not self.parts:
+                return
+            chunk = "".join(self.parts).encode("utf-8")
+            self.parts, self.size = [], 0
+            while True:
+                try:
+                    chunks.put(chunk, timeout=1.0)
+                    return
+                except queue.Full:
+                    if abandoned.is_set():
+                        raise _Abandoned from None
+
+    def produce() -> None:
+        pipe = _Pipe()
+        try:
+            export_dataset(store, dataset, pipe)  # type: ignore[arg-type]
+            pipe.flush()
+        except _Abandoned:
+            return
+        finally:
+            while not abandoned.is_set():
+                with contextlib.suppress(queue.Full):
+                    chunks.put(None, timeout=1.0)
+                    break
+
+    threading.Thread(target=produce, daemon=True, name="arff-export").start()
+    try:
+        while (chunk := chunks.get()) is not None:
+            yield chunk
+    finally:
+        abandoned.set()

@@ -1,0 +1,22 @@
+"""Jobs other than runs: extraction of uploaded sessions, training."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter
+
+from app.api.deps import StoreDep
+from app.schemas.jobs import JobList, JobSchema
+from app.store.jobs import get_job, list_jobs
+
+router = APIRouter(prefix="/api/jobs", tags=["jobs"])
+
+
+@router.get("", response_model=JobList)
+def jobs(store: StoreDep) -> JobList:
+    return JobList(jobs=list_jobs(store))
+
+
+@router.get("/{job_id}", response_model=JobSchema)
+def job(job_id: int, store: StoreDep) -> JobSchema:
+    """A job's status and, once done, its result (the new data set or model)."""
+    return get_job(store, job_id)

@@ -1,0 +1,105 @@
+"""Models: train (a job, 202), list, describe, delete, predict (JSON instances or a file)."""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+from typing import Annotated
+
+from fastapi import APIRouter, File, UploadFile, status
+
+from app.api.deps import ServiceDep, StoreDep
+from app.api.uploads import save_upload
+from app.errors import AppError
+from app.schemas.jobs import JobCreated
+from app.schemas.models import (
+    ModelList,
+    ModelSchema,
+    PredictionReport,
+    PredictRequest,
+    TrainRequest,
+)
+from app.services.jobs import submit_training
+from app.store.models import delete_model, get_model, list_models
+
+router = APIRouter(prefix="/api/models", tags=["models"])
+
+
+@router.post("", status_code=status.HTTP_202_ACCEPTED, response_model=JobCreated)
+def train(body: TrainRequest, service: ServiceDep) -> JobCreated:
+    """Train a classifier on a data set (``dataset`` + ``classifier``), or a run's best
+    classifier (``run``), as a job; the job's result names the model."""
+    if body.run is None and (body.dataset is None or body.classifier is None):
+        raise AppError("give 'dataset' and 'classifier', or 'run' (its best classifier)")
+    if body.run is not None and body.classifier is not None:
+        raise AppError("give 'run' or 'classifier', not both")
+    if body.run is not None:
+        from app.store.runs import get_run
+
+        get_run(service.store, body.run)  # 404 now rather than a failed job later
+        params = {"run": body.run, "name": body.name}
+    else:
+        from app.store.datasets import find_dataset
+
+        find_dataset(service.store, str(body.dataset))
+        params = body.model_dump(exclude={"run"})
+    if body.name is not None:
+        from app.store.models import check_model_name
+
+        check_model_name(body.name)
+    job = submit_training(service.store, params)
+    service.dispatcher.wake()
+    return JobCreated(job=job.id, status=job.status, kind=job.kind)
+
+
+@router.get("", response_model=ModelList)
+def models(store: StoreDep) -> ModelList:
+    return ModelList(models=[m.to_schema() for m in list_models(store)])
+
+
+@router.get("/{model_ref}", response_model=ModelSchema)
+def model(model_ref: str, store: StoreDep) -> ModelSchema:
+    return get_model(store, model_ref).to_schema()
+
+
+@router.delete("/{model_ref}", response_model=ModelSchema)
+def remove(model_ref: str, service: ServiceDep) -> ModelSchema:
+    gone = delete_model(service.store, model_ref)
+    service.models.forget(gone.id)
+    return gone.to_schema()
+
+
+@router.post("/{model_ref}/predict", response_model=PredictionReport)
+def predict_instances(
+    model_ref: str, body: PredictRequest, service: ServiceDep
+) -> PredictionReport:
+    """Predict instances given as ``{attribute: value}`` (matched to the model by name):
+    per instance and target the predicted label and the class probabilities."""
+    from app.services.models import dataset_from_records, predict
+
+    info, trained = service.models.get(service.store, model_ref)
+    data = dataset_from_records(trained.schema, body.instances)
+    return predict(trained, data, source="instances").report(info)
+
+
+@router.post("/{model_ref}/predict/file", response_model=PredictionReport)
+def predict_upload(
+    model_ref: str,
+    service: ServiceDep,
+    file: Annotated[UploadFile, File(description="ARFF or CSV with the model's attributes.")],
+) -> PredictionReport:
+    """Predict every instance of an uploaded ARFF or CSV file (accuracy when it carries the
+    targets)."""
+    from app.services.datasets import read_data_file
+    from app.services.models import predict
+
+    info, trained = service.models.get(service.store, model_ref)
+    with tempfile.TemporaryDirectory(dir=_work_dir(service)) as folder:
+        path = save_upload(file, Path(folder), "upload.arff")
+        data = read_data_file(path)
+        return predict(trained, data, source=path.name).report(info)
+
+
+def _work_dir(service: ServiceDep) -> Path:
+    service.settings.work_dir.mkdir(parents=True, exist_ok=True)
+    return service.settings.work_dir

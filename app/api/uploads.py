@@ -1,0 +1,101 @@
+"""Uploads: a body-size limit enforced while the body streams in, and uploaded files saved
+under safe names."""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+from typing import Any
+
+from fastapi import UploadFile
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+from app.api.errors import UploadTooLarge, error_body
+from app.errors import AppError
+
+#: Bytes copied at a time from an upload to its file.
+CHUNK = 1 << 20
+_UNSAFE = re.compile(r"[^\w.+-]+")
+
+
+class BodyLimit:
+    """ASGI middleware: a request body over ``limit`` bytes is refused with 413.
+
+    A declared ``Content-Length`` over the limit is refused before any byte is read; a
+    body without one is counted as it arrives and refused as soon as it passes the limit,
+    so that nothing larger is ever spooled to memory or disk.
+    """
+
+    def __init__(self, app: ASGIApp, limit: int) -> None:
+        self.app = app
+        self.limit = limit
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        declared = _content_length(scope)
+        if declared is not None and declared > self.limit:
+            await _refuse(send, self.limit)
+            return
+        seen = 0
+
+        async def counted() -> Message:
+            nonlocal seen
+            message = await receive()
+            if message["type"] == "http.request":
+                seen += len(message.get("body", b""))
+                if seen > self.limit:
+                    raise UploadTooLarge(self.limit)
+            return message
+
+        await self.app(scope, counted, send)
+
+
+def safe_name(name: str | None, fallback: str) -> str:
+    """A file name without folders, hidden dots or odd characters."""
+    base = Path(name or "").name
+    base = _UNSAFE.sub("_", base).lstrip(".")
+    return base[:120] or fallback
+
+
+def save_upload(upload: UploadFile, folder: Path, fallback: str) -> Path:
+    """Copy an uploaded file into ``folder`` under its safe name; returns its path.
+
+    Raises
+    ------
+    AppError
+        Two uploads of one request share a name.
+    """
+    folder.mkdir(parents=True, exist_ok=True)
+    target = folder / safe_name(upload.filename, fallback)
+    if target.exists():
+        raise AppError(f"two uploaded files are named '{target.name}'; names must differ")
+    with target.open("wb") as out:
+        shutil.copyfileobj(upload.file, out, CHUNK)
+    return target
+
+
+def _content_length(scope: Scope) -> int | None:
+    for key, value in scope.get("headers", ()):
+        if key == b"content-length":
+            try:
+                return int(value)
+            except ValueError:
+                return None
+    return None
+
+
+async def _refuse(send: Send, limit: int) -> None:
+    import json
+
+    body: Any = json.dumps(error_body("UploadTooLarge", str(UploadTooLarge(limit)), "body"))
+    await send(
+        {
+            "type": "http.response.start",
+            "status": 413,
+            "headers": [(b"content-type", b"application/json"), (b"connection", b"close")],
+        }
+    )
+    await send({"type": "http.response.body", "body": body.encode()})

@@ -1,0 +1,50 @@
+"""typer's help pages, made to read as click's do.
+
+typer 0.29 shows every flag's type as ``<bool>`` and other types as ``<int>``, ``<path>``,
+``<list[Path]>``; writes a required argument as ``{NAME}`` in the usage line; and keeps the
+source's line breaks inside a docstring's later paragraphs.  Mature command lines print
+nothing for a flag and the metavar or an upper-case type otherwise, write ``NAME`` /
+``[NAME]`` / ``NAME...``, and reflow paragraphs.  :func:`install` patches those four
+spots of typer once, at import of the CLI; nothing else of typer is touched.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+#: typer's type labels -> the words click uses.
+_TYPE_WORDS = {"int": "INTEGER", "float": "NUMBER", "str": "TEXT", "path": "PATH"}
+
+
+def install() -> None:
+    """Patch typer's help rendering (idempotent)."""
+    from typer import rich_utils
+    from typer.core import TyperArgument, TyperOption
+
+    def option_type(self: TyperOption, ctx: Any) -> str | None:
+        if self.is_flag or self.count:
+            return None
+        if self.metavar is not None:
+            return str(self.metavar)
+        label = str(self.display_type(ctx)).strip("<>")
+        word = _TYPE_WORDS.get(label, label.upper())
+        return f"{word}..." if self.nargs != 1 else word
+
+    def argument_type(self: TyperArgument, ctx: Any) -> str | None:
+        return None  # the name column (its metavar) already says what it is
+
+    def usage_name(self: TyperArgument) -> str:
+        name = str(self.display_name_raw)
+        name = name if self.required else f"[{name}]"
+        return name + ("..." if self.nargs != 1 and not name.endswith("...") else "")
+
+    def reflow(paragraphs: list[str], markup_mode: Any) -> str:
+        return "\n\n".join(
+            paragraph if paragraph.startswith("\b") else " ".join(paragraph.split())
+            for paragraph in paragraphs
+        )
+
+    TyperOption.display_type_rich = option_type  # type: ignore[method-assign]
+    TyperArgument.display_type_rich = argument_type  # type: ignore[method-assign,assignment]
+    TyperArgument._usage_display_name = usage_name  # type: ignore[method-assign]
+    rich_utils._fix_linebreaks = reflow

@@ -1,0 +1,84 @@
+"""``touchbench serve``: the REST service (uvicorn) on this machine."""
+
+from __future__ import annotations
+
+import ipaddress
+import os
+from typing import Annotated
+
+import typer
+
+from app.cli.state import get_state
+
+
+def register(app: typer.Typer) -> None:
+    app.command("serve")(serve_command)
+
+
+def serve_command(
+    ctx: typer.Context,
+    host: Annotated[
+        str, typer.Option("--host", metavar="ADDRESS", help="Address to listen on.")
+    ] = "127.0.0.1",
+    port: Annotated[
+        int, typer.Option("--port", metavar="PORT", min=1, max=65535, help="Port to listen on.")
+    ] = 8000,
+    workers: Annotated[
+        int,
+        typer.Option(
+            "--workers", metavar="N", min=1, help="Service processes (each dispatches jobs)."
+        ),
+    ] = 1,
+    insecure: Annotated[
+        bool,
+        typer.Option(
+            "--insecure",
+            help="Listen beyond loopback without an API key (anyone who reaches the port "
+            "can read and change the store).",
+        ),
+    ] = False,
+    log_level: Annotated[
+        str, typer.Option("--log-level", metavar="LEVEL", help="debug, info, warning, error.")
+    ] = "info",
+) -> None:
+    """Serve the REST API (data sets, recording uploads, runs, leaderboards, models,
+    predictions) at http://HOST:PORT/api, its documentation at /docs.
+
+    Settings come from TOUCHBENCH_* variables: TOUCHBENCH_API_KEY (required beyond
+    loopback), TOUCHBENCH_JOB_WORKERS, TOUCHBENCH_RUN_JOBS, TOUCHBENCH_DASK_SCHEDULER,
+    TOUCHBENCH_MAX_UPLOAD_MB, TOUCHBENCH_RESUME_ON_START.
+    """
+    import uvicorn
+
+    from app.settings import get_settings
+
+    state = get_state(ctx)
+    os.environ["TOUCHBENCH_DATABASE_URL"] = state.database_url
+    get_settings.cache_clear()
+    settings = get_settings()
+    if settings.api_key is None and not _loopback(host) and not insecure:
+        raise typer.BadParameter(
+            f"{host} is reachable from other machines and TOUCHBENCH_API_KEY is not set: set "
+            "a key, listen on 127.0.0.1, or pass --insecure",
+            param_hint="--host",
+        )
+    state.store  # noqa: B018 (open and migrate the store once, before the workers start)
+    uvicorn.run(
+        "app.api.main:create_app",
+        factory=True,
+        host=host,
+        port=port,
+        workers=workers,
+        log_level=log_level,
+        proxy_headers=False,
+        server_header=False,
+    )
+
+
+def _loopback(host: str) -> bool:
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False

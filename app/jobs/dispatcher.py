@@ -1,0 +1,146 @@
+"""The dispatcher a service process runs: it hands queued runs and jobs to worker processes.
+
+Every ``poll`` seconds it looks in the store for queued work and, while fewer than
+``job_workers`` of its worker processes are busy, starts ``python -m app.jobs.process`` for
+the oldest item.  Worker processes claim items atomically, so several service processes
+(``touchbench serve --workers N``, or several hosts on one PostgreSQL store) can dispatch
+from the same queue; upload folders are on one host's disk, so extraction jobs are only
+taken by a dispatcher on the host that received them.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import socket
+import subprocess
+import sys
+import threading
+from dataclasses import dataclass
+
+from app.settings import Settings
+from app.store.database import Store
+from app.store.jobs import mark_lost_jobs, queued_jobs
+from app.store.runs import list_runs, mark_lost_runs
+
+log = logging.getLogger("touchbench.jobs")
+
+#: Seconds between looks at the queue.
+POLL = 0.5
+
+
+@dataclass
+class _Active:
+    kind: str
+    id: int
+    process: subprocess.Popen[bytes]
+
+
+class Dispatcher:
+    """Starts worker processes for queued work; one per item, ``job_workers`` at once.
+
+    Parameters
+    ----------
+    store : Store
+    settings : Settings
+        ``job_workers``, ``run_jobs``, ``dask_scheduler``.
+    """
+
+    def __init__(self, store: Store, settings: Settings) -> None:
+        self.store = store
+        self.settings = settings
+        self._active: list[_Active] = []
+        self._stop = threading.Event()
+        self._wake = threading.Event()
+        self._thread = threading.Thread(target=self._loop, daemon=True, name="dispatcher")
+
+    def start(self) -> None:
+        self._thread.start()
+
+    def wake(self) -> None:
+        """Look at the queue now (a request just queued something)."""
+        self._wake.set()
+
+    def stop(self) -> None:
+        """Stop dispatching and end the worker processes (their runs become resumable)."""
+        self._stop.set()
+        self._wake.set()
+        self._thread.join(timeout=10)
+        for active in self._active:
+            with contextlib.suppress(ProcessLookupError):
+                active.process.terminate()
+        for active in self._active:
+            try:
+                active.process.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                active.process.kill()
+        mark_lost_runs(self.store)
+        mark_lost_jobs(self.store)
+
+    @property
+    def busy(self) -> int:
+        return len(self._active)
+
+    def _loop(self) -> None:
+        while not self._stop.is_set():
+            try:
+                self._reap()
+                self._dispatch()
+            except Exception as error:  # a busy or unreachable store: try again later
+                log.warning("dispatcher: %s: %s", type(error).__name__, error)
+            self._wake.wait(POLL)
+            self._wake.clear()
+
+    def _reap(self) -> None:
+        finished = [a for a in self._active if a.process.poll() is not None]
+        if not finished:
+            return
+        self._active = [a for a in self._active if a.process.poll() is None]
+        if any(a.process.returncode != 0 for a in finished):
+            mark_lost_runs(self.store)
+            mark_lost_jobs(self.store)
+
+    def _dispatch(self) -> None:
+        while len(self._active) < self.settings.job_workers:
+            item = self._next()
+            if item is None:
+                return
+            self._active.append(_Active(item[0], item[1], self._spawn(*item)))
+
+    def _next(self) -> tuple[str, int] | None:
+        taken = {(a.kind, a.id) for a in self._active}
+        runs = [
+            (run.created_at, "run", run.id)
+            for run in list_runs(self.store, status="queued")
+            if ("run", run.id) not in taken
+        ]
+        host = socket.gethostname()
+        jobs = [
+            (job.created_at, "job", job.id)
+            for job in queued_jobs(self.store)
+            if ("job", job.id) not in taken and job.params.get("host", host) == host
+        ]
+        waiting = sorted(runs + jobs, key=lambda item: (item[0].timestamp(), item[2]))
+        return (waiting[0][1], waiting[0][2]) if waiting else None
+
+    def _spawn(self, kind: str, item_id: int) -> subprocess.Popen[bytes]:
+        command = [
+            sys.executable,
+            "-m",
+            "app.jobs.process",
+            "--db",
+            self.store.url,
+            "--jobs",
+            str(self.settings.run_jobs),
+        ]
+        if self.settings.dask_scheduler:
+            command += ["--scheduler", self.settings.dask_scheduler]
+        command += [kind, str(item_id)]
+        environment = dict(os.environ)
+        paths = [p for p in sys.path if p]
+        environment["PYTHONPATH"] = os.pathsep.join(dict.fromkeys(paths))
+        for name in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS"):
+            environment[name] = "1"
+        log.info("starting %s %s", kind, item_id)
+        return subprocess.Popen(command, env=environment, stdin=subprocess.DEVNULL)

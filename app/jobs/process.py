@@ -1,0 +1,63 @@
+"""A worker process for one queued run or job: ``python -m app.jobs.process --db URL run 5``.
+
+It claims the item (another process claiming it first is not an error: it exits quietly),
+carries it out, records how it ended, and exits.  It ends itself, mid-run included, once
+the service that started it has died, so that a crashed service leaves no orphan work; the
+run is then found ``interrupted`` and can be resumed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import threading
+import time
+
+#: Seconds between checks that the parent service is alive.
+PARENT_CHECK_INTERVAL = 1.0
+
+
+def _exit_with_parent(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(PARENT_CHECK_INTERVAL)
+    os._exit(1)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m app.jobs.process")
+    parser.add_argument("--db", required=True)
+    parser.add_argument("--jobs", type=int, default=1)
+    parser.add_argument("--scheduler", default=None)
+    parser.add_argument("kind", choices=["run", "job"])
+    parser.add_argument("id", type=int)
+    args = parser.parse_args(argv)
+    threading.Thread(target=_exit_with_parent, args=(os.getppid(),), daemon=True).start()
+
+    from app.errors import AppError
+    from app.services.jobs import execute_job
+    from app.services.runs import RunCancelled, execute_run
+    from app.store.database import Store
+
+    store = Store(args.db)
+    try:
+        if args.kind == "job":
+            execute_job(store, args.id)
+            return 0
+        try:
+            execute_run(store, args.id, jobs=args.jobs, scheduler=args.scheduler)
+        except RunCancelled:
+            return 0
+        except AppError as error:  # claimed by another process, or refused: recorded there
+            print(f"run {args.id}: {error}", file=sys.stderr)
+            return 0
+        except Exception as error:  # recorded as failed by execute_run where it could be
+            print(f"run {args.id}: {type(error).__name__}: {error}", file=sys.stderr)
+            return 1
+        return 0
+    finally:
+        store.dispose()
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,41 @@
+"""Jobs other than runs (extraction of an uploaded recording session, training a model), as
+the API answers them."""
+
+from __future__ import annotations
+
+from datetime import datetime
+from typing import Any, Literal
+
+from pydantic import Field
+
+from app.schemas.base import Schema
+
+JobKind = Literal["extract", "train"]
+#: Same life as a run's: queued -> running -> done | failed (| interrupted after a crash).
+JobStatus = Literal["queued", "running", "done", "failed", "cancelled", "interrupted"]
+
+
+class JobSchema(Schema):
+    id: int
+    kind: JobKind
+    status: JobStatus
+    params: dict[str, Any] = Field(description="What the job was asked to do.")
+    result: dict[str, Any] | None = Field(
+        default=None, description="extract: the new data set; train: the new model."
+    )
+    error: str | None = None
+    created_at: datetime
+    started_at: datetime | None = None
+    finished_at: datetime | None = None
+
+
+class JobList(Schema):
+    jobs: list[JobSchema]
+
+
+class JobCreated(Schema):
+    """What a request that starts a job answers at once (status 202)."""
+
+    job: int
+    status: JobStatus
+    kind: JobKind

@@ -1,0 +1,102 @@
+"""Runs and their leaderboards, as ``touchbench runs/bench/leaderboard --json`` print them
+and the API answers them."""
+
+from __future__ import annotations
+
+from datetime import datetime
+from typing import Any, Literal
+
+from pydantic import Field
+
+from app.schemas.base import Schema
+
+#: Where a run is in its life: ``queued`` (created, waiting for a worker), ``running``,
+#: ``done`` (every task has a result), ``failed`` (every task failed, or the run could not
+#: be carried out), ``cancelled`` (on request), ``interrupted`` (its process stopped: Ctrl-C,
+#: kill -9, a crash; ``--resume`` finishes it).
+RunStatus = Literal["queued", "running", "done", "failed", "cancelled", "interrupted"]
+RUN_STATUSES: tuple[RunStatus, ...] = (
+    "queued",
+    "running",
+    "done",
+    "failed",
+    "cancelled",
+    "interrupted",
+)
+#: Statuses after which nothing more happens unless the run is resumed.
+FINAL_STATUSES: frozenset[str] = frozenset({"done", "failed", "cancelled", "interrupted"})
+
+
+class RunSchema(Schema):
+    """A benchmark run: its data set, classifiers, protocol and progress."""
+
+    id: int
+    dataset: str = Field(description="Name of the data set.")
+    dataset_id: int
+    kind: str = Field(description="multiclass or multitarget.")
+    targets: list[str]
+    classifiers: list[str]
+    config: dict[str, Any] = Field(description="Folds, repeats, seed, timeout, ...")
+    status: RunStatus
+    created_at: datetime
+    started_at: datetime | None = None
+    finished_at: datetime | None = None
+    tasks_done: int = Field(description="Tasks with a result (failed ones included).")
+    tasks: int = Field(description="Tasks in all: classifiers x folds x repeats.")
+    tasks_failed: int = 0
+    error: str | None = Field(default=None, description="Why the run failed, if it did.")
+    owner: str | None = Field(default=None, description="host:pid of the executing process.")
+
+
+class RunList(Schema):
+    runs: list[RunSchema]
+
+
+class RunCreated(Schema):
+    """What ``POST /api/runs`` answers at once: the run waits for a worker."""
+
+    id: int
+    status: RunStatus
+
+
+class MetricValue(Schema):
+    """Mean and sample standard deviation over the successful folds (``null``: none)."""
+
+    mean: float | None
+    std: float | None
+
+
+PerTargetScores = dict[str, dict[str, MetricValue]]
+
+
+class LeaderboardRowSchema(Schema):
+    """One classifier's line; ``metrics.per_target`` holds a multi-target row's scores per
+    target (target -> metric -> mean/std)."""
+
+    rank: int
+    classifier: str
+    mark: Literal["v", "*", ""] = Field(description="v: better than the baseline; *: worse.")
+    metrics: dict[str, MetricValue | PerTargetScores]
+    n_ok: int
+    n_failed: int
+    errors: list[str]
+
+
+class MarkSummary(Schema):
+    better: int
+    same: int
+    worse: int
+
+
+class LeaderboardSchema(Schema):
+    """A run's ranked classifiers with WEKA's significance marks."""
+
+    run_id: int
+    dataset: str
+    kind: str
+    targets: list[str]
+    status: RunStatus
+    metric: str
+    baseline: str | None = Field(description="The classifier the marks compare against.")
+    summary: MarkSummary
+    leaderboard: list[LeaderboardRowSchema]

@@ -1,0 +1,114 @@
+"""Jobs in the store: queued by the service, claimed by exactly one worker process, finished
+with a result or an error.  Claiming is one conditional UPDATE, so that two dispatchers (two
+service processes on one store) never carry out the same job twice."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from sqlalchemy import select, update
+
+from app.errors import NotFoundError
+from app.schemas.jobs import JobSchema
+from app.store.database import Store
+from app.store.runs import owner_alive, process_owner
+from app.store.tables import JobRow, utcnow
+
+
+def create_job(store: Store, kind: str, params: dict[str, Any]) -> JobSchema:
+    with store.session() as session:
+        row = JobRow(kind=kind, status="queued", params=params)
+        session.add(row)
+        session.flush()
+        return _schema(row)
+
+
+def get_job(store: Store, job_id: int | str) -> JobSchema:
+    with store.session() as session:
+        return _schema(_row(session, job_id))
+
+
+def list_jobs(store: Store) -> list[JobSchema]:
+    with store.session() as session:
+        return [_schema(row) for row in session.scalars(select(JobRow).order_by(JobRow.id))]
+
+
+def queued_jobs(store: Store) -> list[JobSchema]:
+    with store.session() as session:
+        rows = session.scalars(select(JobRow).where(JobRow.status == "queued").order_by(JobRow.id))
+        return [_schema(row) for row in rows]
+
+
+def claim_job(store: Store, job_id: int, *, owner: str | None = None) -> bool:
+    """Take a queued job for this process; ``False`` if another process took it first."""
+    now = utcnow()
+    with store.session() as session:
+        claimed = session.execute(
+            update(JobRow)
+            .where(JobRow.id == job_id, JobRow.status == "queued")
+            .values(
+                status="running", owner=owner or process_owner(), started_at=now, heartbeat_at=now
+            )
+            .execution_options(synchronize_session=False)
+        ).rowcount  # type: ignore[attr-defined]  # an UPDATE gives a CursorResult
+    return bool(claimed)
+
+
+def finish_job(
+    store: Store,
+    job_id: int,
+    status: str,
+    *,
+    result: dict[str, Any] | None = None,
+    error: str | None = None,
+) -> None:
+    with store.session() as session:
+        session.execute(
+            update(JobRow)
+            .where(JobRow.id == job_id)
+            .values(status=status, result=result, error=error, finished_at=utcnow())
+            .execution_options(synchronize_session=False)
+        )
+
+
+def mark_lost_jobs(store: Store) -> list[int]:
+    """Jobs left ``running`` by a process that died become ``interrupted``; their ids."""
+    with store.session() as session:
+        running = session.execute(
+            select(JobRow.id, JobRow.owner, JobRow.heartbeat_at).where(JobRow.status == "running")
+        ).all()
+        lost = [job_id for job_id, owner, beat in running if not owner_alive(owner, beat)]
+        if lost:
+            session.execute(
+                update(JobRow)
+                .where(JobRow.id.in_(lost))
+                .values(
+                    status="interrupted",
+                    error="the worker process stopped before the job ended",
+                    finished_at=utcnow(),
+                )
+                .execution_options(synchronize_session=False)
+            )
+    return lost
+
+
+def _row(session: Any, job_id: int | str) -> JobRow:
+    text = str(job_id)
+    row = session.get(JobRow, int(text)) if text.isdigit() and len(text) < 12 else None
+    if row is None:
+        raise NotFoundError(f"no job '{text[:40]}'")
+    return row
+
+
+def _schema(row: JobRow) -> JobSchema:
+    return JobSchema(
+        id=row.id,
+        kind=row.kind,  # type: ignore[arg-type]  # a JobKind literal in the column
+        status=row.status,  # type: ignore[arg-type]  # a JobStatus literal in the column
+        params=dict(row.params),
+        result=row.result,
+        error=row.error,
+        created_at=row.created_at,
+        started_at=row.started_at,
+        finished_at=row.finished_at,
+    )

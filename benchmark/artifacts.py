@@ -1,0 +1,118 @@
+"""Model artifacts that cannot run code when they are loaded.
+
+A model is written with :mod:`skops.io`, which stores an object tree of known node kinds
+instead of a pickle's program.  Before anything is loaded, every type the artifact names
+is checked: it must be a class (never a function) defined in a package touchbench's
+models are made of (:data:`TRUSTED_PACKAGES`).  An artifact that names anything else (a
+crafted ``os.system``, ``subprocess.Popen``, ``builtins.eval``...) is refused before a
+single object is built, whoever wrote it into the store.
+"""
+
+from __future__ import annotations
+
+import importlib
+import io
+import zipfile
+from typing import Any
+
+from benchmark.errors import ConfigurationError
+
+#: Format tag written into every artifact, checked on load.
+ARTIFACT_FORMAT = "touchbench-model/1"
+#: Top-level packages whose classes a model may be made of.
+TRUSTED_PACKAGES = frozenset(
+    {
+        "benchmark",
+        "sklearn",
+        "numpy",
+        "scipy",
+        "xgboost",
+        "lightgbm",
+        "catboost",
+        "skmultilearn",
+        "aeon",
+        "wittgenstein",
+        "imodels",
+    }
+)
+#: Classes of trusted packages that touch files, never loaded all the same (a memory-mapped
+#: array or an ``.npz`` archive would open a path the artifact names).
+REFUSED_TYPES = frozenset({"numpy.memmap", "numpy.lib.npyio.NpzFile", "numpy.lib.npyio.DataSource"})
+
+
+def dumps_artifact(content: dict[str, Any]) -> bytes:
+    """Serialise a model's content (estimators, arrays, plain data) as a skops artifact.
+
+    Parameters
+    ----------
+    content : dict
+        JSON-like data and estimators; a ``format`` key is added.
+    """
+    import skops.io
+
+    return bytes(skops.io.dumps({"format": ARTIFACT_FORMAT, **content}))
+
+
+def loads_artifact(data: bytes) -> dict[str, Any]:
+    """Load an artifact written by :func:`dumps_artifact`, refusing untrusted types.
+
+    Raises
+    ------
+    ConfigurationError
+        The bytes are not a skops artifact, name a type outside
+        :data:`TRUSTED_PACKAGES` (or a function), or are not a touchbench model.
+    """
+    import skops.io
+
+    if not zipfile.is_zipfile(io.BytesIO(data)):
+        raise ConfigurationError(
+            "the stored model is not a skops artifact (an old pickle, or foreign bytes); "
+            "touchbench only loads artifacts that cannot run code: train the model again"
+        )
+    try:
+        named = skops.io.get_untrusted_types(data=data)
+    except Exception as exc:
+        raise ConfigurationError(f"the stored model cannot be read: {exc}") from None
+    refused = [name for name in named if not is_trusted_type(name)]
+    if refused:
+        shown = ", ".join(refused[:3]) + (f" (+{len(refused) - 3})" if len(refused) > 3 else "")
+        raise ConfigurationError(
+            f"the stored model names types touchbench does not trust ({shown}); refusing to load it"
+        )
+    try:
+        content = skops.io.loads(data, trusted=named)
+    except Exception as exc:
+        raise ConfigurationError(f"the stored model cannot be loaded: {exc}") from None
+    if not isinstance(content, dict) or content.get("format") != ARTIFACT_FORMAT:
+        raise ConfigurationError("the stored bytes are not a touchbench model")
+    return content
+
+
+def is_trusted_type(name: str) -> bool:
+    """Whether ``name`` (``module.Class``) is a class of a trusted package.
+
+    Only the module is imported (trusted packages' modules import without side effects);
+    the attribute must be a class, so no function can be named and called.
+    """
+    module_name, _, attribute = name.rpartition(".")
+    if not module_name or module_name.split(".", 1)[0] not in TRUSTED_PACKAGES:
+        return False
+    try:
+        target = getattr(importlib.import_module(module_name), attribute)
+    except (ImportError, AttributeError, ValueError):
+        return False
+    if not isinstance(target, type):
+        return False
+    import numpy
+
+    refused = [numpy.memmap, *(_numpy_type(name) for name in REFUSED_TYPES)]
+    return not any(issubclass(target, kind) for kind in refused if kind is not None)
+
+
+def _numpy_type(name: str) -> type | None:
+    module_name, _, attribute = name.rpartition(".")
+    try:
+        found = getattr(importlib.import_module(module_name), attribute)
+    except (ImportError, AttributeError):
+        return None
+    return found if isinstance(found, type) else None

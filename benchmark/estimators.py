@@ -1,0 +1,131 @@
+"""From a classifier id and a problem to an estimator: the one place that decides.
+
+A problem with one target takes a catalogue id (``rf``, ``j48``...); one with several
+targets takes a multi-target configuration (``META:BASE``, e.g. ``bcc:rf``).  The engine,
+its tasks, model training and the app's checks all ask here, so the rule lives once.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from benchmark.catalogue import CATALOGUE, ClassifierSpec, build_pipeline
+from benchmark.catalogue import unknown_classifier_message as _unknown_message
+from benchmark.errors import ConfigurationError
+from benchmark.problem import Problem
+
+__all__ = ["build_estimator", "check_classifier", "classifier_spec", "is_multitarget_id"]
+
+
+def is_multitarget_id(classifier_id: str) -> bool:
+    """Whether ``classifier_id`` names a multi-target configuration (``META:BASE`` or a META)."""
+    from benchmark.multitarget import META_METHODS
+
+    return ":" in classifier_id or classifier_id.lower() in META_METHODS
+
+
+def classifier_spec(
+    classifier_id: str, extra_specs: Mapping[str, ClassifierSpec] | None = None
+) -> ClassifierSpec:
+    """The multi-class spec of ``classifier_id``: an extra spec first, else the catalogue's.
+
+    Raises
+    ------
+    ConfigurationError
+        Unknown id, naming the closest known one.
+    """
+    known = {**CATALOGUE, **(extra_specs or {})}
+    if classifier_id not in known:
+        raise ConfigurationError(_unknown_message(classifier_id, known))
+    return known[classifier_id]
+
+
+def check_classifier(
+    classifier_id: str,
+    problem: Problem,
+    extra_specs: Mapping[str, ClassifierSpec] | None = None,
+) -> ClassifierSpec | None:
+    """Refuse an id that is unknown or does not fit the problem's targets.
+
+    Parameters
+    ----------
+    classifier_id : str
+    problem : Problem
+        Only its shape is used (targets, classes).
+    extra_specs : mapping of str to ClassifierSpec, optional
+        Multi-class specs outside the catalogue.
+
+    Returns
+    -------
+    ClassifierSpec or None
+        The multi-class spec; ``None`` for a multi-target configuration.
+
+    Raises
+    ------
+    ConfigurationError
+        Unknown id; a multi-class id for several targets (or the reverse); a binary-only
+        multi-label method on targets with more than two classes.
+    """
+    from benchmark.multitarget import check_targets, parse_config
+
+    names = ", ".join(problem.target_names)
+    if is_multitarget_id(classifier_id):
+        parse_config(classifier_id)
+        check_targets(classifier_id, problem.n_classes, problem.target_names)
+        return None
+    spec = classifier_spec(classifier_id, extra_specs)
+    if problem.kind == "multitarget":
+        raise ConfigurationError(
+            f"'{classifier_id}' is a multi-class classifier and the data set has "
+            f"{len(problem.target_names)} targets ({names}): use --target NAME for one "
+            f"target, or a multi-target configuration such as bcc:{classifier_id}"
+        )
+    return spec
+
+
+def build_estimator(
+    classifier_id: str,
+    problem: Problem,
+    *,
+    random_state: int | None = 0,
+    extra_specs: Mapping[str, ClassifierSpec] | None = None,
+) -> Any:
+    """A fresh, unfitted estimator for ``classifier_id`` on ``problem``.
+
+    Parameters
+    ----------
+    classifier_id : str
+        A catalogue id (one target) or a ``META:BASE`` configuration (several targets).
+    problem : Problem
+        Decides the kind, the nominal feature columns, the feature count and the declared
+        classes per target.
+    random_state : int or None
+        Seed of the estimator.
+    extra_specs : mapping of str to ClassifierSpec, optional
+        Multi-class specs outside the catalogue.
+
+    Returns
+    -------
+    estimator
+        A scikit-learn pipeline (``fit(X, y)`` with ``y`` of shape (n_instances,)) for one
+        target; a multi-target classifier (``fit(X, Y)`` with ``Y`` of shape
+        (n_instances, n_targets)) for several.
+    """
+    spec = check_classifier(classifier_id, problem, extra_specs)
+    if spec is not None:
+        return build_pipeline(
+            spec,
+            nominal_features=problem.nominal_features,
+            n_features=problem.n_features,
+            random_state=random_state,
+        )
+    from benchmark.multitarget import build_multitarget
+
+    return build_multitarget(
+        classifier_id,
+        nominal_features=problem.nominal_features,
+        n_features=problem.n_features,
+        random_state=random_state,
+        n_classes=problem.n_classes,
+    )

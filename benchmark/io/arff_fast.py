@@ -1,0 +1,221 @@
+"""The vectorised reading of plain blocks of ARFF rows with pandas' C parser.
+
+Most of a real data section is lines such as ``'tap','head',459.375,0,?``: numbers,
+nominal labels (quoted or not) and ``?``, separated by single commas.  On such a block
+WEKA's tokenizer and a CSV parser read the same fields, so pandas' C parser reads the
+block at C speed.  :func:`read_plain_block` first proves, with numpy over the block's
+bytes, that pandas cannot read it differently without saying so, and gives up (returns
+``None``) otherwise, leaving the block to the exact reader (:mod:`benchmark.io.arff_data`):
+
+- no double quote, backslash, brace, ``%``, and no whitespace or control character but
+  the line breaks (``\\n``, or ``\\r\\n`` throughout);
+- no comma at the start or end of a line, none two in a row, and as many on each line as
+  there are attributes less one (pandas itself refuses a line with too many fields);
+- single quotes pair up on each line, each pair enclosing one whole field, and ``'?'``
+  (the label ``?``, not a missing value) does not occur;
+- every numeric field is a number pandas reads (it refuses, for example, ``nan`` and
+  ``1_000``, which Python's ``float`` reads: those blocks go to the exact reader), and
+  every nominal field is a declared label or ``?``; labels that could not be plain fields
+  (with separators, quotes or braces) keep the whole file off this path.
+
+pandas' float parser is correctly rounded (as Python's ``float`` is), so the values are
+the same bits; the tests compare both readers value for value.  pandas is imported on the
+first block, so small files never pay for its import.
+"""
+
+from __future__ import annotations
+
+import io
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from benchmark.dataset import Attribute
+
+_FORBIDDEN = (b'"', b"\\", b"{", b"}", b"%")
+_NOT_PLAIN = re.compile(r"""^$|[\x00-\x20,'"\\{}%]""")
+_COMMA, _QUOTE, _LF, _CR = 44, 39, 10, 13
+
+
+@dataclass(frozen=True)
+class PlainPlan:
+    """How the attributes of a file read in plain blocks.
+
+    Attributes
+    ----------
+    numeric : ndarray of int
+        Positions of the numeric attributes.
+    nominal : ndarray of int
+        Positions of the nominal attributes.
+    labels : tuple of tuple of str
+        The declared labels of each nominal attribute, in the order of ``nominal``.
+    """
+
+    numeric: np.ndarray
+    nominal: np.ndarray
+    labels: tuple[tuple[str, ...], ...]
+
+    @property
+    def n_columns(self) -> int:
+        return len(self.numeric) + len(self.nominal)
+
+
+def plain_plan(attributes: Sequence[Attribute]) -> PlainPlan | None:
+    """The plan for ``attributes``; ``None`` when some are strings or dates, or some label
+    could not be a plain field (empty, ``?``, or holding a separator, quote, brace or ``%``)."""
+    if any(attribute.kind not in ("numeric", "nominal") for attribute in attributes):
+        return None
+    labels = [label for attribute in attributes for label in attribute.values]
+    if any(label == "?" or _NOT_PLAIN.search(label) for label in labels):
+        return None
+    kinds = [attribute.kind for attribute in attributes]
+    nominal = [j for j, kind in enumerate(kinds) if kind == "nominal"]
+    return PlainPlan(
+        numeric=np.array([j for j, kind in enumerate(kinds) if kind == "numeric"], dtype=np.intp),
+        nominal=np.array(nominal, dtype=np.intp),
+        labels=tuple(attributes[j].values for j in nominal),
+    )
+
+
+def read_plain_block(
+    block: bytes, plan: PlainPlan, *, encoding: str
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """The rows of a block of whole lines, if the block is plain.
+
+    Parameters
+    ----------
+    block : bytes
+        Whole lines of the data section, with their line breaks.
+    plan : PlainPlan
+        The attributes.
+    encoding : str
+        The file's encoding (``utf-8`` or ``latin-1``).
+
+    Returns
+    -------
+    values : ndarray of shape (n_rows, n_attributes)
+        As the exact reader decodes them.
+    rows : ndarray of shape (n_rows,)
+        The 0-based index, among the block's lines, of the line of each row.
+
+    Or ``None`` when the block is not plain (see the module docstring).
+    """
+    rows = _plain_rows(block, plan.n_columns)
+    if rows is None:
+        return None
+    if rows.size == 0:
+        return np.empty((0, plan.n_columns)), rows
+    frame = _parse(block, plan, encoding)
+    if frame is None or len(frame) != rows.size:
+        return None
+    values = np.empty((rows.size, plan.n_columns))
+    if plan.numeric.size:
+        values[:, plan.numeric] = frame.iloc[:, plan.numeric].to_numpy(dtype=np.float64)
+    for position, labels in zip(plan.nominal.tolist(), plan.labels, strict=True):
+        codes = _label_codes(frame.iloc[:, position], labels)
+        if codes is None:
+            return None
+        values[:, position] = codes
+    return values, rows
+
+
+def _plain_rows(block: bytes, n_columns: int) -> np.ndarray | None:
+    """The indices of the non-blank lines of a plain block, ``None`` if it is not plain.
+
+    What is checked here is what pandas would read differently from WEKA's tokenizer
+    without saying so; the rest (a line with too many fields, a field that is neither a
+    number nor a label) makes pandas fail or :func:`read_plain_block` refuse the values.
+    """
+    if any(byte in block for byte in _FORBIDDEN):
+        return None
+    data = np.frombuffer(block, dtype=np.uint8)
+    commas = data == _COMMA
+    if np.any(commas[1:] & commas[:-1]):
+        return None  # an empty field
+    breaks = np.flatnonzero(data == _LF)
+    crlf = b"\r" in block
+    carriage_returns = int(np.count_nonzero(data == _CR)) if crlf else 0
+    if np.count_nonzero(data < 0x21) != breaks.size + carriage_returns:
+        return None  # whitespace or control characters other than line breaks
+    if crlf and (carriage_returns != breaks.size or np.any(data[breaks - 1] != _CR)):
+        return None  # "\r" other than in "\r\n" line ends
+    ends = breaks - 1 if crlf else breaks  # where each line's break starts
+    if block[-1] != _LF:
+        ends = np.append(ends, len(block))  # a last line without a line break
+    starts = np.concatenate(([0], breaks + 1))[: ends.size]
+    non_blank = np.flatnonzero(ends > starts)
+    if non_blank.size == 0:
+        return non_blank
+    if np.any(data[ends[non_blank] - 1] == _COMMA) or np.any(data[starts[non_blank]] == _COMMA):
+        return None  # a comma at the start or end of a line
+    # Every line has as many fields as attributes: pandas refuses lines with more fields
+    # than the first, so the total settles it once the first line is right (a quoted
+    # comma would show in a field that is neither a number nor a label).
+    first = non_blank[0]
+    if block.count(b",", starts[first], ends[first]) != n_columns - 1:
+        return None
+    if np.count_nonzero(commas) != non_blank.size * (n_columns - 1):
+        return None
+    if b"'" in block and not _quotes_enclose_fields(data, np.flatnonzero(data == _QUOTE), breaks):
+        return None
+    return non_blank
+
+
+def _quotes_enclose_fields(data: np.ndarray, quotes: np.ndarray, breaks: np.ndarray) -> bool:
+    """Whether the quotes pair up on each line, each pair enclosing one whole field that is
+    neither empty nor ``?``."""
+    if quotes.size % 2:
+        return False
+    opening, closing = quotes[0::2], quotes[1::2]
+    inside = closing - opening - 1
+    if np.any(inside == 0) or np.any((inside == 1) & (data[opening + 1] == ord("?"))):
+        return False
+    before = data[np.maximum(opening - 1, 0)]
+    if np.any((opening > 0) & (before != _COMMA) & (before != _LF)):
+        return False
+    after = data[np.minimum(closing + 1, data.size - 1)]
+    if np.any((closing + 1 < data.size) & (after != _COMMA) & (after != _LF) & (after != _CR)):
+        return False
+    return bool(np.all(np.searchsorted(breaks, opening) == np.searchsorted(breaks, closing)))
+
+
+def _parse(block: bytes, plan: PlainPlan, encoding: str) -> Any | None:
+    """The block as a pandas DataFrame, ``None`` if pandas cannot read it as planned."""
+    import pandas as pd
+
+    dtypes: dict[int, Any] = {int(j): np.float64 for j in plan.numeric}
+    dtypes.update({int(j): object for j in plan.nominal})
+    try:
+        return pd.read_csv(
+            io.BytesIO(block),
+            header=None,
+            names=list(range(plan.n_columns)),
+            dtype=dtypes,
+            quotechar="'",
+            doublequote=False,
+            na_values=["?"],
+            keep_default_na=False,
+            skip_blank_lines=True,
+            encoding=encoding,
+            engine="c",
+            low_memory=False,
+        )
+    except (ValueError, UnicodeDecodeError, pd.errors.ParserError):
+        return None
+
+
+def _label_codes(column: Any, labels: tuple[str, ...]) -> np.ndarray | None:
+    """Codes of a column of nominal texts (NaN where missing); ``None`` on an unknown label."""
+    import pandas as pd
+
+    codes = pd.Index(labels).get_indexer(column).astype(np.float64)
+    unknown = codes < 0
+    if unknown.any():
+        missing = column.isna().to_numpy()
+        if np.any(unknown & ~missing):
+            return None
+        codes[unknown] = np.nan
+    return codes
