@@ -55,12 +55,12 @@ def record_take(
     after ``seconds`` of audio, or at Ctrl-C (then ``interrupted`` is true).
     """
     labels = dict(labels or {})
-    folder.mkdir(parents=True, exist_ok=True)
     labels_path = folder / LABELS
     header = _check_header(labels_path, list(labels)) if labels else []
+    source = SoundDeviceSource(device, samplerate=samplerate, channels=channels, seconds=seconds)
+    folder.mkdir(parents=True, exist_ok=True)  # only once the device is known to work
     path = _next_take(folder)
     part = path.with_name(path.name + ".part")
-    source = SoundDeviceSource(device, samplerate=samplerate, channels=channels, seconds=seconds)
     detector = open_event_stream("snr", source.n_channels, samplerate=source.samplerate)
     rate = source.samplerate
     count, touches, interrupted = 0, 0, False
