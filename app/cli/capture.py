@@ -46,21 +46,31 @@ def devices_command(as_json: JsonOption = False) -> None:
 
 
 def record_command(
-    device: Annotated[str, typer.Option("--device", "-d", help="Device index or name.")],
-    out: Annotated[Path, typer.Option("--out", "-o", help="Session folder (created).")],
+    device: Annotated[
+        str, typer.Option("--device", "-d", metavar="DEV", help="Device index or name.")
+    ],
+    out: Annotated[
+        Path, typer.Option("--out", "-o", metavar="DIR", help="Session folder (created).")
+    ],
     channels: Annotated[
-        int | None, typer.Option("--channels", min=1, help="Channels (default: all).")
+        int | None,
+        typer.Option("--channels", min=1, metavar="N", help="Channels (default: all)."),
     ] = None,
     samplerate: Annotated[
-        float | None, typer.Option("--samplerate", help="Hz (default: the device's).")
+        float | None,
+        typer.Option("--samplerate", metavar="HZ", help="Hz (default: the device's)."),
     ] = None,
     seconds: Annotated[
         float | None,
-        typer.Option("--seconds", min=0.01, help="Length of the take (default: until Ctrl-C)."),
+        typer.Option(
+            "--seconds", min=0.01, metavar="S", help="Length of the take (default: until Ctrl-C)."
+        ),
     ] = None,
     label: Annotated[
         list[str] | None,
-        typer.Option("--label", "-l", help="TARGET=VALUE of every touch of the take."),
+        typer.Option(
+            "--label", "-l", metavar="TARGET=VALUE", help="A label of every touch of the take."
+        ),
     ] = None,
 ) -> None:
     """Record a labelled take into a session folder: OUT/take-NNN.wav plus a row of
@@ -108,11 +118,18 @@ class Sensor(StrEnum):
 
 def simulate_command(
     sensor: Annotated[Sensor, typer.Argument(help="contact-mic or oscillating-link.")],
-    out: Annotated[Path, typer.Option("--out", "-o", help="Folder for recordings + labels.")],
+    out: Annotated[
+        Path, typer.Option("--out", "-o", metavar="DIR", help="Folder for recordings + labels.")
+    ],
     trials: Annotated[
-        int, typer.Option("--trials", min=1, help="Sessions (contact-mic) or trials (link).")
+        int,
+        typer.Option(
+            "--trials", min=1, metavar="N", help="Sessions (contact-mic) or trials (link)."
+        ),
     ] = 12,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of every random draw.")] = 0,
+    seed: Annotated[
+        int, typer.Option("--seed", metavar="S", help="Seed of every random draw.")
+    ] = 0,
     as_json: JsonOption = False,
 ) -> None:
     """Write simulated recordings and their labels CSV.
@@ -137,27 +154,35 @@ def simulate_command(
 
 def live_command(
     ctx: typer.Context,
-    model: Annotated[str, typer.Option("--model", "-m", help="Model name or id.")],
+    model: Annotated[str, typer.Option("--model", "-m", metavar="MODEL", help="Model name or id.")],
     device: Annotated[
-        str | None, typer.Option("--device", "-d", help="Capture device index or name.")
+        str | None,
+        typer.Option("--device", "-d", metavar="DEV", help="Capture device index or name."),
     ] = None,
     replay: Annotated[
-        Path | None, typer.Option("--replay", help="A recording to replay instead.")
+        Path | None, typer.Option("--replay", metavar="FILE", help="A recording to replay instead.")
     ] = None,
     realtime: Annotated[
         bool, typer.Option("--realtime/--fast", help="Pace a replay in real time.")
     ] = False,
     seconds: Annotated[
-        float | None, typer.Option("--seconds", min=0.01, help="Stop after this much audio.")
+        float | None,
+        typer.Option("--seconds", min=0.01, metavar="S", help="Stop after this much audio."),
     ] = None,
-    topic: Annotated[str | None, typer.Option("--topic", help="Audio topic of a bag.")] = None,
+    topic: Annotated[
+        str | None, typer.Option("--topic", metavar="TOPIC", help="Audio topic of a bag.")
+    ] = None,
     channels: Annotated[
         int | None,
-        typer.Option("--channels", min=1, help="Device channels (default: the model's)."),
+        typer.Option(
+            "--channels", min=1, metavar="N", help="Device channels (default: the model's)."
+        ),
     ] = None,
     samplerate: Annotated[
         float | None,
-        typer.Option("--samplerate", help="Device rate in Hz (default: the model's)."),
+        typer.Option(
+            "--samplerate", metavar="HZ", help="Device rate in Hz (default: the model's)."
+        ),
     ] = None,
     as_json: Annotated[
         bool, typer.Option("--json", help="One JSON object per touch on stdout (JSON lines).")

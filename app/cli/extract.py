@@ -52,19 +52,23 @@ def extract_command(
         typer.Option("--segment", help="With --events none: cut files into segments of SECONDS."),
     ] = None,
     topic: Annotated[
-        str | None, typer.Option("--topic", help="Audio topic of ROS bags (if several).")
+        str | None,
+        typer.Option("--topic", metavar="TOPIC", help="Audio topic of ROS bags (if several)."),
     ] = None,
     option: Annotated[
         list[str] | None,
         typer.Option(
             "--option",
             "-O",
+            metavar="KEY=VALUE",
             help="KEY=VALUE option of the extractor or the event detector, e.g. threshold=12.",
         ),
     ] = None,
     max_event: Annotated[
         float | None,
-        typer.Option("--max-event", min=0.001, help="Longest event in seconds (default 60)."),
+        typer.Option(
+            "--max-event", min=0.001, metavar="S", help="Longest event in seconds (default 60)."
+        ),
     ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")] = False,
 ) -> None:
