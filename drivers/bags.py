@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from drivers.errors import DriverError
+from drivers.pcm import SAMPLE_FORMATS, decode_pcm
 from drivers.source import Block, Source
 
 #: ``.msg`` definitions of the audio_common_msgs types touchbench reads.
@@ -33,12 +34,6 @@ AUDIO_MSGS: dict[str, str] = {
         "uint8 channels\nuint32 sample_rate\nstring sample_format\nuint32 bitrate\n"
         "string coding_format\n"
     ),
-}
-#: sample_format -> (numpy dtype, full scale)
-SAMPLE_FORMATS: dict[str, tuple[str, float]] = {
-    "S16LE": ("<i2", 32768.0),
-    "S32LE": ("<i4", 2147483648.0),
-    "F32LE": ("<f4", 1.0),
 }
 _INFO_FIELDS = {
     "channels": "uint8",
@@ -180,8 +175,6 @@ class RosbagSource(Source):
         self.start_time = (first[1] - self._reader.start_time) / 1e9
 
     def blocks(self) -> Iterator[Block]:
-        dtype, scale = SAMPLE_FORMATS[self.sample_format]
-        width = np.dtype(dtype).itemsize * self.n_channels
         stamped = self._kind(self._connection.msgtype) == "stamped"
         position = 0
         try:
@@ -190,14 +183,14 @@ class RosbagSource(Source):
             ):
                 message: Any = self._reader.deserialize(raw, self._connection.msgtype)
                 data = np.asarray((message.audio if stamped else message).data, dtype=np.uint8)
-                if data.size % width:
-                    raise DriverError(
-                        f"{self.name}: message {number} on '{self._connection.topic}' holds "
-                        f"{data.size} bytes, not whole {self.sample_format} frames of "
-                        f"{self.n_channels} channels"
+                try:
+                    samples = decode_pcm(
+                        data, channels=self.n_channels, sample_format=self.sample_format
                     )
-                frames = data.view(dtype).reshape(-1, self.n_channels)
-                samples = np.ascontiguousarray(frames.T, dtype=np.float64) / scale
+                except DriverError as error:
+                    raise DriverError(
+                        f"{self.name}: message {number} on '{self._connection.topic}': {error}"
+                    ) from None
                 yield Block(samples, self.start_time + position / self.samplerate)
                 position += samples.shape[1]
         except DriverError:

@@ -6,7 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from drivers.bags import SAMPLE_FORMATS, audio_typestore
+from drivers.bags import audio_typestore
+from drivers.pcm import SAMPLE_FORMATS
 
 #: A same-named AudioData of another package (the ROS 2 'audio_common' of mgonzs13).
 OTHER_AUDIO_DATA = (
