@@ -55,10 +55,10 @@ def read_recording(path: str | Path, *, samplerate: float | None = None) -> Reco
     if path.is_dir():
         raise DriverError(f"{path}: is a folder, not a recording")
     if samplerate is not None:
-        samplerate = _check_rate(samplerate, path, "the given samplerate")
+        samplerate = check_rate(samplerate, path, "the given samplerate")
     suffix = path.suffix.lower()
     if suffix == ".npy":
-        samples, rate = _read_npy(path), samplerate
+        samples, rate = np.asarray(open_npy(path), dtype=np.float64), samplerate
     elif suffix in _CSV_SUFFIXES:
         samples, rate = _read_csv(path, samplerate)
     else:
@@ -70,7 +70,7 @@ def read_recording(path: str | Path, *, samplerate: float | None = None) -> Reco
     return _finish(samples, rate, path)
 
 
-def _check_rate(rate: float, path: Path, what: str) -> float:
+def check_rate(rate: float, path: Path, what: str) -> float:
     try:
         value = float(rate)
     except (TypeError, ValueError):
@@ -98,7 +98,7 @@ def _read_audio(path: Path, samplerate: float | None) -> tuple[np.ndarray, float
         data, rate = soundfile.read(str(path), dtype="float64", always_2d=True)
     except (soundfile.LibsndfileError, RuntimeError, TypeError) as error:
         raise DriverError(f"{path}: cannot read as audio: {error}") from None
-    rate = _check_rate(rate, path, "the file's sample rate")
+    rate = check_rate(rate, path, "the file's sample rate")
     if samplerate is not None and abs(samplerate - rate) > 1e-6:
         raise DriverError(
             f"{path}: the file is sampled at {rate:g} Hz, but samplerate={samplerate:g} was given"
@@ -106,9 +106,10 @@ def _read_audio(path: Path, samplerate: float | None) -> tuple[np.ndarray, float
     return data.T, rate
 
 
-def _read_npy(path: Path) -> np.ndarray:
+def open_npy(path: Path) -> np.ndarray:
+    """A ``.npy`` recording memory-mapped, shape (n_channels, n_samples), values as stored."""
     try:
-        data = np.load(path, allow_pickle=False)
+        data = np.load(path, mmap_mode="r", allow_pickle=False)
     except (OSError, ValueError) as error:
         raise DriverError(f"{path}: cannot read as a .npy array: {error}") from None
     if data.dtype.kind not in "biuf":
@@ -119,7 +120,7 @@ def _read_npy(path: Path) -> np.ndarray:
         raise DriverError(
             f"{path}: must be 1-D (samples) or 2-D (channels, samples), got shape {data.shape}"
         )
-    return data.astype(np.float64)
+    return data
 
 
 def _read_csv(path: Path, samplerate: float | None) -> tuple[np.ndarray, float | None]:

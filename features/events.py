@@ -11,7 +11,9 @@ Three kinds, each a function from samples ``(n_channels, n_samples)`` to a
 ``dbscan``
     Samples of the high-pass-filtered signal (first-order Butterworth, causal, so that
     onsets are not smeared backwards) beyond ``threshold`` robust standard deviations
-    (``median |x| / 0.6745``), pooled over channels, are clustered in time by
+    (``median |x| / 0.6745`` over the first ``initial`` seconds, so that a live stream
+    finds the same events as the whole recording), pooled over channels, are clustered
+    in time by
     DBSCAN (``eps`` seconds, ``min_samples`` samples); each cluster is one event with one
     contact, isolated detections are dropped as jitter.
 ``none``
@@ -70,11 +72,17 @@ class Event:
 
 @dataclass(frozen=True)
 class Detection:
-    """The events of one recording, the SNR track when the detector made one, warnings."""
+    """The events of one recording, the SNR track when the detector made one, warnings.
+
+    ``origin`` is the recording's sample at index 0 of the samples the events refer to
+    (non-zero when a stream hands an extractor one event's stretch of samples); it only
+    places the times of messages.
+    """
 
     events: tuple[Event, ...]
     snr: SnrTrack | None = None
     warnings: tuple[str, ...] = ()
+    origin: int = 0
 
 
 def detect_snr(
@@ -159,6 +167,7 @@ def detect_dbscan(
     threshold: float = 5.0,
     eps: float = 0.1,
     min_samples: int = 3,
+    initial: float = 1.0,
 ) -> Detection:
     """Events as DBSCAN clusters of supra-threshold sample times.
 
@@ -176,6 +185,9 @@ def detect_dbscan(
         DBSCAN neighbourhood in seconds.
     min_samples : int
         Supra-threshold samples within ``eps`` that make a core point.
+    initial : float
+        Seconds at the start whose filtered samples give each channel's robust
+        standard deviation (causal, so that a live stream detects the same events).
 
     Returns
     -------
@@ -184,22 +196,38 @@ def detect_dbscan(
     """
     samplerate = as_samplerate(samplerate)
     y = np.atleast_2d(as_signal(y))
+    sos = dbscan_filter(samplerate, cutoff)
+    # Start in the steady state of the first sample, so that an offset is no event.
+    state = sosfilt_zi(sos)[:, np.newaxis, :] * y[np.newaxis, :, :1]
+    filtered, _ = sosfilt(sos, y, axis=-1, zi=state)
+    head = filtered[:, : max(1, round(initial * samplerate))]
+    scale = np.median(np.abs(head), axis=-1, keepdims=True) / 0.6745
+    above = np.abs(filtered) > threshold * np.maximum(scale, np.finfo(float).tiny)
+    channel, start, stop = runs(above)
+    return Detection(
+        events=tuple(
+            dbscan_events(channel, start, stop, radius=eps * samplerate, min_samples=min_samples)
+        )
+    )
+
+
+def dbscan_filter(samplerate: float, cutoff: float) -> np.ndarray:
+    """The first-order Butterworth high-pass of the ``dbscan`` detector, as SOS."""
     if not 0 < cutoff < samplerate / 2:
         raise FeatureError(
             f"dbscan cutoff must be between 0 and the Nyquist frequency "
             f"{samplerate / 2:g} Hz, got {cutoff:g}"
         )
-    sos = butter(1, cutoff, btype="highpass", fs=samplerate, output="sos")
-    # Start in the steady state of the first sample, so that an offset is no event.
-    initial = sosfilt_zi(sos)[:, np.newaxis, :] * y[np.newaxis, :, :1]
-    filtered, _ = sosfilt(sos, y, axis=-1, zi=initial)
-    scale = np.median(np.abs(filtered), axis=-1, keepdims=True) / 0.6745
-    above = np.abs(filtered) > threshold * np.maximum(scale, np.finfo(float).tiny)
-    channel, start, stop = _runs(above)
+    return np.asarray(butter(1, cutoff, btype="highpass", fs=samplerate, output="sos"))
+
+
+def dbscan_events(
+    channel: np.ndarray, start: np.ndarray, stop: np.ndarray, *, radius: float, min_samples: int
+) -> list[Event]:
+    """DBSCAN over runs of supra-threshold samples: one event per cluster, in time order."""
     if start.size == 0:
-        return Detection(events=())
-    radius = eps * samplerate
-    times, weights, owner = _run_points(start, stop, stride=max(1, int(radius // 2)))
+        return []
+    times, weights, owner = run_points(start, stop, stride=max(1, int(radius // 2)))
     labels = DBSCAN(eps=radius, min_samples=min_samples).fit_predict(
         times[:, np.newaxis], sample_weight=weights
     )
@@ -216,10 +244,10 @@ def detect_dbscan(
             )
         )
     events.sort(key=lambda event: event.onset)
-    return Detection(events=tuple(events))
+    return events
 
 
-def _run_points(
+def run_points(
     start: np.ndarray, stop: np.ndarray, *, stride: int
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Points standing for runs of samples: (times, weights, run index), one per stride.
@@ -238,7 +266,7 @@ def _run_points(
     return times, weights, owner
 
 
-def _runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Runs of True along the last axis: (channel, start, stop) arrays, stop exclusive."""
     padded = np.zeros((mask.shape[0], mask.shape[1] + 2), dtype=np.int8)
     padded[:, 1:-1] = mask
@@ -323,6 +351,7 @@ EVENT_KINDS: dict[str, EventKind] = {
                 Option("threshold", 5.0, positive_float, "robust standard deviations"),
                 Option("eps", 0.1, positive_float, "DBSCAN neighbourhood in seconds"),
                 Option("min_samples", 3, positive_int, "samples that make a core point"),
+                Option("initial", 1.0, positive_float, "seconds that give the robust scale"),
             ),
             detect=detect_dbscan,
         ),

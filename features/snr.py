@@ -123,15 +123,16 @@ def snr_track(
     y = np.atleast_2d(as_signal(y, min_samples=window_length))
     if y.ndim != 2:
         raise FeatureError(f"y must have shape (n_channels, n_samples), got {y.shape}")
-    if threshold <= 0 or hangover < 0 or not 0 < smoothing <= 1 or noise_min <= 0:
-        raise FeatureError(
-            "threshold and noise_min must be positive, hangover at least 0 and smoothing in "
-            f"(0, 1]; got threshold={threshold}, hangover={hangover}, smoothing={smoothing}, "
-            f"noise_min={noise_min}"
-        )
+    hangover_windows, initial_windows = tracking_windows(
+        samplerate=samplerate,
+        window_length=window_length,
+        threshold=threshold,
+        hangover=hangover,
+        smoothing=smoothing,
+        initial=initial,
+        noise_min=noise_min,
+    )
     level = rms(frame(y, frame_length=window_length, hop_length=window_length))
-    hangover_windows = int(hangover * samplerate / window_length)
-    initial_windows = max(1, int(initial * samplerate / window_length))
     noise = np.empty_like(level)
     touches: list[Touch] = []
     for channel in range(level.shape[0]):
@@ -155,6 +156,27 @@ def snr_track(
         threshold=float(threshold),
         window_length=window_length,
     )
+
+
+def tracking_windows(
+    *,
+    samplerate: float,
+    window_length: int,
+    threshold: float,
+    hangover: float,
+    smoothing: float,
+    initial: float,
+    noise_min: float,
+) -> tuple[int, int]:
+    """Check the tracker's parameters; ``(hangover_windows, initial_windows)``."""
+    if threshold <= 0 or hangover < 0 or not 0 < smoothing <= 1 or noise_min <= 0:
+        raise FeatureError(
+            "threshold and noise_min must be positive, hangover at least 0 and smoothing in "
+            f"(0, 1]; got threshold={threshold}, hangover={hangover}, smoothing={smoothing}, "
+            f"noise_min={noise_min}"
+        )
+    hangover_windows = int(hangover * samplerate / window_length)
+    return hangover_windows, max(1, int(initial * samplerate / window_length))
 
 
 def _track_channel(
@@ -200,10 +222,7 @@ def _quiet_until_onset(
     while start < n_windows:
         stop = min(n_windows, start + chunk)
         levels = level[start:stop]
-        after, _ = lfilter(
-            [smoothing], [1.0, smoothing - 1.0], levels, zi=[(1.0 - smoothing) * floor]
-        )
-        after = np.maximum(after, noise_min)
+        after = follow_floor(levels, floor=floor, smoothing=smoothing, noise_min=noise_min)
         before = np.concatenate([[floor], after[:-1]])
         loud = np.flatnonzero(levels > threshold * before)
         if loud.size:
@@ -215,6 +234,27 @@ def _quiet_until_onset(
         start = stop
         chunk *= 2
     return None, floor
+
+
+def follow_floor(
+    levels: np.ndarray, *, floor: float, smoothing: float, noise_min: float
+) -> np.ndarray:
+    """The noise floor after each quiet window, shape (n_windows,).
+
+    ``floor[n] = max(noise_min, (1 - smoothing) floor[n - 1] + smoothing level[n])``,
+    starting from ``floor``: one ``lfilter`` call, and an exact loop only where the
+    floor would sink below ``noise_min`` (digital silence), so that the result does not
+    depend on how the windows are split into calls.
+    """
+    after, _ = lfilter([smoothing], [1.0, smoothing - 1.0], levels, zi=[(1.0 - smoothing) * floor])
+    if after.size == 0 or after.min() >= noise_min:
+        return np.asarray(after)
+    first = int(np.argmax(after < noise_min))
+    current = float(after[first - 1]) if first else floor
+    for index in range(first, after.size):
+        current = max(noise_min, (1.0 - smoothing) * current + smoothing * float(levels[index]))
+        after[index] = current
+    return np.asarray(after)
 
 
 def _touch_end(level: np.ndarray, onset: int, limit: float, hangover_windows: int) -> int:

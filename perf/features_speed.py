@@ -6,9 +6,10 @@ Run from the repository root::
 
 Everything runs on one core (BLAS/OpenMP threads pinned to 1 before numpy loads).  Part
 1 times each extractor's whole path from samples to instances (event detection
-included) on a synthetic session shaped like its sensor, and prints the real-time
-factor, seconds of signal per second of computing (goal for ``uc3m-audio`` on 3-channel
-44.1 kHz audio: at least 1000).  Part 2 computes the same spectral features on the same
+included) on a synthetic session shaped like its sensor, on one array and streamed
+block by block (what ``extract`` and ``live`` do), and prints the real-time factor,
+seconds of signal per second of computing (goal for ``uc3m-audio`` on 3-channel 44.1 kHz
+audio: at least 1000).  Part 2 computes the same spectral features on the same
 frames with touchbench and with librosa in the same run, checks that they agree, and
 prints librosa's time over ours (above 1: touchbench is faster).  Best of ``repeats``
 runs each.  Not a test: nothing is asserted.
@@ -40,6 +41,7 @@ from features.events import detect_events  # noqa: E402
 from features.extractors import make_extractor  # noqa: E402
 from features.framing import fft_frequencies, frame, power_spectrogram, stft  # noqa: E402
 from features.mel import mel_filter_bank, mel_spectrogram, mfcc  # noqa: E402
+from features.recipe import Recipe  # noqa: E402
 from features.spectral import spectral_centroid, spectral_rolloff  # noqa: E402
 from features.temporal import rms, zero_crossing_rate  # noqa: E402
 
@@ -63,7 +65,7 @@ def best_time(function: Callable[[], Any], repeats: int) -> float:
     return min(times)
 
 
-def extractor_speed(name: str, seconds: float, repeats: int) -> tuple[float, int]:
+def extractor_speed(name: str, seconds: float, repeats: int) -> tuple[float, float, int]:
     n_channels, samplerate, touches_per_minute, segment = SENSORS[name]
     session = simulate_session(
         duration=seconds,
@@ -81,8 +83,20 @@ def extractor_speed(name: str, seconds: float, repeats: int) -> tuple[float, int
         detection = detect_events(kind, y, samplerate=samplerate, segment=segment)
         return extractor.extract(y, samplerate=samplerate, detection=detection).values.shape[0]
 
-    elapsed = best_time(run, repeats)
-    return seconds / elapsed, run()
+    recipe = Recipe.resolve(name, segment=segment)
+
+    def streamed() -> int:
+        stream = recipe.open(samplerate=samplerate, n_channels=n_channels)
+        count = 0
+        for start in range(0, y.shape[1], 65536):
+            count += stream.feed(y[:, start : start + 65536]).values.shape[0]
+        return count + stream.finish().values.shape[0]
+
+    whole, flowing = best_time(run, repeats), best_time(streamed, repeats)
+    count = run()
+    if streamed() != count:
+        raise SystemExit(f"{name}: streaming found another number of instances")
+    return seconds / whole, seconds / flowing, count
 
 
 def spectral_comparison(seconds: float, repeats: int) -> list[tuple[str, float, float]]:
@@ -165,10 +179,13 @@ def main() -> None:
     load = ", ".join(f"{value:.1f}" for value in os.getloadavg())
     print(f"Machine load average (1, 5, 15 min): {load} on {os.cpu_count()} cores")
     print(f"Real-time factor, one core, {arguments.seconds:g} s synthetic sessions")
-    print(f"{'extractor':<12} {'sensor':<22} {'instances':>9} {'x real time':>12}")
+    print("(whole: one array, as before; streamed: 65536-sample blocks through the engine)")
+    header = f"{'extractor':<12} {'sensor':<22} {'instances':>9} {'whole x rt':>11}"
+    print(f"{header} {'streamed x rt':>14}")
     for name, (channels, rate, _, _) in SENSORS.items():
-        factor, count = extractor_speed(name, arguments.seconds, arguments.repeats)
-        print(f"{name:<12} {f'{channels} ch x {rate:g} Hz':<22} {count:>9} {factor:>12.0f}")
+        whole, flowing, count = extractor_speed(name, arguments.seconds, arguments.repeats)
+        sensor = f"{channels} ch x {rate:g} Hz"
+        print(f"{name:<12} {sensor:<22} {count:>9} {whole:>11.0f} {flowing:>14.0f}")
     print()
     print(f"Same features, same frames: touchbench vs librosa {version('librosa')}")
     print(f"{'features':<46} {'ours (ms)':>10} {'librosa (ms)':>13} {'librosa/ours':>13}")

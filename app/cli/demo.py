@@ -48,6 +48,15 @@ def demo_command(
         console.print(
             f"model '{result.model_name}' on the unseen session: {target} accuracy {accuracy:.3f}"
         )
+    if result.live:
+        console.print(f"model '{result.model_name}' live on a fresh take (replayed):")
+    for touch in result.live:
+        said = ", ".join(f"{target} {value}" for target, (value, _) in touch.predictions.items())
+        truth = next(
+            (t for t in result.live_truth if t[0] < touch.end and touch.start < t[1]), None
+        )
+        actual = f"  (true: {truth[2]}, {truth[3]})" if truth else ""
+        console.print(f"  {touch.start:7.2f}-{touch.end:7.2f} s  {said}{actual}")
     info(
         f"everything is in {folder}/ (recordings, labels.csv, holdout.arff, touchbench.db); "
         f"try: touchbench --db sqlite:///{folder}/touchbench.db leaderboard {result.run.id}"

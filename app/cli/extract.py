@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 from typing import Annotated
 
@@ -9,6 +10,7 @@ import typer
 
 from app.cli.output import info, print_json, table
 from app.cli.state import get_state
+from app.errors import AppError
 
 
 def register(app: typer.Typer) -> None:
@@ -49,62 +51,108 @@ def extract_command(
         float | None,
         typer.Option("--segment", help="With --events none: cut files into segments of SECONDS."),
     ] = None,
+    topic: Annotated[
+        str | None,
+        typer.Option("--topic", metavar="TOPIC", help="Audio topic of ROS bags (if several)."),
+    ] = None,
+    option: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--option",
+            "-O",
+            metavar="KEY=VALUE",
+            help="KEY=VALUE option of the extractor or the event detector, e.g. threshold=12.",
+        ),
+    ] = None,
+    max_event: Annotated[
+        float | None,
+        typer.Option(
+            "--max-event", min=0.001, metavar="S", help="Longest event in seconds (default 60)."
+        ),
+    ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")] = False,
 ) -> None:
-    """Detect touch events in recordings, extract features, and store them as a data set."""
-    from app.services.extraction import extract_dataset
-    from app.store.datasets import add_dataset, dataset_digest
+    """Detect touch events in recordings, extract features, and store them as a data set.
 
-    result = extract_dataset(
-        recordings,
-        labels=labels,
-        extractor=extractor,
-        events=events,
-        name=name,
-        samplerate=samplerate,
-        segment=segment,
-    )
-    data = result.dataset
-    dataset_info, created = add_dataset(
-        get_state(ctx).store,
-        data,
-        sha256=dataset_digest(data),
-        name=name,
-        source_name=", ".join(p.name for p in recordings[:3])
-        + (f" (+{len(recordings) - 3})" if len(recordings) > 3 else ""),
-    )
-    summary = {
-        "id": dataset_info.id,
-        "name": dataset_info.name,
-        "n_instances": dataset_info.n_instances,
-        "n_features": dataset_info.n_features,
-        "targets": dataset_info.targets,
-        "events_found": result.n_events,
-        "events_labelled": result.n_labelled,
-        "events_dropped": result.n_dropped,
-        "warnings": result.warnings,
-        "created": created,
-    }
+    Recordings are read block by block (memory follows the longest event, not the
+    recording); ROS bags (.bag, .mcap, .db3) are read for their audio_common audio.
+    """
+    from app.services.extraction import extract_and_store
+
+    with _Reading() as reading:
+        summary = extract_and_store(
+            get_state(ctx).store,
+            recordings,
+            labels=labels,
+            extractor=extractor,
+            events=events,
+            name=name,
+            samplerate=samplerate,
+            segment=segment,
+            options=key_values(option or [], "--option"),
+            topic=topic,
+            max_event=max_event,
+            on_progress=reading.update,
+        )
     if as_json:
-        print_json(summary)
+        print_json(summary.to_json())
         return
-    for warning in result.warnings:
+    for warning in summary.warnings:
         info(f"[yellow]warning:[/yellow] {warning}")
-    if not created:
-        info(f"the same features are already stored as dataset {dataset_info.id}")
+    if not summary.created:
+        info(f"the same features are already stored as dataset {summary.id}")
     table(
         None,
         ["id", "name", "instances", "features", "targets", "events", "labelled", "dropped"],
         [
             (
-                dataset_info.id,
-                dataset_info.name,
-                dataset_info.n_instances,
-                dataset_info.n_features,
-                ", ".join(dataset_info.targets),
-                result.n_events,
-                result.n_labelled,
-                result.n_dropped,
+                summary.id,
+                summary.name,
+                summary.n_instances,
+                summary.n_features,
+                ", ".join(summary.targets),
+                summary.events_found,
+                summary.events_labelled,
+                summary.events_dropped,
             )
         ],
     )
+
+
+def key_values(pairs: list[str], option: str, what: str = "KEY=VALUE") -> dict[str, str]:
+    """``["a=1", "b=2"]`` as ``{"a": "1", "b": "2"}``; AppError naming ``option`` if not."""
+    found: dict[str, str] = {}
+    for pair in pairs:
+        key, sep, value = pair.partition("=")
+        if not sep or not key.strip() or not value.strip():
+            raise AppError(f"{option} must be {what}, got '{pair}'")
+        found[key.strip()] = value.strip()
+    return found
+
+
+class _Reading:
+    """A spinner with the recording being read and its seconds so far (stderr, TTY only)."""
+
+    def __init__(self) -> None:
+        from rich.console import Console
+        from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+
+        self._progress = Progress(
+            SpinnerColumn(),
+            TextColumn("reading {task.fields[file]}: {task.fields[seconds]:.0f} s of audio"),
+            TimeElapsedColumn(),
+            console=Console(stderr=True),
+            transient=True,
+            disable=not sys.stderr.isatty(),
+        )
+        self._task = self._progress.add_task("read", file="", seconds=0.0)
+
+    def __enter__(self) -> _Reading:
+        self._progress.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._progress.stop()
+
+    def update(self, file: str, seconds: float) -> None:
+        self._progress.update(self._task, file=file, seconds=seconds)

@@ -13,6 +13,7 @@ from typing import Annotated
 import typer
 
 from app.cli import bench as bench_commands
+from app.cli import capture as capture_commands
 from app.cli import datasets as datasets_commands
 from app.cli import demo as demo_commands
 from app.cli import extract as extract_commands
@@ -90,6 +91,7 @@ extract_commands.register(app)
 demo_commands.register(app)
 serve_commands.register(app)
 reports_commands.register(app)
+capture_commands.register(app)
 
 
 def main(argv: list[str] | None = None) -> int:

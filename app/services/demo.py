@@ -1,5 +1,6 @@
 """The demo: simulated touch sessions -> event detection and features -> a stored data set
--> cross-validated leaderboard -> a trained model predicting a session it never saw.
+-> cross-validated leaderboard -> a trained model predicting a session it never saw ->
+the same model recognising the touches of a fresh take replayed as a live stream.
 
 Everything is generated (seeded) so that a newcomer sees the whole path work on a fresh
 machine without data of their own.
@@ -12,6 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from app.services.extraction import extract_dataset
+from app.services.live import TouchPrediction, open_live
 from app.services.models import Predictions, load_model, predict, train
 from app.services.runs import RunOptions, default_classifiers, run_leaderboard, start_run
 from app.services.simulation import write_labels, write_session
@@ -20,6 +22,7 @@ from app.store.datasets import DatasetInfo, add_dataset, dataset_digest
 from app.store.runs import RunInfo
 from benchmark.evaluation.leaderboard import Leaderboard
 from benchmark.io.arff import read_arff, write_arff
+from drivers.replay import FileReplaySource
 
 
 @dataclass
@@ -30,6 +33,8 @@ class DemoResult:
     model_name: str
     holdout: Path
     predictions: Predictions
+    live: list[TouchPrediction]
+    live_truth: list[tuple[float, float, str, str]]
 
 
 def run_demo(
@@ -64,6 +69,7 @@ def run_demo(
         sha256=dataset_digest(extraction.dataset),
         name=None,
         source_name="labels.csv",
+        extraction=extraction.recipe,
     )
     say(
         f"   {extraction.n_events} events found, {extraction.n_labelled} labelled -> "
@@ -94,4 +100,15 @@ def run_demo(
     write_arff(holdout, holdout_arff)
     _, trained = load_model(store, model.id)
     predictions = predict(trained, read_arff(holdout_arff), source=str(holdout_arff))
-    return DemoResult(dataset, run, board, model.name, holdout_arff, predictions)
+
+    say("5. replaying a fresh simulated take through `live`: each touch predicted as it ends")
+    take, truth = write_session(folder, "live-take", n_touches=8, seed=2000)
+    live: list[TouchPrediction] = []
+    with FileReplaySource(take, block_length=1024) as source:
+        session = open_live(
+            store, model.id, samplerate=source.samplerate, n_channels=source.n_channels
+        )
+        for block in source.blocks():
+            live += session.feed(block.samples, block.time)
+        live += session.finish()
+    return DemoResult(dataset, run, board, model.name, holdout_arff, predictions, live, list(truth))

@@ -1,7 +1,9 @@
 """Recordings and a labels file to a data set: drivers -> event detection -> extractor.
 
-:func:`extract_dataset` reads every recording, finds its events, turns them into
-instances with the chosen extractor, labels each instance from the labels CSV and
+:func:`extract_dataset` reads every recording block by block through the streaming
+engine (:class:`features.stream.FeatureStream`, so memory follows the longest event, not
+the recording), finds its events, turns them into instances with the chosen extractor,
+labels each instance from the labels CSV and
 returns one :class:`~benchmark.dataset.Dataset` whose targets come first (a MEKA
 ``-C N`` relation), ready for the store.  Every problem is raised before anything is
 returned: :class:`~benchmark.errors.DataFormatError` for the labels file (with its
@@ -13,7 +15,8 @@ Labels CSV (a header row, then one row per interval or per file)::
     file,start,end,gesture,place        file,gesture,place
     s1.wav,0.5,1.9,tap,head             s1.wav,tap,head
 
-``file`` is a recording's file name; ``start``/``end`` are seconds.  An instance takes
+``file`` is a recording's file name; ``start``/``end`` are seconds (for a ROS bag,
+seconds from its first message).  An instance takes
 the targets of the interval of its file it overlaps most (the earlier one on a tie);
 one that overlaps none is dropped and counted.  Without ``start``/``end``, every
 instance of a file takes that file's targets.  An empty cell or ``?`` is a missing
@@ -25,20 +28,22 @@ from __future__ import annotations
 import csv
 import itertools
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from app.schemas.extraction import ExtractionSummary
+from app.store.database import Store
+from app.store.datasets import add_dataset, dataset_digest
 from benchmark.dataset import Attribute, Dataset, Schema
 from benchmark.errors import DataFormatError
-from drivers.files import read_recording
+from drivers.replay import FileReplaySource
 from features.errors import FeatureError
-from features.events import EVENT_KINDS, detect_events
-from features.extractors import EXTRACTORS, Extractor, make_extractor
-from features.options import claim_options
+from features.extractors import Instances
+from features.recipe import Recipe
 
 _MISSING = frozenset({"", "?"})
 
@@ -61,6 +66,9 @@ class ExtractionResult:
         Instances outside every labelled interval, or of a recording without labels.
     warnings : list of str
         What was left out and why, one line each.
+    recipe : dict
+        How the instances were made (:meth:`features.recipe.Recipe.to_json`) with the
+        recordings' ``samplerate`` and ``n_channels``: what a live model repeats.
     """
 
     dataset: Dataset
@@ -68,6 +76,7 @@ class ExtractionResult:
     n_labelled: int
     n_dropped: int
     warnings: list[str] = field(default_factory=list)
+    recipe: dict[str, Any] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -100,13 +109,17 @@ def extract_dataset(
     samplerate: float | None = None,
     segment: float | None = None,
     options: Mapping[str, Any] | None = None,
+    topic: str | None = None,
+    max_event: float | None = None,
+    on_progress: Callable[[str, float], None] | None = None,
 ) -> ExtractionResult:
-    """Turn recordings into a labelled data set.
+    """Turn recordings into a labelled data set, each recording read block by block.
 
     Parameters
     ----------
     recordings : sequence of Path
-        WAV/FLAC/... audio, CSV time series or ``.npy`` files; file names must differ.
+        WAV/FLAC/... audio, CSV time series, ``.npy`` files or ROS bags; file names must
+        differ.
     labels : Path or None
         The labels CSV; ``None`` keeps every instance, without targets.
     extractor : str
@@ -121,6 +134,12 @@ def extract_dataset(
         Segment seconds for events ``none`` (default: the extractor's, else whole files).
     options : mapping, optional
         Options of the extractor and of the event detector, in one flat mapping.
+    topic : str, optional
+        The audio topic of ROS bags.
+    max_event : float, optional
+        Longest event in seconds (default 60); longer ones are cut, with a warning.
+    on_progress : callable, optional
+        Called as ``on_progress(file_name, seconds_read)`` after every block.
 
     Returns
     -------
@@ -128,10 +147,9 @@ def extract_dataset(
     """
     if not recordings:
         raise FeatureError("no recording was given")
-    chosen, detector_options = _configure(extractor, events, options or {})
-    kind = events or chosen.default_events
-    if kind == "none" and segment is None:
-        segment = chosen.default_segment
+    recipe = Recipe.resolve(
+        extractor, events=events, segment=segment, options=options, max_event=max_event
+    )
     paths = [Path(path) for path in recordings]
     by_name = _unique_names(paths)
     table = read_labels(labels) if labels is not None else None
@@ -143,45 +161,27 @@ def extract_dataset(
     spans: list[tuple[str, float, float]] = []
     meta: list[dict[str, Any]] = []
     warnings: list[str] = []
-    n_channels: int | None = None
+    shape: tuple[float, int] | None = None
     for path in paths:
-        recording = read_recording(path, samplerate=samplerate)
-        n_channels = _same_channels(n_channels, recording.n_channels, path)
-        try:
-            chosen.check_input(samplerate=recording.samplerate, n_channels=recording.n_channels)
-            window = chosen.min_samples(recording.samplerate)
-            if recording.n_samples < window:
-                raise FeatureError(
-                    f"lasts {recording.n_samples} samples, shorter than one "
-                    f"'{chosen.name}' window of {window}"
-                )
-            detection = detect_events(
-                kind,
-                recording.samples,
-                samplerate=recording.samplerate,
-                segment=segment,
-                options=detector_options,
-            )
-            instances = chosen.extract(
-                recording.samples, samplerate=recording.samplerate, detection=detection
-            )
-        except FeatureError as error:
-            raise FeatureError(f"{path}: {error}") from None
-        warnings += [f"{path.name}: {text}" for text in (*detection.warnings, *instances.warnings)]
+        with FileReplaySource(path, samplerate=samplerate, topic=topic) as source:
+            shape = _same_shape(shape, (source.samplerate, source.n_channels), path)
+            instances = _extract_one(recipe, source, path, on_progress)
+            origin, rate = source.start_time, source.samplerate
+        warnings += [f"{path.name}: {text}" for text in instances.warnings]
         features.append(instances.values)
         for (first, last), details in zip(instances.spans, instances.meta, strict=True):
-            start, end = first / recording.samplerate, last / recording.samplerate
+            start, end = origin + first / rate, origin + last / rate
             spans.append((path.name, start, end))
             meta.append({"source": path.name, "start": start, "end": end, **details})
 
-    assert n_channels is not None
-    feature_names = chosen.feature_names(n_channels)
+    assert shape is not None
+    feature_names = recipe.make_extractor().feature_names(shape[1])
     matrix = np.concatenate(features) if features else np.zeros((0, len(feature_names)))
     n_events = matrix.shape[0]
     if table is None:
         if n_events == 0:
             raise FeatureError(
-                f"no event was found in {len(paths)} recording(s) with events '{kind}'"
+                f"no event was found in {len(paths)} recording(s) with events '{recipe.events}'"
             )
         keep = np.ones(n_events, dtype=bool)
         target_attributes: list[Attribute] = []
@@ -218,28 +218,86 @@ def extract_dataset(
         n_labelled=int(rows.size),
         n_dropped=n_events - int(rows.size),
         warnings=warnings,
+        recipe={**recipe.to_json(), "samplerate": shape[0], "n_channels": shape[1]},
     )
 
 
-def _configure(
-    extractor: str, events: str | None, options: Mapping[str, Any]
-) -> tuple[Extractor, dict[str, Any]]:
-    """The extractor with its options, and the options left for the detector."""
-    if extractor not in EXTRACTORS:
-        raise FeatureError(f"unknown extractor '{extractor}' (known: {', '.join(EXTRACTORS)})")
-    spec = EXTRACTORS[extractor]
-    kind = events or spec.default_events
-    if kind not in EVENT_KINDS:
-        raise FeatureError(f"unknown event detection '{kind}' (known: {', '.join(EVENT_KINDS)})")
-    mine, rest = claim_options(spec.options, options)
-    detector, unknown = claim_options(EVENT_KINDS[kind].options, rest)
-    if unknown:
-        known = [o.name for o in (*spec.options, *EVENT_KINDS[kind].options)]
-        raise FeatureError(
-            f"unknown option '{sorted(unknown)[0]}' for extractor '{extractor}' with events "
-            f"'{kind}' (options: {', '.join(known) if known else 'none'})"
-        )
-    return make_extractor(extractor, mine), detector
+def extract_and_store(
+    store: Store,
+    recordings: Sequence[Path],
+    *,
+    labels: Path | None,
+    extractor: str,
+    events: str | None = None,
+    name: str | None = None,
+    samplerate: float | None = None,
+    segment: float | None = None,
+    options: Mapping[str, Any] | None = None,
+    topic: str | None = None,
+    max_event: float | None = None,
+    on_progress: Callable[[str, float], None] | None = None,
+) -> ExtractionSummary:
+    """:func:`extract_dataset`, then store the data set with its extraction recipe in one
+    transaction (nothing is stored when anything fails).
+
+    Parameters are those of :func:`extract_dataset`; ``name``, when given, must be free
+    in the store.
+    """
+    result = extract_dataset(
+        recordings,
+        labels=labels,
+        extractor=extractor,
+        events=events,
+        name=name,
+        samplerate=samplerate,
+        segment=segment,
+        options=options,
+        topic=topic,
+        max_event=max_event,
+        on_progress=on_progress,
+    )
+    data = result.dataset
+    shown = ", ".join(Path(p).name for p in recordings[:3])
+    info, created = add_dataset(
+        store,
+        data,
+        sha256=dataset_digest(data),
+        name=name,
+        source_name=shown + (f" (+{len(recordings) - 3})" if len(recordings) > 3 else ""),
+        extraction=result.recipe,
+    )
+    return ExtractionSummary(
+        id=info.id,
+        name=info.name,
+        n_instances=info.n_instances,
+        n_features=info.n_features,
+        targets=info.targets,
+        events_found=result.n_events,
+        events_labelled=result.n_labelled,
+        events_dropped=result.n_dropped,
+        warnings=result.warnings,
+        created=created,
+    )
+
+
+def _extract_one(
+    recipe: Recipe,
+    source: FileReplaySource,
+    path: Path,
+    on_progress: Callable[[str, float], None] | None,
+) -> Instances:
+    """The instances of one recording, read block by block."""
+    try:
+        stream = recipe.open(samplerate=source.samplerate, n_channels=source.n_channels)
+        parts = []
+        for block in source.blocks():
+            parts.append(stream.feed(block.samples))
+            if on_progress is not None:
+                on_progress(path.name, stream.position / source.samplerate)
+        parts.append(stream.finish())
+    except FeatureError as error:
+        raise FeatureError(f"{path}: {error}") from None
+    return Instances.concat(parts, len(stream.feature_names))
 
 
 def _unique_names(paths: Sequence[Path]) -> dict[str, Path]:
@@ -254,11 +312,19 @@ def _unique_names(paths: Sequence[Path]) -> dict[str, Path]:
     return by_name
 
 
-def _same_channels(expected: int | None, found: int, path: Path) -> int:
-    if expected is not None and found != expected:
+def _same_shape(
+    expected: tuple[float, int] | None, found: tuple[float, int], path: Path
+) -> tuple[float, int]:
+    """One sample rate and one channel count for every recording of a data set."""
+    if expected is not None and found[1] != expected[1]:
         raise FeatureError(
-            f"{path}: has {found} channel(s) but the recordings before it have {expected}; "
-            "one data set needs one channel count"
+            f"{path}: has {found[1]} channel(s) but the recordings before it have "
+            f"{expected[1]}; one data set needs one channel count"
+        )
+    if expected is not None and abs(found[0] - expected[0]) > 1e-6:
+        raise FeatureError(
+            f"{path}: is sampled at {found[0]:g} Hz but the recordings before it at "
+            f"{expected[0]:g} Hz; one data set needs one sample rate"
         )
     return found
 
@@ -431,64 +497,3 @@ def _label(
         if file_name not in table.rows
     ]
     return keep, attributes, codes, warnings
-
-
-@dataclass
-class ExtractionSummary:
-    """What ``extract --json`` prints: the stored data set and the event counts."""
-
-    dataset: Any
-    created: bool
-    result: ExtractionResult
-
-    def to_json(self) -> dict[str, Any]:
-        return {
-            "id": self.dataset.id,
-            "name": self.dataset.name,
-            "n_instances": self.dataset.n_instances,
-            "n_features": self.dataset.n_features,
-            "targets": self.dataset.targets,
-            "events_found": self.result.n_events,
-            "events_labelled": self.result.n_labelled,
-            "events_dropped": self.result.n_dropped,
-            "warnings": self.result.warnings,
-            "created": self.created,
-        }
-
-
-def extract_and_store(
-    store: Any,
-    recordings: Sequence[Path],
-    *,
-    labels: Path | None,
-    extractor: str,
-    events: str | None = None,
-    name: str | None = None,
-    samplerate: float | None = None,
-    segment: float | None = None,
-    options: Mapping[str, Any] | None = None,
-    topic: str | None = None,
-) -> ExtractionSummary:
-    """Extract a data set from recordings and store it (deduplicated by content)."""
-    from app.store.datasets import add_dataset, dataset_digest
-
-    result = extract_dataset(
-        recordings,
-        labels=labels,
-        extractor=extractor,
-        events=events,
-        name=name,
-        samplerate=samplerate,
-        segment=segment,
-        options=options,
-    )
-    data = result.dataset
-    info, created = add_dataset(
-        store,
-        data,
-        sha256=dataset_digest(data),
-        name=name,
-        source_name=", ".join(p.name for p in recordings[:3])
-        + (f" (+{len(recordings) - 3})" if len(recordings) > 3 else ""),
-    )
-    return ExtractionSummary(info, created, result)

@@ -1,5 +1,11 @@
-"""Simulated, labelled touch sessions written as WAV files plus a labels CSV: the input of
-the demo and of the extraction tests."""
+"""Simulated, labelled recordings written as WAV files plus a labels CSV: the input of the
+demo, of ``touchbench simulate`` and of the extraction tests.
+
+``contact-mic``: sessions of taps and strokes on three contact microphones (44.1 kHz),
+labelled by interval with gesture and place.  ``oscillating-link``: trials of an
+actively oscillated link with a 3-axis accelerometer (3200 Hz, :mod:`drivers.oscillating`),
+labelled by file with the contact point.
+"""
 
 from __future__ import annotations
 
@@ -9,6 +15,8 @@ from pathlib import Path
 import numpy as np
 import soundfile
 
+from drivers.oscillating import CONTACTS, simulate_link_trial
+from drivers.oscillating import SAMPLERATE as LINK_RATE
 from drivers.simulated import SimulatedTouch, simulate_session
 
 SAMPLERATE = 44100
@@ -66,3 +74,37 @@ def write_labels(path: Path, rows: list[tuple[str, float, float, str, str]]) -> 
         for file, start, end, gesture, place in rows:
             writer.writerow([file, f"{start:.3f}", f"{end:.3f}", gesture, place])
     return path
+
+
+def write_contact_mic_sessions(
+    folder: Path, *, trials: int, seed: int = 0
+) -> tuple[list[Path], Path]:
+    """``trials`` simulated contact-microphone sessions of 16 touches and their labels CSV
+    (``file,start,end,gesture,place``)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    paths, rows = [], []
+    for trial in range(trials):
+        path, touches = write_session(
+            folder, f"session{trial + 1}", n_touches=16, seed=seed + trial
+        )
+        paths.append(path)
+        rows += [(path.name, *touch) for touch in touches]
+    return paths, write_labels(folder / "labels.csv", rows)
+
+
+def write_link_trials(folder: Path, *, trials: int, seed: int = 0) -> tuple[list[Path], Path]:
+    """``trials`` simulated oscillating-link trials (3 s, 3200 Hz, 3 axes), the contact
+    classes in turn, and their labels CSV (``file,contact``: every second of a trial is
+    labelled with its contact)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    paths, lines = [], ["file,contact"]
+    for trial in range(trials):
+        contact = CONTACTS[trial % len(CONTACTS)]
+        link = simulate_link_trial(contact, seed=seed * 100_003 + trial)
+        path = folder / f"trial{trial + 1:03d}.wav"
+        soundfile.write(path, link.recording.samples.T, int(LINK_RATE), subtype="FLOAT")
+        paths.append(path)
+        lines.append(f"{path.name},{contact}")
+    labels = folder / "labels.csv"
+    labels.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return paths, labels

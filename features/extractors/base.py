@@ -44,6 +44,18 @@ class Instances:
             warnings=warnings or [],
         )
 
+    @classmethod
+    def concat(cls, parts: list[Instances], n_features: int) -> Instances:
+        """``parts`` one after the other (an empty result of ``n_features`` if none)."""
+        if not parts:
+            return cls.empty(n_features)
+        return cls(
+            values=np.concatenate([part.values for part in parts]),
+            spans=np.concatenate([part.spans for part in parts]).astype(np.int64),
+            meta=[entry for part in parts for entry in part.meta],
+            warnings=[text for part in parts for text in part.warnings],
+        )
+
 
 class Extractor(ABC):
     """A named recipe from samples and events to instances.
@@ -69,6 +81,9 @@ class Extractor(ABC):
         The lowest sample rate it accepts (Hz).
     min_channels : int
         The fewest channels it needs.
+    track_window : int or None
+        Window length of the SNR track :meth:`extract` reads from the detection (a
+        stream keeps one for it); ``None`` when it needs none.
     """
 
     name: ClassVar[str]
@@ -79,6 +94,7 @@ class Extractor(ABC):
     samplerates: ClassVar[tuple[float, ...] | None] = None
     min_samplerate: ClassVar[float] = 0.0
     min_channels: ClassVar[int] = 1
+    track_window: ClassVar[int | None] = None
 
     def __init__(self, **options: Any) -> None:
         self.params = resolve_options(type(self).options, options, owner=f"extractor '{self.name}'")
@@ -102,6 +118,15 @@ class Extractor(ABC):
                 f"extractor '{self.name}' needs at least {self.min_channels} channels, "
                 f"got {n_channels}"
             )
+
+    def read_span(self, event: Event, samplerate: float) -> tuple[int, int]:
+        """Samples ``[start, stop)`` that :meth:`extract` reads for ``event`` (``start`` may
+        be negative and ``stop`` past the recording: they are clipped)."""
+        return event.onset, event.offset
+
+    def lookback(self, samplerate: float) -> int:
+        """The most samples before an onset that :meth:`read_span` ever starts."""
+        return 0
 
     @abstractmethod
     def min_samples(self, samplerate: float) -> int:
@@ -152,7 +177,8 @@ class Extractor(ABC):
         for event in detection.events:
             segment = y[:, event.onset : event.offset]
             if segment.shape[1] < self.min_samples(samplerate):
-                warnings.append(self._too_short((event.onset, event.offset), samplerate))
+                span = (event.onset + detection.origin, event.offset + detection.origin)
+                warnings.append(self._too_short(span, samplerate))
                 continue
             segments.append((event, segment))
         return segments, warnings

@@ -29,7 +29,7 @@ class Mfcc(Extractor):
     name: ClassVar[str] = "mfcc"
     description: ClassVar[str] = "14 MFCCs (40 mel filters, 30 ms / 10 ms): mean and std"
     default_events: ClassVar[str] = "none"
-    min_samplerate: ClassVar[float] = 4000.0
+    min_samplerate: ClassVar[float] = 2000.0
     options: ClassVar[tuple[Option, ...]] = (
         Option("n_mfcc", 14, positive_int, "coefficients"),
         Option("n_mels", 40, positive_int, "mel filters"),

@@ -34,7 +34,9 @@ semantics follow what the published values show:
   hangover inside the event, a whole number of windows (with the 500 ms hangover the
   shortest touch lasts 87 windows = 505.03 ms, the data's minimum for the Mini robot).
 
-A channel without an active window in the event gives 33 zeros.
+A channel without an active window in the event gives 33 zeros; an event in which no
+channel has one (clipped full-scale noise, whose floor is as loud as any touch) gives
+all zeros, with a warning.
 """
 
 from __future__ import annotations
@@ -94,12 +96,22 @@ class Uc3mAudio(Extractor):
     )
     default_events: ClassVar[str] = "snr"
     samplerates: ClassVar[tuple[float, ...] | None] = (SAMPLERATE,)
+    track_window: ClassVar[int | None] = WINDOW_LENGTH
     options: ClassVar[tuple[Option, ...]] = (
         Option("wavelet_pitch", False, flag, "fill pitchWavelet (0 in the published data)"),
     )
 
     def min_samples(self, samplerate: float) -> int:
         return WINDOW_LENGTH
+
+    def read_span(self, event: Event, samplerate: float) -> tuple[int, int]:
+        """Whole windows from the one before the onset's (the flux looks back one window)
+        to the one holding the last sample."""
+        first = event.onset // WINDOW_LENGTH
+        return (first - 1) * WINDOW_LENGTH, math.ceil(event.offset / WINDOW_LENGTH) * WINDOW_LENGTH
+
+    def lookback(self, samplerate: float) -> int:
+        return 2 * WINDOW_LENGTH
 
     def feature_names(self, n_channels: int) -> list[str]:
         return uc3m_feature_names(n_channels)
@@ -112,7 +124,11 @@ class Uc3mAudio(Extractor):
         if y.shape[0] != n_channels:
             raise FeatureError(f"the SNR track has {n_channels} channels, y has {y.shape[0]}")
         selection = _ActiveWindows.of(detection, track)
-        warnings = [self._too_short(span, samplerate) for span in selection.too_short]
+        origin = detection.origin
+        warnings = [
+            self._too_short((start + origin, end + origin), samplerate)
+            for start, end in selection.too_short
+        ]
         if not selection.events:
             return Instances.empty(len(CHANNEL_FEATURES) * n_channels, warnings)
         windows = y[:, : n_windows * WINDOW_LENGTH].reshape(n_channels, n_windows, WINDOW_LENGTH)
@@ -120,6 +136,15 @@ class Uc3mAudio(Extractor):
         stats = segment_statistics(per_window, lengths=selection.lengths)
         columns = _assemble(stats, selection.duration_windows)
         values = columns.reshape(len(selection.events), n_channels * len(CHANNEL_FEATURES))
+        silent = selection.lengths.reshape(len(selection.events), n_channels).sum(axis=1) == 0
+        warnings += [
+            f"event at {(event.onset + origin) / samplerate:.3f}-"
+            f"{(event.offset + origin) / samplerate:.3f} s has no window above the SNR "
+            f"threshold on any channel: its {values.shape[1]} features are all 0 (is the "
+            "signal clipped, or the noise floor as loud as the touch?)"
+            for event, quiet in zip(selection.events, silent, strict=True)
+            if quiet
+        ]
         spans = np.array(
             [(event.onset, min(event.offset, y.shape[1])) for event in selection.events],
             dtype=np.int64,

@@ -14,7 +14,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from features.events import Detection
+from features.events import Detection, Event
 from features.extractors.base import Extractor, Instances, channel_suffixed
 from features.options import Option, positive_int
 
@@ -33,6 +33,13 @@ class Window(Extractor):
     def min_samples(self, samplerate: float) -> int:
         return int(self.params["length"])
 
+    def read_span(self, event: Event, samplerate: float) -> tuple[int, int]:
+        onset = event.onset
+        return onset - self.params["baseline"], max(event.offset, onset + self.params["length"])
+
+    def lookback(self, samplerate: float) -> int:
+        return int(self.params["baseline"])
+
     def feature_names(self, n_channels: int) -> list[str]:
         return channel_suffixed([f"t{i}" for i in range(self.params["length"])], n_channels)
 
@@ -42,8 +49,8 @@ class Window(Extractor):
         onsets = np.array([event.onset for event in detection.events], dtype=np.int64)
         fits = onsets + length <= n_samples
         warnings = [
-            f"event at {onset / samplerate:.3f} s leaves fewer than {length} samples before "
-            "the end of the recording and was left out"
+            f"event at {(onset + detection.origin) / samplerate:.3f} s leaves fewer than "
+            f"{length} samples before the end of the recording and was left out"
             for onset in onsets[~fits]
         ]
         onsets = onsets[fits]
@@ -63,11 +70,11 @@ class Window(Extractor):
 
 def _baselines(y: np.ndarray, onsets: np.ndarray, baseline: int) -> np.ndarray:
     """Mean of up to ``baseline`` samples before each onset, shape (n_channels, n_onsets)."""
-    cumulative = np.concatenate([np.zeros((y.shape[0], 1)), np.cumsum(y, axis=1)], axis=1)
-    starts = np.maximum(onsets - baseline, 0)
-    counts = onsets - starts
-    sums = cumulative[:, onsets] - cumulative[:, starts]
+    before = onsets[:, np.newaxis] - baseline + np.arange(baseline)
+    there = before >= 0
+    values = np.where(there, y[:, np.maximum(before, 0)], 0.0)
+    counts = there.sum(axis=1)
+    means = values.sum(axis=-1) / np.maximum(counts, 1)
     at_start = counts == 0
-    means = sums / np.maximum(counts, 1)
     means[:, at_start] = y[:, onsets[at_start]]
     return means

@@ -50,10 +50,11 @@ def test_bad_touches_and_sessions_are_rejected() -> None:
 
 def test_recording_source_replays_blocks_that_cover_the_recording() -> None:
     recording = simulate_session(duration=1.0, samplerate=1000.0, n_touches=0).recording
-    source = RecordingSource(recording)
-    blocks = list(source.blocks(300))
-    assert [block.shape for block in blocks] == [(3, 300)] * 3 + [(3, 100)]
-    assert np.array_equal(np.concatenate(blocks, axis=1), recording.samples)
+    with RecordingSource(recording, block_length=300) as source:
+        blocks = list(source.blocks())
+    assert [block.samples.shape for block in blocks] == [(3, 300)] * 3 + [(3, 100)]
+    assert [block.time for block in blocks] == [0.0, 0.3, 0.6, 0.9]
+    assert np.array_equal(np.concatenate([b.samples for b in blocks], axis=1), recording.samples)
     assert source.samplerate == 1000.0 and source.n_channels == 3
     with pytest.raises(DriverError, match="block_length"):
-        next(source.blocks(0))
+        RecordingSource(recording, block_length=0)

@@ -1,0 +1,133 @@
+"""Recording labelled takes from a sound card into a session folder.
+
+A session folder holds one WAV file per take (``take-001.wav``, ...) and ``labels.csv``
+(``file,TARGET...``: every touch of a take has the take's labels), which is what
+``touchbench extract`` reads.  A take is written to ``take-NNN.wav.part`` and renamed
+when it ends, and the labels file is replaced whole, so a Ctrl-C keeps the audio so far
+and a kill at any moment leaves the labels file valid (at worst a ``.part`` file).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import os
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+import soundfile
+
+from app.errors import AppError
+from drivers.errors import DriverError
+from drivers.sound import SoundDeviceSource
+from features.event_streams import open_event_stream
+
+LABELS = "labels.csv"
+
+
+@dataclass(frozen=True)
+class Take:
+    """A recorded take: its file, the labels file, its length, what happened."""
+
+    path: Path
+    labels: Path
+    seconds: float
+    touches: int
+    overflows: int
+    interrupted: bool
+
+
+def record_take(
+    folder: Path,
+    *,
+    device: str | int,
+    samplerate: float | None = None,
+    channels: int | None = None,
+    seconds: float | None = None,
+    labels: Mapping[str, str] | None = None,
+    on_touch: Callable[[float, float, tuple[int, ...]], None] | None = None,
+) -> Take:
+    """Record one take from ``device`` into ``folder`` and label it.
+
+    Touches are detected as the audio arrives (the ``snr`` detector of the streaming
+    engine) and reported through ``on_touch(start, end, channels)``.  Recording stops
+    after ``seconds`` of audio, or at Ctrl-C (then ``interrupted`` is true).
+    """
+    labels = dict(labels or {})
+    labels_path = folder / LABELS
+    header = _check_header(labels_path, list(labels)) if labels else []
+    source = SoundDeviceSource(device, samplerate=samplerate, channels=channels, seconds=seconds)
+    folder.mkdir(parents=True, exist_ok=True)  # only once the device is known to work
+    path = _next_take(folder)
+    part = path.with_name(path.name + ".part")
+    detector = open_event_stream("snr", source.n_channels, samplerate=source.samplerate)
+    rate = source.samplerate
+    count, touches, interrupted = 0, 0, False
+
+    def report(events: list) -> int:
+        for event in events:
+            if on_touch is not None:
+                on_touch(event.onset / rate, event.offset / rate, event.channels)
+        return len(events)
+
+    with (
+        source,
+        soundfile.SoundFile(
+            part,
+            "w",
+            samplerate=round(rate),
+            channels=source.n_channels,
+            subtype="FLOAT",
+            format="WAV",
+        ) as wav,
+    ):
+        try:
+            for block in source.blocks():
+                wav.write(block.samples.T)
+                count += block.samples.shape[1]
+                touches += report(detector.feed(block.samples))
+        except KeyboardInterrupt:
+            interrupted = True
+    if count == 0:
+        part.unlink(missing_ok=True)
+        raise DriverError(f"{source.name}: no audio was captured")
+    touches += report(detector.finish())
+    os.replace(part, path)
+    if labels:
+        _append_row(labels_path, header, [path.name, *labels.values()])
+    return Take(path, labels_path, count / rate, touches, source.overflows, interrupted)
+
+
+def _check_header(labels_path: Path, targets: list[str]) -> list[str]:
+    header = ["file", *targets]
+    if labels_path.exists():
+        with labels_path.open(newline="", encoding="utf-8") as handle:
+            found = next(csv.reader(handle), [])
+        if found != header:
+            raise AppError(
+                f"{labels_path} labels takes with {','.join(found[1:]) or 'no target'}; "
+                f"give the same --label targets (got {','.join(targets) or 'none'}) or "
+                "record into another folder"
+            )
+    return header
+
+
+def _next_take(folder: Path) -> Path:
+    number = 1
+    while (folder / f"take-{number:03d}.wav").exists():
+        number += 1
+    return folder / f"take-{number:03d}.wav"
+
+
+def _append_row(labels_path: Path, header: list[str], row: list[str]) -> None:
+    """Add a row to the labels file by replacing it whole (never half-written)."""
+    text = labels_path.read_text(encoding="utf-8") if labels_path.exists() else ""
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    if not text:
+        writer.writerow(header)
+    writer.writerow(row)
+    temporary = labels_path.with_name(labels_path.name + ".tmp")
+    temporary.write_text(text + buffer.getvalue(), encoding="utf-8")
+    os.replace(temporary, labels_path)

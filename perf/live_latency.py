@@ -1,0 +1,151 @@
+"""Live prediction: latency per touch, and whether the capture path keeps up.
+
+Run from the repository root::
+
+    .venv/bin/python perf/live_latency.py [--sessions 8] [--capture-seconds 60]
+
+1. Latency.  A 100-tree random forest (``rf``) is trained on the ``uc3m-audio``
+   features of simulated 3-microphone sessions (44.1 kHz), then fresh sessions are
+   replayed through :class:`app.services.live.LiveSession` in 1024-sample blocks (23 ms,
+   a usual sound-card period).  For each touch it prints percentiles of: the latency
+   ``live`` reports (from the end of the event, after the hangover, to the prediction:
+   the wait for the block holding the end plus the computing), the computing alone
+   (extraction of the event and prediction), and the two predictions alone
+   (``predict`` and ``predict_proba`` of the forest on one instance).  Goal: p50 under
+   20 ms, p99 under 50 ms.
+2. Capture.  The same model runs on PortAudio capture of 3 channels at 44.1 kHz through
+   ALSA's file plugin (a ``replay`` device in a temporary HOME, as the tests do), pinned
+   to one core.  That device is not paced (it delivers as fast as it can), so the
+   figure is how many times real time the whole capture path (callback, queue,
+   detection, extraction, prediction) runs: above 1 with margin, a paced sound card
+   never fills the queue.  Blocks dropped from a full queue and PortAudio's own input
+   overflows (xruns: the unpaced device outrunning its callback thread) are printed.
+
+Not a test: nothing is asserted.
+"""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import argparse
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import soundfile
+
+ROOT = Path(__file__).resolve().parents[1]
+
+CAPTURE = """
+import os, sys, time
+os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})
+from app.services.live import open_live
+from app.store.database import Store
+from drivers.sound import SoundDeviceSource
+seconds, queue = float(sys.argv[2]), float(sys.argv[3])
+source = SoundDeviceSource("replay", samplerate=44100, channels=3, seconds=seconds,
+                           queue_seconds=queue)
+session = open_live(Store(sys.argv[1]), "touch-rf", samplerate=44100, n_channels=3)
+began, touches = time.perf_counter(), 0
+with source:
+    for block in source.blocks():
+        touches += len(session.feed(block.samples, block.time, arrived=block.arrived))
+    touches += len(session.finish())
+print(seconds / (time.perf_counter() - began), touches, source.dropped, source.xruns)
+"""
+
+
+def percentiles(values: list[float]) -> str:
+    p50, p90, p99 = np.percentile(values, [50, 90, 99])
+    return f"{p50:8.1f} {p90:8.1f} {p99:8.1f} {max(values):8.1f}"
+
+
+def main() -> None:
+    from app.services.extraction import extract_and_store
+    from app.services.live import open_live
+    from app.services.models import load_model, train
+    from app.services.simulation import write_labels, write_session
+    from app.store.database import Store
+    from drivers.replay import FileReplaySource
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sessions", type=int, default=8, help="fresh sessions replayed")
+    parser.add_argument("--capture-seconds", type=float, default=60.0)
+    arguments = parser.parse_args()
+    load = ", ".join(f"{value:.1f}" for value in os.getloadavg())
+    print(f"Machine load average (1, 5, 15 min): {load} on {os.cpu_count()} cores")
+    with tempfile.TemporaryDirectory() as folder:
+        here = Path(folder)
+        db = f"sqlite:///{here / 'live.db'}"
+        store = Store(db)
+        recordings, rows = [], []
+        for seed in range(4):
+            wav, touches = write_session(here, f"train{seed}", n_touches=16, seed=seed)
+            recordings.append(wav)
+            rows += [(wav.name, *touch) for touch in touches]
+        labels = write_labels(here / "labels.csv", rows)
+        extract_and_store(store, recordings, labels=labels, extractor="uc3m-audio", name="touch")
+        train(store, "touch", "rf", targets=["gesture"])
+        _, model = load_model(store, "touch-rf")
+
+        reported, computing, predicting = [], [], []
+        for seed in range(arguments.sessions):
+            wav, _ = write_session(here, f"fresh{seed}", n_touches=16, seed=1000 + seed)
+            with FileReplaySource(wav, block_length=1024) as source:
+                session = open_live(store, "touch-rf", samplerate=44100.0, n_channels=3)
+                for block in source.blocks():
+                    began = time.perf_counter()
+                    touches = session.feed(block.samples, block.time, arrived=began)
+                    if touches:
+                        computing.append(1000 * (time.perf_counter() - began))
+                        reported += [t.latency_ms for t in touches]
+        X = np.zeros((1, len(model.schema.features)))
+        for _ in range(50):
+            began = time.perf_counter()
+            model.predict(X)
+            model.predict_proba(X)
+            predicting.append(1000 * (time.perf_counter() - began))
+        print(f"\n1. Latency per touch, ms ({len(reported)} touches, 1024-sample blocks)")
+        print(f"{'':<44} {'p50':>8} {'p90':>8} {'p99':>8} {'max':>8}")
+        print(f"{'reported by live (end of event -> prediction)':<44} {percentiles(reported)}")
+        print(f"{'computing (extract + predict the block)':<44} {percentiles(computing)}")
+        print(f"{'predict + predict_proba, 100-tree forest':<44} {percentiles(predicting)}")
+
+        print("\n2. Capture path, 3 ch x 44.1 kHz through PortAudio/ALSA, one core")
+        home = here / "home"
+        home.mkdir()
+        raw = here / "capture.s16"
+        parts = []
+        for seed in range(int(np.ceil(arguments.capture_seconds / 25))):
+            wav, _ = write_session(here, f"capture{seed}", n_touches=12, seed=2000 + seed)
+            samples, _ = soundfile.read(wav, always_2d=True)
+            parts.append(samples)
+        audio = np.concatenate(parts)[: round(arguments.capture_seconds * 44100) + 44100]
+        np.clip(np.round(audio * 32768), -32768, 32767).astype("<i2").tofile(raw)
+        (home / ".asoundrc").write_text(
+            f'pcm.replay {{\n type file\n slave.pcm "nullcap"\n file "/dev/null"\n'
+            f' infile "{raw}"\n format "raw"\n}}\npcm.nullcap {{ type null }}\n'
+        )
+        env = {**os.environ, "HOME": str(home), "PYTHONPATH": str(ROOT)}
+        print(f"{'queue':<28} {'x real time':>12} {'touches':>8} {'dropped':>8} {'xruns':>8}")
+        for queue in (arguments.capture_seconds * 2, 5.0):
+            done = subprocess.run(
+                [sys.executable, "-c", CAPTURE, db, str(arguments.capture_seconds), str(queue)],
+                capture_output=True,
+                text=True,
+                env=env,
+                check=True,
+            )
+            factor, touches, dropped, xruns = done.stdout.split()
+            label = f"{queue:g} s" + (" (default)" if queue == 5.0 else " (holds it all)")
+            print(f"{label:<28} {float(factor):>12.1f} {touches:>8} {dropped:>8} {xruns:>8}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,126 @@
+"""ROS bags through `touchbench extract`: real ROS 1 and ROS 2 bags written with rosbags'
+own writers, read back for their audio; and the bags it must refuse."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import soundfile
+
+from app.store.database import Store
+from app.store.datasets import load_dataset
+from drivers.simulated import SimulatedTouch, simulate_session
+from tests.app.cli_runner import run_cli
+from tests.drivers.bagfiles import encode, write_audio_bag, write_other_audio_bag
+
+RATE = 44100
+DELAY = 0.25  # the audio starts this long after the bag's first message
+
+
+@pytest.fixture(scope="module")
+def session() -> np.ndarray:
+    touches = [
+        SimulatedTouch(0.8, 0.05, (0,), "tap", 0.3),
+        SimulatedTouch(2.4, 0.6, (1, 2), "stroke", 0.2),
+    ]
+    return simulate_session(duration=4.0, n_channels=3, touches=touches, seed=5).recording.samples
+
+
+def _labels(folder: Path, name: str) -> Path:
+    # Seconds from the bag's first message: the touches' times plus the audio's delay.
+    path = folder / "labels.csv"
+    path.write_text(
+        "file,start,end,gesture\n"
+        f"{name},{0.7 + DELAY},{1.5 + DELAY},tap\n{name},{2.3 + DELAY},{3.6 + DELAY},stroke\n"
+    )
+    return path
+
+
+@pytest.mark.parametrize(
+    ("suffix", "options"),
+    [
+        (".bag", {}),
+        (".mcap", {"stamped": True}),
+        (".db3", {"with_definitions": False, "sample_format": "S32LE"}),
+        (".mcap", {"sample_format": "F32LE", "message_samples": 4410}),
+    ],
+)
+def test_extract_reads_the_audio_of_ros1_and_ros2_bags(
+    capsys: pytest.CaptureFixture[str],
+    store_url: str,
+    tmp_path: Path,
+    session: np.ndarray,
+    suffix: str,
+    options: dict,
+) -> None:
+    sample_format = options.get("sample_format", "S16LE")
+    bag = write_audio_bag(tmp_path / f"robot{suffix}", session, RATE, **options)
+    labels = _labels(tmp_path, bag.name)
+    result = run_cli(
+        capsys, store_url, "extract", str(bag), "--labels", str(labels), "--name", "bag", "--json"
+    )
+    assert result.code == 0, result.err
+    summary = result.json()
+    assert (summary["events_found"], summary["events_labelled"]) == (2, 2)
+
+    # The same samples, as the bag carries them, from a WAV: the same features.
+    dtype_samples = encode(session, sample_format).view(
+        {"S16LE": "<i2", "S32LE": "<i4", "F32LE": "<f4"}[sample_format]
+    )
+    scale = {"S16LE": 32768.0, "S32LE": 2147483648.0, "F32LE": 1.0}[sample_format]
+    wav = tmp_path / "same.wav"
+    soundfile.write(wav, dtype_samples.reshape(-1, 3) / scale, RATE, subtype="DOUBLE")
+    assert run_cli(capsys, store_url, "extract", str(wav), "--name", "wav").code == 0
+    store = Store(store_url)
+    try:
+        from_bag, from_wav = load_dataset(store, "bag"), load_dataset(store, "wav")
+    finally:
+        store.dispose()
+    assert np.array_equal(from_bag.X, from_wav.X)
+    assert from_bag.meta is not None and from_wav.meta is not None
+    starts = [m["start"] for m in from_bag.meta]
+    assert starts == pytest.approx([m["start"] + DELAY for m in from_wav.meta])
+    assert from_bag.schema.targets[0].values == ("tap", "stroke")
+
+
+def test_bags_touchbench_cannot_use_exit_2_and_store_nothing(
+    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path, session: np.ndarray
+) -> None:
+    short = session[:, :8820]
+    no_audio = write_audio_bag(tmp_path / "quiet.mcap", short, RATE, topic=None)
+    mp3 = write_audio_bag(tmp_path / "mp3.bag", short, RATE, coding_format="mp3")
+    no_info = write_audio_bag(tmp_path / "noinfo.db3", short, RATE, info_topic=None)
+    good = write_audio_bag(tmp_path / "good.bag", session, RATE)
+    truncated = tmp_path / "truncated.bag"
+    truncated.write_bytes(good.read_bytes()[: good.stat().st_size // 2])
+    other = write_other_audio_bag(tmp_path / "other.mcap")
+    cases = [
+        ([str(no_audio)], "no audio topic"),
+        ([str(good), "--topic", "/mic"], "no topic '/mic'; audio topics: /audio/audio"),
+        ([str(good), "--topic", "/status"], "topic '/status' is std_msgs/msg/String"),
+        ([str(mp3)], "carries mp3-coded audio; touchbench reads raw PCM only"),
+        ([str(no_info)], "no AudioInfo topic"),
+        ([str(truncated)], "truncated.bag: cannot read"),
+        ([str(other)], "no audio topic"),
+        ([str(other), "--topic", "/audio"], "fields (float32_data, int32_data"),
+    ]
+    for args, expected in cases:
+        result = run_cli(capsys, store_url, "extract", *args)
+        assert result.code == 2, (args, result.err)
+        assert len(result.err.strip().splitlines()) == 1, result.err
+        assert expected in result.err, result.err
+    assert run_cli(capsys, store_url, "datasets", "--json").json() == {"datasets": []}
+
+
+def test_a_bag_without_audio_definitions_really_lacks_them(tmp_path: Path) -> None:
+    from rosbags.rosbag2 import Reader
+
+    folder = write_audio_bag(
+        tmp_path / "old.db3", np.zeros((1, 2048)), RATE, with_definitions=False
+    )
+    with Reader(folder) as reader:
+        formats = {c.msgtype: c.msgdef.format.name for c in reader.connections}
+    assert formats["audio_common_msgs/msg/AudioData"] == "NONE"
+    assert formats["std_msgs/msg/String"] != "NONE"
