@@ -14,7 +14,7 @@ from fastapi import Depends, FastAPI
 
 from app.api import errors
 from app.api.deps import ModelCache, Service, require_api_key
-from app.api.routes import datasets, health, jobs, models, recordings, runs
+from app.api.routes import datasets, health, jobs, live, models, recordings, runs
 from app.api.uploads import BodyLimit
 from app.jobs.dispatcher import Dispatcher
 from app.settings import Settings, get_settings
@@ -67,6 +67,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.add_middleware(BodyLimit, limit=settings.max_upload_bytes)
     protected = [Depends(require_api_key)]
     app.include_router(health.router)
+    app.include_router(live.router)  # checks the API key itself: see its module
     for router in (
         recordings.router,
         datasets.router,

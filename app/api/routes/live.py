@@ -1,0 +1,139 @@
+"""``WS /api/models/{model}/live``: live predictions on a stream of samples.
+
+The client sends a JSON header ``{"samplerate": 44100, "channels": 3, "format": "S16LE"}``
+(``format``: S16LE, S32LE or F32LE; ``api_key`` here when the handshake could not carry
+the ``X-API-Key`` header), then binary messages of interleaved samples, and
+``{"end": true}`` when its stream ends.  The server sends one JSON message per detected touch,
+as ``touchbench live --json`` prints it, and closes with a reason on bad input: 1008 for a
+missing or wrong key or a model that cannot run live, 1007 for a malformed header or block,
+1009 for a block over the size limit, 1000 when the stream ended.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import hmac
+import json
+from typing import Any
+
+import numpy as np
+from fastapi import APIRouter, WebSocket, WebSocketDisconnect
+from starlette.concurrency import run_in_threadpool
+
+from app.api.deps import Service
+from app.errors import USER_ERRORS
+from drivers.errors import DriverError
+from drivers.pcm import SAMPLE_FORMATS, decode_pcm
+
+router = APIRouter(tags=["models"])
+
+#: Seconds the client has to send its header.
+HEADER_TIMEOUT = 10.0
+#: Longest block, in seconds of audio.
+MAX_BLOCK_SECONDS = 10.0
+
+POLICY, INVALID, TOO_BIG, NORMAL, INTERNAL = 1008, 1007, 1009, 1000, 1011
+
+
+class _Closed(Exception):  # noqa: N818 (ends the session with a close frame)
+    def __init__(self, code: int, reason: str) -> None:
+        super().__init__(reason)
+        self.code = code
+        self.reason = reason[:120]  # a close reason is at most 123 bytes
+
+
+@router.websocket("/api/models/{model_ref}/live")
+async def live(websocket: WebSocket, model_ref: str) -> None:
+    service: Service = websocket.app.state.service
+    await websocket.accept()
+    try:
+        header = await _header(websocket)
+        _check_key(service, websocket, header)
+        samplerate, channels, sample_format = _stream_format(header)
+        info, model = await run_in_threadpool(service.models.get, service.store, model_ref)
+        from app.services.live import LiveSession
+
+        try:
+            session = LiveSession(info, model, samplerate=samplerate, n_channels=channels)
+        except USER_ERRORS as error:
+            raise _Closed(POLICY, str(error)) from None
+        frame = channels * np.dtype(SAMPLE_FORMATS[sample_format][0]).itemsize
+        limit = int(MAX_BLOCK_SECONDS * samplerate) * frame
+        while True:
+            message = await websocket.receive()
+            if message["type"] == "websocket.disconnect":
+                return
+            if message.get("bytes") is not None:
+                data: bytes = message["bytes"]
+                if len(data) > limit:
+                    raise _Closed(TOO_BIG, f"a block holds at most {MAX_BLOCK_SECONDS:g} s")
+                try:
+                    block = decode_pcm(data, channels=channels, sample_format=sample_format)
+                except DriverError as error:
+                    raise _Closed(INVALID, str(error)) from None
+                touches = await run_in_threadpool(session.feed, block)
+            else:
+                if _json(message.get("text")).get("end") is not True:
+                    raise _Closed(INVALID, 'text messages after the header must be {"end": true}')
+                touches = await run_in_threadpool(session.finish)
+                for touch in touches:
+                    await websocket.send_json(touch.to_json())
+                raise _Closed(NORMAL, "stream ended")
+            for touch in touches:
+                await websocket.send_json(touch.to_json())
+    except _Closed as closed:
+        await websocket.close(code=closed.code, reason=closed.reason)
+    except USER_ERRORS as error:
+        await websocket.close(code=POLICY, reason=str(error)[:120])
+    except WebSocketDisconnect:
+        return
+    except Exception as error:  # never crash the server: say what happened, close
+        await websocket.close(code=INTERNAL, reason=f"unexpected {type(error).__name__}")
+
+
+async def _header(websocket: WebSocket) -> dict[str, Any]:
+    try:
+        message = await asyncio.wait_for(websocket.receive(), HEADER_TIMEOUT)
+    except TimeoutError:
+        raise _Closed(INVALID, f"no header within {HEADER_TIMEOUT:g} s") from None
+    if message["type"] == "websocket.disconnect":
+        raise WebSocketDisconnect(code=message.get("code", 1000))
+    return _json(message.get("text"))
+
+
+def _json(text: str | None) -> dict[str, Any]:
+    try:
+        value = json.loads(text or "")
+    except ValueError:
+        raise _Closed(INVALID, "expected a JSON object") from None
+    if not isinstance(value, dict):
+        raise _Closed(INVALID, "expected a JSON object")
+    return value
+
+
+def _check_key(service: Service, websocket: WebSocket, header: dict[str, Any]) -> None:
+    expected = service.settings.api_key
+    if expected is None:
+        return
+    given = websocket.headers.get("x-api-key") or header.get("api_key")
+    if not isinstance(given, str):
+        raise _Closed(POLICY, "this service needs an API key (X-API-Key or api_key)")
+    if not hmac.compare_digest(given.encode(), expected.get_secret_value().encode()):
+        raise _Closed(POLICY, "wrong API key")
+
+
+def _stream_format(header: dict[str, Any]) -> tuple[float, int, str]:
+    samplerate = header.get("samplerate")
+    channels = header.get("channels")
+    kind = str(header.get("format", "S16LE")).upper()
+    if (
+        not isinstance(samplerate, int | float)
+        or isinstance(samplerate, bool)
+        or not (0 < samplerate <= 1_000_000)
+    ):
+        raise _Closed(INVALID, "header: 'samplerate' must be a number of Hz up to 1e6")
+    if not isinstance(channels, int) or isinstance(channels, bool) or not 0 < channels <= 256:
+        raise _Closed(INVALID, "header: 'channels' must be a whole number from 1 to 256")
+    if kind not in SAMPLE_FORMATS:
+        raise _Closed(INVALID, f"header: 'format' must be one of {', '.join(SAMPLE_FORMATS)}")
+    return float(samplerate), channels, kind
