@@ -73,5 +73,5 @@ class TrainRequest(Schema):
     classifier: str | None = None
     target: str | None = None
     run: int | None = None
-    name: str | None = None
-    seed: int = 0
+    name: str | None = Field(default=None, max_length=200)
+    seed: int = Field(default=0, ge=0, le=2**31 - 1)

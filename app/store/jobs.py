@@ -11,6 +11,7 @@ from sqlalchemy import select, update
 from app.errors import NotFoundError
 from app.schemas.jobs import JobSchema
 from app.store.database import Store
+from app.store.naming import is_row_id
 from app.store.ownership import mark_lost, process_owner
 from app.store.tables import JobRow, utcnow
 
@@ -85,7 +86,7 @@ def mark_lost_jobs(store: Store) -> list[int]:
 
 def _row(session: Any, job_id: int | str) -> JobRow:
     text = str(job_id)
-    row = session.get(JobRow, int(text)) if text.isdigit() and len(text) < 12 else None
+    row = session.get(JobRow, int(text)) if is_row_id(text) else None
     if row is None:
         raise NotFoundError(f"no job '{text[:40]}'")
     return row

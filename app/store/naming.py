@@ -27,6 +27,15 @@ class Named(Protocol):
 RowT = TypeVar("RowT", bound=Named)
 
 
+#: The largest id a row can have (the columns are 32-bit integers on PostgreSQL).
+MAX_ROW_ID = 2**31 - 1
+
+
+def is_row_id(text: str) -> bool:
+    """Whether ``text`` can be the id of a row (so that looking it up cannot fail)."""
+    return text.isdigit() and len(text) <= 10 and 0 < int(text) <= MAX_ROW_ID
+
+
 def find_row(session: Session, model: type[RowT], ref: str | int, *, kind: str, hint: str) -> RowT:
     """The row called ``ref``, else the one with id ``ref``.
 
@@ -39,7 +48,7 @@ def find_row(session: Session, model: type[RowT], ref: str | int, *, kind: str, 
     text = str(ref)
     name_column: InstrumentedAttribute[str] = model.name
     row = session.scalars(select(model).where(name_column == text)).first()
-    if row is None and text.isdigit() and len(text) < 10:
+    if row is None and is_row_id(text):
         row = session.get(model, int(text))
     if row is None:
         names = session.scalars(select(name_column).order_by(model.id).limit(_NAMES_SHOWN)).all()

@@ -23,6 +23,7 @@ from sqlalchemy.orm import Session
 from app.errors import AppError, NotFoundError
 from app.schemas.runs import FINAL_STATUSES, RunSchema, RunStatus
 from app.store.database import Store
+from app.store.naming import is_row_id
 from app.store.ownership import aware, mark_lost, owner_alive, process_owner
 from app.store.tables import DatasetRow, FoldResultRow, RunRow, utcnow
 from benchmark.results import TaskKey, TaskResult
@@ -304,7 +305,7 @@ def _keys(session: Session, run_id: int) -> set[tuple[str, int, int]]:
 
 def _row(session: Session, run_id: int | str) -> RunRow:
     text = str(run_id)
-    row = session.get(RunRow, int(text)) if text.isdigit() and len(text) < 12 else None
+    row = session.get(RunRow, int(text)) if is_row_id(text) else None
     if row is None:
         last = session.scalar(select(func.max(RunRow.id)))
         known = f"runs are 1..{last}" if last else "the store has no runs yet"
