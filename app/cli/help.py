@@ -2,14 +2,15 @@
 
 typer 0.29 shows every flag's type as ``<bool>`` and other types as ``<int>``, ``<path>``,
 ``<list[Path]>``; writes a required argument as ``{NAME}`` in the usage line; and keeps the
-source's line breaks inside a docstring's later paragraphs.  Mature command lines print
-nothing for a flag and the metavar or an upper-case type otherwise, write ``NAME`` /
-``[NAME]`` / ``NAME...``, and reflow paragraphs.  :func:`install` patches those four
-spots of typer once, at import of the CLI; nothing else of typer is touched.
+source's line breaks inside a docstring's later paragraphs and in the command list.  Mature
+command lines print nothing for a flag and the metavar or an upper-case type otherwise,
+write ``NAME`` / ``[NAME]`` / ``NAME...``, and reflow paragraphs.  :func:`install` patches
+those spots of typer once, at import of the CLI; nothing else of typer is touched.
 """
 
 from __future__ import annotations
 
+import inspect
 from typing import Any
 
 #: typer's type labels -> the words click uses.
@@ -43,6 +44,16 @@ def install() -> None:
             paragraph if paragraph.startswith("\b") else " ".join(paragraph.split())
             for paragraph in paragraphs
         )
+
+    if not getattr(rich_utils, "_touchbench_patched", False):
+        command_help = rich_utils._make_command_help
+
+        def short_help(*, help_text: str, markup_mode: Any) -> Any:
+            first = inspect.cleandoc(help_text).split("\n\n")[0]
+            return command_help(help_text=" ".join(first.split()), markup_mode=markup_mode)
+
+        rich_utils._make_command_help = short_help
+        rich_utils._touchbench_patched = True  # type: ignore[attr-defined]
 
     TyperOption.display_type_rich = option_type  # type: ignore[method-assign]
     TyperArgument.display_type_rich = argument_type  # type: ignore[method-assign,assignment]
