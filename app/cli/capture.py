@@ -117,7 +117,9 @@ class Sensor(StrEnum):
 
 
 def simulate_command(
-    sensor: Annotated[Sensor, typer.Argument(help="contact-mic or oscillating-link.")],
+    sensor: Annotated[
+        Sensor, typer.Argument(metavar="SENSOR", help="contact-mic or oscillating-link.")
+    ],
     out: Annotated[
         Path, typer.Option("--out", "-o", metavar="DIR", help="Folder for recordings + labels.")
     ],
