@@ -1,0 +1,161 @@
+"""WEKA's IBk (``weka.classifiers.lazy.IBk``, 3.6): k nearest neighbours on WEKA's distance.
+
+The distance is WEKA's ``EuclideanDistance``: a numeric attribute is normalised by the
+range it spans, a nominal one differs by 0 (same label) or 1; a missing value differs by
+1 from another missing value or any nominal label, and from a known numeric value ``v``
+(normalised) by ``max(v, 1 - v)``.  Every training instance tied with the k-th nearest
+counts as a neighbour; each class starts with a vote of ``1 / n_train`` and the votes are
+normalised into probabilities.
+
+WEKA widens the attribute ranges with each instance it is asked to classify, before
+searching (``IBk.distributionForInstance`` calls ``addInstanceInfo``), so the ranges used
+for the i-th row of a prediction call are those of the training data and rows ``0..i``.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Mapping
+from typing import Literal
+
+import numpy as np
+from sklearn.base import BaseEstimator, ClassifierMixin
+from sklearn.utils.validation import check_is_fitted
+
+from benchmark.weka._data import check_test_data, check_training_data
+
+Weighting = Literal["none", "inverse", "similarity"]
+
+#: Bytes of scratch memory per block of prediction rows.
+BLOCK_BYTES = 4 * 2**20
+
+
+class WekaIBk(ClassifierMixin, BaseEstimator):
+    """k-nearest-neighbour classifier with WEKA's distance, ties and vote.
+
+    Parameters
+    ----------
+    n_neighbors : int
+        k (``-K``).
+    weighting : {"none", "inverse", "similarity"}
+        Vote of a neighbour at distance d: 1, ``1 / (d + 0.001)`` (``-I``) or ``1 - d``
+        (``-F``), with d the Euclidean distance divided by the square root of the number
+        of attributes.
+    nominal_features : mapping of int to int, optional
+        Nominal column index to its number of declared labels; other columns are numeric.
+
+    Attributes
+    ----------
+    classes_ : ndarray of shape (n_classes,)
+    nominal_ : dict of int to int
+    X_ : ndarray of shape (n_train, n_features)
+        The training instances.
+    y_ : ndarray of shape (n_train,)
+        Their class codes.
+    minimum_, maximum_ : ndarray of shape (n_features,)
+        Training range of each attribute (NaN when it has no known value).
+    """
+
+    def __init__(
+        self,
+        n_neighbors: int = 1,
+        weighting: Weighting = "none",
+        nominal_features: Mapping[int, int] | None = None,
+    ) -> None:
+        self.n_neighbors = n_neighbors
+        self.weighting = weighting
+        self.nominal_features = nominal_features
+
+    def fit(self, X: object, y: object) -> WekaIBk:
+        """Store the training instances ``X`` (n_samples, n_features) and labels ``y``."""
+        if not isinstance(self.n_neighbors, int | np.integer) or self.n_neighbors < 1:
+            raise ValueError(f"n_neighbors must be a positive integer, got {self.n_neighbors!r}")
+        if self.weighting not in ("none", "inverse", "similarity"):
+            raise ValueError(
+                f"weighting must be 'none', 'inverse' or 'similarity', got {self.weighting!r}"
+            )
+        X, codes, nominal = check_training_data(self, X, y)
+        self.nominal_ = nominal
+        self.X_, self.y_ = X, codes
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN columns
+            self.minimum_ = np.nanmin(X, axis=0) if X.size else np.full(X.shape[1], np.nan)
+            self.maximum_ = np.nanmax(X, axis=0) if X.size else np.full(X.shape[1], np.nan)
+        return self
+
+    def predict_proba(self, X: object) -> np.ndarray:
+        """Normalised votes of shape (n_samples, n_classes), columns as ``classes_``."""
+        check_is_fitted(self)
+        X = check_test_data(self, X)
+        n_train, n_features = self.X_.shape
+        minimum, maximum = self._ranges(X)
+        numeric = np.ones(n_features, dtype=bool)
+        numeric[list(self.nominal_)] = False
+        block = max(1, BLOCK_BYTES // (8 * max(1, n_train * n_features)))
+        out = np.empty((X.shape[0], len(self.classes_)))
+        for start in range(0, X.shape[0], block):
+            stop = min(start + block, X.shape[0])
+            squared = _squared_distances(
+                X[start:stop], self.X_, minimum[start:stop], maximum[start:stop], numeric
+            )
+            out[start:stop] = self._vote(squared, n_features)
+        return out
+
+    def predict(self, X: object) -> np.ndarray:
+        """Labels of shape (n_samples,): the largest vote (the first class on ties)."""
+        return np.asarray(self.classes_[np.argmax(self.predict_proba(X), axis=1)])
+
+    def _ranges(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Per-row attribute ranges: training ranges widened by rows 0..i of ``X``."""
+        with np.errstate(all="ignore"):
+            low = np.fmin.accumulate(np.vstack([self.minimum_, X]), axis=0)[1:]
+            high = np.fmax.accumulate(np.vstack([self.maximum_, X]), axis=0)[1:]
+        return low, high
+
+    def _vote(self, squared: np.ndarray, n_features: int) -> np.ndarray:
+        """Class distributions of shape (n_rows, n_classes) from squared distances."""
+        n_rows, n_train = squared.shape
+        n_classes = len(self.classes_)
+        k = min(self.n_neighbors, n_train)
+        kth = np.partition(squared, k - 1, axis=1)[:, k - 1 : k]
+        neighbour = squared <= kth  # every instance tied with the k-th nearest counts
+        distance = np.sqrt(squared / n_features)
+        if self.weighting == "inverse":
+            weight = 1.0 / (distance + 0.001)
+        elif self.weighting == "similarity":
+            weight = 1.0 - distance
+        else:
+            weight = np.ones_like(distance)
+        weight = np.where(neighbour, weight, 0.0)
+        votes = np.full((n_rows, n_classes), 1.0 / max(1, n_train))
+        for c in range(n_classes):
+            votes[:, c] += weight[:, self.y_ == c].sum(axis=1)
+        return np.asarray(votes / votes.sum(axis=1, keepdims=True))
+
+
+def _squared_distances(
+    rows: np.ndarray,
+    train: np.ndarray,
+    minimum: np.ndarray,
+    maximum: np.ndarray,
+    numeric: np.ndarray,
+) -> np.ndarray:
+    """Squared WEKA distances of shape (n_rows, n_train).
+
+    ``minimum`` and ``maximum`` have shape (n_rows, n_features): the ranges in force for
+    each row.
+    """
+    width = maximum - minimum
+    flat = ~(width > 0)  # no range (or no known value): normalised values are 0
+    safe = np.where(flat, 1.0, width)[:, None, :]
+    a, b = rows[:, None, :], train[None, :, :]
+    a_missing, b_missing = np.isnan(a), np.isnan(b)
+    norm_a = np.where(flat[:, None, :], 0.0, (a - minimum[:, None, :]) / safe)
+    norm_b = np.where(flat[:, None, :], 0.0, (b - minimum[:, None, :]) / safe)
+    diff = norm_a - norm_b
+    one_missing = np.where(a_missing, norm_b, norm_a)
+    diff = np.where(a_missing ^ b_missing, np.maximum(one_missing, 1.0 - one_missing), diff)
+    diff = np.where(a_missing & b_missing, 1.0, diff)
+    nominal_diff = np.where(a_missing | b_missing | (a != b), 1.0, 0.0)
+    diff = np.where(numeric, diff, nominal_diff)
+    return np.asarray(np.einsum("rtf,rtf->rt", diff, diff))
