@@ -29,7 +29,7 @@ from scipy.special import ndtri
 from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.utils.validation import check_is_fitted
 
-from benchmark.weka._data import check_test_data, check_training_data, one_hot_weights
+from benchmark.weka._data import check_test_data, check_training_data
 
 #: WEKA's tolerance in comparisons (``Utils.SMALL``).
 SMALL = 1e-6
@@ -227,8 +227,10 @@ class _Node:
 
 
 def _x_log2_x(x: np.ndarray) -> np.ndarray:
-    safe = np.where(x < 1e-6, 1.0, x)
-    return np.where(x < 1e-6, 0.0, x * np.log2(safe))
+    """``x * log2(x)``, 0 below 1e-6 (WEKA's ``logFunc``)."""
+    x = np.asarray(x, dtype=np.float64)
+    logs = np.log2(x, out=np.zeros_like(x), where=x >= 1e-6)
+    return np.asarray(x * logs)
 
 
 class _Grower:
@@ -290,29 +292,24 @@ class _Grower:
         total = counts.sum()
         if total < 2 * self.min_instances - SMALL or abs(total - counts.max()) < SMALL:
             return None
-        gains, ratios, splits = [], [], []
-        for feature in range(self.X.shape[1]):
-            if feature in self.nominal:
-                found = self._nominal_split(feature, rows, weight, total)
-            else:
-                found = self._numeric_split(feature, rows, weight, total)
-            if found is not None:
-                gain, ratio, split = found
-                gains.append(gain)
-                ratios.append(ratio)
-                splits.append(split)
-        if not splits:
+        found = self._numeric_splits(rows, weight, total)
+        for feature in self.nominal:
+            candidate = self._nominal_split(feature, rows, weight, total)
+            if candidate is not None:
+                found.append(candidate)
+        if not found:
             return None
+        found.sort(key=lambda item: item[2].feature)  # WEKA scans attributes in order
         counted = [
-            g
-            for g, s in zip(gains, splits, strict=True)
-            if s.numeric or self.multi_valued or s.n_branches < 0.3 * self.X.shape[0]
+            gain
+            for gain, _, split in found
+            if split.numeric or self.multi_valued or split.n_branches < 0.3 * self.X.shape[0]
         ]
         if not counted:
             return None
         average = sum(counted) / len(counted)
         best, best_ratio = None, 0.0
-        for gain, ratio, split in zip(gains, ratios, splits, strict=True):
+        for gain, ratio, split in found:
             if gain >= average - 1e-3 and ratio - best_ratio > SMALL:
                 best, best_ratio = split, ratio
         if best is None or abs(best_ratio) < SMALL:
@@ -334,59 +331,75 @@ class _Grower:
             return None
         gain = _info_gain(bags[None], total)[0]
         ratio = _gain_ratio(bags[None], total, np.array([gain]))[0]
-        return gain, ratio, _Split(feature, False, np.nan, n_labels)
+        return float(gain), float(ratio), _Split(feature, False, np.nan, n_labels)
 
-    def _numeric_split(
-        self, feature: int, rows: np.ndarray, weight: np.ndarray, total: float
-    ) -> tuple[float, float, _Split] | None:
-        values = self.X[rows, feature]
-        known = ~np.isnan(values)
-        n_known = int(np.count_nonzero(known))
-        order = np.argsort(values[known], kind="stable")
-        v = values[known][order]
-        w = weight[known][order]
-        indicator = one_hot_weights(self.codes[rows][known][order], w, self.n_classes)
-        known_total = w.sum()
+    def _numeric_splits(
+        self, rows: np.ndarray, weight: np.ndarray, total: float
+    ) -> list[tuple[float, float, _Split]]:
+        """The best cut of every numeric attribute at once (``C45Split`` on each).
+
+        Each column is sorted (missing values last); cumulative class weights give the
+        class distribution on each side of every candidate cut, of shape
+        (n_rows - 1, n_numeric, n_classes).
+        """
+        columns = self.numeric
+        if columns.size == 0 or rows.size < 2:
+            return []
+        values = self.X[np.ix_(rows, columns)]
+        order = np.argsort(values, axis=0, kind="stable")
+        v = np.take_along_axis(values, order, axis=0)
+        missing = np.isnan(v)
+        w = np.where(missing, 0.0, weight[order])
+        codes = self.codes[rows][order]
+        cumulative = np.stack(
+            [np.cumsum(np.where(codes == c, w, 0.0), axis=0) for c in range(self.n_classes)],
+            axis=2,
+        )
+        known_counts = cumulative[-1]  # (n_numeric, C)
+        known_total = known_counts.sum(axis=1)
+        n_known = np.count_nonzero(~missing, axis=0)
         min_split = 0.1 * known_total / self.n_classes
-        if min_split - self.min_instances < SMALL:
-            min_split = self.min_instances
-        elif min_split - 25 > SMALL:
-            min_split = 25.0
-        if n_known < 2 * min_split - SMALL:
-            return None
-        left = np.cumsum(indicator, axis=0)[:-1]  # after rows 0..i, candidate cut i|i+1
-        left_total = np.cumsum(w)[:-1]
-        candidate = (v[:-1] + 1e-5 < v[1:]) & (left_total - min_split > -SMALL)
-        candidate &= known_total - left_total - min_split > -SMALL
-        n_candidates = int(np.count_nonzero(candidate))
-        if n_candidates == 0:
-            return None
-        cut = np.flatnonzero(candidate)
-        bags = np.stack([left[cut], indicator.sum(axis=0) - left[cut]], axis=1)
-        gains = _info_gain(bags, total)
-        best = _first_best(gains)
-        if best < 0:
-            return None
-        gain = gains[best]
+        min_split = np.where(min_split - 25 > SMALL, 25.0, min_split)
+        min_split = np.where(min_split - self.min_instances < SMALL, self.min_instances, min_split)
+        left = cumulative[:-1]
+        left_total = left.sum(axis=2)
+        right = known_counts[None] - left
+        right_total = known_total[None] - left_total
+        with np.errstate(invalid="ignore"):
+            valid = (np.arange(v.shape[0] - 1)[:, None] < n_known - 1) & (v[:-1] + 1e-5 < v[1:])
+        valid &= (left_total - min_split > -SMALL) & (right_total - min_split > -SMALL)
+        valid &= ~(n_known < 2 * min_split - SMALL)
+        n_candidates = np.count_nonzero(valid, axis=0)
+        old = _x_log2_x(known_total) - _x_log2_x(known_counts).sum(axis=1)
+        new = (
+            _x_log2_x(left_total)
+            + _x_log2_x(right_total)
+            - _x_log2_x(left).sum(axis=2)
+            - _x_log2_x(right).sum(axis=2)
+        )
+        numerator = (known_total / total) * (old - new)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            gain = np.where(np.abs(numerator) < SMALL, 0.0, numerator / known_total)
+        gain = np.where(valid & (gain > SMALL), gain, -np.inf)
+        top = gain.max(axis=0)
+        # WEKA keeps the first cut unless a later one gains more than 1e-6
+        best = np.argmax(gain > (top - SMALL)[None, :], axis=0)
+        chosen = np.flatnonzero(np.isfinite(top))
+        i = best[chosen]
+        corrected = gain[i, chosen]
         if self.mdl:
-            gain -= np.log2(n_candidates) / total
-        if gain < SMALL:
-            return None
-        i = cut[best]
-        threshold = (v[i] + v[i + 1]) / 2.0
-        if threshold == v[i + 1]:
-            threshold = v[i]
-        ratio = _gain_ratio(bags[best][None], total, np.array([gain]))[0]
-        return float(gain), float(ratio), _Split(feature, True, float(threshold), 2)
-
-
-def _first_best(gains: np.ndarray) -> int:
-    """WEKA's scan: a later candidate wins only by more than 1e-6; -1 if none gains."""
-    best, best_gain = -1, 0.0
-    for i in np.flatnonzero(gains > SMALL):
-        if gains[i] - best_gain > SMALL:
-            best, best_gain = int(i), float(gains[i])
-    return best
+            corrected = corrected - np.log2(n_candidates[chosen]) / total
+        keep = corrected >= SMALL
+        chosen, i, corrected = chosen[keep], i[keep], corrected[keep]
+        below, above = v[i, chosen], v[i + 1, chosen]
+        thresholds = (below + above) / 2.0
+        thresholds = np.where(thresholds == above, below, thresholds)
+        bags = np.stack([left[i, chosen], right[i, chosen]], axis=1)
+        ratios = _gain_ratio(bags, total, corrected)
+        return [
+            (float(g), float(r), _Split(int(columns[j]), True, float(t), 2))
+            for j, g, r, t in zip(chosen, corrected, ratios, thresholds, strict=True)
+        ]
 
 
 def _info_gain(bags: np.ndarray, total: float) -> np.ndarray:

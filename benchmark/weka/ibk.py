@@ -27,7 +27,7 @@ from benchmark.weka._data import check_test_data, check_training_data
 Weighting = Literal["none", "inverse", "similarity"]
 
 #: Bytes of scratch memory per block of prediction rows.
-BLOCK_BYTES = 4 * 2**20
+BLOCK_BYTES = 8 * 2**20
 
 
 class WekaIBk(ClassifierMixin, BaseEstimator):
@@ -88,17 +88,21 @@ class WekaIBk(ClassifierMixin, BaseEstimator):
         check_is_fitted(self)
         X = check_test_data(self, X)
         n_train, n_features = self.X_.shape
-        minimum, maximum = self._ranges(X)
-        numeric = np.ones(n_features, dtype=bool)
-        numeric[list(self.nominal_)] = False
-        block = max(1, BLOCK_BYTES // (8 * max(1, n_train * n_features)))
+        low, high = self._ranges(X)
+        # rows share their ranges until a row widens them: one block per stretch
+        widened = np.any(
+            (low[1:] != low[:-1]) & ~(np.isnan(low[1:]) & np.isnan(low[:-1]))
+            | (high[1:] != high[:-1]) & ~(np.isnan(high[1:]) & np.isnan(high[:-1])),
+            axis=1,
+        )
+        starts = [0, *(np.flatnonzero(widened) + 1).tolist()]
+        block = max(1, BLOCK_BYTES // (8 * max(1, n_train)))
         out = np.empty((X.shape[0], len(self.classes_)))
-        for start in range(0, X.shape[0], block):
-            stop = min(start + block, X.shape[0])
-            squared = _squared_distances(
-                X[start:stop], self.X_, minimum[start:stop], maximum[start:stop], numeric
-            )
-            out[start:stop] = self._vote(squared, n_features)
+        for start, end in zip(starts, [*starts[1:], X.shape[0]], strict=True):
+            for first in range(start, end, block):
+                last = min(first + block, end)
+                squared = self._squared_distances(X[first:last], low[first], high[first])
+                out[first:last] = self._vote(squared, n_features)
         return out
 
     def predict(self, X: object) -> np.ndarray:
@@ -111,6 +115,32 @@ class WekaIBk(ClassifierMixin, BaseEstimator):
             low = np.fmin.accumulate(np.vstack([self.minimum_, X]), axis=0)[1:]
             high = np.fmax.accumulate(np.vstack([self.maximum_, X]), axis=0)[1:]
         return low, high
+
+    def _squared_distances(self, rows: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
+        """Squared WEKA distances of shape (n_rows, n_train), ranges ``low..high``.
+
+        Accumulated attribute by attribute, in WEKA's order and arithmetic, so that ties
+        between neighbours are the ones WEKA sees.
+        """
+        out = np.zeros((rows.shape[0], self.X_.shape[0]))
+        for column in range(rows.shape[1]):
+            a, b = rows[:, column][:, None], self.X_[:, column][None, :]
+            a_missing, b_missing = np.isnan(a), np.isnan(b)
+            if column in self.nominal_:
+                out += (a != b) | a_missing | b_missing
+                continue
+            width = high[column] - low[column]
+            if width > 0:
+                a, b = (a - low[column]) / width, (b - low[column]) / width
+            else:  # no range: WEKA normalises every value to 0
+                a, b = np.where(a_missing, np.nan, 0.0), np.where(b_missing, np.nan, 0.0)
+            diff = a - b
+            if a_missing.any() or b_missing.any():
+                one = np.where(a_missing, b, a)
+                diff = np.where(a_missing ^ b_missing, np.maximum(one, 1.0 - one), diff)
+                diff = np.where(a_missing & b_missing, 1.0, diff)
+            out += diff * diff
+        return out
 
     def _vote(self, squared: np.ndarray, n_features: int) -> np.ndarray:
         """Class distributions of shape (n_rows, n_classes) from squared distances."""
@@ -131,31 +161,3 @@ class WekaIBk(ClassifierMixin, BaseEstimator):
         for c in range(n_classes):
             votes[:, c] += weight[:, self.y_ == c].sum(axis=1)
         return np.asarray(votes / votes.sum(axis=1, keepdims=True))
-
-
-def _squared_distances(
-    rows: np.ndarray,
-    train: np.ndarray,
-    minimum: np.ndarray,
-    maximum: np.ndarray,
-    numeric: np.ndarray,
-) -> np.ndarray:
-    """Squared WEKA distances of shape (n_rows, n_train).
-
-    ``minimum`` and ``maximum`` have shape (n_rows, n_features): the ranges in force for
-    each row.
-    """
-    width = maximum - minimum
-    flat = ~(width > 0)  # no range (or no known value): normalised values are 0
-    safe = np.where(flat, 1.0, width)[:, None, :]
-    a, b = rows[:, None, :], train[None, :, :]
-    a_missing, b_missing = np.isnan(a), np.isnan(b)
-    norm_a = np.where(flat[:, None, :], 0.0, (a - minimum[:, None, :]) / safe)
-    norm_b = np.where(flat[:, None, :], 0.0, (b - minimum[:, None, :]) / safe)
-    diff = norm_a - norm_b
-    one_missing = np.where(a_missing, norm_b, norm_a)
-    diff = np.where(a_missing ^ b_missing, np.maximum(one_missing, 1.0 - one_missing), diff)
-    diff = np.where(a_missing & b_missing, 1.0, diff)
-    nominal_diff = np.where(a_missing | b_missing | (a != b), 1.0, 0.0)
-    diff = np.where(numeric, diff, nominal_diff)
-    return np.asarray(np.einsum("rtf,rtf->rt", diff, diff))
