@@ -1,0 +1,43 @@
+"""WEKA's ZeroR (``weka.classifiers.rules.ZeroR``): the majority class.
+
+The class distribution is estimated with a Laplace correction (every class count starts
+at 1), as WEKA's ``DiscreteEstimator`` does; the prediction is the most frequent class
+(the first on ties).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from sklearn.base import BaseEstimator, ClassifierMixin
+from sklearn.utils.multiclass import check_classification_targets
+from sklearn.utils.validation import check_is_fitted, validate_data
+
+
+class WekaZeroR(ClassifierMixin, BaseEstimator):
+    """Predict the majority class with Laplace-corrected class frequencies.
+
+    Attributes
+    ----------
+    classes_ : ndarray of shape (n_classes,)
+    distribution_ : ndarray of shape (n_classes,)
+        ``(count + 1) / (n + n_classes)`` per class.
+    """
+
+    def fit(self, X: object, y: object) -> WekaZeroR:
+        """Count the classes of ``y`` (n_samples,); ``X`` (n_samples, n_features) is unused."""
+        X, y = validate_data(self, X, y, ensure_all_finite="allow-nan", dtype=np.float64)
+        check_classification_targets(y)
+        self.classes_, codes = np.unique(y, return_inverse=True)
+        counts = np.bincount(codes, minlength=len(self.classes_)) + 1.0
+        self.distribution_ = counts / counts.sum()
+        return self
+
+    def predict_proba(self, X: object) -> np.ndarray:
+        """The class distribution for every row: shape (n_samples, n_classes)."""
+        check_is_fitted(self)
+        X = validate_data(self, X, reset=False, ensure_all_finite="allow-nan", dtype=np.float64)
+        return np.tile(self.distribution_, (X.shape[0], 1))
+
+    def predict(self, X: object) -> np.ndarray:
+        """The majority class for every row: shape (n_samples,)."""
+        return np.asarray(self.classes_[np.argmax(self.predict_proba(X), axis=1)])
