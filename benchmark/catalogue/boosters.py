@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 from sklearn.base import BaseEstimator, ClassifierMixin
+from sklearn.utils import Tags
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, validate_data
 
@@ -24,6 +25,11 @@ class _NominalBooster(ClassifierMixin, BaseEstimator):
 
     nominal_features: Mapping[int, int] | None
     random_state: int | None
+
+    def __sklearn_tags__(self) -> Tags:
+        tags = super().__sklearn_tags__()
+        tags.input_tags.allow_nan = True
+        return tags
 
     def fit(self, X: object, y: object) -> _NominalBooster:
         """Fit on ``X`` of shape (n_samples, n_features) and labels ``y`` (n_samples,)."""
@@ -46,7 +52,8 @@ class _NominalBooster(ClassifierMixin, BaseEstimator):
 
     def predict(self, X: object) -> np.ndarray:
         """Labels of shape (n_samples,)."""
-        return np.asarray(self.classes_[np.argmax(self.predict_proba(X), axis=1)])
+        proba = self.predict_proba(X)
+        return np.asarray(self.classes_[np.argmax(proba, axis=1)])
 
     def _prepare(self, X: np.ndarray) -> Any:
         return X

@@ -11,8 +11,33 @@ from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
+from sklearn.base import BaseEstimator, ClassifierMixin
+from sklearn.utils import Tags
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import validate_data
+
+
+class NanClassifier(ClassifierMixin, BaseEstimator):
+    """Base of classifiers that take NaN as a missing value and predict the likeliest class.
+
+    Subclasses implement ``predict_proba`` (which checks that the model is fitted); the
+    prediction is the first class of highest probability, as WEKA's ``Utils.maxIndex``.
+    """
+
+    classes_: np.ndarray
+
+    def __sklearn_tags__(self) -> Tags:
+        tags = super().__sklearn_tags__()
+        tags.input_tags.allow_nan = True
+        return tags
+
+    def predict_proba(self, X: Any) -> np.ndarray:
+        raise NotImplementedError
+
+    def predict(self, X: Any) -> np.ndarray:
+        """Labels of shape (n_samples,): the most probable class (the first on ties)."""
+        proba = self.predict_proba(X)
+        return np.asarray(self.classes_[np.argmax(proba, axis=1)])
 
 
 def nominal_columns(nominal_features: Mapping[int, int] | None, n_features: int) -> dict[int, int]:

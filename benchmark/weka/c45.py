@@ -26,16 +26,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.special import ndtri
-from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.utils.validation import check_is_fitted
 
-from benchmark.weka._data import check_test_data, check_training_data
+from benchmark.weka._data import NanClassifier, check_test_data, check_training_data
 
 #: WEKA's tolerance in comparisons (``Utils.SMALL``).
 SMALL = 1e-6
 
 
-class C45Classifier(ClassifierMixin, BaseEstimator):
+class C45Classifier(NanClassifier):
     """C4.5 decision tree with WEKA J48's defaults and behaviour.
 
     Parameters
@@ -153,10 +152,6 @@ class C45Classifier(ClassifierMixin, BaseEstimator):
         out[lost] = self._distribution(0)
         total[lost] = 1.0
         return np.asarray(out / total[:, None])
-
-    def predict(self, X: object) -> np.ndarray:
-        """Labels of shape (n_samples,): the most probable class (the first on ties)."""
-        return np.asarray(self.classes_[np.argmax(self.predict_proba(X), axis=1)])
 
     def _distribution(self, node: int) -> np.ndarray:
         counts = self.counts_[node]

@@ -19,10 +19,9 @@ from collections.abc import Mapping
 from typing import Literal
 
 import numpy as np
-from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.utils.validation import check_is_fitted
 
-from benchmark.weka._data import check_test_data, check_training_data
+from benchmark.weka._data import NanClassifier, check_test_data, check_training_data
 
 Weighting = Literal["none", "inverse", "similarity"]
 
@@ -30,7 +29,7 @@ Weighting = Literal["none", "inverse", "similarity"]
 BLOCK_BYTES = 8 * 2**20
 
 
-class WekaIBk(ClassifierMixin, BaseEstimator):
+class WekaIBk(NanClassifier):
     """k-nearest-neighbour classifier with WEKA's distance, ties and vote.
 
     Parameters
@@ -104,10 +103,6 @@ class WekaIBk(ClassifierMixin, BaseEstimator):
                 squared = self._squared_distances(X[first:last], low[first], high[first])
                 out[first:last] = self._vote(squared, n_features)
         return out
-
-    def predict(self, X: object) -> np.ndarray:
-        """Labels of shape (n_samples,): the largest vote (the first class on ties)."""
-        return np.asarray(self.classes_[np.argmax(self.predict_proba(X), axis=1)])
 
     def _ranges(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Per-row attribute ranges: training ranges widened by rows 0..i of ``X``."""

@@ -20,10 +20,9 @@ from typing import Literal
 
 import numpy as np
 from scipy.special import ndtr
-from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.utils.validation import check_is_fitted
 
-from benchmark.weka._data import check_test_data, check_training_data
+from benchmark.weka._data import NanClassifier, check_test_data, check_training_data
 from benchmark.weka.discretize import mdl_cut_points
 
 NumericModel = Literal["normal", "kernel", "discretize"]
@@ -34,7 +33,7 @@ DEFAULT_PRECISION = 0.01
 MIN_FACTOR = 1e-75
 
 
-class WekaNaiveBayes(ClassifierMixin, BaseEstimator):
+class WekaNaiveBayes(NanClassifier):
     """Naive Bayes exactly as WEKA 3.6 computes it.
 
     Parameters
@@ -148,10 +147,6 @@ class WekaNaiveBayes(ClassifierMixin, BaseEstimator):
     def predict_proba(self, X: object) -> np.ndarray:
         """Probabilities of shape (n_samples, n_classes), columns as ``classes_``."""
         return np.exp(self.predict_log_proba(X))
-
-    def predict(self, X: object) -> np.ndarray:
-        """Labels of shape (n_samples,): the most probable class (the first on ties)."""
-        return np.asarray(self.classes_[np.argmax(self._joint_log_likelihood(X), axis=1)])
 
     def _joint_log_likelihood(self, X: object) -> np.ndarray:
         check_is_fitted(self)

@@ -8,12 +8,14 @@ at 1), as WEKA's ``DiscreteEstimator`` does; the prediction is the most frequent
 from __future__ import annotations
 
 import numpy as np
-from sklearn.base import BaseEstimator, ClassifierMixin
+from sklearn.utils import Tags
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from benchmark.weka._data import NanClassifier
 
-class WekaZeroR(ClassifierMixin, BaseEstimator):
+
+class WekaZeroR(NanClassifier):
     """Predict the majority class with Laplace-corrected class frequencies.
 
     Attributes
@@ -22,6 +24,12 @@ class WekaZeroR(ClassifierMixin, BaseEstimator):
     distribution_ : ndarray of shape (n_classes,)
         ``(count + 1) / (n + n_classes)`` per class.
     """
+
+    def __sklearn_tags__(self) -> Tags:
+        tags = super().__sklearn_tags__()
+        if tags.classifier_tags is not None:
+            tags.classifier_tags.poor_score = True
+        return tags
 
     def fit(self, X: object, y: object) -> WekaZeroR:
         """Count the classes of ``y`` (n_samples,); ``X`` (n_samples, n_features) is unused."""
@@ -37,7 +45,3 @@ class WekaZeroR(ClassifierMixin, BaseEstimator):
         check_is_fitted(self)
         X = validate_data(self, X, reset=False, ensure_all_finite="allow-nan", dtype=np.float64)
         return np.tile(self.distribution_, (X.shape[0], 1))
-
-    def predict(self, X: object) -> np.ndarray:
-        """The majority class for every row: shape (n_samples,)."""
-        return np.asarray(self.classes_[np.argmax(self.predict_proba(X), axis=1)])
