@@ -31,7 +31,7 @@ class _NominalBooster(ClassifierMixin, BaseEstimator):
         tags.input_tags.allow_nan = True
         return tags
 
-    def fit(self, X: object, y: object) -> _NominalBooster:
+    def fit(self, X: Any, y: Any) -> _NominalBooster:
         """Fit on ``X`` of shape (n_samples, n_features) and labels ``y`` (n_samples,)."""
         X, y = validate_data(self, X, y, ensure_all_finite="allow-nan", dtype=np.float64)
         check_classification_targets(y)
@@ -42,7 +42,7 @@ class _NominalBooster(ClassifierMixin, BaseEstimator):
             self.model_ = self._fit_model(X, codes)
         return self
 
-    def predict_proba(self, X: object) -> np.ndarray:
+    def predict_proba(self, X: Any) -> np.ndarray:
         """Probabilities of shape (n_samples, n_classes), columns as ``classes_``."""
         check_is_fitted(self)
         X = validate_data(self, X, reset=False, ensure_all_finite="allow-nan", dtype=np.float64)
@@ -50,7 +50,7 @@ class _NominalBooster(ClassifierMixin, BaseEstimator):
             return np.ones((X.shape[0], 1))
         return np.asarray(self.model_.predict_proba(self._prepare(X)), dtype=np.float64)
 
-    def predict(self, X: object) -> np.ndarray:
+    def predict(self, X: Any) -> np.ndarray:
         """Labels of shape (n_samples,)."""
         proba = self.predict_proba(X)
         return np.asarray(self.classes_[np.argmax(proba, axis=1)])

@@ -1029,7 +1029,7 @@ SPECS: tuple[ClassifierSpec, ...] = (
     _spec(
         "mlp-small",
         MLPClassifier,
-        {"hidden_layer_sizes": (30,), "alpha": 1e-2, "max_iter": 500, "early_stopping": True},
+        {"hidden_layer_sizes": (30,), "alpha": 1e-2, "max_iter": 1000},
         family="neural-network",
         description="Multilayer perceptron, one hidden layer of 30, weight decay 0.01",
         scaling="standard",

@@ -59,7 +59,7 @@ class OrderedRuleClassifier(ClassifierMixin, BaseEstimator):
         self.n_discretize_bins = n_discretize_bins
         self.random_state = random_state
 
-    def fit(self, X: object, y: object) -> OrderedRuleClassifier:
+    def fit(self, X: Any, y: Any) -> OrderedRuleClassifier:
         """Learn one rule set per class on ``X`` (n_samples, n_features) and ``y``."""
         import wittgenstein
 
@@ -96,7 +96,7 @@ class OrderedRuleClassifier(ClassifierMixin, BaseEstimator):
             remaining &= codes != code
         return self
 
-    def predict(self, X: object) -> np.ndarray:
+    def predict(self, X: Any) -> np.ndarray:
         """Labels of shape (n_samples,): the class of the first rule set that fires."""
         check_is_fitted(self)
         X = validate_data(self, X, reset=False, dtype=np.float64)

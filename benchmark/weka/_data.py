@@ -107,7 +107,7 @@ def check_codes(X: np.ndarray, nominal: Mapping[int, int]) -> None:
         bad = (known < 0) | (known >= n_labels) | (known != np.floor(known))
         if bad.any():
             raise ValueError(
-                f"nominal feature column {column} holds {known[bad][0]!r}; "
+                f"nominal feature column {column} holds {float(known[bad][0])!r}; "
                 f"its codes must be whole numbers in 0..{n_labels - 1} (NaN for missing)"
             )
 

@@ -60,7 +60,9 @@ def run_weka(arguments: Sequence[str], *, timeout: float = 600.0) -> str:
     return completed.stdout
 
 
-def cross_validated_accuracy(command: str, data: Path, *, folds: int = 10, seed: int = 1) -> float:
+def cross_validated_accuracy(
+    command: str, data: Path, *, folds: int = 10, seed: int = 1, class_index: str = "last"
+) -> float:
     """WEKA's stratified cross-validation accuracy (percent) of a command on an ARFF file.
 
     Parameters
@@ -71,18 +73,22 @@ def cross_validated_accuracy(command: str, data: Path, *, folds: int = 10, seed:
         ARFF file; the last attribute is the class.
     folds, seed : int
         WEKA's ``-x`` and ``-s``.
+    class_index : str
+        WEKA's ``-c``: ``"last"``, ``"first"`` or a 1-based index.
     """
     scheme, *options = shlex.split(command)
-    output = run_weka([scheme, "-t", str(data), "-x", str(folds), "-s", str(seed), "-o", *options])
+    arguments = ["-t", str(data), "-c", class_index, "-x", str(folds), "-s", str(seed), "-o"]
+    output = run_weka([scheme, *arguments, *options])
     match = _CORRECT.search(output.split("=== Stratified cross-validation ===")[-1])
     if match is None:
         raise ConfigurationError(f"no accuracy in WEKA's output for {command} on {data}")
     return float(match.group(1))
 
 
-def predictions(command: str, train: Path, test: Path) -> np.ndarray:
+def predictions(command: str, train: Path, test: Path, *, class_index: str = "last") -> np.ndarray:
     """Class codes (0-based) WEKA predicts for the instances of ``test``, in order."""
     scheme, *options = shlex.split(command)
-    output = run_weka([scheme, "-t", str(train), "-T", str(test), "-p", "0", *options])
+    arguments = ["-t", str(train), "-T", str(test), "-c", class_index, "-p", "0"]
+    output = run_weka([scheme, *arguments, *options])
     codes = [int(m.group(1)) - 1 for line in output.splitlines() if (m := _PREDICTION.match(line))]
     return np.asarray(codes, dtype=np.int64)

@@ -7,6 +7,8 @@ at 1), as WEKA's ``DiscreteEstimator`` does; the prediction is the most frequent
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from sklearn.utils import Tags
 from sklearn.utils.multiclass import check_classification_targets
@@ -31,7 +33,7 @@ class WekaZeroR(NanClassifier):
             tags.classifier_tags.poor_score = True
         return tags
 
-    def fit(self, X: object, y: object) -> WekaZeroR:
+    def fit(self, X: Any, y: Any) -> WekaZeroR:
         """Count the classes of ``y`` (n_samples,); ``X`` (n_samples, n_features) is unused."""
         X, y = validate_data(self, X, y, ensure_all_finite="allow-nan", dtype=np.float64)
         check_classification_targets(y)
@@ -40,7 +42,7 @@ class WekaZeroR(NanClassifier):
         self.distribution_ = counts / counts.sum()
         return self
 
-    def predict_proba(self, X: object) -> np.ndarray:
+    def predict_proba(self, X: Any) -> np.ndarray:
         """The class distribution for every row: shape (n_samples, n_classes)."""
         check_is_fitted(self)
         X = validate_data(self, X, reset=False, ensure_all_finite="allow-nan", dtype=np.float64)
