@@ -575,6 +575,7 @@ SPECS: tuple[ClassifierSpec, ...] = (
         description="LightGBM, 300 rounds of 31-leaf trees, native nominal features",
         missing=True,
         nominal=True,
+        cost="slow",
     ),
     _spec(
         "lgbm-small",
@@ -600,6 +601,7 @@ SPECS: tuple[ClassifierSpec, ...] = (
         description="LightGBM with 80% row and feature sampling per round",
         missing=True,
         nominal=True,
+        suites=ALL_ONLY,
     ),
     _spec(
         "lgbm-balanced",
@@ -647,6 +649,7 @@ SPECS: tuple[ClassifierSpec, ...] = (
         missing=True,
         nominal=True,
         cost="slow",
+        suites=ALL_ONLY,
     ),
     _spec(
         "catboost-shallow",
@@ -656,6 +659,7 @@ SPECS: tuple[ClassifierSpec, ...] = (
         description="CatBoost, 300 rounds of depth-4 trees",
         missing=True,
         nominal=True,
+        cost="slow",
     ),
     _spec(
         "catboost-balanced",

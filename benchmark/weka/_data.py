@@ -110,10 +110,3 @@ def check_codes(X: np.ndarray, nominal: Mapping[int, int]) -> None:
                 f"nominal feature column {column} holds {float(known[bad][0])!r}; "
                 f"its codes must be whole numbers in 0..{n_labels - 1} (NaN for missing)"
             )
-
-
-def one_hot_weights(codes: np.ndarray, weights: np.ndarray, n_classes: int) -> np.ndarray:
-    """Weighted class indicators of shape (n_samples, n_classes)."""
-    out = np.zeros((codes.size, n_classes))
-    out[np.arange(codes.size), codes] = weights
-    return out
