@@ -6,8 +6,8 @@ take the outer model's parameters so that ``params`` shows them.  Nested ``rando
 parameters are set by :func:`benchmark.catalogue.build_pipeline`, not here.
 
 An entry carries a WEKA command line only where it computes what that command computes
-(:mod:`benchmark.weka` reimplements WEKA's J48, NaiveBayes, IBk and ZeroR on nominal
-codes); ``perf/weka_agreement.py`` measures each against WEKA itself.
+(:mod:`benchmark.weka` reimplements WEKA's J48, PART, NaiveBayes, IBk and ZeroR on
+nominal codes); ``perf/weka_agreement.py`` measures each against WEKA itself.
 """
 
 from __future__ import annotations
@@ -50,7 +50,7 @@ from benchmark.catalogue.estimators import LabelEncodedClassifier, OneRuleClassi
 from benchmark.catalogue.rules import OrderedRuleClassifier
 from benchmark.catalogue.spec import ClassifierSpec
 from benchmark.catalogue.weka_schemes import weka_command
-from benchmark.weka import C45Classifier, WekaIBk, WekaNaiveBayes, WekaZeroR
+from benchmark.weka import C45Classifier, PARTClassifier, WekaIBk, WekaNaiveBayes, WekaZeroR
 
 FAST = frozenset({"fast", "default"})
 DEFAULT = frozenset({"default"})
@@ -282,6 +282,19 @@ SPECS: tuple[ClassifierSpec, ...] = (
         description="Best single-feature interval rule (OneR-like: intervals from a 1-D tree)",
         suites=FAST,
         limits="not WEKA's OneR: intervals from a 1-D tree, not OneR's bucket merging",
+    ),
+    _spec(
+        "part",
+        PARTClassifier,
+        {"min_instances": 2, "confidence": 0.25},
+        family="rules",
+        description="PART: decision list of rules from partial C4.5 trees",
+        weka=W + "rules.PART",
+        missing=True,
+        nominal=True,
+        cost="slow",
+        suites=ALL_ONLY,
+        limits=WEKA_NATIVE,
     ),
     _spec(
         "ripper",

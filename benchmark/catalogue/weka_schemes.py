@@ -37,7 +37,8 @@ class WekaOption:
         The estimator parameter it sets; None for an option accepted only with the value
         WEKA uses by default (``accepted``).
     kind : {"flag", "int", "float", "fixed"}
-        A switch, a number, or a value that must be one of ``accepted``.
+        A switch, a number, or a value that must be one of ``accepted``.  A number with
+        no ``param`` is checked and ignored (it does not change the model).
     set_to : Any
         For a switch: the parameter's value when the switch is present.
     accepted : tuple of str
@@ -141,8 +142,7 @@ def _value(weka_class: str, option: WekaOption, text: str) -> dict[str, Any]:
     if not option.low < number <= option.high:
         limit = f"at most {option.high:g}" if number > option.high else f"above {option.low:g}"
         raise ConfigurationError(f"{where}: the value must be {limit}")
-    assert option.param is not None
-    return {option.param: number}
+    return {} if option.param is None else {option.param: number}
 
 
 def _normalise(text: str) -> list[str]:
@@ -207,6 +207,11 @@ def _j48_check(present: set[str]) -> None:
         )
 
 
+def _part_options(params: Mapping[str, Any]) -> list[str]:
+    minimum, confidence = params.get("min_instances", 2), params.get("confidence", 0.25)
+    return ["-M", str(minimum), "-C", _float(confidence), "-Q", "1"]
+
+
 def _naive_bayes_options(params: Mapping[str, Any]) -> list[str]:
     return {"kernel": ["-K"], "discretize": ["-D"]}.get(params.get("numeric", "normal"), [])
 
@@ -250,6 +255,17 @@ SCHEMES: tuple[WekaScheme, ...] = (
         ),
         _j48_options,
         _j48_check,
+    ),
+    WekaScheme(
+        W + "rules.PART",
+        "part",
+        (
+            WekaOption("-M", "min_instances", "int"),
+            WekaOption("-C", "confidence", "float", high=0.5),
+            # the seed of reduced-error pruning, which touchbench does not offer: no effect
+            WekaOption("-Q", None, "int", low=-float("inf")),
+        ),
+        _part_options,
     ),
     WekaScheme(
         W + "bayes.NaiveBayes",

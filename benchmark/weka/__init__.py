@@ -9,6 +9,7 @@ check them.
 from benchmark.weka.c45 import C45Classifier
 from benchmark.weka.ibk import WekaIBk
 from benchmark.weka.naive_bayes import WekaNaiveBayes
+from benchmark.weka.part import PARTClassifier
 from benchmark.weka.zeror import WekaZeroR
 
-__all__ = ["C45Classifier", "WekaIBk", "WekaNaiveBayes", "WekaZeroR"]
+__all__ = ["C45Classifier", "PARTClassifier", "WekaIBk", "WekaNaiveBayes", "WekaZeroR"]

@@ -25,7 +25,17 @@ pytestmark = pytest.mark.skipif(
     reason="needs WEKA and Java (apt-get install weka default-jre-headless)",
 )
 
-ENTRIES = ("zeror", "j48", "j48-unpruned", "nb", "nb-kernel", "nb-discretized", "ibk", "ibk5-w")
+ENTRIES = (
+    "zeror",
+    "j48",
+    "j48-unpruned",
+    "part",
+    "nb",
+    "nb-kernel",
+    "nb-discretized",
+    "ibk",
+    "ibk5-w",
+)
 
 
 def split(name: str, folder: Path) -> tuple[Dataset, Dataset, Path, Path]:
