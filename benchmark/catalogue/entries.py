@@ -261,6 +261,16 @@ def _spec(
 W = "weka.classifiers."
 WEKA_NATIVE = "computes what WEKA 3.6 computes (checked prediction by prediction)"
 
+
+def _weka(
+    id: str, factory: Any, params: dict[str, Any], weka: str, **fields: Any
+) -> ClassifierSpec:
+    """An entry of :mod:`benchmark.weka`: WEKA's command, nominal codes and NaN as they are."""
+    return _spec(
+        id, factory, params, weka=W + weka, missing=True, nominal=True, limits=WEKA_NATIVE, **fields
+    )
+
+
 SPECS: tuple[ClassifierSpec, ...] = (
     # Baselines and rules
     _spec(
@@ -283,18 +293,15 @@ SPECS: tuple[ClassifierSpec, ...] = (
         suites=FAST,
         limits="not WEKA's OneR: intervals from a 1-D tree, not OneR's bucket merging",
     ),
-    _spec(
+    _weka(
         "part",
         PARTClassifier,
         {"min_instances": 2, "confidence": 0.25},
+        "rules.PART",
         family="rules",
         description="PART: decision list of rules from partial C4.5 trees",
-        weka=W + "rules.PART",
-        missing=True,
-        nominal=True,
         cost="slow",
         suites=ALL_ONLY,
-        limits=WEKA_NATIVE,
     ),
     _spec(
         "ripper",
@@ -328,63 +335,48 @@ SPECS: tuple[ClassifierSpec, ...] = (
         limits="predicts at most two classes; not WEKA's DecisionStump (no missing branch)",
     ),
     # C4.5 (WEKA's J48)
-    _spec(
+    _weka(
         "j48",
         C45Classifier,
         {"confidence": 0.25, "min_instances": 2},
+        "trees.J48",
         family="trees",
         description="C4.5 (J48): gain ratio, multiway nominal splits, pruned with confidence 0.25",
-        weka=W + "trees.J48",
-        missing=True,
-        nominal=True,
         suites=FAST,
-        limits=WEKA_NATIVE,
     ),
-    _spec(
+    _weka(
         "j48-pruned",
         C45Classifier,
         {"confidence": 0.1, "min_instances": 2},
+        "trees.J48",
         family="trees",
         description="C4.5 (J48) pruned harder: confidence 0.1",
-        weka=W + "trees.J48",
-        missing=True,
-        nominal=True,
-        limits=WEKA_NATIVE,
     ),
-    _spec(
+    _weka(
         "j48-unpruned",
         C45Classifier,
         {"pruned": False, "min_instances": 2},
+        "trees.J48",
         family="trees",
         description="C4.5 (J48) without pruning",
-        weka=W + "trees.J48",
-        missing=True,
-        nominal=True,
-        limits=WEKA_NATIVE,
     ),
-    _spec(
+    _weka(
         "j48-no-raising",
         C45Classifier,
         {"confidence": 0.25, "subtree_raising": False, "min_instances": 2},
+        "trees.J48",
         family="trees",
         description="C4.5 (J48) pruned without subtree raising",
-        weka=W + "trees.J48",
-        missing=True,
-        nominal=True,
         suites=ALL_ONLY,
-        limits=WEKA_NATIVE,
     ),
-    _spec(
+    _weka(
         "j48-m5",
         C45Classifier,
         {"confidence": 0.25, "min_instances": 5},
+        "trees.J48",
         family="trees",
         description="C4.5 (J48) with at least 5 instances per branch",
-        weka=W + "trees.J48",
-        missing=True,
-        nominal=True,
         suites=ALL_ONLY,
-        limits=WEKA_NATIVE,
     ),
     # Other single trees
     _spec(
@@ -686,85 +678,64 @@ SPECS: tuple[ClassifierSpec, ...] = (
         suites=ALL_ONLY,
     ),
     # Nearest neighbours: WEKA's IBk exactly, then scikit-learn's
-    _spec(
+    _weka(
         "ibk",
         WekaIBk,
         {"n_neighbors": 1},
+        "lazy.IBk",
         family="nearest-neighbours",
         description="1-nearest neighbour on WEKA's distance (range-normalised, nominal 0/1)",
-        weka=W + "lazy.IBk",
-        missing=True,
-        nominal=True,
         suites=FAST,
-        limits=WEKA_NATIVE,
     ),
-    _spec(
+    _weka(
         "ibk3",
         WekaIBk,
         {"n_neighbors": 3},
+        "lazy.IBk",
         family="nearest-neighbours",
         description="3-nearest neighbours (IBk)",
-        weka=W + "lazy.IBk",
-        missing=True,
-        nominal=True,
-        limits=WEKA_NATIVE,
     ),
-    _spec(
+    _weka(
         "ibk5",
         WekaIBk,
         {"n_neighbors": 5},
+        "lazy.IBk",
         family="nearest-neighbours",
         description="5-nearest neighbours (IBk)",
-        weka=W + "lazy.IBk",
-        missing=True,
-        nominal=True,
-        limits=WEKA_NATIVE,
     ),
-    _spec(
+    _weka(
         "ibk10",
         WekaIBk,
         {"n_neighbors": 10},
+        "lazy.IBk",
         family="nearest-neighbours",
         description="10-nearest neighbours (IBk)",
-        weka=W + "lazy.IBk",
-        missing=True,
-        nominal=True,
-        limits=WEKA_NATIVE,
     ),
-    _spec(
+    _weka(
         "ibk-w",
         WekaIBk,
         {"n_neighbors": 10, "weighting": "inverse"},
+        "lazy.IBk",
         family="nearest-neighbours",
         description="10-nearest neighbours weighted by 1/distance (IBk -I)",
-        weka=W + "lazy.IBk",
-        missing=True,
-        nominal=True,
-        limits=WEKA_NATIVE,
     ),
-    _spec(
+    _weka(
         "ibk5-w",
         WekaIBk,
         {"n_neighbors": 5, "weighting": "inverse"},
+        "lazy.IBk",
         family="nearest-neighbours",
         description="5-nearest neighbours weighted by 1/distance (IBk -I)",
-        weka=W + "lazy.IBk",
-        missing=True,
-        nominal=True,
         suites=ALL_ONLY,
-        limits=WEKA_NATIVE,
     ),
-    _spec(
+    _weka(
         "ibk10-f",
         WekaIBk,
         {"n_neighbors": 10, "weighting": "similarity"},
+        "lazy.IBk",
         family="nearest-neighbours",
         description="10-nearest neighbours weighted by 1 - distance (IBk -F)",
-        weka=W + "lazy.IBk",
-        missing=True,
-        nominal=True,
         suites=ALL_ONLY,
-        limits=WEKA_NATIVE,
     ),
     _spec(
         "knn5",
@@ -793,39 +764,30 @@ SPECS: tuple[ClassifierSpec, ...] = (
         suites=ALL_ONLY,
     ),
     # Naive Bayes: WEKA's NaiveBayes exactly, then scikit-learn's
-    _spec(
+    _weka(
         "nb",
         WekaNaiveBayes,
         {"numeric": "normal"},
+        "bayes.NaiveBayes",
         family="naive-bayes",
         description="Naive Bayes: Laplace frequencies for nominal, normal density for numeric",
-        weka=W + "bayes.NaiveBayes",
-        missing=True,
-        nominal=True,
         suites=FAST,
-        limits=WEKA_NATIVE,
     ),
-    _spec(
+    _weka(
         "nb-kernel",
         WekaNaiveBayes,
         {"numeric": "kernel"},
+        "bayes.NaiveBayes",
         family="naive-bayes",
         description="Naive Bayes with kernel density estimates for numeric attributes (-K)",
-        weka=W + "bayes.NaiveBayes",
-        missing=True,
-        nominal=True,
-        limits=WEKA_NATIVE,
     ),
-    _spec(
+    _weka(
         "nb-discretized",
         WekaNaiveBayes,
         {"numeric": "discretize"},
+        "bayes.NaiveBayes",
         family="naive-bayes",
         description="Naive Bayes on Fayyad-Irani MDL intervals of numeric attributes (-D)",
-        weka=W + "bayes.NaiveBayes",
-        missing=True,
-        nominal=True,
-        limits=WEKA_NATIVE,
     ),
     _spec(
         "nb-gaussian",

@@ -237,6 +237,14 @@ def _gain_ratio(bags: np.ndarray, total: float, gains: np.ndarray) -> np.ndarray
     return np.where(np.abs(split_info) < SMALL, 0.0, out)
 
 
+def check_pruning(confidence: float, min_instances: int) -> None:
+    """Raise ValueError unless ``confidence`` is in (0, 0.5] and ``min_instances`` >= 1."""
+    if not 0 < confidence <= 0.5:
+        raise ValueError(f"confidence must lie in (0, 0.5], got {confidence!r}")
+    if not isinstance(min_instances, int | np.integer) or min_instances < 1:
+        raise ValueError(f"min_instances must be a positive integer, got {min_instances!r}")
+
+
 def added_errors(n: float, errors: float, confidence: float) -> float:
     """Pessimistic extra errors of a leaf of weight ``n`` with ``errors`` (WEKA ``Stats.addErrs``).
 

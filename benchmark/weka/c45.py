@@ -30,6 +30,7 @@ from benchmark.weka._splits import (
     Split,
     SplitSelector,
     added_errors,
+    check_pruning,
     training_errors,
 )
 
@@ -95,12 +96,7 @@ class C45Classifier(NanClassifier):
 
     def fit(self, X: object, y: object) -> C45Classifier:
         """Grow and prune the tree on ``X`` (n_samples, n_features) and labels ``y``."""
-        if not 0 < self.confidence <= 0.5:
-            raise ValueError(f"confidence must lie in (0, 0.5], got {self.confidence!r}")
-        if not isinstance(self.min_instances, int | np.integer) or self.min_instances < 1:
-            raise ValueError(
-                f"min_instances must be a positive integer, got {self.min_instances!r}"
-            )
+        check_pruning(self.confidence, self.min_instances)
         X, codes, nominal = check_training_data(self, X, y)
         self.nominal_ = nominal
         grower = _Grower(

@@ -19,7 +19,14 @@ import numpy as np
 from sklearn.utils.validation import check_is_fitted
 
 from benchmark.weka._data import NanClassifier, check_test_data, check_training_data
-from benchmark.weka._splits import SMALL, Split, SplitSelector, added_errors, training_errors
+from benchmark.weka._splits import (
+    SMALL,
+    Split,
+    SplitSelector,
+    added_errors,
+    check_pruning,
+    training_errors,
+)
 
 
 class PARTClassifier(NanClassifier):
@@ -56,12 +63,7 @@ class PARTClassifier(NanClassifier):
 
     def fit(self, X: Any, y: Any) -> PARTClassifier:
         """Learn the decision list from ``X`` (n_samples, n_features) and labels ``y``."""
-        if not 0 < self.confidence <= 0.5:
-            raise ValueError(f"confidence must lie in (0, 0.5], got {self.confidence!r}")
-        if not isinstance(self.min_instances, int | np.integer) or self.min_instances < 1:
-            raise ValueError(
-                f"min_instances must be a positive integer, got {self.min_instances!r}"
-            )
+        check_pruning(self.confidence, self.min_instances)
         X, codes, nominal = check_training_data(self, X, y)
         self.nominal_ = nominal
         builder = _RuleBuilder(
