@@ -50,11 +50,14 @@ class C45Classifier(NanClassifier):
         Consider replacing a subtree by its largest branch while pruning (``False`` is
         ``-S``).
     collapse : bool
-        Collapse subtrees that do not reduce training errors (``False`` is ``-O``).
+        Collapse subtrees that do not reduce training errors (``False`` is WEKA 3.7's
+        ``-O``; WEKA 3.6 always collapses).
     mdl_correction : bool
-        Penalise numeric cuts by log2(#candidate cuts) / n (``False`` is ``-J``).
+        Penalise numeric cuts by log2(#candidate cuts) / n (``False`` is WEKA 3.7's
+        ``-J``; WEKA 3.6 always does).
     laplace : bool
-        Laplace-smoothed leaf probabilities (``-A``); predictions are unchanged.
+        Laplace-smoothed leaf probabilities (``-A``); predictions change only where a
+        missing value mixes several leaves.
     nominal_features : mapping of int to int, optional
         Nominal column index to its number of declared labels; other columns are numeric.
 
