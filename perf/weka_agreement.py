@@ -82,12 +82,8 @@ def data_files(names: list[str], folder: Path) -> dict[str, tuple[Path, str]]:
 def touchbench_accuracy(path: Path, ids: list[str], repeats: int, jobs: int) -> dict[str, float]:
     """Accuracy (percent) of each id, pooled over the folds of each repetition as WEKA
     reports it, then averaged over ``repeats`` x stratified 10-fold CV."""
-    dataset = read_arff(path)
-    if dataset.schema.target_indices != (dataset.schema.n_attributes - 1,) and (
-        dataset.n_targets != 1
-    ):
-        dataset = dataset.with_targets([dataset.schema.n_attributes - 1])
-    problem, _ = problem_from_dataset(dataset)
+    # WEKA's files: the last attribute is the class; ours: the MEKA header names it
+    problem, _ = problem_from_dataset(read_arff(path))
     folds, _ = make_folds(problem.Y, n_folds=10, n_repeats=repeats)
     results = run_tasks(problem, ids, folds, jobs=jobs, timeout=None)
     out = {}
