@@ -359,6 +359,7 @@ SPECS: tuple[ClassifierSpec, ...] = (
         "trees.J48",
         family="trees",
         description="C4.5 (J48) without pruning",
+        suites=ALL_ONLY,
     ),
     _weka(
         "j48-no-raising",
@@ -581,6 +582,7 @@ SPECS: tuple[ClassifierSpec, ...] = (
         missing=True,
         nominal=True,
         cost="slow",
+        suites=ALL_ONLY,
     ),
     _spec(
         "lgbm-small",
@@ -665,6 +667,7 @@ SPECS: tuple[ClassifierSpec, ...] = (
         missing=True,
         nominal=True,
         cost="slow",
+        suites=ALL_ONLY,
     ),
     _spec(
         "catboost-balanced",
