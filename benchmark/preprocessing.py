@@ -76,7 +76,9 @@ def make_preprocessor(
     -------
     transformer : ColumnTransformer
         Output columns: numeric features, then nominal features (one-hot blocks, or codes
-        when ``native_nominal``), then the pass-through columns.
+        when ``native_nominal``), then the pass-through columns.  With ``native_nominal``
+        and nothing to do to numeric columns, every column passes through in its own
+        order (WEKA's learners scan attributes in file order, which breaks their ties).
     native_positions : list of int
         Output positions of the nominal code columns when ``native_nominal``, else empty.
 
@@ -89,6 +91,14 @@ def make_preprocessor(
     nominal = sorted(nominal_features)
     numeric = [c for c in range(n_features) if c not in nominal_features]
     transformers: list[tuple[str, object, list[int]]] = []
+    if native_nominal and not impute and scaling is None:
+        transformer = ColumnTransformer(
+            [("features", "passthrough", list(range(n_features)))],
+            remainder="passthrough",
+            sparse_threshold=0.0,
+            verbose_feature_names_out=False,
+        )
+        return transformer, nominal
     if numeric:
         transformers.append(("numeric", _numeric_steps(impute, scaling), numeric))
     native_positions: list[int] = []

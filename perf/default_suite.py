@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import subprocess
 import tempfile
 import time
@@ -102,6 +103,20 @@ def run_suite(problem: Problem, ids: list[str], n_folds: int, jobs: int, top: in
     print(
         f"  wall {elapsed:.1f} s = {elapsed / 60:.2f} min; "
         f"{len(ids) / (elapsed / 60):.1f} classifiers cross-validated per minute"
+    )
+    # CPU seconds of the fits and predictions themselves: on a shared machine the wall
+    # time says as much about the neighbours as about the suite
+    cpu = sum(
+        r.metrics.get("fit_cpu_time", 0.0) + r.metrics.get("predict_cpu_time", 0.0) for r in results
+    )
+    print(
+        f"  CPU in fits and predictions {cpu:.0f} s = {cpu / jobs / 60:.2f} min over {jobs} "
+        f"jobs; load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores"
+    )
+    slowest = sorted(board.rows, key=lambda row: -row.metrics.get("fit_time", (0.0,))[0])[:5]
+    print(
+        "  slowest fits (s/fold): "
+        + ", ".join(f"{row.classifier} {row.metrics['fit_time'][0]:.1f}" for row in slowest)
     )
     return elapsed
 

@@ -1,7 +1,9 @@
 """The classifier catalogue: every benchmarkable configuration, as data.
 
->>> get_spec("rf").weka_name
-'weka.classifiers.trees.RandomForest'
+>>> get_spec("j48").weka_command
+'weka.classifiers.trees.J48 -C 0.25 -M 2'
+>>> parse_weka_command("weka.classifiers.trees.J48 -U -M 2").id
+'j48-unpruned'
 >>> "zeror" in suite("fast")
 True
 """
@@ -9,7 +11,9 @@ True
 from __future__ import annotations
 
 import difflib
+import re
 from collections.abc import Mapping
+from dataclasses import replace
 from types import MappingProxyType
 
 from sklearn.pipeline import Pipeline
@@ -17,9 +21,18 @@ from sklearn.pipeline import Pipeline
 from benchmark.catalogue.entries import SPECS
 from benchmark.catalogue.pipeline import pipeline_for_spec
 from benchmark.catalogue.spec import ClassifierSpec
+from benchmark.catalogue.weka_schemes import scheme_for, split_command
 from benchmark.errors import ConfigurationError
 
-__all__ = ["CATALOGUE", "SUITES", "ClassifierSpec", "build_pipeline", "get_spec", "suite"]
+__all__ = [
+    "CATALOGUE",
+    "SUITES",
+    "ClassifierSpec",
+    "build_pipeline",
+    "get_spec",
+    "parse_weka_command",
+    "suite",
+]
 
 CATALOGUE: Mapping[str, ClassifierSpec] = MappingProxyType({spec.id: spec for spec in SPECS})
 SUITES: tuple[str, ...] = ("fast", "default", "all")
@@ -44,6 +57,54 @@ def unknown_classifier_message(classifier_id: str, known: Mapping[str, object]) 
     close = difflib.get_close_matches(classifier_id.lower(), list(known), n=1, cutoff=0.5)
     hint = f"did you mean '{close[0]}'?" if close else "see `touchbench classifiers`"
     return f"unknown classifier '{classifier_id}'; {hint}"
+
+
+def parse_weka_command(text: str) -> ClassifierSpec:
+    """The catalogue configuration that runs a WEKA command line.
+
+    Parameters
+    ----------
+    text : str
+        A WEKA class and its options, as on WEKA's command line or in a results file's
+        ``Key_Scheme`` and ``Key_Scheme_options`` (``"weka.classifiers.trees.J48 -C 0.1
+        -M 5"``; the class may be given by its last part, ``"J48 -C 0.1"``).
+
+    Returns
+    -------
+    ClassifierSpec
+        The catalogue entry whose ``weka_command`` it is, or else a new spec on the same
+        estimator with the options' parameters, its id derived from the entry's
+        (``"j48-c0.1-m5"``), in no suite; pass it to the engine as an extra spec.
+
+    Raises
+    ------
+    ConfigurationError
+        A WEKA class touchbench does not reproduce, or an option it does not support
+        (the message names it).
+    """
+    weka_class, tokens = split_command(text)
+    scheme = scheme_for(weka_class)
+    params = scheme.parse(tokens)
+    base = CATALOGUE[scheme.base_id]
+    merged = {**base.params, **params}
+    command = scheme.command(merged)
+    for spec in CATALOGUE.values():
+        if spec.weka_command == command:
+            return spec
+    words = [t.lstrip("-").lower() for t in split_command(command)[1] if " " not in t]
+    slug = "-".join(
+        word + words[i + 1] if i + 1 < len(words) and not words[i + 1].isalpha() else word
+        for i, word in enumerate(words)
+        if not re.fullmatch(r"[0-9.e-]+", word) and word not in ("w", "a")
+    )
+    return replace(
+        base,
+        id=f"{base.id}-{slug}" if slug else base.id,
+        weka_command=command,
+        params=merged,
+        suites=frozenset(),
+        description=f"{base.description} ({scheme.weka_class} {command.split(' ', 1)[-1]})",
+    )
 
 
 def suite(name: str) -> list[str]:

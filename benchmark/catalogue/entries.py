@@ -4,6 +4,10 @@ Plain scikit-learn classes are their own factories; composite models (wrappers a
 ensembles around a base estimator) are built by the module-level functions below, which
 take the outer model's parameters so that ``params`` shows them.  Nested ``random_state``
 parameters are set by :func:`benchmark.catalogue.build_pipeline`, not here.
+
+An entry carries a WEKA command line only where it computes what that command computes
+(:mod:`benchmark.weka` reimplements WEKA's J48, PART, NaiveBayes, IBk and ZeroR on
+nominal codes); ``perf/weka_agreement.py`` measures each against WEKA itself.
 """
 
 from __future__ import annotations
@@ -13,7 +17,6 @@ from typing import Any
 from sklearn.base import BaseEstimator
 from sklearn.calibration import CalibratedClassifierCV
 from sklearn.discriminant_analysis import LinearDiscriminantAnalysis, QuadraticDiscriminantAnalysis
-from sklearn.dummy import DummyClassifier
 from sklearn.ensemble import (
     AdaBoostClassifier,
     BaggingClassifier,
@@ -42,8 +45,12 @@ from sklearn.preprocessing import KBinsDiscretizer
 from sklearn.svm import SVC, LinearSVC, NuSVC
 from sklearn.tree import DecisionTreeClassifier, ExtraTreeClassifier
 
+from benchmark.catalogue.boosters import CatBoostNominalClassifier, LightGBMClassifier
 from benchmark.catalogue.estimators import LabelEncodedClassifier, OneRuleClassifier
+from benchmark.catalogue.rules import OrderedRuleClassifier
 from benchmark.catalogue.spec import ClassifierSpec
+from benchmark.catalogue.weka_schemes import weka_command
+from benchmark.weka import C45Classifier, PARTClassifier, WekaIBk, WekaNaiveBayes, WekaZeroR
 
 FAST = frozenset({"fast", "default"})
 DEFAULT = frozenset({"default"})
@@ -70,7 +77,7 @@ def xgboost_classifier(**params: Any) -> BaseEstimator:
     return LabelEncodedClassifier(XGBClassifier(**params))
 
 
-def discretized_naive_bayes(n_bins: int = 10) -> BaseEstimator:
+def quantile_naive_bayes(n_bins: int = 10) -> BaseEstimator:
     """Equal-frequency discretisation followed by categorical naive Bayes."""
     from sklearn.naive_bayes import CategoricalNB
 
@@ -81,14 +88,19 @@ def discretized_naive_bayes(n_bins: int = 10) -> BaseEstimator:
 
 
 def bagged_trees(n_estimators: int = 50, max_samples: float = 1.0) -> BaseEstimator:
-    """Bagging of unpruned decision trees (WEKA's Bagging with REPTree, roughly)."""
+    """Bagging of unpruned CART trees."""
     return BaggingClassifier(
         DecisionTreeClassifier(), n_estimators=n_estimators, max_samples=max_samples
     )
 
 
+def bagged_c45(n_estimators: int = 10) -> BaseEstimator:
+    """Bagging of C4.5 trees (WEKA J48's defaults) on bootstrap samples, probabilities averaged."""
+    return BaggingClassifier(C45Classifier(), n_estimators=n_estimators)
+
+
 def random_subspace_trees(n_estimators: int = 50, max_features: float = 0.5) -> BaseEstimator:
-    """Decision trees each on a random half of the features (WEKA's RandomSubSpace)."""
+    """CART trees each on a random half of the features (random subspaces)."""
     return BaggingClassifier(
         DecisionTreeClassifier(),
         n_estimators=n_estimators,
@@ -98,7 +110,7 @@ def random_subspace_trees(n_estimators: int = 50, max_features: float = 0.5) -> 
 
 
 def boosted_stumps(n_estimators: int = 100, learning_rate: float = 1.0) -> BaseEstimator:
-    """AdaBoost (SAMME) over decision stumps, like WEKA's AdaBoostM1 default."""
+    """AdaBoost (SAMME) over decision stumps."""
     return AdaBoostClassifier(
         DecisionTreeClassifier(max_depth=1),
         n_estimators=n_estimators,
@@ -205,7 +217,7 @@ _BASES = {
     "svm-linear": _linear_svm,
     "svm-rbf": _rbf_svm,
     "nb": GaussianNB,
-    "j48": _entropy_tree,
+    "entropy-tree": _entropy_tree,
 }
 
 
@@ -230,7 +242,7 @@ def _spec(
 ) -> ClassifierSpec:
     return ClassifierSpec(
         id=id,
-        weka_name=weka,
+        weka_command=weka_command(weka, params) if weka else None,
         family=family,
         description=description,
         factory=factory,
@@ -247,27 +259,71 @@ def _spec(
 
 
 W = "weka.classifiers."
+WEKA_NATIVE = "computes what WEKA 3.6 computes (checked prediction by prediction)"
+
+
+def _weka(
+    id: str, factory: Any, params: dict[str, Any], weka: str, **fields: Any
+) -> ClassifierSpec:
+    """An entry of :mod:`benchmark.weka`: WEKA's command, nominal codes and NaN as they are."""
+    return _spec(
+        id, factory, params, weka=W + weka, missing=True, nominal=True, limits=WEKA_NATIVE, **fields
+    )
+
 
 SPECS: tuple[ClassifierSpec, ...] = (
     # Baselines and rules
     _spec(
         "zeror",
-        DummyClassifier,
-        {"strategy": "prior"},
+        WekaZeroR,
+        {},
         family="majority",
-        description="Majority class; class priors as probabilities",
+        description="Majority class; Laplace-corrected class frequencies as probabilities",
         weka=W + "rules.ZeroR",
+        missing=True,
         suites=FAST,
+        limits=WEKA_NATIVE,
     ),
     _spec(
         "oner",
         OneRuleClassifier,
         {"min_bucket": 6},
         family="rules",
-        description="Best single-feature interval rule (OneR-like)",
-        weka=W + "rules.OneR",
+        description="Best single-feature interval rule (OneR-like: intervals from a 1-D tree)",
         suites=FAST,
-        limits="intervals from a 1-D tree, not OneR's bucket merging",
+        limits="not WEKA's OneR: intervals from a 1-D tree, not OneR's bucket merging",
+    ),
+    _weka(
+        "part",
+        PARTClassifier,
+        {"min_instances": 2, "confidence": 0.25},
+        "rules.PART",
+        family="rules",
+        description="PART: decision list of rules from partial C4.5 trees",
+        cost="slow",
+        suites=ALL_ONLY,
+    ),
+    _spec(
+        "ripper",
+        OrderedRuleClassifier,
+        {"algorithm": "ripper", "k": 2},
+        family="rules",
+        description="RIPPER rule sets per class in JRip's order (wittgenstein), 2 passes",
+        probabilities=False,
+        cost="slow",
+        suites=ALL_ONLY,
+        limits="not WEKA's JRip: numeric attributes binned into 10 quantiles first",
+    ),
+    _spec(
+        "irep",
+        OrderedRuleClassifier,
+        {"algorithm": "irep"},
+        family="rules",
+        description="IREP rule sets per class in JRip's order (wittgenstein)",
+        probabilities=False,
+        cost="slow",
+        suites=ALL_ONLY,
+        limits="numeric attributes binned into 10 quantiles first",
     ),
     _spec(
         "stump",
@@ -275,40 +331,81 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"max_depth": 1},
         family="trees",
         description="Decision stump: one binary split",
-        weka=W + "trees.DecisionStump",
         missing=True,
-        limits="predicts at most two classes",
+        limits="predicts at most two classes; not WEKA's DecisionStump (no missing branch)",
     ),
-    # Single trees
-    _spec(
+    # C4.5 (WEKA's J48)
+    _weka(
         "j48",
+        C45Classifier,
+        {"confidence": 0.25, "min_instances": 2},
+        "trees.J48",
+        family="trees",
+        description="C4.5 (J48): gain ratio, multiway nominal splits, pruned with confidence 0.25",
+        suites=FAST,
+    ),
+    _weka(
+        "j48-pruned",
+        C45Classifier,
+        {"confidence": 0.1, "min_instances": 2},
+        "trees.J48",
+        family="trees",
+        description="C4.5 (J48) pruned harder: confidence 0.1",
+    ),
+    _weka(
+        "j48-unpruned",
+        C45Classifier,
+        {"pruned": False, "min_instances": 2},
+        "trees.J48",
+        family="trees",
+        description="C4.5 (J48) without pruning",
+        suites=ALL_ONLY,
+    ),
+    _weka(
+        "j48-no-raising",
+        C45Classifier,
+        {"confidence": 0.25, "subtree_raising": False, "min_instances": 2},
+        "trees.J48",
+        family="trees",
+        description="C4.5 (J48) pruned without subtree raising",
+        suites=ALL_ONLY,
+    ),
+    _weka(
+        "j48-m5",
+        C45Classifier,
+        {"confidence": 0.25, "min_instances": 5},
+        "trees.J48",
+        family="trees",
+        description="C4.5 (J48) with at least 5 instances per branch",
+        suites=ALL_ONLY,
+    ),
+    # Other single trees
+    _spec(
+        "entropy-tree",
         DecisionTreeClassifier,
         {"criterion": "entropy", "min_samples_leaf": 2},
         family="trees",
-        description="C4.5-like entropy tree, at least 2 instances per leaf",
-        weka=W + "trees.J48",
+        description="Binary information-gain tree (CART with entropy), 2 instances per leaf",
         missing=True,
-        suites=FAST,
-        limits="information gain, binary splits, no error-based pruning",
-    ),
-    _spec(
-        "j48-pruned",
-        DecisionTreeClassifier,
-        {"criterion": "entropy", "min_samples_leaf": 2, "ccp_alpha": 0.002},
-        family="trees",
-        description="Entropy tree with cost-complexity pruning",
-        weka=W + "trees.J48",
-        missing=True,
-        limits="cost-complexity pruning instead of C4.5's confidence pruning",
+        suites=ALL_ONLY,
     ),
     _spec(
         "cart",
         DecisionTreeClassifier,
         {"criterion": "gini", "min_samples_leaf": 2},
         family="trees",
-        description="CART: Gini tree",
-        weka=W + "trees.SimpleCart",
+        description="CART: Gini tree, unpruned",
         missing=True,
+        limits="not WEKA's SimpleCart: no minimal cost-complexity pruning by cross-validation",
+    ),
+    _spec(
+        "cart-pruned",
+        DecisionTreeClassifier,
+        {"criterion": "gini", "min_samples_leaf": 2, "ccp_alpha": 0.002},
+        family="trees",
+        description="CART with cost-complexity pruning (alpha 0.002)",
+        missing=True,
+        suites=ALL_ONLY,
     ),
     _spec(
         "random-tree",
@@ -316,8 +413,8 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"max_features": "log2", "criterion": "entropy"},
         family="trees",
         description="Unpruned tree over log2(d) random features per node",
-        weka=W + "trees.RandomTree",
         missing=True,
+        limits="not WEKA's RandomTree: binary splits, log2(d) rather than log2(d)+1 features",
     ),
     _spec(
         "extra-tree",
@@ -335,7 +432,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"n_estimators": 100},
         family="forests",
         description="Random forest, 100 trees, sqrt(d) features per split",
-        weka=W + "trees.RandomForest",
         missing=True,
         suites=FAST,
     ),
@@ -345,7 +441,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"n_estimators": 500},
         family="forests",
         description="Random forest, 500 trees",
-        weka=W + "trees.RandomForest",
         missing=True,
         suites=ALL_ONLY,
     ),
@@ -355,7 +450,15 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"n_estimators": 100, "class_weight": "balanced"},
         family="forests",
         description="Random forest with class weights inversely proportional to frequency",
-        weka=W + "trees.RandomForest",
+        missing=True,
+        suites=ALL_ONLY,
+    ),
+    _spec(
+        "rf-entropy",
+        RandomForestClassifier,
+        {"n_estimators": 100, "criterion": "entropy", "max_features": "log2"},
+        family="forests",
+        description="Random forest of information-gain trees, log2(d) features per split",
         missing=True,
         suites=ALL_ONLY,
     ),
@@ -368,20 +471,37 @@ SPECS: tuple[ClassifierSpec, ...] = (
         missing=True,
     ),
     _spec(
+        "extra-trees-entropy",
+        ExtraTreesClassifier,
+        {"n_estimators": 300, "criterion": "entropy"},
+        family="forests",
+        description="Extremely randomised information-gain trees, 300 trees",
+        missing=True,
+        suites=ALL_ONLY,
+    ),
+    _spec(
         "bagging",
         bagged_trees,
         {"n_estimators": 50, "max_samples": 1.0},
         family="bagging",
-        description="Bagging of 50 unpruned trees",
-        weka=W + "meta.Bagging",
+        description="Bagging of 50 unpruned CART trees",
+    ),
+    _spec(
+        "bagging-j48",
+        bagged_c45,
+        {"n_estimators": 10},
+        family="bagging",
+        description="Bagging of 10 C4.5 (J48) trees, probabilities averaged",
+        cost="slow",
+        suites=ALL_ONLY,
+        limits="nominal attributes reach the trees one-hot encoded; bags drawn by numpy",
     ),
     _spec(
         "random-subspace",
         random_subspace_trees,
         {"n_estimators": 50, "max_features": 0.5},
         family="bagging",
-        description="50 trees, each on half of the features",
-        weka=W + "meta.RandomSubSpace",
+        description="50 CART trees, each on half of the features",
     ),
     # Boosting
     _spec(
@@ -390,7 +510,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"n_estimators": 100, "learning_rate": 1.0},
         family="boosting",
         description="AdaBoost (SAMME) over 100 decision stumps",
-        weka=W + "meta.AdaBoostM1",
     ),
     _spec(
         "adaboost-tree",
@@ -398,7 +517,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"n_estimators": 100, "max_depth": 3, "learning_rate": 0.5},
         family="boosting",
         description="AdaBoost (SAMME) over 100 depth-3 trees",
-        weka=W + "meta.AdaBoostM1",
     ),
     _spec(
         "hgb",
@@ -411,12 +529,31 @@ SPECS: tuple[ClassifierSpec, ...] = (
         limits="nominal attributes with more than 255 labels are one-hot encoded instead",
     ),
     _spec(
+        "hgb-balanced",
+        HistGradientBoostingClassifier,
+        {**HGB_PARAMS, "class_weight": "balanced"},
+        family="boosting",
+        description="Histogram gradient boosting with balanced class weights",
+        missing=True,
+        nominal=True,
+        suites=ALL_ONLY,
+    ),
+    _spec(
+        "hgb-small",
+        HistGradientBoostingClassifier,
+        {"max_iter": 300, "learning_rate": 0.05, "max_leaf_nodes": 15, "l2_regularization": 1.0},
+        family="boosting",
+        description="Histogram gradient boosting, 15-leaf trees, slower learning, L2 1.0",
+        missing=True,
+        nominal=True,
+        suites=ALL_ONLY,
+    ),
+    _spec(
         "gbm",
         GradientBoostingClassifier,
         {"n_estimators": 100, "max_depth": 3},
         family="boosting",
         description="Gradient boosting of depth-3 trees, 100 stages",
-        weka=W + "meta.LogitBoost",
         cost="slow",
     ),
     _spec(
@@ -427,80 +564,249 @@ SPECS: tuple[ClassifierSpec, ...] = (
         description="XGBoost, 300 rounds of depth-6 trees",
         missing=True,
     ),
-    # Nearest neighbours (attributes normalised to [0, 1] as WEKA's EuclideanDistance does)
     _spec(
+        "xgb-shallow",
+        xgboost_classifier,
+        {**XGB_PARAMS, "max_depth": 3, "n_estimators": 500},
+        family="boosting",
+        description="XGBoost, 500 rounds of depth-3 trees",
+        missing=True,
+        suites=ALL_ONLY,
+    ),
+    _spec(
+        "lgbm",
+        LightGBMClassifier,
+        {"n_estimators": 300, "learning_rate": 0.05, "num_leaves": 31},
+        family="boosting",
+        description="LightGBM, 300 rounds of 31-leaf trees, native nominal features",
+        missing=True,
+        nominal=True,
+        cost="slow",
+        suites=ALL_ONLY,
+    ),
+    _spec(
+        "lgbm-small",
+        LightGBMClassifier,
+        {"n_estimators": 300, "learning_rate": 0.05, "num_leaves": 15, "min_child_samples": 5},
+        family="boosting",
+        description="LightGBM, 300 rounds of 15-leaf trees",
+        missing=True,
+        nominal=True,
+        suites=ALL_ONLY,
+    ),
+    _spec(
+        "lgbm-bagged",
+        LightGBMClassifier,
+        {
+            "n_estimators": 300,
+            "learning_rate": 0.05,
+            "subsample": 0.8,
+            "subsample_freq": 1,
+            "colsample_bytree": 0.8,
+        },
+        family="boosting",
+        description="LightGBM with 80% row and feature sampling per round",
+        missing=True,
+        nominal=True,
+        suites=ALL_ONLY,
+    ),
+    _spec(
+        "lgbm-balanced",
+        LightGBMClassifier,
+        {"n_estimators": 300, "learning_rate": 0.05, "class_weight": "balanced"},
+        family="boosting",
+        description="LightGBM with balanced class weights",
+        missing=True,
+        nominal=True,
+        suites=ALL_ONLY,
+    ),
+    _spec(
+        "lgbm-dart",
+        LightGBMClassifier,
+        {"n_estimators": 200, "learning_rate": 0.1, "boosting_type": "dart"},
+        family="boosting",
+        description="LightGBM DART (dropout boosting), 200 rounds",
+        missing=True,
+        nominal=True,
+        cost="slow",
+        suites=ALL_ONLY,
+    ),
+    _spec(
+        "lgbm-rf",
+        LightGBMClassifier,
+        {
+            "n_estimators": 200,
+            "boosting_type": "rf",
+            "subsample": 0.632,
+            "subsample_freq": 1,
+            "colsample_bytree": 0.5,
+        },
+        family="forests",
+        description="LightGBM in random-forest mode, 200 trees",
+        missing=True,
+        nominal=True,
+        suites=ALL_ONLY,
+    ),
+    _spec(
+        "catboost",
+        CatBoostNominalClassifier,
+        {"iterations": 300, "depth": 6},
+        family="boosting",
+        description="CatBoost, 300 rounds of depth-6 oblivious trees, nominal features native",
+        missing=True,
+        nominal=True,
+        cost="slow",
+        suites=ALL_ONLY,
+    ),
+    _spec(
+        "catboost-shallow",
+        CatBoostNominalClassifier,
+        {"iterations": 300, "depth": 4},
+        family="boosting",
+        description="CatBoost, 300 rounds of depth-4 trees",
+        missing=True,
+        nominal=True,
+        cost="slow",
+        suites=ALL_ONLY,
+    ),
+    _spec(
+        "catboost-balanced",
+        CatBoostNominalClassifier,
+        {"iterations": 300, "depth": 6, "auto_class_weights": "Balanced"},
+        family="boosting",
+        description="CatBoost with balanced class weights",
+        missing=True,
+        nominal=True,
+        cost="slow",
+        suites=ALL_ONLY,
+    ),
+    # Nearest neighbours: WEKA's IBk exactly, then scikit-learn's
+    _weka(
         "ibk",
-        KNeighborsClassifier,
+        WekaIBk,
         {"n_neighbors": 1},
+        "lazy.IBk",
         family="nearest-neighbours",
-        description="1-nearest neighbour, features normalised to [0, 1]",
-        weka=W + "lazy.IBk",
-        scaling="minmax",
+        description="1-nearest neighbour on WEKA's distance (range-normalised, nominal 0/1)",
         suites=FAST,
     ),
-    _spec(
+    _weka(
         "ibk3",
-        KNeighborsClassifier,
+        WekaIBk,
         {"n_neighbors": 3},
+        "lazy.IBk",
         family="nearest-neighbours",
-        description="3-nearest neighbours",
-        weka=W + "lazy.IBk",
-        scaling="minmax",
+        description="3-nearest neighbours (IBk)",
+    ),
+    _weka(
+        "ibk5",
+        WekaIBk,
+        {"n_neighbors": 5},
+        "lazy.IBk",
+        family="nearest-neighbours",
+        description="5-nearest neighbours (IBk)",
+    ),
+    _weka(
+        "ibk10",
+        WekaIBk,
+        {"n_neighbors": 10},
+        "lazy.IBk",
+        family="nearest-neighbours",
+        description="10-nearest neighbours (IBk)",
+    ),
+    _weka(
+        "ibk-w",
+        WekaIBk,
+        {"n_neighbors": 10, "weighting": "inverse"},
+        "lazy.IBk",
+        family="nearest-neighbours",
+        description="10-nearest neighbours weighted by 1/distance (IBk -I)",
+    ),
+    _weka(
+        "ibk5-w",
+        WekaIBk,
+        {"n_neighbors": 5, "weighting": "inverse"},
+        "lazy.IBk",
+        family="nearest-neighbours",
+        description="5-nearest neighbours weighted by 1/distance (IBk -I)",
+        suites=ALL_ONLY,
+    ),
+    _weka(
+        "ibk10-f",
+        WekaIBk,
+        {"n_neighbors": 10, "weighting": "similarity"},
+        "lazy.IBk",
+        family="nearest-neighbours",
+        description="10-nearest neighbours weighted by 1 - distance (IBk -F)",
+        suites=ALL_ONLY,
     ),
     _spec(
-        "ibk5",
+        "knn5",
         KNeighborsClassifier,
         {"n_neighbors": 5},
         family="nearest-neighbours",
-        description="5-nearest neighbours",
-        weka=W + "lazy.IBk",
+        description="5-nearest neighbours (scikit-learn) on [0, 1]-scaled, one-hot features",
         scaling="minmax",
-    ),
-    _spec(
-        "ibk10",
-        KNeighborsClassifier,
-        {"n_neighbors": 10},
-        family="nearest-neighbours",
-        description="10-nearest neighbours",
-        weka=W + "lazy.IBk",
-        scaling="minmax",
-    ),
-    _spec(
-        "ibk-w",
-        KNeighborsClassifier,
-        {"n_neighbors": 10, "weights": "distance"},
-        family="nearest-neighbours",
-        description="10-nearest neighbours weighted by 1/distance",
-        weka=W + "lazy.IBk",
-        scaling="minmax",
+        suites=ALL_ONLY,
     ),
     _spec(
         "ibk5-std",
         KNeighborsClassifier,
         {"n_neighbors": 5},
         family="nearest-neighbours",
-        description="5-nearest neighbours on standardised features",
-        weka=W + "lazy.IBk",
+        description="5-nearest neighbours (scikit-learn) on standardised features",
         scaling="standard",
     ),
-    # Naive Bayes
     _spec(
+        "knn10-distance",
+        KNeighborsClassifier,
+        {"n_neighbors": 10, "weights": "distance"},
+        family="nearest-neighbours",
+        description="10-nearest neighbours (scikit-learn) weighted by 1/distance, standardised",
+        scaling="standard",
+        suites=ALL_ONLY,
+    ),
+    # Naive Bayes: WEKA's NaiveBayes exactly, then scikit-learn's
+    _weka(
         "nb",
+        WekaNaiveBayes,
+        {"numeric": "normal"},
+        "bayes.NaiveBayes",
+        family="naive-bayes",
+        description="Naive Bayes: Laplace frequencies for nominal, normal density for numeric",
+        suites=FAST,
+    ),
+    _weka(
+        "nb-kernel",
+        WekaNaiveBayes,
+        {"numeric": "kernel"},
+        "bayes.NaiveBayes",
+        family="naive-bayes",
+        description="Naive Bayes with kernel density estimates for numeric attributes (-K)",
+    ),
+    _weka(
+        "nb-discretized",
+        WekaNaiveBayes,
+        {"numeric": "discretize"},
+        "bayes.NaiveBayes",
+        family="naive-bayes",
+        description="Naive Bayes on Fayyad-Irani MDL intervals of numeric attributes (-D)",
+    ),
+    _spec(
+        "nb-gaussian",
         GaussianNB,
         {},
         family="naive-bayes",
-        description="Gaussian naive Bayes",
-        weka=W + "bayes.NaiveBayes",
-        suites=FAST,
+        description="Gaussian naive Bayes (scikit-learn) on imputed, one-hot features",
+        suites=ALL_ONLY,
     ),
     _spec(
-        "nb-discretized",
-        discretized_naive_bayes,
+        "nb-quantile",
+        quantile_naive_bayes,
         {"n_bins": 10},
         family="naive-bayes",
-        description="Naive Bayes on 10 equal-frequency bins per feature",
-        weka=W + "bayes.NaiveBayes",
-        limits="unsupervised quantile bins, not WEKA's supervised discretisation (-D)",
+        description="Categorical naive Bayes on 10 equal-frequency bins per feature",
+        suites=ALL_ONLY,
     ),
     _spec(
         "nb-bernoulli",
@@ -516,7 +822,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"alpha": 1.0},
         family="naive-bayes",
         description="Multinomial naive Bayes on [0, 1]-scaled features",
-        weka=W + "bayes.NaiveBayesMultinomial",
         scaling="minmax",
     ),
     _spec(
@@ -534,7 +839,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"solver": "svd"},
         family="discriminant-analysis",
         description="Linear discriminant analysis",
-        weka=W + "functions.LDA",
         suites=FAST,
     ),
     _spec(
@@ -551,8 +855,16 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"reg_param": 0.1},
         family="discriminant-analysis",
         description="Quadratic discriminant analysis, covariance regularised by 0.1",
-        weka=W + "functions.QDA",
         scaling="standard",
+    ),
+    _spec(
+        "qda-strong",
+        QuadraticDiscriminantAnalysis,
+        {"reg_param": 0.5},
+        family="discriminant-analysis",
+        description="Quadratic discriminant analysis, covariance regularised by 0.5",
+        scaling="standard",
+        suites=ALL_ONLY,
     ),
     # Logistic regression
     _spec(
@@ -561,7 +873,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"C": 10.0, "max_iter": 2000},
         family="logistic",
         description="Multinomial logistic regression with a ridge (C=10) on standardised features",
-        weka=W + "functions.Logistic",
         scaling="standard",
         suites=FAST,
     ),
@@ -570,9 +881,18 @@ SPECS: tuple[ClassifierSpec, ...] = (
         LogisticRegression,
         {"C": 1000.0, "max_iter": 5000},
         family="logistic",
-        description="Nearly unregularised logistic regression (WEKA's ridge 1e-8)",
-        weka=W + "functions.Logistic",
+        description="Nearly unregularised logistic regression (C=1000)",
         scaling="standard",
+    ),
+    _spec(
+        "logistic-mle",
+        LogisticRegression,
+        {"C": 5e7, "max_iter": 10000},
+        family="logistic",
+        description="Multinomial logistic regression with a ridge of 1e-8 (maximum likelihood)",
+        scaling="standard",
+        suites=ALL_ONLY,
+        limits="WEKA's Logistic has this ridge but replaces missing nominal values by the mode",
     ),
     _spec(
         "logistic-l1",
@@ -593,6 +913,15 @@ SPECS: tuple[ClassifierSpec, ...] = (
         scaling="standard",
         suites=ALL_ONLY,
     ),
+    _spec(
+        "logistic-strong",
+        LogisticRegression,
+        {"C": 0.1, "max_iter": 2000},
+        family="logistic",
+        description="Logistic regression with a strong ridge (C=0.1)",
+        scaling="standard",
+        suites=ALL_ONLY,
+    ),
     # Support vector machines
     _spec(
         "svm-linear",
@@ -600,7 +929,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"C": 1.0, "max_iter": 5000},
         family="svm",
         description="Linear SVM (liblinear, one-vs-rest)",
-        weka=W + "functions.SMO",
         probabilities=False,
         scaling="standard",
     ),
@@ -609,8 +937,7 @@ SPECS: tuple[ClassifierSpec, ...] = (
         SVC,
         {"kernel": "linear", "C": 1.0},
         family="svm",
-        description="Linear-kernel SVM (libsvm, one-vs-one) like SMO's PolyKernel -E 1",
-        weka=W + "functions.SMO",
+        description="Linear-kernel SVM (libsvm, one-vs-one) on [0, 1]-scaled features",
         probabilities=False,
         scaling="minmax",
     ),
@@ -620,9 +947,18 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"kernel": "poly", "degree": 2, "C": 10.0, "coef0": 1.0},
         family="svm",
         description="Quadratic-kernel SVM",
-        weka=W + "functions.SMO",
         probabilities=False,
         scaling="standard",
+    ),
+    _spec(
+        "svm-poly3",
+        SVC,
+        {"kernel": "poly", "degree": 3, "C": 1.0, "coef0": 1.0},
+        family="svm",
+        description="Cubic-kernel SVM",
+        probabilities=False,
+        scaling="standard",
+        suites=ALL_ONLY,
     ),
     _spec(
         "svm-rbf",
@@ -630,9 +966,18 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"kernel": "rbf", "C": 10.0, "gamma": "scale"},
         family="svm",
         description="RBF-kernel SVM on standardised features",
-        weka=W + "functions.SMO",
         probabilities=False,
         scaling="standard",
+    ),
+    _spec(
+        "svm-rbf-c1",
+        SVC,
+        {"kernel": "rbf", "C": 1.0, "gamma": "scale"},
+        family="svm",
+        description="RBF-kernel SVM, C=1",
+        probabilities=False,
+        scaling="standard",
+        suites=ALL_ONLY,
     ),
     _spec(
         "svm-rbf-balanced",
@@ -640,7 +985,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"kernel": "rbf", "C": 10.0, "class_weight": "balanced"},
         family="svm",
         description="RBF-kernel SVM with balanced class weights",
-        weka=W + "functions.SMO",
         probabilities=False,
         scaling="standard",
         suites=ALL_ONLY,
@@ -651,7 +995,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"nu": 0.3, "kernel": "rbf"},
         family="svm",
         description="Nu-SVM with an RBF kernel (nu=0.3)",
-        weka=W + "functions.LibSVM",
         probabilities=False,
         scaling="standard",
         limits="fails ('specified nu is infeasible') when a class is much rarer than nu",
@@ -663,8 +1006,16 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"hidden_layer_sizes": (100,), "alpha": 1e-3, "max_iter": 500, "early_stopping": True},
         family="neural-network",
         description="Multilayer perceptron, one hidden layer of 100",
-        weka=W + "functions.MultilayerPerceptron",
         scaling="standard",
+    ),
+    _spec(
+        "mlp-small",
+        MLPClassifier,
+        {"hidden_layer_sizes": (30,), "alpha": 1e-2, "max_iter": 1000},
+        family="neural-network",
+        description="Multilayer perceptron, one hidden layer of 30, weight decay 0.01",
+        scaling="standard",
+        suites=ALL_ONLY,
     ),
     _spec(
         "mlp-deep",
@@ -672,7 +1023,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"hidden_layer_sizes": (256, 128), "alpha": 1e-3, "max_iter": 500, "early_stopping": True},
         family="neural-network",
         description="Multilayer perceptron, hidden layers 256 and 128",
-        weka=W + "functions.MultilayerPerceptron",
         scaling="standard",
         suites=ALL_ONLY,
     ),
@@ -683,7 +1033,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"loss": "hinge", "alpha": 1e-4},
         family="linear-sgd",
         description="Linear SVM trained by SGD",
-        weka=W + "functions.SGD",
         probabilities=False,
         scaling="standard",
     ),
@@ -693,7 +1042,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"loss": "log_loss", "alpha": 1e-4},
         family="linear-sgd",
         description="Logistic regression trained by SGD",
-        weka=W + "functions.SGD",
         scaling="standard",
     ),
     _spec(
@@ -710,7 +1058,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {},
         family="linear-sgd",
         description="Perceptron (one-vs-rest)",
-        weka=W + "functions.VotedPerceptron",
         probabilities=False,
         scaling="standard",
     ),
@@ -764,7 +1111,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"length_scale": 10.0, "optimize": False},
         family="gaussian-process",
         description="Gaussian process classifier, fixed RBF kernel (length 10), one-vs-rest",
-        weka=W + "functions.GaussianProcesses",
         scaling="standard",
         cost="slow",
         suites=ALL_ONLY,
@@ -777,7 +1123,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"base": "svm-linear", "method": "sigmoid"},
         family="calibration",
         description="Linear SVM with sigmoid-calibrated probabilities",
-        weka=W + "functions.SMO",
         scaling="standard",
     ),
     _spec(
@@ -786,7 +1131,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"base": "svm-rbf", "method": "sigmoid"},
         family="calibration",
         description="RBF SVM with sigmoid-calibrated probabilities",
-        weka=W + "functions.SMO",
         scaling="standard",
     ),
     _spec(
@@ -802,7 +1146,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"base": "logistic"},
         family="multiclass-wrapper",
         description="One-vs-rest logistic regressions",
-        weka=W + "meta.MultiClassClassifier",
         scaling="standard",
     ),
     _spec(
@@ -811,7 +1154,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"base": "svm-rbf"},
         family="multiclass-wrapper",
         description="One-vs-rest RBF SVMs",
-        weka=W + "meta.MultiClassClassifier",
         probabilities=False,
         scaling="standard",
     ),
@@ -821,18 +1163,16 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"base": "logistic"},
         family="multiclass-wrapper",
         description="One-vs-one logistic regressions, majority vote",
-        weka=W + "meta.MultiClassClassifier",
         probabilities=False,
         scaling="standard",
     ),
     _spec(
         "ovo-j48",
         one_vs_one,
-        {"base": "j48"},
+        {"base": "entropy-tree"},
         family="multiclass-wrapper",
-        description="One-vs-one entropy trees, majority vote",
+        description="One-vs-one information-gain trees, majority vote",
         probabilities=False,
-        weka=W + "meta.MultiClassClassifier",
     ),
     _spec(
         "ecoc",
@@ -840,7 +1180,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"base": "logistic", "code_size": 2.0},
         family="multiclass-wrapper",
         description="Error-correcting output codes over logistic regressions",
-        weka=W + "meta.MultiClassClassifier",
         probabilities=False,
         scaling="standard",
     ),
@@ -851,7 +1190,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {},
         family="voting",
         description="Soft vote of XGBoost, histogram boosting and calibrated RBF SVM",
-        weka=W + "meta.Vote",
         scaling="standard",
         cost="slow",
     ),
@@ -861,7 +1199,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {},
         family="voting",
         description="Majority vote of logistic regression, random forest and RBF SVM",
-        weka=W + "meta.Vote",
         probabilities=False,
         scaling="standard",
     ),
@@ -871,7 +1208,6 @@ SPECS: tuple[ClassifierSpec, ...] = (
         {"cv": 5},
         family="stacking",
         description="RF, extra trees, RBF SVM and logistic stacked by logistic regression",
-        weka=W + "meta.Stacking",
         scaling="standard",
         cost="slow",
     ),

@@ -9,7 +9,8 @@ from sklearn.pipeline import Pipeline
 from benchmark.catalogue.spec import ClassifierSpec
 from benchmark.preprocessing import make_preprocessor
 
-#: HistGradientBoosting's limit on the labels of a native categorical feature.
+#: HistGradientBoosting's limit on the labels of a native categorical feature (estimators
+#: that take ``nominal_features`` have none).
 MAX_NATIVE_LABELS = 255
 
 
@@ -42,7 +43,11 @@ def pipeline_for_spec(
         integer labels y of shape (n_samples,).
     """
     nominal = dict(nominal_features or {})
-    native = spec.handles_nominal and all(k <= MAX_NATIVE_LABELS for k in nominal.values())
+    estimator = spec.make_estimator()
+    takes_labels = "nominal_features" in estimator.get_params(deep=False)
+    native = spec.handles_nominal and (
+        takes_labels or all(k <= MAX_NATIVE_LABELS for k in nominal.values())
+    )
     preprocessor, native_positions = make_preprocessor(
         n_features=n_features,
         nominal_features=nominal,
@@ -50,8 +55,10 @@ def pipeline_for_spec(
         scaling=spec.scaling if spec.needs_scaling else None,
         native_nominal=native,
     )
-    estimator = spec.make_estimator()
-    if native_positions:
+    if native_positions and takes_labels:
+        labels = [nominal[column] for column in sorted(nominal)]
+        estimator.set_params(nominal_features=dict(zip(native_positions, labels, strict=True)))
+    elif native_positions:
         estimator.set_params(categorical_features=native_positions)
     seeds = {
         name: random_state

@@ -20,8 +20,10 @@ class ClassifierSpec:
     ----------
     id : str
         Short, lower-case, stable identifier (``"rf"``, ``"svm-rbf"``).
-    weka_name : str or None
-        The WEKA class it corresponds to, if one does.
+    weka_command : str or None
+        The WEKA command line (class, then options as WEKA writes them) whose behaviour
+        and defaults this entry reproduces, checked against WEKA itself
+        (``perf/weka_agreement.py``); ``None`` when no WEKA scheme computes the same.
     family : str
         The kind of model (``"trees"``, ``"svm"``, ``"naive-bayes"``...).
     description : str
@@ -38,8 +40,9 @@ class ClassifierSpec:
     handles_missing : bool
         Whether the estimator takes NaN itself, so that the pipeline does not impute.
     handles_nominal : bool
-        Whether the estimator takes nominal codes natively (given through its
-        ``categorical_features`` parameter) instead of one-hot columns.
+        Whether the estimator takes nominal codes natively instead of one-hot columns:
+        their positions go to its ``nominal_features`` parameter (position to number of
+        labels) or, failing that, to its ``categorical_features`` parameter (positions).
     cost : {"fast", "slow"}
         Rough cost: ``"slow"`` means more than about 5 s per fold on a few thousand
         instances and a hundred features, single-threaded.
@@ -52,7 +55,7 @@ class ClassifierSpec:
     """
 
     id: str
-    weka_name: str | None
+    weka_command: str | None
     family: str
     description: str
     factory: Callable[..., BaseEstimator]
@@ -66,6 +69,17 @@ class ClassifierSpec:
     limits: str = ""
     scaling: Scaling = "standard"
 
+    @property
+    def weka_name(self) -> str | None:
+        """The WEKA class of ``weka_command`` (``"weka.classifiers.trees.J48"``), if any."""
+        return self.weka_command.split(maxsplit=1)[0] if self.weka_command else None
+
+    @property
+    def weka_options(self) -> str:
+        """The options of ``weka_command`` (``"-C 0.25 -M 2"``), empty without one."""
+        parts = (self.weka_command or "").split(maxsplit=1)
+        return parts[1] if len(parts) > 1 else ""
+
     def make_estimator(self) -> BaseEstimator:
         """A new unfitted estimator built from ``factory(**params)``."""
         return self.factory(**self.params)
@@ -75,6 +89,7 @@ class ClassifierSpec:
         return {
             "id": self.id,
             "weka_name": self.weka_name,
+            "weka_command": self.weka_command,
             "family": self.family,
             "description": self.description,
             "estimator": f"{self.factory.__module__}.{self.factory.__qualname__}",

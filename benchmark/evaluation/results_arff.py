@@ -121,9 +121,12 @@ def results_to_dataset(
     timestamp : datetime, optional
         ``Date_time`` of every row (WEKA's ``yyyymmdd.HHMM`` number); default now.
     scheme_names : {"weka", "id"}
-        ``Key_Scheme``: the WEKA class a configuration corresponds to, when it has one,
-        else ``touchbench.<id>``; or always ``touchbench.<id>``.  ``Key_Scheme_options``
-        always starts with ``-id <id>`` so that configurations stay distinct.
+        ``"weka"``: a configuration that reproduces a WEKA command (its
+        ``weka_command``) is written as WEKA writes it, ``Key_Scheme`` the class and
+        ``Key_Scheme_options`` the options, so that WEKA's Experimenter and
+        :func:`benchmark.catalogue.parse_weka_command` read it back; any other is
+        ``touchbench.<id>`` with options ``-id <id>`` and its parameters.  ``"id"``: every
+        configuration as ``touchbench.<id>``.
 
     Returns
     -------
@@ -262,9 +265,9 @@ def weka_measures(result: TaskResult) -> dict[str, float]:
 
 def _scheme(classifier: str, spec: ClassifierSpec | None, style: str) -> tuple[str, str]:
     """``Key_Scheme`` and ``Key_Scheme_options`` of a classifier."""
-    name = f"touchbench.{classifier}"
     if style == "weka" and spec is not None and spec.weka_name:
-        name = spec.weka_name
+        return spec.weka_name, spec.weka_options
+    name = f"touchbench.{classifier}"
     options = [f"-id {classifier}"]
     if spec is not None:
         options += [f"-{key} {_option_text(value)}" for key, value in spec.params.items()]

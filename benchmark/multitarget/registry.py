@@ -42,7 +42,7 @@ DEFAULT_BASES: tuple[str, ...] = (
     "extra-trees",
 )
 #: The catalogue classifier whose preprocessing steps feed the methods without a base.
-PREPROCESSING_SOURCE = "ibk"
+PREPROCESSING_SOURCE = "knn5"  # imputation, one-hot and [0, 1] scaling
 
 
 @dataclass(frozen=True)

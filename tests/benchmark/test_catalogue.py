@@ -7,18 +7,25 @@ from collections.abc import Iterator
 
 import numpy as np
 import pytest
+import skops.io
 from sklearn.base import clone
 from sklearn.ensemble import RandomForestClassifier
 from sklearn.linear_model import LogisticRegression
-from sklearn.naive_bayes import GaussianNB
-from sklearn.neighbors import KNeighborsClassifier
 from sklearn.svm import SVC
 from sklearn.tree import DecisionTreeClassifier
 from threadpoolctl import threadpool_limits
 
-from benchmark.catalogue import CATALOGUE, ClassifierSpec, build_pipeline, get_spec, suite
+from benchmark.catalogue import (
+    CATALOGUE,
+    ClassifierSpec,
+    build_pipeline,
+    get_spec,
+    parse_weka_command,
+    suite,
+)
 from benchmark.catalogue.estimators import LabelEncodedClassifier, OneRuleClassifier
 from benchmark.errors import ConfigurationError
+from benchmark.weka import C45Classifier, WekaIBk, WekaNaiveBayes, WekaZeroR
 
 FAMILIES = {
     "majority",
@@ -67,8 +74,8 @@ def tiny_data(seed: int = 0) -> tuple[np.ndarray, np.ndarray, dict[int, int]]:
     return X, y, {2: 3, 5: 4}
 
 
-def test_catalogue_has_at_least_fifty_configurations_with_stable_ids() -> None:
-    assert len(CATALOGUE) >= 50
+def test_catalogue_has_at_least_a_hundred_configurations_with_stable_ids() -> None:
+    assert len(CATALOGUE) >= 100
     for classifier_id, spec in CATALOGUE.items():
         assert spec.id == classifier_id
         assert re.fullmatch(r"[a-z0-9]+(-[a-z0-9]+)*", classifier_id), classifier_id
@@ -82,34 +89,112 @@ def test_every_family_of_the_issue_is_covered() -> None:
 
 
 @pytest.mark.parametrize(
-    ("classifier_id", "estimator_type", "weka_name"),
+    ("classifier_id", "estimator_type", "weka_command"),
     [
-        ("j48", DecisionTreeClassifier, "weka.classifiers.trees.J48"),
-        ("rf", RandomForestClassifier, "weka.classifiers.trees.RandomForest"),
-        ("nb", GaussianNB, "weka.classifiers.bayes.NaiveBayes"),
-        ("ibk", KNeighborsClassifier, "weka.classifiers.lazy.IBk"),
-        ("logistic", LogisticRegression, "weka.classifiers.functions.Logistic"),
-        ("svm-rbf", SVC, "weka.classifiers.functions.SMO"),
+        ("zeror", WekaZeroR, "weka.classifiers.rules.ZeroR"),
+        ("j48", C45Classifier, "weka.classifiers.trees.J48 -C 0.25 -M 2"),
+        ("j48-unpruned", C45Classifier, "weka.classifiers.trees.J48 -U -M 2"),
+        ("nb", WekaNaiveBayes, "weka.classifiers.bayes.NaiveBayes"),
+        ("nb-kernel", WekaNaiveBayes, "weka.classifiers.bayes.NaiveBayes -K"),
+        ("nb-discretized", WekaNaiveBayes, "weka.classifiers.bayes.NaiveBayes -D"),
+        (
+            "ibk",
+            WekaIBk,
+            "weka.classifiers.lazy.IBk -K 1 -W 0 -A "
+            '"weka.core.neighboursearch.LinearNNSearch -A \\"weka.core.EuclideanDistance '
+            '-R first-last\\""',
+        ),
+        ("rf", RandomForestClassifier, None),
+        ("logistic", LogisticRegression, None),
+        ("svm-rbf", SVC, None),
     ],
 )
 def test_required_ids_mean_what_the_issue_says(
-    classifier_id: str, estimator_type: type, weka_name: str
+    classifier_id: str, estimator_type: type, weka_command: str | None
 ) -> None:
     spec = get_spec(classifier_id)
-    estimator = spec.make_estimator()
-    assert isinstance(estimator, estimator_type)
-    assert spec.weka_name == weka_name
+    assert isinstance(spec.make_estimator(), estimator_type)
+    assert spec.weka_command == weka_command
+    assert spec.weka_name == (weka_command.split()[0] if weka_command else None)
+
+
+def test_weka_names_only_on_estimators_that_compute_what_weka_computes() -> None:
+    named = {i for i, spec in CATALOGUE.items() if spec.weka_command}
+    assert {"zeror", "j48", "nb", "ibk"} <= named
+    for classifier_id in named:
+        estimator = get_spec(classifier_id).make_estimator()
+        assert type(estimator).__module__.startswith("benchmark.weka."), classifier_id
+    commands = [CATALOGUE[i].weka_command for i in named]
+    assert len(set(commands)) == len(commands), "two entries claim the same WEKA command"
 
 
 def test_required_ids_details() -> None:
-    assert get_spec("j48").make_estimator().criterion == "entropy"
+    j48 = get_spec("j48").make_estimator()
+    assert (j48.confidence, j48.min_instances, j48.pruned, j48.subtree_raising) == (
+        0.25,
+        2,
+        True,
+        True,
+    )
     assert get_spec("ibk").make_estimator().n_neighbors == 1
+    assert get_spec("ibk-w").make_estimator().weighting == "inverse"
     assert get_spec("svm-rbf").make_estimator().kernel == "rbf"
-    assert get_spec("zeror").make_estimator().strategy == "prior"
     assert type(get_spec("mlp").make_estimator()).__name__ == "MLPClassifier"
     xgb = get_spec("xgb").make_estimator()
     assert isinstance(xgb, LabelEncodedClassifier)
     assert type(xgb.estimator).__name__ == "XGBClassifier"
+
+
+@pytest.mark.parametrize("classifier_id", [i for i, s in CATALOGUE.items() if s.weka_command])
+def test_every_weka_command_reads_back_to_its_entry(classifier_id: str) -> None:
+    spec = get_spec(classifier_id)
+    assert spec.weka_command is not None
+    assert parse_weka_command(spec.weka_command) is spec
+    short = spec.weka_command.replace("weka.classifiers.", "").split(".", 1)[1]
+    assert parse_weka_command(short) is spec
+
+
+def test_a_weka_command_outside_the_catalogue_becomes_a_new_configuration() -> None:
+    spec = parse_weka_command("weka.classifiers.trees.J48 -C 0.1 -M 5")
+    assert spec.id == "j48-c0.1-m5" and spec.id not in CATALOGUE
+    assert spec.params == {"confidence": 0.1, "min_instances": 5}
+    assert spec.weka_command == "weka.classifiers.trees.J48 -C 0.1 -M 5"
+    assert spec.suites == frozenset()
+    model = build_pipeline(spec, n_features=3)
+    assert model.named_steps["classifier"].min_instances == 5
+    assert parse_weka_command("IBk -K 7 -I").params == {"n_neighbors": 7, "weighting": "inverse"}
+    assert parse_weka_command("weka.classifiers.trees.J48").id == "j48"
+
+
+@pytest.mark.parametrize(
+    ("command", "message"),
+    [
+        ("weka.classifiers.trees.J48 -B", r"J48: option '-B' is not supported by touchbench"),
+        ("J48 -R -N 3", r"option '-R' is not supported"),
+        ("J48 -C x", r"option '-C x': expected a number"),
+        ("J48 -C 0.7", r"option '-C 0.7': the value must be at most 0.5"),
+        ("J48 -M", r"option '-M' needs a value"),
+        ("J48 -M 2 -M 3", r"option '-M' is given twice"),
+        ("J48 -U -S", r"option '-S' .* makes no sense with '-U'"),
+        ("NaiveBayes -K -D", r"options '-K' and '-D' exclude each other"),
+        ("IBk -X", r"IBk: option '-X' is not supported"),
+        (
+            'IBk -A "weka.core.neighboursearch.KDTree"',
+            r"option '-A weka.core.neighboursearch.KDTree'",
+        ),
+        (
+            "weka.classifiers.functions.SMO",
+            r"does not reproduce WEKA's 'weka.classifiers.functions.SMO'",
+        ),
+        ('J48 "-C', r"cannot read WEKA command line"),
+        ("", r"empty WEKA command line"),
+    ],
+)
+def test_unsupported_weka_commands_are_refused_naming_the_option(
+    command: str, message: str
+) -> None:
+    with pytest.raises(ConfigurationError, match=message):
+        parse_weka_command(command)
 
 
 def test_unknown_id_suggests_the_closest() -> None:
@@ -125,7 +210,7 @@ def test_suites_nest_and_mark_slow_entries_honestly() -> None:
     assert set(fast) < set(default) < set(everything)
     assert everything == list(CATALOGUE)
     assert all(get_spec(i).cost == "fast" for i in fast)
-    for slow in ("gp", "stacking", "gbm"):
+    for slow in ("gp", "stacking", "gbm", "catboost", "ripper"):
         assert get_spec(slow).cost == "slow"
     assert "gp" not in default
     with pytest.raises(ConfigurationError, match="unknown suite 'quick'"):
@@ -138,6 +223,10 @@ def test_spec_to_json_is_plain_data() -> None:
     assert data["estimator"] == "sklearn.ensemble._forest.RandomForestClassifier"
     assert data["params"] == {"n_estimators": 100}
     assert "all" in data["suites"]
+    assert data["weka_name"] is None and data["weka_command"] is None
+    j48 = get_spec("j48").to_json()
+    assert j48["weka_name"] == "weka.classifiers.trees.J48"
+    assert j48["weka_command"] == "weka.classifiers.trees.J48 -C 0.25 -M 2"
 
 
 @pytest.mark.filterwarnings("ignore:Bins whose width are too small:UserWarning")
@@ -159,6 +248,9 @@ def test_every_entry_fits_and_predicts_nominal_and_missing_inputs(classifier_id:
     if classifier_id != "zeror":
         training = model.predict(X[::2])
         assert np.mean(training == y[::2]) > 0.4, "no better than chance on its training data"
+    data = skops.io.dumps(model)
+    loaded = skops.io.loads(data, trusted=skops.io.get_untrusted_types(data=data))
+    np.testing.assert_array_equal(loaded.predict(X[1::2]), predicted)
 
 
 def test_extra_columns_after_the_features_pass_through() -> None:
@@ -181,9 +273,22 @@ def test_histogram_boosting_gets_nominal_columns_natively() -> None:
     X, y, nominal = tiny_data()
     model = build_pipeline("hgb", nominal_features=nominal, n_features=X.shape[1])
     model.fit(X, y)
-    # numeric columns 0, 1, 3, 4 come first, then the nominal codes 2 and 5
-    assert model.named_steps["classifier"].categorical_features == [4, 5]
-    assert model.named_steps["classifier"].is_categorical_.tolist() == [0, 0, 0, 0, 1, 1]
+    # nothing to impute or scale: the columns keep their order, codes 2 and 5 nominal
+    assert model.named_steps["classifier"].categorical_features == [2, 5]
+    assert model.named_steps["classifier"].is_categorical_.tolist() == [0, 0, 1, 0, 0, 1]
+
+
+@pytest.mark.parametrize("classifier_id", ["j48", "nb", "ibk", "lgbm", "catboost-shallow"])
+def test_weka_and_boosting_estimators_get_nominal_codes_and_label_counts(
+    classifier_id: str,
+) -> None:
+    X, y, nominal = tiny_data()
+    extra = (y[:, None] == np.array([0, 2])).astype(np.float64)
+    model = build_pipeline(classifier_id, nominal_features=nominal, n_features=X.shape[1])
+    model.fit(np.hstack([X, extra]), y)
+    assert model.named_steps["classifier"].nominal_features == {2: 3, 5: 4}
+    passed = model.named_steps["preprocess"].transform(np.hstack([X, extra]))
+    np.testing.assert_array_equal(passed, np.hstack([X, extra]))
 
 
 def test_nominal_columns_with_too_many_labels_fall_back_to_one_hot() -> None:
@@ -194,7 +299,7 @@ def test_nominal_columns_with_too_many_labels_fall_back_to_one_hot() -> None:
 def test_build_pipeline_accepts_a_spec_outside_the_catalogue() -> None:
     spec = ClassifierSpec(
         id="my-tree",
-        weka_name=None,
+        weka_command=None,
         family="trees",
         description="a test tree",
         factory=DecisionTreeClassifier,

@@ -47,14 +47,24 @@ def test_minmax_scaling_clips_to_the_training_range() -> None:
     )
 
 
-def test_native_nominal_codes_pass_through_with_their_positions() -> None:
-    data = np.array([[0.5, 1.0, 2.0], [NAN, NAN, 0.0]])
+def test_native_nominal_codes_pass_through_in_place_when_nothing_else_is_done() -> None:
+    data = np.array([[0.5, 1.0, 2.0, 9.0], [NAN, NAN, 0.0, 8.0]])
     transformer, native = make_preprocessor(
         n_features=3, nominal_features={1: 2}, impute=False, scaling=None, native_nominal=True
     )
     out = transformer.fit_transform(data)
+    assert native == [1]
+    np.testing.assert_array_equal(out, data)
+
+
+def test_native_nominal_codes_follow_scaled_numeric_columns() -> None:
+    data = np.array([[0.0, 1.0, 2.0], [NAN, NAN, 4.0]])
+    transformer, native = make_preprocessor(
+        n_features=3, nominal_features={1: 2}, impute=True, scaling="minmax", native_nominal=True
+    )
+    out = transformer.fit_transform(data)
     assert native == [2]
-    np.testing.assert_array_equal(out, [[0.5, 2.0, 1.0], [NAN, 0.0, NAN]])
+    np.testing.assert_array_equal(out, [[0.0, 0.0, 1.0], [0.0, 1.0, NAN]])
 
 
 def test_columns_after_the_features_pass_through_untouched() -> None:

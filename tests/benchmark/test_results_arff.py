@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmark.catalogue import CATALOGUE
+from benchmark.catalogue import CATALOGUE, parse_weka_command
 from benchmark.errors import ConfigurationError
 from benchmark.evaluation.results_arff import RESULT_ATTRIBUTES, results_to_dataset, weka_measures
 from benchmark.io.arff import dumps_arff, loads_arff, read_arff
@@ -59,11 +59,15 @@ def test_export_reads_back_with_weka_attribute_names_and_one_row_per_success(
         "weka.classifiers.lazy.IBk",
         "weka.classifiers.bayes.NaiveBayes",
     )
+    # WEKA-named entries are written as WEKA writes their command: class, then options
     assert labels["Key_Scheme_options"] == (
-        "-id ibk -n_neighbors 1",
-        "-id ibk3 -n_neighbors 3",
-        "-id nb",
+        CATALOGUE["ibk"].weka_options,
+        CATALOGUE["ibk3"].weka_options,
+        "",
     )
+    assert labels["Key_Scheme_options"][0].startswith("-K 1 -W 0 -A ")
+    for scheme, options in zip(labels["Key_Scheme"], labels["Key_Scheme_options"][1:], strict=True):
+        assert parse_weka_command(f"{scheme} {options}").id in ("ibk3", "nb")
     np.testing.assert_array_equal(column["Date_time"], 20170922.0948)
     np.testing.assert_array_equal(column["Number_of_testing_instances"], 20)
     nb = [r for r in results if r.key.classifier == "nb"]
@@ -81,6 +85,20 @@ def test_scheme_names_can_be_touchbench_ids(results: list[TaskResult]) -> None:
     dataset = results_to_dataset(results, dataset_name="d", scheme_names="id")
     scheme = dataset.schema.attributes[dataset.schema.index("Key_Scheme")]
     assert scheme.values == ("touchbench.ibk", "touchbench.ibk3", "touchbench.nb")
+    options = dataset.schema.attributes[dataset.schema.index("Key_Scheme_options")]
+    assert options.values == (
+        "-id ibk -n_neighbors 1",
+        "-id ibk3 -n_neighbors 3",
+        "-id nb -numeric normal",
+    )
+
+
+def test_entries_without_a_weka_command_keep_their_touchbench_name() -> None:
+    result = TaskResult(TaskKey("rf", 0, 0), "ok", None, {}, [[3, 1], [1, 5]], 90, 10)
+    dataset = results_to_dataset([result], dataset_name="d")
+    keys = {a.name: a.values for a in dataset.schema.attributes[:6]}
+    assert keys["Key_Scheme"] == ("touchbench.rf",)
+    assert keys["Key_Scheme_options"] == ("-id rf -n_estimators 100",)
 
 
 def test_weka_measures_by_hand() -> None:

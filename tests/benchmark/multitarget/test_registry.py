@@ -71,7 +71,7 @@ def test_bad_configuration_ids(config: str, message: str) -> None:
 
 
 def test_build_gives_a_fresh_unfitted_estimator_seeded_and_sized() -> None:
-    model = build_multitarget("bcc:j48", n_features=4, random_state=7, n_classes=[3, 2, 3])
+    model = build_multitarget("bcc:cart", n_features=4, random_state=7, n_classes=[3, 2, 3])
     assert isinstance(model, MultiTargetClassifier)
     assert not hasattr(model, "n_classes_")
     assert model.get_params()["random_state"] == 7
