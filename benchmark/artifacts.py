@@ -35,6 +35,16 @@ TRUSTED_PACKAGES = frozenset(
         "imodels",
     }
 )
+#: Types and functions outside those packages, or functions inside them, that models hold
+#: and that cannot do harm whatever their arguments (a crafted artifact could otherwise
+#: make a model call a function that opens files or runs code).
+TRUSTED_NAMES = frozenset(
+    {
+        "collections.OrderedDict",  # LightGBM's boosters keep their parameters in one
+        "functools.partial",  # histogram boosting's input check ...
+        "sklearn.utils.validation.check_array",  # ... binds this function
+    }
+)
 #: Classes of trusted packages that touch files, never loaded all the same (a memory-mapped
 #: array or an ``.npz`` archive would open a path the artifact names).
 REFUSED_TYPES = frozenset({"numpy.memmap", "numpy.lib.npyio.NpzFile", "numpy.lib.npyio.DataSource"})
@@ -94,6 +104,8 @@ def is_trusted_type(name: str) -> bool:
     Only the module is imported (trusted packages' modules import without side effects);
     the attribute must be a class, so no function can be named and called.
     """
+    if name in TRUSTED_NAMES:
+        return True
     module_name, _, attribute = name.rpartition(".")
     if not module_name or module_name.split(".", 1)[0] not in TRUSTED_PACKAGES:
         return False

@@ -213,6 +213,18 @@ def bench_command(
         int | None,
         typer.Option("--resume", metavar="RUN", help="Finish an interrupted run.", min=1),
     ] = None,
+    weka: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--weka",
+            metavar="COMMAND",
+            help=(
+                'A WEKA command line to run as well, e.g. "weka.classifiers.trees.J48 -C 0.1 '
+                '-M 5" (J48, PART, NaiveBayes, IBk, ZeroR; repeat for several).'
+            ),
+            show_default=False,
+        ),
+    ] = None,
     independent: Annotated[
         bool,
         typer.Option(
@@ -286,6 +298,7 @@ def bench_command(
             targets=[target] if target else None,
             options=options,
             on_warning=progress.note,
+            weka=weka or (),
         ).id
     try:
         with progress:

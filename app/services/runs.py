@@ -10,7 +10,7 @@ processes it is alive (and hears a cancel request), and writes the final status.
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -41,6 +41,7 @@ from benchmark.problem import Problem, problem_from_dataset, restrict_targets
 from benchmark.results import TaskKey, TaskResult
 
 if TYPE_CHECKING:  # scipy.stats (significance) loads when a leaderboard is first built
+    from benchmark.catalogue import ClassifierSpec
     from benchmark.evaluation.leaderboard import Leaderboard
 
 #: Metric a leaderboard is ranked by unless asked otherwise, per kind of run.
@@ -148,14 +149,27 @@ def default_classifiers(n_targets: int, suite_name: str = "default") -> list[str
     return suite(suite_name)
 
 
-def check_classifiers(problem: Problem, classifiers: Sequence[str]) -> None:
+def check_classifiers(
+    problem: Problem,
+    classifiers: Sequence[str],
+    extra_specs: Mapping[str, ClassifierSpec] | None = None,
+) -> None:
     """Refuse, before a run exists, ids that are unknown or do not fit the problem."""
     from benchmark.estimators import check_classifier
 
     if not classifiers:
         raise ConfigurationError("no classifiers to run")
     for classifier in classifiers:
-        check_classifier(classifier, problem)
+        check_classifier(classifier, problem, extra_specs)
+
+
+def weka_specs(commands: Sequence[str] | Mapping[str, str | None]) -> dict[str, ClassifierSpec]:
+    """The catalogue configurations of WEKA command lines, by id (a run's ``--weka``)."""
+    from benchmark.catalogue import parse_weka_command
+
+    texts = commands.values() if isinstance(commands, Mapping) else commands
+    specs = [parse_weka_command(text) for text in texts if text]
+    return {spec.id: spec for spec in specs}
 
 
 def create_run(
@@ -167,6 +181,7 @@ def create_run(
     targets: Sequence[str] | None = None,
     options: RunOptions | None = None,
     on_warning: Callable[[str], None] | None = None,
+    weka: Sequence[str] = (),
 ) -> RunInfo:
     """Check a benchmark request and store it as a ``queued`` run.
 
@@ -184,6 +199,9 @@ def create_run(
     options : RunOptions, optional
     on_warning : callable, optional
         Hears adjustments made (fewer folds than asked, unstratified folds, ...).
+    weka : sequence of str
+        WEKA command lines (``"weka.classifiers.trees.J48 -C 0.1"``) to run as well, each
+        as the catalogue configuration that computes what WEKA computes.
 
     Raises
     ------
@@ -195,12 +213,14 @@ def create_run(
         raise ConfigurationError("give classifiers or a suite, not both")
     options = options or RunOptions()
     _check_options(options)
+    commands = weka_specs(weka)
     info = find_dataset(store, dataset_ref)
     prepared = prepare_problem(load_dataset(store, info.id), targets)
-    ids = list(dict.fromkeys(classifiers or ())) or default_classifiers(
-        len(prepared.target_names), suite or "default"
-    )
-    check_classifiers(prepared.problem, ids)
+    ids = list(dict.fromkeys(classifiers or ()))
+    if not ids and not commands:
+        ids = default_classifiers(len(prepared.target_names), suite or "default")
+    ids = list(dict.fromkeys([*ids, *commands]))
+    check_classifiers(prepared.problem, ids, commands)
     folds, fold_notes = _folds(prepared, options)
     effective = max(f.fold for f in folds) + 1
     config = {
@@ -208,7 +228,8 @@ def create_run(
         "folds": effective,
         "folds_requested": options.folds,
         "targets_given": list(targets) if targets else None,
-        "suite": None if classifiers else (suite or "default"),
+        "suite": None if classifiers or weka else (suite or "default"),
+        "weka": {spec_id: spec.weka_command for spec_id, spec in commands.items()},
         "n_tasks": len(ids) * len(folds),
         "n_instances": int(prepared.problem.X.shape[0]),
         "grouped": prepared.problem.groups is not None,
@@ -293,6 +314,7 @@ def execute_run(
                 on_result=persist,
                 max_memory=_bytes(options.max_memory_mb),
                 stop=stop.is_set,
+                extra_specs=weka_specs(run.config.get("weka") or {}),
             )
         except RunStopped:
             finish_run(store, run.id, "cancelled")
@@ -326,6 +348,7 @@ def start_run(
     jobs: int = 1,
     scheduler: str | None = None,
     callbacks: Callbacks | None = None,
+    weka: Sequence[str] = (),
 ) -> tuple[RunInfo, list[TaskResult]]:
     """Create a run and carry it out at once (the CLI's ``bench``)."""
     callbacks = callbacks or Callbacks()
@@ -337,6 +360,7 @@ def start_run(
         targets=targets,
         options=options,
         on_warning=callbacks.on_note,
+        weka=weka,
     )
     run = execute_run(store, run.id, jobs=jobs, scheduler=scheduler, callbacks=callbacks)
     return run, load_results(store, run.id)

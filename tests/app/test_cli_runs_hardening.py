@@ -373,3 +373,33 @@ def test_processes_opening_a_new_store_at_once_migrate_it_once(store_url: str) -
     assert [code for code, _, _ in results] == [0, 0, 0, 0], results
     assert all(json.loads(out) == {"datasets": []} for _, out, _ in results)
     assert _scalar(store_url, "SELECT count(*) FROM alembic_version") == 1
+
+
+def test_weka_command_lines_run_and_export_as_weka_wrote_them(
+    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+) -> None:
+    _import(capsys, store_url, touch_arff(tmp_path / "t.arff"), "touch")
+    result = run_cli(
+        capsys,
+        store_url,
+        "bench",
+        "touch",
+        "--target",
+        "gesture",
+        "--weka",
+        "weka.classifiers.trees.J48 -C 0.1 -M 5",
+        "--weka",
+        "NaiveBayes -K",
+        "--folds",
+        "3",
+        "--json",
+    )
+    assert result.code == 0, result.err
+    ids = {row["classifier"] for row in result.json()["leaderboard"]}
+    assert len(ids) == 2 and "nb-kernel" in ids
+    arff = run_cli(capsys, store_url, "leaderboard", "1", "--format", "arff")
+    assert "weka.classifiers.trees.J48,'-C 0.1 -M 5'" in arff.out.replace('"', "'")
+    refused = run_cli(
+        capsys, store_url, "bench", "touch", "--target", "gesture", "--weka", "J48 -B"
+    )
+    assert refused.code == 2 and "option '-B'" in refused.err

@@ -26,6 +26,11 @@ class RunRequest(Schema):
         default=None, description="One target for the multi-class catalogue."
     )
     classifiers: list[str] | None = Field(default=None, min_length=1, max_length=500)
+    weka: list[str] | None = Field(
+        default=None,
+        max_length=50,
+        description='WEKA command lines, e.g. "weka.classifiers.trees.J48 -C 0.1 -M 5".',
+    )
     suite: Literal["fast", "default", "all"] | None = None
     folds: int = Field(default=10, ge=2, le=100)
     repeats: int = Field(default=1, ge=1, le=100)
@@ -50,6 +55,7 @@ def start_run(body: RunRequest, service: ServiceDep) -> RunCreated:
             timeout=body.timeout,
             max_memory_mb=body.max_memory_mb,
         ),
+        weka=body.weka or (),
     )
     service.dispatcher.wake()
     return RunCreated(id=run.id, status=run.status)
