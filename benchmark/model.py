@@ -100,6 +100,37 @@ class TrainedModel:
             return [expand_proba(proba, self.estimator.classes_, n_classes=self.n_classes[0])]
         return [np.asarray(p, dtype=np.float64) for p in self.estimator.predict_proba(features)]
 
+    def predict_with_proba(self, X: np.ndarray) -> tuple[np.ndarray, list[np.ndarray] | None]:
+        """Codes and probabilities at once, in one pass where the classifier allows it.
+
+        A forest or a tree predicts the class of highest probability, so its codes are read
+        off the probabilities instead of computing every tree twice (live prediction pays
+        for each pass).  Other classifiers predict in their own way.
+
+        Returns
+        -------
+        codes : ndarray of shape (n_instances, n_targets), int64
+        probabilities : list of ndarray of shape (n_instances, n_classes[t]) or None
+            None when the classifier gives no probabilities.
+        """
+        try:
+            probabilities = self.predict_proba(X)
+        except NotImplementedError:
+            return self.predict(X), None
+        if self._predicts_most_probable():
+            codes = np.column_stack([np.argmax(p, axis=1) for p in probabilities])
+            return codes.astype(np.int64), probabilities
+        return self.predict(X), probabilities
+
+    def _predicts_most_probable(self) -> bool:
+        from sklearn.ensemble._forest import ForestClassifier
+        from sklearn.tree import BaseDecisionTree
+
+        if len(self.schema.target_indices) != 1:
+            return False
+        final = self.estimator[-1] if hasattr(self.estimator, "steps") else self.estimator
+        return isinstance(final, ForestClassifier | BaseDecisionTree)
+
     def _features(self, X: np.ndarray) -> np.ndarray:
         X = np.asarray(X, dtype=np.float64)
         expected = len(self.schema.feature_indices)

@@ -172,14 +172,9 @@ class LiveSession:
         if instances.values.shape[0] == 0:
             return []
         X = instances.values[:, self.columns]
-        codes = np.asarray(self.model.predict(X)).reshape(X.shape[0], -1)
+        codes, probabilities = self.model.predict_with_proba(X)
+        codes = np.asarray(codes).reshape(X.shape[0], -1)
         targets = self.model.schema.targets
-        try:
-            probabilities: list[np.ndarray] | None = [
-                np.asarray(p) for p in self.model.predict_proba(X)
-            ]
-        except (AttributeError, NotImplementedError):
-            probabilities = None
         done = time.perf_counter()
         origin = self.origin or 0.0
         out = []

@@ -103,3 +103,14 @@ def test_serialised_models_load_only_with_their_digest() -> None:
     other = pickle.dumps({"not": "a model"})
     with pytest.raises(ConfigurationError, match="not a skops artifact"):
         loads_model(other, sha256=model_digest(other))
+
+
+@pytest.mark.parametrize("classifier", ["rf", "extra-trees", "cart", "nb", "logistic", "cc:j48"])
+def test_codes_and_probabilities_in_one_pass_agree_with_predict(classifier: str) -> None:
+    data = dataset(targets=2 if ":" in classifier else 1)
+    model = fit_model(data, classifier)
+    codes, probabilities = model.predict_with_proba(data.X)
+    np.testing.assert_array_equal(codes, model.predict(data.X))
+    assert probabilities is not None
+    for mine, theirs in zip(probabilities, model.predict_proba(data.X), strict=True):
+        np.testing.assert_allclose(mine, theirs)
