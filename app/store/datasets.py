@@ -15,7 +15,7 @@ import json
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
-from datetime import UTC, datetime, timedelta
+from datetime import UTC, datetime
 from typing import Any, Protocol
 
 import numpy as np
@@ -26,6 +26,7 @@ from sqlalchemy.orm import Session
 from app.errors import AppError
 from app.store.database import Store
 from app.store.naming import check_name, default_name, find_row, free_name, shorten
+from app.store.ownership import owner_alive
 from app.store.tables import DatasetRow, InstanceRow, RunRow
 from benchmark.dataset import Dataset, InstanceBlock, Schema, dataset_blocks
 
@@ -33,8 +34,6 @@ _LITTLE_F8 = np.dtype("<f8")
 _INSERT_BATCH = 5000
 #: Rows fetched at a time when instances are read back.
 READ_BATCH = 5000
-#: A queued or running run whose process said it was alive this recently holds its data set.
-LIVE_RUN = timedelta(seconds=60)
 _PGCOPY_HEADER = b"PGCOPY\n\xff\r\n\x00" + bytes(8)
 _PGCOPY_TRAILER = b"\xff\xff"
 
@@ -602,8 +601,8 @@ def delete_dataset(store: Store, ref: str | int) -> DatasetInfo:
     Raises
     ------
     AppError
-        If a run on it is queued or running (its process alive in the last
-        :data:`LIVE_RUN`): the run must be cancelled first.
+        If a run on it is queued, or running in a process that is alive: the run must be
+        cancelled first.
     """
     with store.session() as session:
         row = _row(session, ref, lock=True)
@@ -621,22 +620,15 @@ def delete_dataset(store: Store, ref: str | int) -> DatasetInfo:
 
 
 def _live_run(session: Session, dataset_id: int) -> tuple[int, str] | None:
-    """A queued or running run on the data set whose process is alive, if any."""
+    """A queued run on the data set, or a running one whose process is alive, if any."""
     runs = session.execute(
-        select(RunRow.id, RunRow.status, RunRow.heartbeat_at)
+        select(RunRow.id, RunRow.status, RunRow.owner, RunRow.heartbeat_at)
         .where(RunRow.dataset_id == dataset_id)
         .where(RunRow.status.in_(("queued", "running")))
         .order_by(RunRow.id)
     ).all()
-    now = datetime.now(UTC)
-    for run_id, status, heartbeat in runs:
-        if heartbeat is None:
-            if status == "queued":
-                return run_id, status
-            continue
-        if heartbeat.tzinfo is None:  # SQLite keeps naive UTC times
-            heartbeat = heartbeat.replace(tzinfo=UTC)
-        if now - heartbeat < LIVE_RUN:
+    for run_id, status, owner, heartbeat in runs:
+        if status == "queued" or owner_alive(owner, heartbeat):
             return run_id, status
     return None
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import re
+import subprocess
 from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
@@ -206,7 +207,9 @@ def test_an_export_that_fails_midway_keeps_the_old_file(
     assert sorted(p.name for p in files.iterdir()) == ["mini.arff", "out.arff"]
 
 
-def _add_run(store_url: str, status: str, heartbeat: datetime | None) -> int:
+def _add_run(
+    store_url: str, status: str, heartbeat: datetime | None, owner: str | None = None
+) -> int:
     store = Store(store_url)
     with store.session() as session:
         run = RunRow(
@@ -217,6 +220,7 @@ def _add_run(store_url: str, status: str, heartbeat: datetime | None) -> int:
             config={},
             status=status,
             heartbeat_at=heartbeat,
+            owner=owner,
         )
         session.add(run)
         session.flush()
@@ -225,15 +229,22 @@ def _add_run(store_url: str, status: str, heartbeat: datetime | None) -> int:
     return run_id
 
 
+#: A process on another machine (judged by its heartbeat), this test's own process (alive),
+#: and a process of this machine that has ended.
+ELSEWHERE, HERE, GONE = "elsewhere.example:4242@1", "here", "gone"
+
+
 @pytest.mark.parametrize(
-    ("status", "age", "refused"),
+    ("status", "owner", "age", "refused"),
     [
-        ("running", timedelta(seconds=5), True),
-        ("queued", None, True),
-        ("queued", timedelta(seconds=10), True),
-        ("running", timedelta(minutes=5), False),
-        ("running", None, False),
-        ("done", timedelta(seconds=1), False),
+        ("running", ELSEWHERE, timedelta(seconds=5), True),
+        ("running", HERE, timedelta(minutes=5), True),
+        ("queued", None, None, True),
+        ("queued", None, timedelta(seconds=10), True),
+        ("running", ELSEWHERE, timedelta(minutes=5), False),
+        ("running", GONE, timedelta(seconds=1), False),
+        ("running", None, None, False),
+        ("done", None, timedelta(seconds=1), False),
     ],
 )
 def test_delete_is_refused_while_a_live_run_uses_the_dataset(
@@ -241,13 +252,21 @@ def test_delete_is_refused_while_a_live_run_uses_the_dataset(
     store_url: str,
     tmp_path: Path,
     status: str,
+    owner: str | None,
     age: timedelta | None,
     refused: bool,
 ) -> None:
+    from app.store.ownership import process_owner
+
     imported = run_cli(capsys, store_url, "import", str(write(tmp_path, "mini.arff", TOUCH_ARFF)))
     assert imported.code == 0
     heartbeat = None if age is None else datetime.now(UTC) - age
-    run_id = _add_run(store_url, status, heartbeat)
+    if owner == HERE:
+        owner = process_owner()
+    elif owner == GONE:
+        ended = subprocess.run(["true"], check=True)
+        owner = process_owner(pid=2**22 + ended.returncode)  # a pid no process has here
+    run_id = _add_run(store_url, status, heartbeat, owner)
     result = run_cli(capsys, store_url, "delete", "mini")
     if refused:
         one_error_line(result, f"in use by run {run_id}", f"touchbench cancel {run_id}")
