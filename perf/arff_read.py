@@ -187,7 +187,7 @@ def main() -> int:
         f"{'':<40} {'':>13} {'s':>9} {'block s':>9} {'s':>9} {'s':>9} {'touchb':>6} {'pandas':>6}"
     )
     np.seterr(all="ignore")
-    read_arff(files[0]) if files else None  # pandas imported before anything is timed
+    read_arff(files[0]) if files else None  # pyarrow imported before anything is timed
     for path in files:
         print(table_row(path, str(path.relative_to(folder)), options.repeat), flush=True)
     if options.rows:

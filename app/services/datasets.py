@@ -263,7 +263,7 @@ class _CheckedInstances:
 def prefetched(blocks: Iterator[InstanceBlock], depth: int = 2) -> Iterator[InstanceBlock]:
     """``blocks``, read ahead by a thread while the caller stores the ones before.
 
-    Parsing (pandas' C parser) and inserting (the database driver) both release the GIL
+    Parsing (Arrow's CSV reader) and inserting (the database driver) both release the GIL
     for most of their work, so on two cores an import takes about the longer of the two
     rather than their sum.  At most ``depth`` blocks wait; what the reader raises is
     raised here, and the reader stops when the caller does.

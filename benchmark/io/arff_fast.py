@@ -1,32 +1,33 @@
-"""The vectorised reading of plain blocks of ARFF rows with pandas' C parser.
+"""The vectorised reading of plain blocks of ARFF rows with Apache Arrow's CSV reader.
 
 Most of a real data section is lines such as ``'tap','head',459.375,0,?``: numbers,
 nominal labels (quoted or not) and ``?``, separated by single commas.  On such a block
-WEKA's tokenizer and a CSV parser read the same fields, so pandas' C parser reads the
-block at C speed.  :func:`read_plain_block` first proves, with numpy over the block's
-bytes, that pandas cannot read it differently without saying so, and gives up (returns
-``None``) otherwise, leaving the block to the exact reader (:mod:`benchmark.io.arff_data`):
+WEKA's tokenizer and a CSV parser read the same fields, so Arrow's multi-threaded C++
+reader reads the block at C speed.  :func:`read_plain_block` first proves, with numpy over
+the block's bytes, that Arrow cannot read it differently without saying so, and gives up
+(returns ``None``) otherwise, leaving the block to the exact reader
+(:mod:`benchmark.io.arff_data`):
 
 - no double quote, backslash, brace, ``%``, and no whitespace or control character but
   the line breaks (``\\n``, or ``\\r\\n`` throughout);
 - no comma at the start or end of a line, none two in a row, and as many on each line as
-  there are attributes less one (pandas itself refuses a line with too many fields);
+  there are attributes less one (Arrow itself refuses a line with another number);
 - single quotes pair up on each line, each pair enclosing one whole field, and ``'?'``
   (the label ``?``, not a missing value) does not occur;
-- every numeric field is a number pandas reads (it refuses, for example, ``nan`` and
-  ``1_000``, which Python's ``float`` reads: those blocks go to the exact reader), and
-  every nominal field is a declared label or ``?``; labels that could not be plain fields
-  (with separators, quotes or braces) keep the whole file off this path.
+- every numeric field is a number Arrow reads (it refuses, for example, ``1_000``, which
+  Python's ``float`` reads: such blocks go to the exact reader), and every nominal field
+  is a declared label or ``?``; labels that could not be plain fields (with separators,
+  quotes or braces) keep the whole file off this path.
 
-pandas parses floats correctly rounded (as Python's ``float`` does: by default from
-pandas 3.1, with ``float_precision="round_trip"`` before it), so the values are the same
-bits; the tests compare both readers value for value.  pandas is imported on the
-first block, so small files never pay for its import.
+Arrow converts text to float64 with ``fast_float``, correctly rounded as Python's own
+``float`` is, so the values are the same bits whatever the version of pandas (whose C
+parser rounds correctly only from 3.1, and before it only through Python's own conversion,
+one number at a time); the tests compare both readers bit for bit.  pyarrow is imported
+on the first block, so small files never pay for its import.
 """
 
 from __future__ import annotations
 
-import io
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -109,14 +110,14 @@ def read_plain_block(
         return None
     if rows.size == 0:
         return np.empty((0, plan.n_columns)), rows
-    frame = _parse(block, plan, encoding)
-    if frame is None or len(frame) != rows.size:
+    table = _parse(block, plan, encoding)
+    if table is None or table.num_rows != rows.size:
         return None
     values = np.empty((rows.size, plan.n_columns))
-    if plan.numeric.size:
-        values[:, plan.numeric] = frame.iloc[:, plan.numeric].to_numpy(dtype=np.float64)
+    for position in plan.numeric.tolist():
+        values[:, position] = table.column(position).to_numpy()  # nulls become NaN
     for position, labels in zip(plan.nominal.tolist(), plan.labels, strict=True):
-        codes = _label_codes(frame.iloc[:, position], labels)
+        codes = _label_codes(table.column(position), labels)
         if codes is None:
             return None
         values[:, position] = codes
@@ -126,9 +127,9 @@ def read_plain_block(
 def _plain_rows(block: bytes, n_columns: int) -> np.ndarray | None:
     """The indices of the non-blank lines of a plain block, ``None`` if it is not plain.
 
-    What is checked here is what pandas would read differently from WEKA's tokenizer
+    What is checked here is what Arrow would read differently from WEKA's tokenizer
     without saying so; the rest (a line with too many fields, a field that is neither a
-    number nor a label) makes pandas fail or :func:`read_plain_block` refuse the values.
+    number nor a label) makes Arrow fail or :func:`read_plain_block` refuse the values.
     """
     if any(byte in block for byte in _FORBIDDEN):
         return None
@@ -152,8 +153,8 @@ def _plain_rows(block: bytes, n_columns: int) -> np.ndarray | None:
         return non_blank
     if np.any(data[ends[non_blank] - 1] == _COMMA) or np.any(data[starts[non_blank]] == _COMMA):
         return None  # a comma at the start or end of a line
-    # Every line has as many fields as attributes: pandas refuses lines with more fields
-    # than the first, so the total settles it once the first line is right (a quoted
+    # Every line has as many fields as attributes: Arrow refuses lines with another number
+    # of fields than the first, so the total settles it once the first line is right (a quoted
     # comma would show in a field that is neither a number nor a label).
     first = non_blank[0]
     if block.count(b",", starts[first], ends[first]) != n_columns - 1:
@@ -183,52 +184,38 @@ def _quotes_enclose_fields(data: np.ndarray, quotes: np.ndarray, breaks: np.ndar
     return bool(np.all(np.searchsorted(breaks, opening) == np.searchsorted(breaks, closing)))
 
 
-def _exact_floats(version: str) -> dict[str, str]:
-    """The ``read_csv`` option that makes pandas parse floats as Python does.
-
-    pandas 3.1 parses every float correctly rounded (and deprecates the option); before
-    it, only ``float_precision="round_trip"`` does (Python's own conversion), the default
-    being off by one unit in the last place now and then.
-    """
-    major, minor = (int(part) for part in version.split(".")[:2])
-    return {} if (major, minor) >= (3, 1) else {"float_precision": "round_trip"}
-
-
 def _parse(block: bytes, plan: PlainPlan, encoding: str) -> Any | None:
-    """The block as a pandas DataFrame, ``None`` if pandas cannot read it as planned."""
-    import pandas as pd
+    """The block as an Arrow table, ``None`` if Arrow cannot read it as planned."""
+    import pyarrow as pa
+    import pyarrow.csv as csv
 
-    dtypes: dict[int, Any] = {int(j): np.float64 for j in plan.numeric}
-    dtypes.update({int(j): object for j in plan.nominal})
+    names = [str(j) for j in range(plan.n_columns)]
+    types = {names[j]: pa.float64() for j in plan.numeric.tolist()}
+    types.update({names[j]: pa.string() for j in plan.nominal.tolist()})
     try:
-        return pd.read_csv(
-            io.BytesIO(block),
-            header=None,
-            names=list(range(plan.n_columns)),
-            dtype=dtypes,
-            quotechar="'",
-            doublequote=False,
-            na_values=["?"],
-            keep_default_na=False,
-            skip_blank_lines=True,
-            encoding=encoding,
-            engine="c",
-            low_memory=False,
-            **_exact_floats(pd.__version__),
+        return csv.read_csv(
+            pa.py_buffer(block),
+            read_options=csv.ReadOptions(column_names=names, encoding=encoding, use_threads=True),
+            parse_options=csv.ParseOptions(
+                delimiter=",", quote_char="'", double_quote=False, escape_char=False
+            ),
+            convert_options=csv.ConvertOptions(
+                column_types=types,
+                null_values=["?"],
+                strings_can_be_null=True,
+                quoted_strings_can_be_null=False,
+            ),
         )
-    except (ValueError, UnicodeDecodeError, pd.errors.ParserError):
+    except (pa.ArrowException, ValueError, UnicodeDecodeError):
         return None
 
 
 def _label_codes(column: Any, labels: tuple[str, ...]) -> np.ndarray | None:
     """Codes of a column of nominal texts (NaN where missing); ``None`` on an unknown label."""
-    import pandas as pd
+    import pyarrow as pa
+    import pyarrow.compute as pc
 
-    codes = pd.Index(labels).get_indexer(column).astype(np.float64)
-    unknown = codes < 0
-    if unknown.any():
-        missing = column.isna().to_numpy()
-        if np.any(unknown & ~missing):
-            return None
-        codes[unknown] = np.nan
-    return codes
+    codes = pc.index_in(column, value_set=pa.array(labels, pa.string()))
+    if codes.null_count != column.null_count:
+        return None
+    return np.asarray(codes.to_numpy(), dtype=np.float64)

@@ -4,7 +4,7 @@
 blocks of instances, so that a file of any size is read with memory bounded by the block
 size.  Each block of lines is read the fastest way that is exact for it:
 
-1. plain blocks (numbers and nominal labels between single commas) by pandas' C parser
+1. plain blocks (numbers and nominal labels between single commas) by Arrow's CSV reader
    (:mod:`benchmark.io.arff_fast`);
 2. other lines without double quotes, backslashes, braces or comments by splitting on
    commas, a column at a time (:mod:`benchmark.io.arff_data`);
@@ -45,7 +45,7 @@ from benchmark.io.textfile import (
 
 TargetSpec = int | Sequence[str] | None
 Parser = Literal["auto", "vectorised", "tokenizer"]
-#: Blocks smaller than this are split on commas rather than handed to pandas, whose import
+#: Blocks smaller than this are split on commas rather than handed to Arrow, whose import
 #: costs more than it saves on a small file.
 VECTORISED_MIN_BYTES = 1 << 20
 #: Files larger than this have their first bytes parsed as a header before they are read
@@ -68,7 +68,7 @@ class ArffReader:
         ``None``: MEKA's ``-C`` in the relation name, else the last attribute; ``N``:
         the first N attributes; ``-N``: the last N; names: those attributes.
     parser : {"auto", "vectorised", "tokenizer"}
-        ``auto`` hands plain blocks of at least :data:`VECTORISED_MIN_BYTES` to pandas;
+        ``auto`` hands plain blocks of at least :data:`VECTORISED_MIN_BYTES` to Arrow;
         ``vectorised`` hands it every plain block; ``tokenizer`` reads every row with
         WEKA's tokenizer.
     block_bytes : int

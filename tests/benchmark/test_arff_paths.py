@@ -1,7 +1,7 @@
 """The fast ways of reading ARFF agree with WEKA's tokenizer, value for value, bit for bit.
 
 ``parser="tokenizer"`` reads every row with the exact tokenizer; ``"vectorised"`` hands
-every plain block to pandas' C parser (and the rest to the comma split or the tokenizer);
+every plain block to Arrow's CSV reader (and the rest to the comma split or the tokenizer);
 ``"auto"`` is what users get.  Every ARFF text of the tests and of ``../shared/datasets``
 must read the same three ways, or fail the same way at the same line.
 """
@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import os
+from decimal import Context, Decimal
 from pathlib import Path
 
 import numpy as np
@@ -53,7 +54,12 @@ NOMINAL_HEADER = (
 PLAIN_CASES = {
     "quoted and bare labels": "'tap',1.5,2\nslap,-0,1e-300\n'0',?,?\n1,7,8\n",
     "quoted numbers": "tap,'1.5','2'\n",
-    "numbers pandas refuses": "tap,nan,1_000\nslap,NaN,-inf\n",
+    "numbers a C parser may refuse": "tap,nan,1_000\nslap,NaN,-inf\n",
+    "not a number and infinities": "tap,nan,-nan\nslap,NaN,-inf\n0,Infinity,+inf\n",
+    "spellings of numbers": "tap,+1,1.\ntap,.5,-0\ntap,1E+05,00012\ntap,0e0,-0.0\n",
+    "almost numbers": "tap,1e,2\n",
+    "hexadecimal": "tap,0x10,2\n",
+    "other digits": "tap,\u0661\u0662,2\n",
     "numbers at the edges of float64": (
         "tap,4.9e-324,2.4703282292062327e-324\ntap,1.7976931348623157e308,1e309\n"
         "tap,2.2250738585072011e-308,9007199254740993\n"
@@ -99,10 +105,27 @@ def test_the_fast_path_is_taken_and_refuses_what_it_cannot_prove() -> None:
     values, rows = read
     np.testing.assert_array_equal(values, [[0, 1.5, np.nan], [1, 2, 3]])
     np.testing.assert_array_equal(rows, [0, 2])
-    for refused in (b"tap,nan,1\n", b"tap,1\nslap,2,3,4\n", b"tip,1,2\n", b"'tap,'1,2\n"):
+    for refused in (b"tap,1_000,1\n", b"tap,1\nslap,2,3,4\n", b"tip,1,2\n", b"'tap,'1,2\n"):
         assert read_plain_block(refused, plan, encoding="utf-8") is None
     labels_with_spaces = loads_arff("@relation r\n@attribute g {'a b'}\n@data\n")
     assert plain_plan(labels_with_spaces.schema.attributes) is None
+
+
+SPELLINGS = ["nan", "-nan", "NaN", "inf", "-Infinity", "+1", "1.", ".5", "-0", "+0", "1E+05",
+             "00012", "0e0", "-0.0", "1e-400", "4.9e-324", "1.7976931348623159e308"]  # fmt: skip
+
+
+def test_the_fast_path_reads_every_spelling_of_a_number_as_python_does() -> None:
+    from benchmark.io.arff_fast import plain_plan, read_plain_block
+
+    plan = plain_plan(loads_arff(NOMINAL_HEADER).schema.attributes)
+    assert plan is not None
+    block = "".join(f"tap,{text},?\n" for text in SPELLINGS).encode()
+    read = read_plain_block(block, plan, encoding="utf-8")
+    assert read is not None, "the fast path refused numbers it should read"
+    expected = np.array([float(text) for text in SPELLINGS])
+    assert read[0][:, 1].tobytes() == expected.tobytes()
+    assert read[0][:, 2].tobytes() == np.full(len(SPELLINGS), np.nan).tobytes()
 
 
 @pytest.mark.parametrize("text", [CANONICAL, MESSY, TOUCH_ARFF, HEADER + "1,x\n?,y,{2}\n"])
@@ -143,11 +166,25 @@ def test_every_float_text_reads_as_python_reads_it() -> None:
     values = bits.view(np.float64)
     values = values[np.isfinite(values)]
     texts = [repr(float(v)) for v in values] + [f"{float(v):.12e}" for v in values[:500]]
-    texts += [f"{rng.integers(0, 10**18)}.{rng.integers(0, 10**18)}e{rng.integers(-330, 310)}"]
+    texts += [
+        f"{rng.integers(0, 10**18)}.{rng.integers(0, 10**18)}e{rng.integers(-330, 310)}"
+        for _ in range(500)
+    ]
+    # Exact midpoints between neighbouring doubles: rounding to even decides them.
+    exact = Context(prec=1000)
+    texts += [
+        str(exact.add(Decimal(float(v)), exact.divide(Decimal(math.ulp(float(v))), 2)))
+        for v in values[:300]
+    ]
     body = "".join(f"tap,{text},{text}\n" for text in texts)
-    dataset = loads_arff(NOMINAL_HEADER + body, parser="vectorised")
+    from benchmark.io.arff_fast import plain_plan, read_plain_block
+
+    plan = plain_plan(loads_arff(NOMINAL_HEADER).schema.attributes)
+    assert plan is not None
+    read = read_plain_block(body.encode(), plan, encoding="utf-8")
+    assert read is not None, "the fast path refused the block"
     expected = np.array([float(text) for text in texts])
-    assert dataset.values[:, 1].tobytes() == expected.tobytes()
+    assert read[0][:, 1].tobytes() == expected.tobytes()
     assert assert_all_parsers_agree(NOMINAL_HEADER + body)[0] == "data"
 
 
@@ -271,12 +308,3 @@ def test_every_reference_file_reads_alike(shared_datasets: Path, relative: str) 
 def test_the_reference_files_are_all_compared(shared_datasets: Path) -> None:
     found = {str(p.relative_to(shared_datasets)) for p in shared_datasets.rglob("*.arff")}
     assert found == set(REFERENCE_FILES)
-
-
-def test_pandas_before_3_1_is_asked_for_pythons_own_float_conversion() -> None:
-    from benchmark.io.arff_fast import _exact_floats
-
-    assert _exact_floats("2.2.3") == {"float_precision": "round_trip"}
-    assert _exact_floats("3.0.6") == {"float_precision": "round_trip"}
-    assert _exact_floats("3.1.1") == {}
-    assert _exact_floats("4.0.0.dev0+12.gabc") == {}
