@@ -47,6 +47,7 @@ from sklearn.tree import DecisionTreeClassifier, ExtraTreeClassifier
 
 from benchmark.catalogue.boosters import CatBoostNominalClassifier, LightGBMClassifier
 from benchmark.catalogue.estimators import LabelEncodedClassifier, OneRuleClassifier
+from benchmark.catalogue.model_trees import LogisticModelTree
 from benchmark.catalogue.rules import OrderedRuleClassifier
 from benchmark.catalogue.spec import ClassifierSpec
 from benchmark.catalogue.weka_schemes import weka_command
@@ -406,6 +407,28 @@ SPECS: tuple[ClassifierSpec, ...] = (
         description="CART with cost-complexity pruning (alpha 0.002)",
         missing=True,
         suites=ALL_ONLY,
+    ),
+    _spec(
+        "lmt",
+        LogisticModelTree,
+        {"min_samples_leaf": 50, "C": 1.0},
+        family="trees",
+        description="Entropy tree, 50+ instances per leaf, an L2 logistic regression per leaf",
+        cost="fast",
+        suites=ALL_ONLY,
+        limits="not WEKA's LMT: leaf models are plain logistic regressions, not LogitBoost "
+        "refined from the parent's, and the tree is not pruned",
+    ),
+    _spec(
+        "lmt-fine",
+        LogisticModelTree,
+        {"min_samples_leaf": 15, "C": 0.3},
+        family="trees",
+        description="Entropy tree, 15+ instances per leaf, a stronger-regularised logistic leaf",
+        cost="fast",
+        suites=ALL_ONLY,
+        limits="not WEKA's LMT: leaf models are plain logistic regressions, not LogitBoost "
+        "refined from the parent's, and the tree is not pruned",
     ),
     _spec(
         "random-tree",

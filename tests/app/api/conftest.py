@@ -86,7 +86,8 @@ class Server:
             except subprocess.TimeoutExpired:
                 os.killpg(self.process.pid, signal.SIGKILL)
                 self.process.wait()
-        self.client.close()
+        if hasattr(self, "client"):
+            self.client.close()
         self.process = None
 
     def wait_for(
