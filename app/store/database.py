@@ -17,7 +17,7 @@ from app.errors import AppError
 
 MIGRATIONS = Path(__file__).with_name("migrations")
 #: The newest migration; a test checks it against Alembic's own idea of the head.
-HEAD_REVISION = "0003"
+HEAD_REVISION = "0004"
 
 
 class Store:
@@ -111,13 +111,16 @@ def _lock_for_migration(connection: Any) -> None:
     if connection.dialect.name == "postgresql":
         connection.execute(text(f"SELECT pg_advisory_xact_lock({_MIGRATION_LOCK})"))
     elif connection.dialect.name == "sqlite":
-        # a write that takes SQLite's lock at once; rolled back with the rest on failure
         connection.execute(
             text(
                 "CREATE TABLE IF NOT EXISTS alembic_version "
                 "(version_num VARCHAR(32) NOT NULL PRIMARY KEY)"
             )
         )
+        # Python's sqlite3 opens a transaction before a DELETE, not before DDL (which runs
+        # in autocommit): a DELETE of nothing takes SQLite's write lock at once and keeps
+        # it, with the migrations that follow, until the transaction ends.
+        connection.execute(text("DELETE FROM alembic_version WHERE 0 = 1"))
 
 
 def _normalise(url: str) -> str:

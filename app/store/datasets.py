@@ -1,11 +1,11 @@
 """Data sets in the store: add (one transaction, streamed, deduplicated by content), look
 up by name or id, load whole or in blocks, rename and delete.
 
-Instances go in and out through the database driver's own bulk paths (SQLite's
-``executemany``, PostgreSQL's binary ``COPY``) in blocks, so that importing or exporting a
-data set of any size keeps memory flat; SQLAlchemy's per-row processing would take most of
-the time.  An import is one transaction: interrupted (Ctrl-C, ``kill -9``) or failed, it
-leaves nothing behind.
+Instances are stored in blocks of consecutive instances, about :data:`STORED_BLOCK_BYTES`
+of values each (see :mod:`app.store.tables`): an import of 235 000 instances writes a few
+hundred rows, so its cost is that of writing its bytes, not of 235 000 inserts, and
+reading back one block at a time keeps memory flat whatever the data set's size.  An import
+is one transaction: interrupted (Ctrl-C, ``kill -9``) or failed, it leaves nothing behind.
 """
 
 from __future__ import annotations
@@ -27,15 +27,16 @@ from app.errors import AppError
 from app.store.database import Store
 from app.store.naming import check_name, default_name, find_row, free_name, shorten
 from app.store.ownership import owner_alive
-from app.store.tables import DatasetRow, InstanceRow, RunRow
+from app.store.tables import DatasetRow, InstanceBlockRow, InstanceRow, RunRow
 from benchmark.dataset import Dataset, InstanceBlock, Schema, dataset_blocks
 
 _LITTLE_F8 = np.dtype("<f8")
+#: Instances per block when a data set held in memory is stored.
 _INSERT_BATCH = 5000
-#: Rows fetched at a time when instances are read back.
+#: At most this many instances are handed on at a time when instances are read back.
 READ_BATCH = 5000
-_PGCOPY_HEADER = b"PGCOPY\n\xff\r\n\x00" + bytes(8)
-_PGCOPY_TRAILER = b"\xff\xff"
+#: About how many bytes of values one stored block holds.
+STORED_BLOCK_BYTES = 1 << 20
 
 
 @dataclass(frozen=True)
@@ -315,112 +316,57 @@ def _insert_blocks(
     on_block: Callable[[InstanceBlock], None] | None,
 ) -> int:
     """Insert every block's instances; the number inserted."""
-    connection = session.connection()
-    bulk = _copy_block if connection.dialect.name == "postgresql" else _executemany_block
     position = 0
     for block in blocks:
         if on_block is not None:
             on_block(block)
-        _write_block(session, dataset_id, position, block, bulk)
+        _write_block(session, dataset_id, position, block)
         position += block.n_instances
     return position
 
 
-def _write_block(
-    session: Session,
-    dataset_id: int,
-    start: int,
-    block: InstanceBlock,
-    bulk: Callable[[Session, int, int, InstanceBlock], None],
-) -> None:
-    """Insert one block: in bulk, or through SQLAlchemy when it has groups or metadata."""
-    if block.groups is not None or block.meta is not None:
-        _orm_block(session, dataset_id, start, block)
-    else:
-        bulk(session, dataset_id, start, block)
-
-
-def _rows_bytes(block: InstanceBlock) -> np.ndarray:
+def _write_block(session: Session, dataset_id: int, start: int, block: InstanceBlock) -> None:
+    """Insert one block: its values and weights as stored blocks, then the groups and
+    metadata of the instances that have any."""
     values = np.ascontiguousarray(block.values, dtype=_LITTLE_F8)
-    return values.view(np.dtype((np.void, values.shape[1] * 8))).ravel()
-
-
-def _executemany_block(session: Session, dataset_id: int, start: int, block: InstanceBlock) -> None:
-    n, width = block.n_instances, block.values.shape[1] * 8
-    data = np.ascontiguousarray(block.values, dtype=_LITTLE_F8).tobytes()
-    weights = [None] * n if block.weights is None else block.weights.tolist()
-    cursor = _dbapi(session).cursor()
-    try:
-        cursor.executemany(
-            "INSERT INTO instances (dataset_id, position, data, weight) VALUES (?, ?, ?, ?)",
-            zip(
-                [dataset_id] * n,
-                range(start, start + n),
-                [data[i : i + width] for i in range(0, n * width, width)],
-                weights,
-                strict=True,
-            ),
-        )
-    finally:
-        cursor.close()
-
-
-def _copy_block(session: Session, dataset_id: int, start: int, block: InstanceBlock) -> None:
-    """One binary ``COPY`` of a block, its tuples laid out by numpy."""
-    n, width = block.n_instances, block.values.shape[1] * 8
-    fields = [
-        ("count", ">i2"),
-        ("id_size", ">i4"),
-        ("id", ">i4"),
-        ("position_size", ">i4"),
-        ("position", ">i4"),
-        ("data_size", ">i4"),
-        ("data", f"V{width}"),
+    weights = None if block.weights is None else np.asarray(block.weights, dtype=_LITTLE_F8)
+    rows = stored_rows(values.shape[1])
+    stored = [
+        {
+            "dataset_id": dataset_id,
+            "start": start + first,
+            "n_rows": min(rows, block.n_instances - first),
+            "data": values[first : first + rows].tobytes(),
+            "weights": None if weights is None else weights[first : first + rows].tobytes(),
+        }
+        for first in range(0, block.n_instances, rows)
     ]
-    if block.weights is not None:
-        fields += [("weight_size", ">i4"), ("weight", ">f8")]
-    tuples = np.empty(n, dtype=np.dtype(fields))
-    tuples["count"] = 3 if block.weights is None else 4
-    tuples["id_size"] = tuples["position_size"] = 4
-    tuples["id"] = dataset_id
-    tuples["position"] = np.arange(start, start + n)
-    tuples["data_size"] = width
-    tuples["data"] = _rows_bytes(block)
-    columns = "dataset_id, position, data"
-    if block.weights is not None:
-        tuples["weight_size"] = 8
-        tuples["weight"] = block.weights
-        columns += ", weight"
-    cursor = _dbapi(session).cursor()
-    try:
-        with cursor.copy(f"COPY instances ({columns}) FROM STDIN (FORMAT BINARY)") as copy:
-            copy.write(_PGCOPY_HEADER)
-            copy.write(tuples.tobytes())
-            copy.write(_PGCOPY_TRAILER)
-    finally:
-        cursor.close()
+    if stored:
+        session.execute(insert(InstanceBlockRow), stored)
+    extras = _extras(dataset_id, start, block)
+    if extras:
+        session.execute(insert(InstanceRow), extras)
 
 
-def _orm_block(session: Session, dataset_id: int, start: int, block: InstanceBlock) -> None:
-    """Instances with groups or metadata (extracted data sets), through SQLAlchemy."""
-    values = np.ascontiguousarray(block.values, dtype=_LITTLE_F8)
-    weights, groups, metas = block.weights, block.groups, block.meta
-    for first in range(0, block.n_instances, _INSERT_BATCH):
-        stop = min(first + _INSERT_BATCH, block.n_instances)
-        session.execute(
-            insert(InstanceRow),
-            [
-                {
-                    "dataset_id": dataset_id,
-                    "position": start + i,
-                    "data": values[i].tobytes(),
-                    "weight": None if weights is None else float(weights[i]),
-                    "group_id": None if groups is None else str(groups[i]),
-                    "meta": None if metas is None else metas[i],
-                }
-                for i in range(first, stop)
-            ],
-        )
+def stored_rows(n_attributes: int) -> int:
+    """Instances per stored block of a data set with ``n_attributes`` attributes."""
+    return max(1, STORED_BLOCK_BYTES // (_LITTLE_F8.itemsize * max(1, n_attributes)))
+
+
+def _extras(dataset_id: int, start: int, block: InstanceBlock) -> list[dict[str, Any]]:
+    """Rows of ``instances`` for the instances of ``block`` with a group or metadata."""
+    groups, metas = block.groups, block.meta
+    if groups is None and metas is None:
+        return []
+    rows = []
+    for i in range(block.n_instances):
+        group = None if groups is None or groups[i] is None else str(groups[i])
+        meta = None if metas is None else metas[i]
+        if group is not None or meta is not None:
+            rows.append(
+                {"dataset_id": dataset_id, "position": start + i, "group_id": group, "meta": meta}
+            )
+    return rows
 
 
 def _dbapi(session: Session) -> Any:
@@ -453,16 +399,23 @@ def load_dataset(store: Store, ref: str | int) -> Dataset:
     with store.session() as session:
         row = _row(session, ref)
         schema = Schema.from_json(row.schema)
-        values = np.empty((row.n_instances, schema.n_attributes))
+        n = row.n_instances
+        values = np.empty((n, schema.n_attributes))
+        weights: np.ndarray | None = None
         count = 0
-        for block in _value_batches(session, row.id, schema.n_attributes, with_weights=False):
-            values[count : count + block.n_instances] = block.values
-            count += block.n_instances
-        weights, groups, meta = _instance_extras(session, row.id, count)
+        for block in _value_batches(session, row.id, schema.n_attributes, with_weights=True):
+            stop = count + block.n_instances
+            values[count:stop] = block.values
+            if block.weights is not None:
+                if weights is None:
+                    weights = np.ones(n)
+                weights[count:stop] = block.weights
+            count = stop
+        groups, meta = _instance_extras(session, row.id, count)
         return Dataset(
             schema=schema,
             values=values[:count],
-            weights=weights,
+            weights=None if weights is None else weights[:count],
             groups=groups,
             meta=meta,
             sparse=row.sparse,
@@ -512,8 +465,9 @@ def _value_batches(
     with_weights: bool,
     rows: int | None = None,
 ) -> Iterator[InstanceBlock]:
-    """Instances in order, ``rows`` at a time, through the driver's own cursor: SQLAlchemy's
-    per-row processing and psycopg's text-format ``bytea`` would triple the load time."""
+    """Instances in order, at most ``rows`` at a time, one stored block fetched at a time,
+    through the driver's own cursor (PostgreSQL's in binary: the text form of ``bytea``
+    doubles what crosses the wire and costs its decoding)."""
     connection = session.connection()
     dbapi = _dbapi(session)
     style = connection.dialect.paramstyle
@@ -522,43 +476,36 @@ def _value_batches(
     cursor = (
         dbapi.cursor(name=f"instances_{dataset_id}", binary=True) if postgresql else dbapi.cursor()
     )
-    columns = "data, weight" if with_weights else "data"
+    limit = rows or READ_BATCH
+    columns = "n_rows, data, weights" if with_weights else "n_rows, data, NULL"
     try:
         cursor.execute(
-            f"SELECT {columns} FROM instances WHERE dataset_id = {marker} ORDER BY position",
+            f"SELECT {columns} FROM instance_blocks WHERE dataset_id = {marker} ORDER BY start",
             {"id": dataset_id} if style == "named" else (dataset_id,),
         )
-        while batch := cursor.fetchmany(rows or READ_BATCH):
-            values = np.frombuffer(b"".join(bytes(r[0]) for r in batch), dtype=_LITTLE_F8)
-            weights = None
-            if with_weights and any(r[1] is not None for r in batch):
-                weights = np.array([1.0 if r[1] is None else r[1] for r in batch])
-            yield InstanceBlock(values.reshape(len(batch), n_attributes), weights=weights)
+        while stored := cursor.fetchone():
+            n_rows, data, weights = stored
+            values = np.frombuffer(data, dtype=_LITTLE_F8).reshape(n_rows, n_attributes)
+            scale = None if weights is None else np.frombuffer(weights, dtype=_LITTLE_F8)
+            for first in range(0, n_rows, limit):
+                part = slice(first, first + limit)
+                yield InstanceBlock(values[part], weights=None if scale is None else scale[part])
     finally:
         cursor.close()
 
 
 def _instance_extras(
     session: Session, dataset_id: int, n: int
-) -> tuple[np.ndarray | None, np.ndarray | None, list[dict[str, Any]] | None]:
-    """Weights, group ids and metadata, read only from the instances that have any."""
+) -> tuple[np.ndarray | None, list[dict[str, Any]] | None]:
+    """Group ids and metadata, from the instances that have any."""
     rows = session.execute(
-        select(InstanceRow.position, InstanceRow.weight, InstanceRow.group_id, InstanceRow.meta)
-        .where(InstanceRow.dataset_id == dataset_id)
-        .where(
-            InstanceRow.weight.is_not(None)
-            | InstanceRow.group_id.is_not(None)
-            | InstanceRow.meta.is_not(None)
+        select(InstanceRow.position, InstanceRow.group_id, InstanceRow.meta).where(
+            InstanceRow.dataset_id == dataset_id
         )
     ).all()
-    weights: np.ndarray | None = None
     groups: np.ndarray | None = None
     meta: list[dict[str, Any]] | None = None
-    for position, weight, group, extra in rows:
-        if weight is not None:
-            if weights is None:
-                weights = np.ones(n)
-            weights[position] = weight
+    for position, group, extra in rows:
         if group is not None:
             if groups is None:
                 groups = np.full(n, None, dtype=object)
@@ -567,7 +514,7 @@ def _instance_extras(
             if meta is None:
                 meta = [{} for _ in range(n)]
             meta[position] = extra
-    return weights, groups, meta
+    return groups, meta
 
 
 def rename_dataset(store: Store, ref: str | int, new_name: str) -> tuple[DatasetInfo, str]:
@@ -615,6 +562,7 @@ def delete_dataset(store: Store, ref: str | int) -> DatasetInfo:
                 f"cancel it first (`touchbench cancel {run_id}`) or wait for it to end"
             )
         session.execute(delete(InstanceRow).where(InstanceRow.dataset_id == row.id))
+        session.execute(delete(InstanceBlockRow).where(InstanceBlockRow.dataset_id == row.id))
         session.delete(row)
         return info
 

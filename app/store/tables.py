@@ -1,9 +1,12 @@
 """ORM models of the store: data sets and their instances, benchmark runs and their
 per-fold results, trained models.
 
-Instances keep WEKA's encoding (see :mod:`benchmark.dataset`): each row holds one
-instance's values as little-endian float64 bytes in attribute order, so a whole data set
-loads into numpy with one ``frombuffer`` and nothing is lost to text formatting.
+Instances keep WEKA's encoding (see :mod:`benchmark.dataset`) in blocks of consecutive
+instances: each row of ``instance_blocks`` holds a block's values as little-endian float64
+bytes, row by row in attribute order, so that a block loads into numpy with one
+``frombuffer``, nothing is lost to text formatting, and a data set of 235 000 instances is
+a few hundred rows to write, not 235 000.  The few instances that carry a group or
+metadata (extracted data sets) have a row of ``instances`` for it.
 """
 
 from __future__ import annotations
@@ -14,7 +17,6 @@ from typing import Any
 from sqlalchemy import (
     JSON,
     DateTime,
-    Float,
     ForeignKey,
     Integer,
     LargeBinary,
@@ -58,8 +60,25 @@ class DatasetRow(Base):
     )
 
 
+class InstanceBlockRow(Base):
+    """Consecutive instances of a data set: their values and weights."""
+
+    __tablename__ = "instance_blocks"
+
+    dataset_id: Mapped[int] = mapped_column(
+        ForeignKey("datasets.id", ondelete="CASCADE"), primary_key=True
+    )
+    #: The position (0-based, in file order) of the block's first instance.
+    start: Mapped[int] = mapped_column(Integer, primary_key=True)
+    n_rows: Mapped[int] = mapped_column(Integer)
+    #: ``n_rows x n_attributes`` little-endian float64, row by row.
+    data: Mapped[bytes] = mapped_column(LargeBinary)
+    #: ``n_rows`` little-endian float64; ``None`` when every weight is 1.
+    weights: Mapped[bytes | None] = mapped_column(LargeBinary)
+
+
 class InstanceRow(Base):
-    """One instance (ARFF row) of a data set, in file order."""
+    """The group and metadata of one instance that has either (extracted data sets)."""
 
     __tablename__ = "instances"
 
@@ -67,8 +86,6 @@ class InstanceRow(Base):
         ForeignKey("datasets.id", ondelete="CASCADE"), primary_key=True
     )
     position: Mapped[int] = mapped_column(Integer, primary_key=True)
-    data: Mapped[bytes] = mapped_column(LargeBinary)
-    weight: Mapped[float | None] = mapped_column(Float)
     group_id: Mapped[str | None] = mapped_column(Text)
     meta: Mapped[dict[str, Any] | None] = mapped_column(JSON(none_as_null=True))
 

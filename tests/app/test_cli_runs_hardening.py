@@ -283,7 +283,7 @@ def test_an_old_store_migrates_and_finished_runs_become_done(tmp_path: Path) -> 
     from alembic import command
     from alembic.config import Config
 
-    from app.store.database import MIGRATIONS
+    from app.store.database import HEAD_REVISION, MIGRATIONS
 
     url = f"sqlite:///{tmp_path / 'old.db'}"
     engine = create_engine(url)
@@ -310,7 +310,7 @@ def test_an_old_store_migrates_and_finished_runs_become_done(tmp_path: Path) -> 
     store = Store(url)
     try:
         assert _scalar(url, "SELECT status FROM runs") == "done"
-        assert _scalar(url, "SELECT version_num FROM alembic_version") == "0003"
+        assert _scalar(url, "SELECT version_num FROM alembic_version") == HEAD_REVISION
     finally:
         store.dispose()
 

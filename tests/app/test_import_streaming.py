@@ -24,7 +24,7 @@ from sqlalchemy import func, select
 
 from app.store.database import Store
 from app.store.datasets import list_datasets
-from app.store.tables import InstanceRow
+from app.store.tables import InstanceBlockRow, InstanceRow
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 PEAK_BOUND_MB = 400
@@ -149,4 +149,5 @@ def test_an_import_interrupted_midway_leaves_nothing_behind(
     assert list_datasets(store) == []
     with store.session() as session:
         assert session.scalar(select(func.count()).select_from(InstanceRow)) == 0
+        assert session.scalar(select(func.count()).select_from(InstanceBlockRow)) == 0
     store.dispose()

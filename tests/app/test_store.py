@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from typing import Any
 
 import numpy as np
@@ -19,7 +20,7 @@ from app.store.datasets import (
     list_datasets,
     load_dataset,
 )
-from app.store.tables import DatasetRow, InstanceRow
+from app.store.tables import DatasetRow, InstanceBlockRow, InstanceRow
 from benchmark.dataset import Attribute, Dataset, Schema
 
 
@@ -50,10 +51,12 @@ def small_dataset(n: int = 7, relation: str = "touch: -C 1") -> Dataset:
     return Dataset(schema=schema, values=values)
 
 
-def count_rows(store: Store) -> tuple[int, int]:
+def count_rows(store: Store) -> tuple[int, int, int]:
+    """Data sets, instances in blocks of values, and instances with a group or metadata."""
     with store.session() as session:
         return (
             session.scalar(select(func.count()).select_from(DatasetRow)) or 0,
+            session.scalar(select(func.coalesce(func.sum(InstanceBlockRow.n_rows), 0))) or 0,
             session.scalar(select(func.count()).select_from(InstanceRow)) or 0,
         )
 
@@ -71,6 +74,7 @@ def test_round_trip_keeps_values_missing_weights_groups_and_meta(store: Store) -
         4,
         ["gesture"],
     )
+    assert count_rows(store) == (1, 7, 7)
     loaded = load_dataset(store, info.id)
     assert loaded.equals(data)
     assert list(loaded.groups) == list(data.groups)  # type: ignore[arg-type]
@@ -84,7 +88,7 @@ def test_same_content_is_stored_once(store: Store) -> None:
     second, created_second = add_dataset(store, data, sha256="a" * 64, name="other")
     assert created_first and not created_second
     assert second.id == first.id
-    assert count_rows(store) == (1, 7)
+    assert count_rows(store) == (1, 7, 0)
 
 
 def test_default_names_are_made_unique_and_explicit_clashes_refused(store: Store) -> None:
@@ -95,7 +99,7 @@ def test_default_names_are_made_unique_and_explicit_clashes_refused(store: Store
         add_dataset(store, small_dataset(), sha256="3" * 64, name="touch")
     with pytest.raises(AppError, match="cannot be a number"):
         add_dataset(store, small_dataset(), sha256="4" * 64, name="12")
-    assert count_rows(store) == (2, 14)
+    assert count_rows(store) == (2, 14, 0)
 
 
 def test_find_by_name_or_id_and_delete(store: Store) -> None:
@@ -106,7 +110,7 @@ def test_find_by_name_or_id_and_delete(store: Store) -> None:
         find_dataset(store, "maggie")
     assert delete_dataset(store, "mini").id == info.id
     assert list_datasets(store) == []
-    assert count_rows(store) == (0, 0)
+    assert count_rows(store) == (0, 0, 0)
 
 
 def test_a_failure_while_importing_leaves_nothing_behind(
@@ -126,7 +130,7 @@ def test_a_failure_while_importing_leaves_nothing_behind(
     with pytest.raises(RuntimeError, match="disk full"):
         add_dataset(store, small_dataset(), sha256="f" * 64)
     assert calls["n"] == 3
-    assert count_rows(store) == (0, 0)
+    assert count_rows(store) == (0, 0, 0)
 
 
 def test_reopening_a_store_keeps_its_data(store_url: str) -> None:
@@ -160,3 +164,73 @@ def test_a_fresh_store_is_migrated_to_head(store: Store) -> None:
     from app.store.database import HEAD_REVISION
 
     assert store.revision() == HEAD_REVISION
+
+
+def _alembic(connection: Any, action: str, revision: str) -> None:
+    from alembic import command
+    from alembic.config import Config
+
+    from app.store.database import MIGRATIONS
+
+    config = Config()
+    config.set_main_option("script_location", str(MIGRATIONS))
+    config.attributes["connection"] = connection
+    getattr(command, action)(config, revision)
+
+
+def test_instances_stored_one_a_row_move_into_blocks_and_back(store_url: str) -> None:
+    """A store of revision 0003 (one row per instance) migrates to blocks; downgraded, it has
+    its rows back as they were."""
+    from sqlalchemy import create_engine, text
+
+    data = small_dataset(n=3000)
+    data.weights = np.where(np.arange(3000) % 7 == 0, 0.5, 1.0)
+    rows = [
+        {
+            "id": 1,
+            "position": i,
+            "data": data.values[i].astype("<f8").tobytes(),
+            "weight": 0.5 if i % 7 == 0 else None,
+            "group_id": "s1" if i == 5 else None,
+            "meta": '{"source": "a.wav"}' if i == 9 else None,
+        }
+        for i in range(3000)
+    ]
+    engine = create_engine(store_url)
+    with engine.begin() as connection:
+        _alembic(connection, "upgrade", "0003")
+        connection.execute(
+            text(
+                "INSERT INTO datasets (id, name, relation, schema, target_names, n_instances, "
+                "n_attributes, sparse, sha256, created_at) VALUES (1, 'old', :relation, "
+                ":schema, '[\"gesture\"]', 3000, 5, false, 'x', '2026-01-01')"
+            ),
+            {"relation": data.schema.relation, "schema": json.dumps(data.schema.to_json())},
+        )
+        connection.execute(
+            text(
+                "INSERT INTO instances (dataset_id, position, data, weight, group_id, meta) "
+                "VALUES (:id, :position, :data, :weight, :group_id, :meta)"
+            ),
+            rows,
+        )
+    store = Store(store_url)
+    try:
+        assert count_rows(store) == (1, 3000, 2)
+        loaded = load_dataset(store, "old")
+        assert loaded.values.tobytes() == data.values.tobytes()
+        assert loaded.weights is not None and loaded.weights.tobytes() == data.weights.tobytes()
+        assert loaded.groups is not None and loaded.groups[5] == "s1"
+        assert loaded.meta is not None and loaded.meta[9] == {"source": "a.wav"}
+    finally:
+        store.dispose()
+    with engine.begin() as connection:
+        _alembic(connection, "downgrade", "0003")
+        back = connection.execute(
+            text("SELECT position, data, weight, group_id FROM instances ORDER BY position")
+        ).all()
+    engine.dispose()
+    # A weight left out meant 1; a block with weights gives each instance its own.
+    assert [tuple(row) for row in back] == [
+        (r["position"], r["data"], r["weight"] or 1.0, r["group_id"]) for r in rows
+    ]
