@@ -181,6 +181,9 @@ def _check_sqlite_file(path: Path, url: str) -> None:
 def _sqlite_pragmas(dbapi_connection: Any, _record: Any) -> None:
     cursor = dbapi_connection.cursor()
     cursor.execute("PRAGMA busy_timeout=30000")
+    # Pages of 64 KiB (a new database's only: an existing one keeps its own) halve the cost
+    # of writing and checkpointing the megabyte blocks of instances an import stores.
+    cursor.execute("PRAGMA page_size=65536")
     cursor.execute("PRAGMA journal_mode=WAL")
     cursor.execute("PRAGMA foreign_keys=ON")
     cursor.execute("PRAGMA synchronous=NORMAL")

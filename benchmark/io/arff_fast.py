@@ -114,13 +114,17 @@ def read_plain_block(
     if table is None or table.num_rows != rows.size:
         return None
     values = np.empty((rows.size, plan.n_columns))
-    for position in plan.numeric.tolist():
-        values[:, position] = table.column(position).to_numpy()  # nulls become NaN
-    for position, labels in zip(plan.nominal.tolist(), plan.labels, strict=True):
-        codes = _label_codes(table.column(position), labels)
-        if codes is None:
-            return None
-        values[:, position] = codes
+    start = 0
+    for batch in table.to_batches():
+        part = values[start : start + batch.num_rows]
+        for position in plan.numeric.tolist():
+            part[:, position] = _numbers(batch.column(position))
+        for position, labels in zip(plan.nominal.tolist(), plan.labels, strict=True):
+            codes = _label_codes(batch.column(position), labels)
+            if codes is None:
+                return None
+            part[:, position] = codes
+        start += batch.num_rows
     return values, rows
 
 
@@ -191,7 +195,8 @@ def _parse(block: bytes, plan: PlainPlan, encoding: str) -> Any | None:
 
     names = [str(j) for j in range(plan.n_columns)]
     types = {names[j]: pa.float64() for j in plan.numeric.tolist()}
-    types.update({names[j]: pa.string() for j in plan.nominal.tolist()})
+    labels = pa.dictionary(pa.int32(), pa.string())
+    types.update({names[j]: labels for j in plan.nominal.tolist()})
     try:
         return csv.read_csv(
             pa.py_buffer(block),
@@ -210,12 +215,42 @@ def _parse(block: bytes, plan: PlainPlan, encoding: str) -> Any | None:
         return None
 
 
-def _label_codes(column: Any, labels: tuple[str, ...]) -> np.ndarray | None:
-    """Codes of a column of nominal texts (NaN where missing); ``None`` on an unknown label."""
-    import pyarrow as pa
-    import pyarrow.compute as pc
+# Arrow arrays are read through their buffers: pyarrow's own conversion to numpy of an
+# array with nulls imports pandas, 50 MB for what a bitmap says.
 
-    codes = pc.index_in(column, value_set=pa.array(labels, pa.string()))
-    if codes.null_count != column.null_count:
+
+def _numbers(array: Any) -> np.ndarray:
+    """The values of an Arrow float64 array, NaN where null; shape (len(array),)."""
+    return _with_nulls(array, _buffer(array, np.dtype(np.float64)))
+
+
+def _label_codes(array: Any, labels: tuple[str, ...]) -> np.ndarray | None:
+    """Codes of an Arrow dictionary array of nominal texts, NaN where missing; ``None`` if
+    some text is not one of ``labels``."""
+    lookup = {label: float(code) for code, label in enumerate(labels)}
+    texts = array.dictionary.to_pylist()
+    if any(text not in lookup for text in texts):
         return None
-    return np.asarray(codes.to_numpy(), dtype=np.float64)
+    table = np.array([lookup[text] for text in texts] or [np.nan])
+    indices = _buffer(array.indices, np.dtype(np.int32))
+    if array.null_count:
+        indices = np.where(_valid(array), indices, 0)
+    return _with_nulls(array, table[indices])
+
+
+def _buffer(array: Any, dtype: np.dtype) -> np.ndarray:
+    """The values buffer of a primitive Arrow array, as a read-only view."""
+    data = array.buffers()[1]
+    return np.frombuffer(data, dtype=dtype, count=len(array), offset=array.offset * dtype.itemsize)
+
+
+def _valid(array: Any) -> np.ndarray:
+    """Which items of an Arrow array with nulls are not null (its validity bitmap)."""
+    bitmap = np.frombuffer(array.buffers()[0], dtype=np.uint8)
+    bits = np.unpackbits(bitmap, count=array.offset + len(array), bitorder="little")
+    return bits[array.offset :].astype(bool)
+
+
+def _with_nulls(array: Any, values: np.ndarray) -> np.ndarray:
+    """``values`` with NaN where ``array`` is null (a new array if it has nulls)."""
+    return np.where(_valid(array), values, np.nan) if array.null_count else values

@@ -188,6 +188,25 @@ def test_every_float_text_reads_as_python_reads_it() -> None:
     assert assert_all_parsers_agree(NOMINAL_HEADER + body)[0] == "data"
 
 
+def test_a_block_arrow_reads_in_several_batches_reads_alike() -> None:
+    """Over a megabyte of rows (Arrow parses it in batches), missing values everywhere."""
+    from benchmark.io.arff_fast import plain_plan, read_plain_block
+
+    rng = np.random.default_rng(3)
+    labels = np.array(["tap", "'slap'", "0", "'1'", "?"])
+    numbers = rng.normal(scale=1e3, size=(40_000, 2)).astype(str)
+    numbers[rng.random(numbers.shape) < 0.1] = "?"
+    picked = labels[rng.integers(0, labels.size, 40_000)]
+    body = "".join(f"{g},{x},{y}\n" for g, (x, y) in zip(picked, numbers, strict=True))
+    assert len(body) > 1 << 20
+    plan = plain_plan(loads_arff(NOMINAL_HEADER).schema.attributes)
+    assert plan is not None
+    read = read_plain_block(body.encode(), plan, encoding="utf-8")
+    assert read is not None, "the fast path refused the block"
+    exact = loads_arff(NOMINAL_HEADER + body, parser="tokenizer")
+    assert read[0].tobytes() == exact.values.tobytes()
+
+
 def test_blocks_stream_the_file_with_line_numbers(tmp_path: Path) -> None:
     rows = [f"{'tap' if i % 3 else 'slap'},{i / 7!r},{i}" for i in range(3000)]
     rows[1500] = "% a comment in the middle"
