@@ -6,7 +6,8 @@ Maggie-like file of N rows), in this one process:
 - ``liac-arff``: ``arff.load``, the usual Python reader;
 - ``pandas block``: ``pandas.read_csv`` on the data section alone (the lines after
   ``@data``, no header, no checks): the floor a C parser sets;
-- ``touchbench``: ``read_arff``, the whole file, every check, same values bit for bit;
+- ``touchbench``: ``read_arff``, the whole file, every check, same values bit for bit
+  (plain blocks by Arrow's CSV reader, the rest by the exact reader);
 - ``tokenizer``: ``read_arff(parser="tokenizer")``, WEKA's tokenizer on every row (the
   exact reference the fast paths are tested against);
 
@@ -178,7 +179,12 @@ def main() -> int:
             file=sys.stderr,
         )
         return 2
-    print(f"best of {options.repeat} reads per file and reader (tokenizer: fewer)\n")
+    import pyarrow
+
+    print(
+        f"best of {options.repeat} reads per file and reader (tokenizer: fewer); "
+        f"pandas {pd.__version__}, pyarrow {pyarrow.__version__}, liac-arff {arff.__version__}\n"
+    )
     print(
         f"{'file':<40} {'rows x attr':>13} {'liac-arff':>9} {'pandas':>9} {'touchb.':>9} "
         f"{'tokenizer':>9} {'liac/':>6} {'touchb/':>6}"

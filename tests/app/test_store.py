@@ -234,3 +234,21 @@ def test_instances_stored_one_a_row_move_into_blocks_and_back(store_url: str) ->
     assert [tuple(row) for row in back] == [
         (r["position"], r["data"], r["weight"] or 1.0, r["group_id"]) for r in rows
     ]
+
+
+def test_stored_blocks_are_written_the_cheap_way(store: Store) -> None:
+    """New SQLite stores have 64 KiB pages; PostgreSQL keeps blocks out of line, uncompressed."""
+    from sqlalchemy import text
+
+    with store.engine.connect() as connection:
+        if connection.dialect.name == "sqlite":
+            assert connection.execute(text("PRAGMA page_size")).scalar() == 65536
+        else:
+            storage = connection.execute(
+                text(
+                    "SELECT attname, attstorage FROM pg_attribute WHERE attrelid = "
+                    "'instance_blocks'::regclass AND attname IN ('data', 'weights') "
+                    "ORDER BY attname"
+                )
+            ).all()
+            assert [tuple(row) for row in storage] == [("data", "e"), ("weights", "e")]

@@ -55,6 +55,13 @@ def upgrade() -> None:
         sa.Column("weights", sa.LargeBinary),
     )
     bind = op.get_bind()
+    if bind.dialect.name == "postgresql":
+        # Out of line without compression: PostgreSQL's would try (and fail) to compress
+        # every megabyte of float64, which makes an import four times slower.
+        op.execute(
+            "ALTER TABLE instance_blocks ALTER COLUMN data SET STORAGE EXTERNAL, "
+            "ALTER COLUMN weights SET STORAGE EXTERNAL"
+        )
     for dataset_id, n_attributes in bind.execute(
         sa.select(_datasets.c.id, _datasets.c.n_attributes)
     ).all():
