@@ -403,7 +403,7 @@ def load_dataset(store: Store, ref: str | int) -> Dataset:
         values = np.empty((n, schema.n_attributes))
         weights: np.ndarray | None = None
         count = 0
-        for block in _value_batches(session, row.id, schema.n_attributes, with_weights=True):
+        for block in _value_batches(session, row.id, schema.n_attributes):
             stop = count + block.n_instances
             values[count:stop] = block.values
             if block.weights is not None:
@@ -453,7 +453,7 @@ def read_blocks(
     with store.session() as session:
         row = _row(session, ref)
         schema = Schema.from_json(row.schema)
-        batches = _value_batches(session, row.id, schema.n_attributes, with_weights=True, rows=rows)
+        batches = _value_batches(session, row.id, schema.n_attributes, rows=rows)
         yield StoredInstances(DatasetInfo.of(row), schema, row.sparse, batches)
 
 
@@ -462,7 +462,6 @@ def _value_batches(
     dataset_id: int,
     n_attributes: int,
     *,
-    with_weights: bool,
     rows: int | None = None,
 ) -> Iterator[InstanceBlock]:
     """Instances in order, at most ``rows`` at a time, one stored block fetched at a time,
@@ -477,10 +476,10 @@ def _value_batches(
         dbapi.cursor(name=f"instances_{dataset_id}", binary=True) if postgresql else dbapi.cursor()
     )
     limit = rows or READ_BATCH
-    columns = "n_rows, data, weights" if with_weights else "n_rows, data, NULL"
     try:
         cursor.execute(
-            f"SELECT {columns} FROM instance_blocks WHERE dataset_id = {marker} ORDER BY start",
+            "SELECT n_rows, data, weights FROM instance_blocks "
+            f"WHERE dataset_id = {marker} ORDER BY start",
             {"id": dataset_id} if style == "named" else (dataset_id,),
         )
         while stored := cursor.fetchone():
