@@ -111,16 +111,10 @@ def _lock_for_migration(connection: Any) -> None:
     if connection.dialect.name == "postgresql":
         connection.execute(text(f"SELECT pg_advisory_xact_lock({_MIGRATION_LOCK})"))
     elif connection.dialect.name == "sqlite":
-        connection.execute(
-            text(
-                "CREATE TABLE IF NOT EXISTS alembic_version "
-                "(version_num VARCHAR(32) NOT NULL PRIMARY KEY)"
-            )
-        )
-        # Python's sqlite3 opens a transaction before a DELETE, not before DDL (which runs
-        # in autocommit): a DELETE of nothing takes SQLite's write lock at once and keeps
-        # it, with the migrations that follow, until the transaction ends.
-        connection.execute(text("DELETE FROM alembic_version WHERE 0 = 1"))
+        # Python's sqlite3 opens no transaction before DDL (which would each commit on its
+        # own, showing other processes a store half made): this one takes SQLite's write
+        # lock at once and keeps it, with every table the migrations make, until it ends.
+        connection.exec_driver_sql("BEGIN IMMEDIATE")
 
 
 def _normalise(url: str) -> str:
