@@ -26,7 +26,7 @@ from benchmark.evaluation.metrics import expand_proba
 from benchmark.problem import feature_matrix, problem_from_dataset
 
 #: Libraries whose versions are recorded with a model.
-RECORDED_LIBRARIES = ("numpy", "scikit-learn", "xgboost")
+RECORDED_LIBRARIES = ("numpy", "scikit-learn", "xgboost", "aeon")
 
 
 @dataclass
