@@ -1255,6 +1255,7 @@ SPECS: tuple[ClassifierSpec, ...] = (
         family="time-series",
         description="MultiRocket (aeon): 4 poolings of series and differences, ridge classifier",
         probabilities=False,
+        cost="slow",
         min_sequence=10,
         limits="sequence data sets only; missing values imputed by the training mean",
     ),

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 
+from app.services.runs import default_classifiers
 from tests.app.cli_runner import run_cli
 
 
@@ -76,3 +77,12 @@ def test_sequence_classifiers_on_a_flat_data_set_exit_2_with_one_line(
         assert "Traceback" not in result.err
     runs = run_cli(capsys, store_url, "runs", "--json").json()
     assert runs["runs"] == []  # nothing half-written
+
+
+def test_suites_hold_sequence_classifiers_only_for_sequence_data_sets() -> None:
+    sequence_ids = {"minirocket", "multirocket", "interval-forest"}
+    flat = default_classifiers(1, "default")
+    assert "rf" in flat and not sequence_ids & set(flat)
+    assert sequence_ids <= set(default_classifiers(1, "default", sequences=True))
+    assert not sequence_ids & set(default_classifiers(1, "all"))
+    assert "rf" in default_classifiers(1, "all", sequences=True)
