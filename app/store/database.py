@@ -111,13 +111,10 @@ def _lock_for_migration(connection: Any) -> None:
     if connection.dialect.name == "postgresql":
         connection.execute(text(f"SELECT pg_advisory_xact_lock({_MIGRATION_LOCK})"))
     elif connection.dialect.name == "sqlite":
-        # a write that takes SQLite's lock at once; rolled back with the rest on failure
-        connection.execute(
-            text(
-                "CREATE TABLE IF NOT EXISTS alembic_version "
-                "(version_num VARCHAR(32) NOT NULL PRIMARY KEY)"
-            )
-        )
+        # Python's sqlite3 opens no transaction before DDL, so each CREATE TABLE would
+        # commit on its own and two processes would both create the schema: take SQLite's
+        # write lock explicitly; the migration's DDL then runs, and commits, inside it.
+        connection.exec_driver_sql("BEGIN IMMEDIATE")
 
 
 def _normalise(url: str) -> str:
