@@ -6,6 +6,8 @@ from fastapi import APIRouter
 from fastapi.responses import HTMLResponse
 
 from app.api.deps import StoreDep
+from app.schemas.runs import FINAL_STATUSES
+from app.store.jobs import list_jobs
 from app.store.models import get_model, list_models
 from app.web.rendering import render
 from app.web.routes.pages import Ref
@@ -16,7 +18,13 @@ router = APIRouter(prefix="/fragments/models", include_in_schema=False)
 
 @router.get("", response_class=HTMLResponse)
 def models(store: StoreDep) -> HTMLResponse:
-    return render("fragments/models.html.j2", models=list_models(store))
+    """Every model; polled while a training job is queued or running."""
+    training = [
+        job
+        for job in list_jobs(store)
+        if job.kind == "train" and job.status not in FINAL_STATUSES
+    ]
+    return render("fragments/models.html.j2", models=list_models(store), training=training)
 
 
 @router.get("/{model}", response_class=HTMLResponse)

@@ -7,6 +7,12 @@
 
 const KEY = "touchbench.apiKey";
 
+// A form's controls shadow its properties by name (a control called "dataset" or "target"
+// hides form.dataset or form.target), so forms are read through the prototypes.
+const attribute = (element, name) => Element.prototype.getAttribute.call(element, name);
+const find = (element, selector) => Element.prototype.querySelector.call(element, selector);
+const findAll = (element, selector) => Element.prototype.querySelectorAll.call(element, selector);
+
 function apiHeaders(extra = {}) {
   const key = sessionStorage.getItem(KEY);
   return key ? { ...extra, "X-API-Key": key } : extra;
@@ -110,7 +116,7 @@ async function upload(form, outcome) {
   const what = result.created ? "Imported" : "Already stored as";
   message(outcome, `${what} '${result.name}': ${result.n_instances} instances, ` +
     `${result.n_features} features, targets ${result.targets.join(", ")}.`, "ok");
-  form.reset();
+  HTMLFormElement.prototype.reset.call(form);
   document.querySelectorAll("#datasets-list").forEach(load);
 }
 
@@ -141,16 +147,17 @@ async function startRun(form, outcome) {
 
 function instanceOf(form) {
   const instance = {};
-  for (const field of form.querySelectorAll("[data-kind]")) {
+  for (const field of findAll(form, "[data-kind]")) {
     if (field.value === "") continue;
-    instance[field.name] = field.dataset.kind === "numeric" ? Number(field.value) : field.value;
+    const value = field.dataset.kind === "numeric" ? Number(field.value) : field.value;
+    instance[field.dataset.feature] = value;
   }
   return instance;
 }
 
 async function predict(form, file) {
   const target = document.getElementById("predictions");
-  const url = `/api/models/${form.dataset.model}/predict` + (file ? "/file" : "");
+  const url = `/api/models/${attribute(form, "data-model")}/predict` + (file ? "/file" : "");
   const options = file
     ? { method: "POST", body: new FormData(form) }
     : {
@@ -243,8 +250,7 @@ async function download(link) {
 
 function fillTargets(root) {
   for (const select of root.querySelectorAll("select[data-targets-of]")) {
-    const form = select.form;
-    const source = form.elements[select.dataset.targetsOf];
+    const source = find(select.form, `select[name="${select.dataset.targetsOf}"]`);
     const refill = () => {
       const chosen = source.selectedOptions[0];
       const targets = chosen ? chosen.dataset.targets.split(",").filter(Boolean) : [];
@@ -273,20 +279,21 @@ const ACTIONS = {
 
 document.addEventListener("submit", (event) => {
   const form = event.target;
-  if (form.id === "api-key") {
+  if (attribute(form, "id") === "api-key") {
     event.preventDefault();
-    const key = form.elements.key.value.trim();
+    const input = document.getElementById("api-key-input");
+    const key = input.value.trim();
     if (key) sessionStorage.setItem(KEY, key);
-    form.elements.key.value = "";
+    input.value = "";
     showKeyState(0);
     loadAll();
     return;
   }
-  const action = ACTIONS[form.dataset.action];
+  const action = ACTIONS[attribute(form, "data-action")];
   if (!action) return; // a GET form: the browser navigates
   event.preventDefault();
-  const outcome = form.querySelector(".outcome") || document.getElementById("predictions");
-  const button = form.querySelector("button[type=submit]");
+  const outcome = find(form, ".outcome") || document.getElementById("predictions");
+  const button = find(form, "button[type=submit]");
   button.disabled = true;
   Promise.resolve(action(form, outcome))
     .catch((error) => message(outcome, `Failed: ${error.message}`))
@@ -310,7 +317,9 @@ document.addEventListener("click", (event) => {
 
 document.addEventListener("change", (event) => {
   const form = event.target.form;
-  if (form && form.hasAttribute("data-autosubmit")) form.requestSubmit();
+  if (form && attribute(form, "data-autosubmit") !== null) {
+    HTMLFormElement.prototype.requestSubmit.call(form);
+  }
 });
 
 document.addEventListener("DOMContentLoaded", () => {
