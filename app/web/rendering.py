@@ -14,17 +14,17 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 from urllib.parse import quote, urlencode
 
 from fastapi.responses import HTMLResponse
-from jinja2 import Environment
-from matplotlib.figure import Figure
 
 from app.errors import AppError
-from app.reports.html import template_environment
-from app.reports.plots import svg_text
 from benchmark.errors import BenchmarkError
+
+if TYPE_CHECKING:  # Jinja, matplotlib and the statistics load with the first page, not at start
+    from jinja2 import Environment
+    from matplotlib.figure import Figure
 
 TEMPLATES = Path(__file__).with_name("templates")
 STATIC = Path(__file__).with_name("static")
@@ -55,6 +55,8 @@ SECURITY_HEADERS = {
 def environment() -> Environment:
     """The report's environment with the web templates searched first, and the filters the
     web templates use."""
+    from app.reports.html import template_environment
+
     env = template_environment(TEMPLATES)
     env.filters["segment"] = lambda value: quote(str(value), safe="")
     env.filters["query"] = lambda pairs: urlencode(
@@ -64,10 +66,10 @@ def environment() -> Environment:
     return env
 
 
-def render(template: str, status_code: int = 200, **context: Any) -> HTMLResponse:
+def render(template: str, /, **context: Any) -> HTMLResponse:
     """A template as an HTML answer with the security headers."""
     html = environment().get_template(template).render(**context)
-    return HTMLResponse(html, status_code=status_code, headers=SECURITY_HEADERS)
+    return HTMLResponse(html, headers=SECURITY_HEADERS)
 
 
 @dataclass(frozen=True)
@@ -99,5 +101,7 @@ def draw(caption: str, build: Callable[[], Figure]) -> Plot:
 
 def svg_data_uri(figure: Figure) -> str:
     """The figure as a ``data:`` URI of its SVG (text kept as text)."""
+    from app.reports.plots import svg_text
+
     encoded = base64.b64encode(svg_text(figure).encode("utf-8")).decode("ascii")
     return f"data:image/svg+xml;base64,{encoded}"

@@ -11,9 +11,6 @@ from fastapi.responses import HTMLResponse
 
 from app.api.deps import StoreDep
 from app.errors import AppError
-from app.reports.figures import cd_figure
-from app.reports.html import comparison_context
-from app.services.compare import compare_runs
 from app.store.runs import list_runs
 from app.web.rendering import draw, render
 from benchmark.errors import BenchmarkError
@@ -29,6 +26,10 @@ def compare(
     alpha: Annotated[float, Query(gt=0, lt=1)] = 0.05,
 ) -> HTMLResponse:
     """One run ranks its classifiers over its folds; several, over their data sets."""
+    from app.reports.figures import cd_figure
+    from app.reports.html import comparison_context
+    from app.services.compare import compare_runs
+
     context: dict[str, object] = {
         "runs": [run for run in list_runs(store) if run.n_results > 0],
         "chosen": runs,
@@ -45,7 +46,5 @@ def compare(
             context["problem"] = str(error)
         else:
             context["comparison"] = comparison_context(comparison)
-            context["plot"] = draw(
-                "Critical-difference diagram", partial(cd_figure, comparison)
-            )
+            context["plot"] = draw("Critical-difference diagram", partial(cd_figure, comparison))
     return render("fragments/compare.html.j2", **context)

@@ -8,7 +8,6 @@ from fastapi import APIRouter
 from fastapi.responses import HTMLResponse
 
 from app.api.deps import StoreDep
-from app.reports.figures import dataset_classes_figure
 from app.services.datasets import describe_dataset, list_datasets
 from app.store.runs import list_runs
 from app.web.rendering import draw, render
@@ -25,6 +24,8 @@ def datasets(store: StoreDep) -> HTMLResponse:
 @router.get("/{dataset}", response_class=HTMLResponse)
 def dataset(dataset: Ref, store: StoreDep) -> HTMLResponse:
     """Attributes, class distribution per target (table and plot), the runs on it."""
+    from app.reports.figures import dataset_classes_figure
+
     description = describe_dataset(store, dataset)
     return render(
         "fragments/dataset.html.j2",

@@ -20,9 +20,7 @@ router = APIRouter(prefix="/fragments/models", include_in_schema=False)
 def models(store: StoreDep) -> HTMLResponse:
     """Every model; polled while a training job is queued or running."""
     training = [
-        job
-        for job in list_jobs(store)
-        if job.kind == "train" and job.status not in FINAL_STATUSES
+        job for job in list_jobs(store) if job.kind == "train" and job.status not in FINAL_STATUSES
     ]
     return render("fragments/models.html.j2", models=list_models(store), training=training)
 

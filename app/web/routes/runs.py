@@ -5,24 +5,26 @@ the form that starts a run."""
 from __future__ import annotations
 
 from functools import partial
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 from fastapi import APIRouter, Query
 from fastapi.responses import HTMLResponse
 
 from app.api.deps import StoreDep
 from app.errors import NotFoundError
-from app.reports import figures
-from app.reports.leaderboard import leaderboard_header, leaderboard_rows, mean_std, metric_columns
 from app.schemas.runs import FINAL_STATUSES
 from app.services.datasets import list_datasets
-from app.services.report import RunView, run_view
 from app.services.runs import run_leaderboard
 from app.store.runs import RunInfo, get_run, list_runs
 from app.web.rendering import draw, render
 from app.web.routes.pages import Ref
-from benchmark.evaluation.leaderboard import Leaderboard
-from benchmark.evaluation.metrics import LOWER_IS_BETTER
+from benchmark.errors import ConfigurationError
+
+# The plots and the statistics (matplotlib, scipy) load with the first fragment that needs
+# them, so that the service starts at once.
+if TYPE_CHECKING:
+    from app.services.report import RunView
+    from benchmark.evaluation.leaderboard import Leaderboard
 
 router = APIRouter(prefix="/fragments/runs", include_in_schema=False)
 
@@ -71,10 +73,15 @@ def leaderboard(
     run_id: int, store: StoreDep, metric: Metric = None, baseline: Baseline = None
 ) -> HTMLResponse:
     """The run's classifiers ranked by ``metric`` with WEKA's marks against ``baseline``."""
-    run = get_run(store, run_id)
-    if run.n_results == 0:
+    try:
+        run, board = run_leaderboard(
+            store, run_id, metric=metric or None, baseline=baseline or None
+        )
+    except ConfigurationError:
+        run = get_run(store, run_id)
+        if run.n_results:
+            raise  # an unknown metric or baseline
         return render("fragments/leaderboard.html.j2", run=run, board=None)
-    run, board = run_leaderboard(store, run.id, metric=metric or None, baseline=baseline or None)
     return render(
         "fragments/leaderboard.html.j2",
         run=run,
@@ -85,7 +92,10 @@ def leaderboard(
 
 @router.get("/{run_id}/plots", response_class=HTMLResponse)
 def plots(run_id: int, store: StoreDep, metric: Metric = None) -> HTMLResponse:
-    """Every fold's score, the ranks over folds, per-target scores and class counts."""
+    """Every fold's score, per-target scores and class counts."""
+    from app.reports import figures
+    from app.services.report import run_view
+
     run = get_run(store, run_id)
     if run.n_results == 0:
         return render("fragments/plots.html.j2", plots=[])
@@ -102,6 +112,10 @@ def classifier(
     run_id: int, classifier: Ref, store: StoreDep, metric: Metric = None, baseline: Baseline = None
 ) -> HTMLResponse:
     """A classifier's confusion matrix, its scores and its folds beside the baseline's."""
+    from app.reports import figures
+    from app.reports.leaderboard import mean_std
+    from app.services.report import run_view
+
     view = run_view(store, run_id, metric=metric or None)
     if classifier not in view.run.classifiers:
         raise NotFoundError(
@@ -127,6 +141,8 @@ def classifier(
 
 def _folds(view: RunView, shown: list[str]) -> dict[str, Any]:
     """Per-fold scores of ``shown`` as a table and a strip plot."""
+    from app.reports import figures
+
     table = view.fold_scores()
     return {
         "names": shown,
@@ -134,14 +150,15 @@ def _folds(view: RunView, shown: list[str]) -> dict[str, Any]:
             (block, [table.column(name)[i] for name in shown])
             for i, block in enumerate(table.blocks)
         ],
-        "plot": draw(
-            f"{view.metric} of every fold", partial(figures.folds_figure, view, shown)
-        ),
+        "plot": draw(f"{view.metric} of every fold", partial(figures.folds_figure, view, shown)),
     }
 
 
 def _table(run: RunInfo, board: Leaderboard, *, chosen_baseline: str | None) -> dict[str, Any]:
     """The leaderboard's header (metric columns sortable), rows, and the pickers' options."""
+    from app.reports.leaderboard import leaderboard_header, leaderboard_rows, metric_columns
+    from benchmark.evaluation.metrics import LOWER_IS_BETTER
+
     columns = metric_columns(run, board)
     metrics = sorted({name for row in board.rows for name in row.metrics})
     return {
@@ -153,4 +170,3 @@ def _table(run: RunInfo, board: Leaderboard, *, chosen_baseline: str | None) -> 
         "chosen_baseline": chosen_baseline,
         "direction": "lower is better" if board.metric in LOWER_IS_BETTER else "higher is better",
     }
-

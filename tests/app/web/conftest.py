@@ -21,8 +21,8 @@ from playwright.sync_api import Browser, Page, sync_playwright
 from tests.app.api.conftest import (  # noqa: F401 (fixtures of the real service)
     ROOT,
     make_server,
-    server,
     make_sqlite_server,
+    server,
 )
 from tests.app.test_plots import svg_texts
 
@@ -82,9 +82,11 @@ def tab(browser: Browser, request: pytest.FixtureRequest) -> Iterator[Tab]:
     page.on("pageerror", lambda error: opened.page_errors.append(str(error)))
     page.on(
         "console",
-        lambda message: opened.policy_violations.append(message.text)
-        if "Content Security Policy" in message.text
-        else None,
+        lambda message: (
+            opened.policy_violations.append(message.text)
+            if "Content Security Policy" in message.text
+            else None
+        ),
     )
     yield opened
     context.close()

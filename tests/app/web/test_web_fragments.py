@@ -32,8 +32,8 @@ def _markup_arff(path: Path) -> Path:
         "@attribute class {'<b>bold</b>', plain}",
         "@data",
     ]
-    lines += [f"{i % 7},{i % 3},{'plain' if i % 2 else chr(39) + '<b>bold</b>' + chr(39)}"
-              for i in range(30)]
+    labels = ("'<b>bold</b>'", "plain")
+    lines += [f"{i % 7},{i % 3},{labels[i % 2]}" for i in range(30)]
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path
 
@@ -101,8 +101,8 @@ def test_plots_of_every_kind_of_run_and_figures_drawn_at_once(
     capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path
 ) -> None:
     db, api = server.database_url, server.client
-    assert run_cli(capsys, db, "import", str(touch_arff(tmp_path / "t.arff", n=60)), "--name",
-                   "touch").code == 0
+    data = touch_arff(tmp_path / "t.arff", n=60)
+    assert run_cli(capsys, db, "import", str(data), "--name", "touch").code == 0
     single = _bench(capsys, db, "touch", "--target", "gesture", "-c", "nb,zeror,j48", "-k", "3")
     multi = _bench(capsys, db, "touch", "-c", "cr:nb,cc:j48", "-k", "3")
 

@@ -56,7 +56,8 @@ def test_a_researcher_benchmarks_compares_and_predicts_in_the_browser(
     tab.shot("uploaded")
 
     # a run from the form: one target of a multi-target data set, three classifiers
-    page.locator("#datasets-list tr", has_text="touch").get_by_role("link", name="Benchmark").click()
+    touch_row = page.locator("#datasets-list tr", has_text="touch")
+    touch_row.get_by_role("link", name="Benchmark").click()
     form = page.locator("form[data-action=start-run]")
     expect(form.locator("select[name=dataset]")).to_have_value("touch")
     form.locator("select[name=target]").select_option("gesture")
