@@ -20,6 +20,7 @@ nothing is asserted.
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import sys
 import tempfile
@@ -164,7 +165,9 @@ def main() -> None:
                 for label, path in paths.items():
                     results[label] += timed(lambda path=path: client.get(path).status_code, 1)
             rows = len(client.get(paths["page /fragments/runs/{id}/leaderboard"]).text)
-    print(f"\n{options.requests} requests each, in-process (ms)   median     best      p90")
+    load = ", ".join(f"{value:.1f}" for value in os.getloadavg())
+    print(f"\n{options.requests} requests each, in-process (ms), load average {load}")
+    print(f"  {'':<38} {'median':>8} {'best':>8} {'p90':>8}")
     for label, times in results.items():
         p90 = float(np.percentile(times, 90))
         print(f"  {label:<38} {statistics.median(times):8.1f} {min(times):8.1f} {p90:8.1f}")

@@ -116,14 +116,14 @@ def classifier(
     from app.reports.leaderboard import mean_std
     from app.services.report import run_view
 
-    view = run_view(store, run_id, metric=metric or None)
+    view = run_view(store, run_id, metric=metric or None, baseline=baseline or None)
     if classifier not in view.run.classifiers:
         raise NotFoundError(
             f"run {view.run.id} has no classifier '{classifier}' "
             f"(classifiers: {', '.join(view.run.classifiers)})"
         )
     row = view.board.row(classifier)
-    reference = baseline or view.board.baseline or classifier
+    reference = view.board.baseline or classifier
     shown = list(dict.fromkeys([classifier, reference]))
     return render(
         "fragments/classifier.html.j2",

@@ -116,6 +116,9 @@ def test_a_researcher_benchmarks_compares_and_predicts_in_the_browser(
     assert {"tap", "slap", "stroke", "predicted", "true"} <= set(confusion)
     assert "j48, summed over 3 folds" in " ".join(confusion)  # the title, wrapped
     expect(page.locator("table", has_text="fold 1").locator("tbody tr")).to_have_count(3)
+    # the metric and baseline chosen on the leaderboard follow to the classifier's page
+    expect(page.locator("#classifier .meta")).to_contain_text("by kappa")
+    expect(page.locator("#classifier th", has_text="zeror (baseline)")).to_be_visible()
     tab.shot("confusion-j48")
 
     # the data set: schema and class distribution per target
