@@ -153,16 +153,13 @@ def predict(model: TrainedModel, data: Dataset, *, source: str = "input") -> Pre
     """Predict every instance of ``data`` whose attributes match the model's by name."""
     warnings: list[str] = []
     X = align_features(model.schema, data, source=source, warnings=warnings)
-    codes = np.asarray(model.predict(X)).reshape(X.shape[0], -1)
+    predicted, probas = model.predict_with_proba(X)
+    codes = np.asarray(predicted).reshape(X.shape[0], -1)
     targets = model.schema.targets
     labels = {t.name: [t.values[int(c)] for c in codes[:, j]] for j, t in enumerate(targets)}
-    try:
-        probas = model.predict_proba(X)
-        probabilities: dict[str, np.ndarray] | None = {
-            t.name: np.asarray(p) for t, p in zip(targets, probas, strict=True)
-        }
-    except (AttributeError, NotImplementedError):
-        probabilities = None
+    probabilities: dict[str, np.ndarray] | None = None
+    if probas is not None:
+        probabilities = {t.name: np.asarray(p) for t, p in zip(targets, probas, strict=True)}
     accuracy = {}
     for t in targets:
         truth = _true_labels(t, data)
