@@ -30,7 +30,6 @@ TRUSTED_PACKAGES = frozenset(
         "lightgbm",
         "catboost",
         "skmultilearn",
-        "aeon",
         "wittgenstein",
         "imodels",
     }
@@ -43,6 +42,10 @@ TRUSTED_NAMES = frozenset(
         "collections.OrderedDict",  # LightGBM's boosters keep their parameters in one
         "functools.partial",  # histogram boosting's input check ...
         "sklearn.utils.validation.check_array",  # ... binds this function
+        # aeon's rockets as sequence classifiers fit them: kernels as plain arrays.  Only
+        # these two: aeon's other transforms hold compiled functions and generators.
+        "aeon.transformations.collection.convolution_based._minirocket.MiniRocket",
+        "aeon.transformations.collection.convolution_based._multirocket.MultiRocket",
     }
 )
 #: Classes of trusted packages that touch files, never loaded all the same (a memory-mapped

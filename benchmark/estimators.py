@@ -10,12 +10,18 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from benchmark.catalogue import CATALOGUE, ClassifierSpec, build_pipeline
+from benchmark.catalogue import CATALOGUE, ClassifierSpec, build_pipeline, check_sequence_input
 from benchmark.catalogue import unknown_classifier_message as _unknown_message
 from benchmark.errors import ConfigurationError
 from benchmark.problem import Problem
 
-__all__ = ["build_estimator", "check_classifier", "classifier_spec", "is_multitarget_id"]
+__all__ = [
+    "build_estimator",
+    "check_classifier",
+    "classifier_spec",
+    "is_multitarget_id",
+    "reads_sequences",
+]
 
 
 def is_multitarget_id(classifier_id: str) -> bool:
@@ -23,6 +29,16 @@ def is_multitarget_id(classifier_id: str) -> bool:
     from benchmark.multitarget import META_METHODS
 
     return ":" in classifier_id or classifier_id.lower() in META_METHODS
+
+
+def reads_sequences(classifier_id: str) -> bool:
+    """Whether a catalogue id or ``META:BASE`` configuration needs a sequence data set."""
+    if is_multitarget_id(classifier_id):
+        from benchmark.multitarget import parse_config
+
+        _, base = parse_config(classifier_id)
+        return bool(base) and CATALOGUE[base].needs_sequence
+    return classifier_spec(classifier_id).needs_sequence
 
 
 def classifier_spec(
@@ -65,16 +81,20 @@ def check_classifier(
     ------
     ConfigurationError
         Unknown id; a multi-class id for several targets (or the reverse); a binary-only
-        multi-label method on targets with more than two classes.
+        multi-label method on targets with more than two classes; a sequence classifier
+        (as the classifier or as a base) on flat features.
     """
     from benchmark.multitarget import check_targets, parse_config
 
     names = ", ".join(problem.target_names)
     if is_multitarget_id(classifier_id):
-        parse_config(classifier_id)
+        _, base = parse_config(classifier_id)
         check_targets(classifier_id, problem.n_classes, problem.target_names)
+        if base:
+            check_sequence_input(CATALOGUE[base], problem.sequence)
         return None
     spec = classifier_spec(classifier_id, extra_specs)
+    check_sequence_input(spec, problem.sequence)
     if problem.kind == "multitarget":
         raise ConfigurationError(
             f"'{classifier_id}' is a multi-class classifier and the data set has "
@@ -119,6 +139,7 @@ def build_estimator(
             nominal_features=problem.nominal_features,
             n_features=problem.n_features,
             random_state=random_state,
+            sequence=problem.sequence,
         )
     from benchmark.multitarget import build_multitarget
 
@@ -128,4 +149,5 @@ def build_estimator(
         n_features=problem.n_features,
         random_state=random_state,
         n_classes=problem.n_classes,
+        sequence=problem.sequence,
     )

@@ -26,7 +26,7 @@ from benchmark.evaluation.metrics import expand_proba
 from benchmark.problem import feature_matrix, problem_from_dataset
 
 #: Libraries whose versions are recorded with a model.
-RECORDED_LIBRARIES = ("numpy", "scikit-learn", "xgboost")
+RECORDED_LIBRARIES = ("numpy", "scikit-learn", "xgboost", "aeon")
 
 
 @dataclass
@@ -103,9 +103,12 @@ class TrainedModel:
     def predict_with_proba(self, X: np.ndarray) -> tuple[np.ndarray, list[np.ndarray] | None]:
         """Codes and probabilities at once, in one pass where the classifier allows it.
 
-        A forest or a tree predicts the class of highest probability, so its codes are read
-        off the probabilities instead of computing every tree twice (live prediction pays
-        for each pass).  Other classifiers predict in their own way.
+        Forests, trees, logistic regression, Gaussian naive Bayes and k-nearest neighbours
+        predict the class of highest probability (their probabilities are a monotone map
+        of what ``predict`` maximises), so their codes are read off the probabilities
+        instead of running the model twice: live and served predictions pay for each pass.
+        Other classifiers (an SVM's Platt scaling, calibration, voting) predict in their
+        own way.
 
         Returns
         -------
@@ -124,12 +127,22 @@ class TrainedModel:
 
     def _predicts_most_probable(self) -> bool:
         from sklearn.ensemble._forest import ForestClassifier
+        from sklearn.linear_model import LogisticRegression
+        from sklearn.naive_bayes import GaussianNB
+        from sklearn.neighbors import KNeighborsClassifier
         from sklearn.tree import BaseDecisionTree
 
         if len(self.schema.target_indices) != 1:
             return False
         final = self.estimator[-1] if hasattr(self.estimator, "steps") else self.estimator
-        return isinstance(final, ForestClassifier | BaseDecisionTree)
+        most_probable = (
+            ForestClassifier,
+            BaseDecisionTree,
+            LogisticRegression,
+            GaussianNB,
+            KNeighborsClassifier,
+        )
+        return isinstance(final, most_probable)
 
     def _features(self, X: np.ndarray) -> np.ndarray:
         X = np.asarray(X, dtype=np.float64)

@@ -10,6 +10,7 @@ import numpy as np
 
 from benchmark.dataset import Dataset, Schema
 from benchmark.errors import ConfigurationError
+from benchmark.sequence import SequenceLayout, find_sequence
 
 
 @dataclass(frozen=True, eq=False)
@@ -30,6 +31,9 @@ class Problem:
         Nominal feature column index to its number of declared labels.
     groups : ndarray of shape (n_instances,) or None
         Recording/session id per instance, for group-aware folds.
+    sequence : SequenceLayout or None
+        Where the columns of a sequence data set's windows lie (:mod:`benchmark.sequence`);
+        ``None`` for flat features.
     """
 
     X: np.ndarray
@@ -38,6 +42,7 @@ class Problem:
     target_names: tuple[str, ...]
     nominal_features: Mapping[int, int] = field(default_factory=dict)
     groups: np.ndarray | None = None
+    sequence: SequenceLayout | None = None
 
     def __post_init__(self) -> None:
         X = np.asarray(self.X, dtype=np.float64)
@@ -56,6 +61,14 @@ class Problem:
             raise ConfigurationError(
                 f"{Y.shape[1]} target column(s) but {len(self.n_classes)} class counts and "
                 f"{len(self.target_names)} target names"
+            )
+        if self.sequence is not None and (
+            self.sequence.stop > X.shape[1]
+            or any(self.sequence.start <= c < self.sequence.stop for c in self.nominal_features)
+        ):
+            raise ConfigurationError(
+                f"a sequence of {self.sequence.describe()} from column {self.sequence.start} "
+                f"does not fit {X.shape[1]} numeric feature columns"
             )
         for t, (name, k) in enumerate(zip(self.target_names, self.n_classes, strict=True)):
             if Y.shape[0] and (Y[:, t].min() < 0 or Y[:, t].max() >= k):
@@ -145,6 +158,9 @@ def problem_from_dataset(dataset: Dataset) -> tuple[Problem, list[str]]:
     if unused:
         notes.append(f"string attribute(s) not used as features: {', '.join(unused)}")
     X, nominal = feature_matrix(schema, dataset.X)
+    sequence, note = sequence_layout(schema)
+    if note is not None:
+        notes.append(note)
     if X.shape[1] == 0:
         raise ConfigurationError(
             "the data set has no numeric, nominal or date feature to learn from"
@@ -162,8 +178,32 @@ def problem_from_dataset(dataset: Dataset) -> tuple[Problem, list[str]]:
         target_names=schema.target_names,
         nominal_features=nominal,
         groups=None if dataset.groups is None else np.asarray(dataset.groups)[complete],
+        sequence=sequence,
     )
     return problem, notes
+
+
+def sequence_layout(schema: Schema) -> tuple[SequenceLayout | None, str | None]:
+    """The sequence block among the usable feature columns (:func:`feature_matrix`'s).
+
+    Returns
+    -------
+    layout : SequenceLayout or None
+        ``None`` for flat features.
+    note : str or None
+        Why attributes named like a sequence were read as flat features.
+    """
+    features = schema.features
+    columns = usable_feature_columns(schema)
+    layout, note = find_sequence([features[c].name for c in columns])
+    if layout is None:
+        return None, note
+    kinds = {features[c].kind for c in columns[layout.start : layout.stop]}
+    if kinds != {"numeric"}:
+        return None, (
+            "attributes named like a sequence (CHANNEL[T]) are not all numeric: read as flat"
+        )
+    return layout, None
 
 
 def restrict_targets(dataset: Dataset, targets: Sequence[str] | None = None) -> Dataset:

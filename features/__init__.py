@@ -13,7 +13,8 @@ signal, channel axis first and frame axis last, vectorised over frames, one erro
 ``stats``     per-event mean, minimum, maximum, range
 ``events``    event detection: ``snr``, ``dbscan``, ``none``
 ``extractors`` the named extractors (``uc3m-audio``, ``band-peaks``, ``mfcc``,
-              ``taxel-dft``, ``window``) and their registry
+              ``taxel-dft``, ``window``, ``sequence``) and their registry
+``resample``  sequences to a fixed number of steps
 ``snr_stream``, ``event_streams``  the tracker and the detectors fed block by block
 ``stream``    the streaming engine: blocks in, instances out as events end
 ``history``   the bounded history of samples (and windows) a stream keeps

@@ -59,6 +59,14 @@ def positive_int(value: Any) -> int:
     return int(number)
 
 
+def non_negative_int(value: Any) -> int:
+    """A whole number of at least 0."""
+    number = _float(value)
+    if number != int(number) or number < 0:
+        raise ValueError("must be a whole number of at least 0")
+    return int(number)
+
+
 def flag(value: Any) -> bool:
     """A boolean; text ``true/false/yes/no/1/0``."""
     if isinstance(value, bool):

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Sets touchbench up on a fresh Debian machine with Python >= 3.11: the system libraries it
 # needs (PortAudio for sound-card capture, libsndfile for audio files; WEKA and a Java
-# runtime, which the tests run to check the WEKA-named classifiers), a .venv/ at the
-# repository root, and touchbench with its test tools installed (editable) inside it.
+# runtime, which the tests run to check the WEKA-named classifiers; Chromium, which the
+# web-page tests drive through Playwright), a .venv/ at the repository root, and touchbench
+# with its test tools installed (editable) inside it.
 # Safe to run again: it only does what is missing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -28,7 +29,7 @@ if ! "$PYTHON" -c 'import sys; sys.exit(sys.version_info < (3, 11))' 2>/dev/null
   exit 2
 fi
 
-apt_install libportaudio2 libsndfile1 weka default-jre-headless
+apt_install libportaudio2 libsndfile1 weka default-jre-headless chromium
 "$PYTHON" -c 'import ensurepip, venv' 2>/dev/null || apt_install python3-venv
 
 [ -x .venv/bin/python ] || "$PYTHON" -m venv .venv

@@ -21,6 +21,7 @@ from app.settings import Settings, get_settings
 from app.store.database import Store
 from app.store.jobs import mark_lost_jobs
 from app.store.runs import finish_run, mark_lost_runs
+from app.web.site import install as install_web_page
 
 
 def _warm_up() -> None:
@@ -76,4 +77,5 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         jobs.router,
     ):
         app.include_router(router, dependencies=protected, responses=errors.ERROR_RESPONSES)
+    install_web_page(app, dependencies=protected)
     return app

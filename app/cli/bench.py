@@ -43,7 +43,11 @@ def classifiers_command(
         ),
     ] = False,
 ) -> None:
-    """List the classifier catalogue (id, WEKA name, family, capabilities)."""
+    """List the classifier catalogue (id, WEKA name, family, capabilities).
+
+    Classifiers marked 'sequence' read a sequence data set's windows (extract with -e
+    sequence, or -e mfcc -O frames=N) and refuse flat data sets.
+    """
     from benchmark.catalogue import CATALOGUE, get_spec, suite
 
     if multi_target:
@@ -65,6 +69,7 @@ def classifiers_command(
                         "needs_scaling": s.needs_scaling,
                         "handles_missing": s.handles_missing,
                         "handles_nominal": s.handles_nominal,
+                        "sequence": s.needs_sequence,
                         "cost": s.cost,
                         "suites": sorted(s.suites),
                         "limits": s.limits,
@@ -77,7 +82,18 @@ def classifiers_command(
     yes = "✓"
     table(
         f"{len(specs)} classifiers",
-        ["id", "WEKA", "family", "proba", "scaled", "missing", "nominal", "cost", "suites"],
+        [
+            "id",
+            "WEKA",
+            "family",
+            "proba",
+            "scaled",
+            "missing",
+            "nominal",
+            "sequence",
+            "cost",
+            "suites",
+        ],
         [
             (
                 s.id,
@@ -87,6 +103,7 @@ def classifiers_command(
                 yes if s.needs_scaling else "",
                 yes if s.handles_missing else "",
                 yes if s.handles_nominal else "",
+                yes if s.needs_sequence else "",
                 s.cost,
                 ",".join(sorted(s.suites)),
             )

@@ -33,7 +33,9 @@ def extract_command(
     extractor: Annotated[
         str,
         typer.Option(
-            "--extractor", "-e", help="uc3m-audio, band-peaks, mfcc, taxel-dft or window."
+            "--extractor",
+            "-e",
+            help="uc3m-audio, band-peaks, mfcc, taxel-dft, window or sequence.",
         ),
     ] = "uc3m-audio",
     events: Annotated[

@@ -4,9 +4,12 @@ page all draw through these, so a plot reads the same wherever it appears."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 from matplotlib.figure import Figure
 
 from app.reports import plots
+from app.schemas.datasets import DatasetDescription
 from app.services.compare import Comparison
 from app.services.report import RunView
 from benchmark.errors import ConfigurationError
@@ -33,11 +36,12 @@ def cd_figure(comparison: Comparison) -> Figure:
     )
 
 
-def folds_figure(view: RunView) -> Figure:
-    """Every fold's score of every classifier of a run."""
+def folds_figure(view: RunView, classifiers: Sequence[str] | None = None) -> Figure:
+    """Every fold's score of every classifier of a run (or of ``classifiers`` only)."""
     scores = view.fold_scores()
+    names = scores.classifiers if classifiers is None else dict.fromkeys(classifiers)
     return plots.fold_strip_plot(
-        {name: scores.column(name) for name in scores.classifiers},
+        {name: scores.column(name) for name in names},
         metric=view.metric,
         lower_is_better=view.metric in LOWER_IS_BETTER,
         title=view.title,
@@ -83,4 +87,12 @@ def classes_figure(view: RunView) -> Figure:
         )
     return plots.class_distribution_figure(
         counts, title=f"{view.run.dataset_name}: instances per class in run {view.run.id}"
+    )
+
+
+def dataset_classes_figure(description: DatasetDescription) -> Figure:
+    """Instances per class of each nominal target of a stored data set."""
+    return plots.class_distribution_figure(
+        description.class_distribution,
+        title=f"{description.name}: instances per class ({description.n_instances} in all)",
     )

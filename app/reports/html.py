@@ -58,7 +58,7 @@ def render_report(
     comparison = None
     plots: list[_Plot] = []
     if report.comparison is not None:
-        comparison = _comparison(report.comparison)
+        comparison = comparison_context(report.comparison)
         comparison["plot"] = _plan(
             plots,
             "Critical-difference diagram across data sets",
@@ -74,15 +74,7 @@ def render_report(
         else:
             plot.svg = Markup(svg_text(figure, inline=True))
         on_figure()
-    environment = Environment(
-        loader=FileSystemLoader(TEMPLATES),
-        autoescape=select_autoescape(["html", "j2"]),
-        undefined=StrictUndefined,
-        trim_blocks=True,
-        lstrip_blocks=True,
-    )
-    environment.filters["score"] = _score
-    template = environment.get_template("report.html.j2")
+    template = template_environment().get_template("report.html.j2")
     return template.render(
         title=_title(report),
         created_at=report.created_at.strftime("%Y-%m-%d %H:%M UTC"),
@@ -91,6 +83,20 @@ def render_report(
         runs=runs,
         versions=report.versions,
     )
+
+
+def template_environment(*folders: Path) -> Environment:
+    """The Jinja environment of the report's templates, ``folders`` searched first (the web
+    page's): autoescaped, strict about undefined names, with the ``score`` filter."""
+    environment = Environment(
+        loader=FileSystemLoader([*folders, TEMPLATES]),
+        autoescape=select_autoescape(["html", "j2"]),
+        undefined=StrictUndefined,
+        trim_blocks=True,
+        lstrip_blocks=True,
+    )
+    environment.filters["score"] = score
+    return environment
 
 
 def _plan(plots: list[_Plot], caption: str, build: Callable[[], Figure]) -> _Plot:
@@ -105,7 +111,8 @@ def _title(report: Report) -> str:
     return f"touchbench report: run{'s' if len(report.views) > 1 else ''} {runs} ({names})"
 
 
-def _comparison(comparison: Comparison) -> dict[str, Any]:
+def comparison_context(comparison: Comparison) -> dict[str, Any]:
+    """What the comparison section (``comparison.html.j2``) shows of a comparison."""
     ranks = comparison.ranks
     holm = {h.classifier: h for h in ranks.holm}
     rows = []
@@ -197,7 +204,7 @@ def _run(report: Report, view: RunView, plots: list[_Plot]) -> dict[str, Any]:
     }
 
 
-def _score(value: Any) -> str:
+def score(value: Any) -> str:
     """A score as the tables show it: 4 decimals, ``-`` when there is none."""
     if value is None or (isinstance(value, float) and not math.isfinite(value)):
         return "-"

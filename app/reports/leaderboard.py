@@ -37,7 +37,7 @@ def leaderboard_rows(board: Leaderboard, columns: Sequence[str]) -> list[tuple[A
         cells: list[Any] = [row.rank, row.classifier, _mark(row, board)]
         for column in columns:
             value = row.metrics.get(column)
-            cells.append(_mean_std(value) if isinstance(value, tuple) else "-")
+            cells.append(mean_std(value) if isinstance(value, tuple) else "-")
         if any(r.n_failed for r in board.rows):
             cells.append(f"{row.n_failed} failed: {row.errors[0]}" if row.errors else "")
         out.append(tuple(cells))
@@ -86,7 +86,8 @@ def _mark(row: LeaderboardRow, board: Leaderboard) -> str:
     return "(base)" if row.classifier == board.baseline else row.mark
 
 
-def _mean_std(value: tuple[float, float]) -> str:
+def mean_std(value: tuple[float, float]) -> str:
+    """``"0.8440 ±0.012"``; ``-`` without a mean, the mean alone without a deviation."""
     mean, std = value
     if mean is None or (isinstance(mean, float) and math.isnan(mean)):
         return "-"

@@ -2,8 +2,10 @@
 reports) or PNG bytes.
 
 Every plot function takes plain numbers and labels, never the store, and returns a
-:class:`matplotlib.figure.Figure` built without pyplot (no global state, safe in a web
-server's threads).  :func:`svg_text` renders one with its text kept as text
+:class:`matplotlib.figure.Figure` built without pyplot.  matplotlib's settings are global,
+so building and rendering hold one lock while the plots' settings are in force: a web
+server's threads drawing at once would otherwise undo each other's settings (text drawn
+as paths, lost to the SVG's readers).  :func:`svg_text` renders one with its text kept as text
 (``svg.fonttype: none``), so labels stay searchable and parseable and the file small, and
 with fixed ids and no date, so the same figure renders to the same bytes.
 """
@@ -15,6 +17,7 @@ import math
 import os
 import secrets
 import textwrap
+import threading
 from collections.abc import Callable, Mapping, Sequence
 from functools import wraps
 from pathlib import Path
@@ -42,6 +45,8 @@ _RC: Any = {
     "figure.dpi": 100,
 }
 _P = ParamSpec("_P")
+#: Held while the plots' settings are in force (see the module's docstring).
+_SETTINGS = threading.RLock()
 _METADATA_SVG = {"Date": None, "Creator": "touchbench"}
 _METADATA_PNG = {"Software": "touchbench"}
 _LINE = "#333333"
@@ -54,7 +59,7 @@ def _styled(build: Callable[_P, Figure]) -> Callable[_P, Figure]:
 
     @wraps(build)
     def styled(*args: _P.args, **kwargs: _P.kwargs) -> Figure:
-        with rc_context(_RC):
+        with _SETTINGS, rc_context(_RC):
             return build(*args, **kwargs)
 
     return styled
@@ -365,7 +370,7 @@ def svg_text(figure: Figure, *, inline: bool = False) -> str:
         Drop the XML declaration and DOCTYPE, for an ``<svg>`` element inside HTML.
     """
     buffer = io.StringIO()
-    with rc_context(_RC):
+    with _SETTINGS, rc_context(_RC):
         figure.savefig(buffer, format="svg", metadata=_METADATA_SVG)
     text = buffer.getvalue()
     if inline:
@@ -376,7 +381,7 @@ def svg_text(figure: Figure, *, inline: bool = False) -> str:
 def png_bytes(figure: Figure, *, dpi: int = 150) -> bytes:
     """The figure as PNG."""
     buffer = io.BytesIO()
-    with rc_context(_RC):
+    with _SETTINGS, rc_context(_RC):
         figure.savefig(buffer, format="png", dpi=dpi, metadata=_METADATA_PNG)
     return buffer.getvalue()
 

@@ -19,12 +19,12 @@ import numpy as np
 from app.errors import AppError
 from app.schemas.models import PredictionReport, PredictionRow
 from app.store.database import Store
-from app.store.datasets import find_dataset, load_dataset
+from app.store.datasets import find_dataset, load_dataset, load_schema
 from app.store.models import ModelInfo, load_artifact, save_model
 from benchmark.dataset import Attribute, Dataset, Schema
 from benchmark.errors import DataFormatError
 from benchmark.model import TrainedModel, dumps_model, fit_model, loads_model
-from benchmark.problem import restrict_targets
+from benchmark.problem import problem_from_dataset, restrict_targets
 
 #: Labels quoted in one warning at most.
 MAX_QUOTED = 5
@@ -55,6 +55,20 @@ def train(
         run_id=run_id,
         name=name,
     )
+
+
+def check_training(
+    store: Store, dataset_ref: str, classifier: str, *, targets: Sequence[str] | None = None
+) -> None:
+    """Refuse at once, from the data set's schema alone, what :func:`train` would refuse
+    after loading it: an unknown data set, target or classifier, a multi-class classifier
+    for several targets (or the reverse), a sequence classifier on flat features."""
+    from benchmark.estimators import check_classifier
+
+    _, schema, _ = load_schema(store, dataset_ref)
+    empty = Dataset(schema, np.zeros((0, schema.n_attributes)))
+    problem, _ = problem_from_dataset(restrict_targets(empty, targets))
+    check_classifier(classifier, problem)
 
 
 def train_best(store: Store, run_id: int | str, *, name: str | None = None) -> ModelInfo:
@@ -139,16 +153,13 @@ def predict(model: TrainedModel, data: Dataset, *, source: str = "input") -> Pre
     """Predict every instance of ``data`` whose attributes match the model's by name."""
     warnings: list[str] = []
     X = align_features(model.schema, data, source=source, warnings=warnings)
-    codes = np.asarray(model.predict(X)).reshape(X.shape[0], -1)
+    predicted, probas = model.predict_with_proba(X)
+    codes = np.asarray(predicted).reshape(X.shape[0], -1)
     targets = model.schema.targets
     labels = {t.name: [t.values[int(c)] for c in codes[:, j]] for j, t in enumerate(targets)}
-    try:
-        probas = model.predict_proba(X)
-        probabilities: dict[str, np.ndarray] | None = {
-            t.name: np.asarray(p) for t, p in zip(targets, probas, strict=True)
-        }
-    except (AttributeError, NotImplementedError):
-        probabilities = None
+    probabilities: dict[str, np.ndarray] | None = None
+    if probas is not None:
+        probabilities = {t.name: np.asarray(p) for t, p in zip(targets, probas, strict=True)}
     accuracy = {}
     for t in targets:
         truth = _true_labels(t, data)

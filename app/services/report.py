@@ -172,9 +172,12 @@ class Report:
     created_at: datetime = field(default_factory=lambda: datetime.now(UTC))
 
 
-def run_view(store: Store, run_ref: int | str, *, metric: str | None = None) -> RunView:
-    """A run with its leaderboard, results and class labels."""
-    run, board = run_leaderboard(store, run_ref, metric=metric)
+def run_view(
+    store: Store, run_ref: int | str, *, metric: str | None = None, baseline: str | None = None
+) -> RunView:
+    """A run with its leaderboard (marks against ``baseline``, default the best), results
+    and class labels."""
+    run, board = run_leaderboard(store, run_ref, metric=metric, baseline=baseline)
     _, schema, _ = load_schema(store, run.dataset_id)
     labels = {}
     for target in run.targets:

@@ -138,15 +138,24 @@ def prepare_problem(dataset: Dataset, targets: Sequence[str] | None = None) -> P
     return PreparedProblem(problem, list(problem.target_names), warnings)
 
 
-def default_classifiers(n_targets: int, suite_name: str = "default") -> list[str]:
-    """The classifiers a suite means for a data set with ``n_targets`` targets."""
+def default_classifiers(
+    n_targets: int, suite_name: str = "default", *, sequences: bool = False
+) -> list[str]:
+    """The classifiers a suite means for a data set with ``n_targets`` targets.
+
+    Sequence classifiers are among them only for a sequence data set (``sequences``).
+    """
+    from benchmark.estimators import reads_sequences
+
     if n_targets > 1:
         from benchmark.multitarget.suites import multitarget_suite
 
-        return multitarget_suite(suite_name)
-    from benchmark.catalogue import suite
+        ids = multitarget_suite(suite_name)
+    else:
+        from benchmark.catalogue import suite
 
-    return suite(suite_name)
+        ids = suite(suite_name)
+    return [i for i in ids if sequences or not reads_sequences(i)]
 
 
 def check_classifiers(
@@ -218,7 +227,11 @@ def create_run(
     prepared = prepare_problem(load_dataset(store, info.id), targets)
     ids = list(dict.fromkeys(classifiers or ()))
     if not ids and not commands:
-        ids = default_classifiers(len(prepared.target_names), suite or "default")
+        ids = default_classifiers(
+            len(prepared.target_names),
+            suite or "default",
+            sequences=prepared.problem.sequence is not None,
+        )
     ids = list(dict.fromkeys([*ids, *commands]))
     check_classifiers(prepared.problem, ids, commands)
     folds, fold_notes = _folds(prepared, options)

@@ -111,9 +111,9 @@ def _lock_for_migration(connection: Any) -> None:
     if connection.dialect.name == "postgresql":
         connection.execute(text(f"SELECT pg_advisory_xact_lock({_MIGRATION_LOCK})"))
     elif connection.dialect.name == "sqlite":
-        # Python's sqlite3 opens no transaction before DDL (which would each commit on its
-        # own, showing other processes a store half made): this one takes SQLite's write
-        # lock at once and keeps it, with every table the migrations make, until it ends.
+        # Python's sqlite3 opens no transaction before DDL, so each CREATE TABLE would
+        # commit on its own and two processes would both create the schema: take SQLite's
+        # write lock explicitly; the migration's DDL then runs, and commits, inside it.
         connection.exec_driver_sql("BEGIN IMMEDIATE")
 
 

@@ -19,16 +19,18 @@ from types import MappingProxyType
 from sklearn.pipeline import Pipeline
 
 from benchmark.catalogue.entries import SPECS
-from benchmark.catalogue.pipeline import pipeline_for_spec
+from benchmark.catalogue.pipeline import check_sequence_input, pipeline_for_spec
 from benchmark.catalogue.spec import ClassifierSpec
 from benchmark.catalogue.weka_schemes import scheme_for, split_command
 from benchmark.errors import ConfigurationError
+from benchmark.sequence import SequenceLayout
 
 __all__ = [
     "CATALOGUE",
     "SUITES",
     "ClassifierSpec",
     "build_pipeline",
+    "check_sequence_input",
     "get_spec",
     "parse_weka_command",
     "suite",
@@ -127,6 +129,7 @@ def build_pipeline(
     nominal_features: Mapping[int, int] | None = None,
     n_features: int,
     random_state: int | None = 0,
+    sequence: SequenceLayout | None = None,
 ) -> Pipeline:
     """The preprocessing-plus-classifier pipeline of a catalogue entry.
 
@@ -142,6 +145,9 @@ def build_pipeline(
         inputs) pass through unchanged.
     random_state : int or None
         Seed for every ``random_state`` of the estimator.
+    sequence : SequenceLayout or None
+        Where a sequence data set's windows lie among the feature columns (sequence
+        classifiers need it).
 
     Returns
     -------
@@ -151,5 +157,9 @@ def build_pipeline(
     """
     spec = classifier_id if isinstance(classifier_id, ClassifierSpec) else get_spec(classifier_id)
     return pipeline_for_spec(
-        spec, nominal_features=nominal_features, n_features=n_features, random_state=random_state
+        spec,
+        nominal_features=nominal_features,
+        n_features=n_features,
+        random_state=random_state,
+        sequence=sequence,
     )

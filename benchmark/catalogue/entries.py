@@ -50,6 +50,7 @@ from benchmark.catalogue.estimators import LabelEncodedClassifier, OneRuleClassi
 from benchmark.catalogue.model_trees import LogisticModelTree
 from benchmark.catalogue.rules import OrderedRuleClassifier
 from benchmark.catalogue.spec import ClassifierSpec
+from benchmark.catalogue.time_series import IntervalForestClassifier, RocketClassifier
 from benchmark.catalogue.weka_schemes import weka_command
 from benchmark.weka import C45Classifier, PARTClassifier, WekaIBk, WekaNaiveBayes, WekaZeroR
 
@@ -240,6 +241,7 @@ def _spec(
     cost: str = "fast",
     suites: frozenset[str] = DEFAULT,
     limits: str = "",
+    min_sequence: int | None = None,
 ) -> ClassifierSpec:
     return ClassifierSpec(
         id=id,
@@ -256,6 +258,7 @@ def _spec(
         suites=suites,
         limits=limits,
         scaling=scaling or "standard",  # type: ignore[arg-type]
+        min_sequence=min_sequence,
     )
 
 
@@ -1233,5 +1236,38 @@ SPECS: tuple[ClassifierSpec, ...] = (
         description="RF, extra trees, RBF SVM and logistic stacked by logistic regression",
         scaling="standard",
         cost="slow",
+    ),
+    # Time series: the windows of a sequence data set (benchmark.sequence)
+    _spec(
+        "minirocket",
+        RocketClassifier,
+        {"variant": "minirocket", "n_kernels": 10_000},
+        family="time-series",
+        description="MiniRocket (aeon): 10,000 dilated-convolution features, ridge classifier",
+        probabilities=False,
+        min_sequence=9,
+        limits="sequence data sets only; missing values imputed by the training mean",
+    ),
+    _spec(
+        "multirocket",
+        RocketClassifier,
+        {"variant": "multirocket", "n_kernels": 6_250},
+        family="time-series",
+        description="MultiRocket (aeon): 4 poolings of series and differences, ridge classifier",
+        probabilities=False,
+        cost="slow",
+        min_sequence=10,
+        limits="sequence data sets only; missing values imputed by the training mean",
+    ),
+    _spec(
+        "interval-forest",
+        IntervalForestClassifier,
+        {"n_intervals": None, "n_estimators": 300},
+        family="time-series",
+        description="7 statistics of random intervals of series, differences and spectra; "
+        "extra trees",
+        min_sequence=2,
+        limits="sequence data sets only; one draw of intervals for the forest (aeon's "
+        "RandomIntervalClassifier), not a draw per tree as DrCIF; no catch22 features",
     ),
 )

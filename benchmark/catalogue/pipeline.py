@@ -7,7 +7,9 @@ from collections.abc import Mapping
 from sklearn.pipeline import Pipeline
 
 from benchmark.catalogue.spec import ClassifierSpec
+from benchmark.errors import ConfigurationError
 from benchmark.preprocessing import make_preprocessor
+from benchmark.sequence import SequenceLayout
 
 #: HistGradientBoosting's limit on the labels of a native categorical feature (estimators
 #: that take ``nominal_features`` have none).
@@ -20,6 +22,7 @@ def pipeline_for_spec(
     nominal_features: Mapping[int, int] | None = None,
     n_features: int,
     random_state: int | None = 0,
+    sequence: SequenceLayout | None = None,
 ) -> Pipeline:
     """The pipeline ``[("preprocess", ColumnTransformer), ("classifier", estimator)]``.
 
@@ -35,6 +38,9 @@ def pipeline_for_spec(
     random_state : int or None
         Seed given to every ``random_state`` parameter of the estimator, nested ones
         included.
+    sequence : SequenceLayout or None
+        Where a sequence data set's windows lie among the feature columns; a sequence
+        classifier gets their place after preprocessing as its ``sequence`` parameter.
 
     Returns
     -------
@@ -42,6 +48,7 @@ def pipeline_for_spec(
         Unfitted; ``fit(X, y)`` takes X of shape (n_samples, n_features + n_extra) and
         integer labels y of shape (n_samples,).
     """
+    check_sequence_input(spec, sequence)
     nominal = dict(nominal_features or {})
     estimator = spec.make_estimator()
     takes_labels = "nominal_features" in estimator.get_params(deep=False)
@@ -66,4 +73,35 @@ def pipeline_for_spec(
         if name == "random_state" or name.endswith("__random_state")
     }
     estimator.set_params(**seeds)
+    if spec.needs_sequence:
+        assert sequence is not None
+        # Numeric columns leave the preprocessor first, in their order (one-hot blocks
+        # follow them): the block moves left by the nominal columns before it.
+        moved = sum(1 for column in nominal if column < sequence.start)
+        estimator.set_params(
+            sequence=(sequence.start - moved, sequence.n_channels, sequence.length)
+        )
     return Pipeline([("preprocess", preprocessor), ("classifier", estimator)])
+
+
+def check_sequence_input(spec: ClassifierSpec, sequence: SequenceLayout | None) -> None:
+    """Refuse a sequence classifier on flat features, or on sequences too short for it.
+
+    Raises
+    ------
+    ConfigurationError
+        One line naming the classifier and what it needs.
+    """
+    if spec.min_sequence is None:
+        return
+    if sequence is None:
+        raise ConfigurationError(
+            f"classifier '{spec.id}' needs a sequence data set (attributes named "
+            "CHANNEL[T], as `touchbench extract -e sequence` or `-e mfcc -O frames=N` make "
+            "them); this data set has flat features"
+        )
+    if sequence.length < spec.min_sequence:
+        raise ConfigurationError(
+            f"classifier '{spec.id}' needs sequences of at least {spec.min_sequence} steps; "
+            f"this data set's are {sequence.describe()}"
+        )

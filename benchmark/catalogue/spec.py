@@ -52,6 +52,10 @@ class ClassifierSpec:
         Known limits and differences from the WEKA counterpart.
     scaling : {"standard", "minmax"}
         The scaler used when ``needs_scaling``.
+    min_sequence : int or None
+        ``None`` for a classifier of flat feature vectors; otherwise it reads a sequence
+        data set's windows (:mod:`benchmark.sequence`) through its ``sequence`` parameter,
+        and needs at least this many time steps per channel.
     """
 
     id: str
@@ -68,6 +72,12 @@ class ClassifierSpec:
     suites: frozenset[str]
     limits: str = ""
     scaling: Scaling = "standard"
+    min_sequence: int | None = None
+
+    @property
+    def needs_sequence(self) -> bool:
+        """Whether it only works on a sequence data set."""
+        return self.min_sequence is not None
 
     @property
     def weka_name(self) -> str | None:
@@ -102,6 +112,7 @@ class ClassifierSpec:
             "cost": self.cost,
             "suites": sorted(self.suites | {"all"}),
             "limits": self.limits,
+            "min_sequence": self.min_sequence,
         }
 
 

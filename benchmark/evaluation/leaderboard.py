@@ -203,10 +203,20 @@ def build_leaderboard(
 def _summarise(classifier: str, results: list[TaskResult], names: list[str]) -> LeaderboardRow:
     ok = [r for r in results if r.ok]
     failed = [r for r in results if not r.ok]
+    # one (n_metrics, n_ok) table and one mean and deviation per row: the same numbers as
+    # per metric (each row is reduced as its own array), without a numpy call per metric
+    table = np.array(
+        [[r.metrics.get(name, math.nan) for r in ok] for name in names], dtype=np.float64
+    ).reshape(len(names), len(ok))
+    complete = np.isnan(table).sum(axis=1) == 0
+    means = table.mean(axis=1) if ok else np.full(len(names), math.nan)
+    stds = table.std(axis=1, ddof=1) if len(ok) > 1 else np.zeros(len(names))
     metrics = {}
-    for name in names:
-        values = np.array([r.metrics.get(name, math.nan) for r in ok], dtype=np.float64)
-        values = values[~np.isnan(values)]
+    for i, name in enumerate(names):
+        if complete[i] and ok:
+            metrics[name] = (float(means[i]), float(stds[i]))
+            continue
+        values = table[i][~np.isnan(table[i])]
         if values.size == 0:
             metrics[name] = (math.nan, math.nan)
         else:

@@ -26,6 +26,7 @@ from benchmark.multitarget.multilabel import MultiLabelAdapter
 from benchmark.multitarget.rakeld import RAkELd
 from benchmark.multitarget.relevance import ClassRelevance
 from benchmark.multitarget.superclass import SuperClassClassifier
+from benchmark.sequence import SequenceLayout
 
 #: Factory signature: (base estimator or preprocessor, random_state, n_classes) -> estimator.
 Factory = Callable[[Any, int | None, Sequence[int] | None], MultiTargetClassifier]
@@ -307,6 +308,7 @@ def build_multitarget(
     n_features: int,
     random_state: int | None = 0,
     n_classes: Sequence[int] | None = None,
+    sequence: SequenceLayout | None = None,
 ) -> MultiTargetClassifier:
     """A fresh, unfitted estimator for a configuration id.
 
@@ -323,6 +325,9 @@ def build_multitarget(
     n_classes : sequence of int, optional
         Declared classes per target, so that probabilities cover classes a training
         fold lacks; default: inferred from each training ``Y``.
+    sequence : SequenceLayout or None
+        Where a sequence data set's windows lie among the feature columns, for a
+        sequence classifier as the base.
 
     Returns
     -------
@@ -341,6 +346,7 @@ def build_multitarget(
         nominal_features=nominal,
         n_features=n_features,
         random_state=random_state,
+        sequence=sequence if base else None,
     )
     part = pipeline if spec.needs_base else pipeline[:-1]
     return spec.factory(part, random_state, None if n_classes is None else tuple(n_classes))

@@ -14,12 +14,14 @@ from features.errors import FeatureError
 from features.extractors.band_peaks import BandPeaks
 from features.extractors.base import Extractor, Instances
 from features.extractors.mfcc import Mfcc
+from features.extractors.sequence import Sequence
 from features.extractors.taxel_dft import TaxelDft
 from features.extractors.uc3m_audio import Uc3mAudio, uc3m_feature_names
 from features.extractors.window import Window
 
 EXTRACTORS: dict[str, type[Extractor]] = {
-    extractor.name: extractor for extractor in (Uc3mAudio, BandPeaks, Mfcc, TaxelDft, Window)
+    extractor.name: extractor
+    for extractor in (Uc3mAudio, BandPeaks, Mfcc, TaxelDft, Window, Sequence)
 }
 
 

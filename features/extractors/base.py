@@ -194,3 +194,9 @@ class Extractor(ABC):
 def channel_suffixed(names: list[str], n_channels: int) -> list[str]:
     """``name_1 ... name_k`` for channel 1, then channel 2, ... (1-based, the UC3M style)."""
     return [f"{name}_{channel}" for channel in range(1, n_channels + 1) for name in names]
+
+
+def sequence_names(channels: list[str], length: int) -> list[str]:
+    """Names of a sequence instance's columns: ``channel[0] ... channel[length-1]`` for
+    each channel in turn, the layout ``benchmark.sequence`` reads back."""
+    return [f"{channel}[{step}]" for channel in channels for step in range(length)]

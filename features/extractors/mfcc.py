@@ -1,4 +1,4 @@
-"""``mfcc``: mel-frequency cepstral coefficients, summarised per instance.
+"""``mfcc``: mel-frequency cepstral coefficients, summarised per instance or kept as frames.
 
 Per channel: 30 ms frames with a 10 ms hop (98 frames in 1 s, not centred), periodic
 Hann window, power spectrum with ``n_fft`` = the frame length, 40 HTK-mel filters of
@@ -7,27 +7,36 @@ features are the mean and the standard deviation (population, ``ddof=0``) of eac
 coefficient over its frames: ``mfcc1_mean_1 ... mfcc14_mean_1, mfcc1_std_1 ...`` for
 channel 1, then channel 2, ....  The frame sequence, shape (n_frames, n_mfcc *
 n_channels) in the same channel order, is kept in the instance's metadata under
-``"frames"`` for sequence models.
+``"frames"``.
+
+With ``frames=N``, the instance keeps the coefficients frame by frame instead of their
+summary, as a sequence for time-series models: each coefficient's track is brought to
+``N`` steps (:func:`features.resample.to_length`) and stored as the columns
+``mfcc1_1[0] ... mfcc1_1[N-1], mfcc2_1[0] ...`` (coefficient q of channel c is the
+sequence channel ``mfccq_c``), the layout ``benchmark.sequence`` reads back.
 """
 
 from __future__ import annotations
 
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
 from features.events import Detection
-from features.extractors.base import Extractor, Instances, channel_suffixed
+from features.extractors.base import Extractor, Instances, channel_suffixed, sequence_names
 from features.framing import frame, power_spectrogram
 from features.mel import mel_filter_bank, mel_spectrogram, mfcc
 from features.options import Option, positive_float, positive_int
+from features.resample import to_length
 
 
 class Mfcc(Extractor):
     """MFCC mean and standard deviation per coefficient; see the module docstring."""
 
     name: ClassVar[str] = "mfcc"
-    description: ClassVar[str] = "14 MFCCs (40 mel filters, 30 ms / 10 ms): mean and std"
+    description: ClassVar[str] = (
+        "14 MFCCs (40 mel filters, 30 ms / 10 ms): mean and std, or N frames (frames=N)"
+    )
     default_events: ClassVar[str] = "none"
     min_samplerate: ClassVar[float] = 2000.0
     options: ClassVar[tuple[Option, ...]] = (
@@ -35,6 +44,7 @@ class Mfcc(Extractor):
         Option("n_mels", 40, positive_int, "mel filters"),
         Option("frame", 0.030, positive_float, "frame length in seconds"),
         Option("hop", 0.010, positive_float, "hop in seconds"),
+        Option("frames", None, positive_int, "keep N frames as a sequence, not mean and std"),
     )
 
     def frame_length(self, samplerate: float) -> int:
@@ -48,6 +58,13 @@ class Mfcc(Extractor):
 
     def feature_names(self, n_channels: int) -> list[str]:
         count = self.params["n_mfcc"]
+        if self.params["frames"] is not None:
+            tracks = [
+                f"mfcc{q}_{channel}"
+                for channel in range(1, n_channels + 1)
+                for q in range(1, count + 1)
+            ]
+            return sequence_names(tracks, self.params["frames"])
         names = [f"mfcc{q}_mean" for q in range(1, count + 1)]
         names += [f"mfcc{q}_std" for q in range(1, count + 1)]
         return channel_suffixed(names, n_channels)
@@ -58,7 +75,8 @@ class Mfcc(Extractor):
         filters = mel_filter_bank(
             samplerate=samplerate, n_fft=frame_length, n_mels=self.params["n_mels"]
         )
-        rows, spans, meta = [], [], []
+        rows, spans = [], []
+        meta: list[dict[str, Any]] = []
         segments, warnings = self._long_enough(y, samplerate=samplerate, detection=detection)
         for event, segment in segments:
             frames = frame(segment, frame_length=frame_length, hop_length=hop_length)
@@ -66,11 +84,15 @@ class Mfcc(Extractor):
             coefficients = mfcc(
                 mel_spectrogram(power, filter_bank=filters), n_mfcc=self.params["n_mfcc"]
             )
+            spans.append((event.onset, event.offset))
+            if self.params["frames"] is not None:
+                rows.append(to_length(coefficients, self.params["frames"]).reshape(-1))
+                meta.append({"channels": list(event.channels), "n_contacts": event.n_contacts})
+                continue
             summary = np.concatenate(
                 [coefficients.mean(axis=-1), coefficients.std(axis=-1)], axis=-1
             )
             rows.append(summary.reshape(-1))
-            spans.append((event.onset, event.offset))
             sequence = np.moveaxis(coefficients, -1, 0).reshape(coefficients.shape[-1], -1)
             meta.append(
                 {

@@ -58,7 +58,7 @@ class Window(Extractor):
         if onsets.size == 0:
             return Instances.empty(len(self.feature_names(y.shape[0])), warnings)
         after = y[:, onsets[:, np.newaxis] + np.arange(length)]
-        reference = _baselines(y, onsets, baseline)
+        reference = baselines(y, onsets, baseline)
         values = after - reference[:, :, np.newaxis]
         return Instances(
             values=np.moveaxis(values, 0, 1).reshape(onsets.size, -1),
@@ -68,8 +68,14 @@ class Window(Extractor):
         )
 
 
-def _baselines(y: np.ndarray, onsets: np.ndarray, baseline: int) -> np.ndarray:
-    """Mean of up to ``baseline`` samples before each onset, shape (n_channels, n_onsets)."""
+def baselines(y: np.ndarray, onsets: np.ndarray, baseline: int) -> np.ndarray:
+    """Mean of up to ``baseline`` samples before each onset, shape (n_channels, n_onsets).
+
+    An onset with fewer samples before it uses those there are, an onset at sample 0 is
+    its own baseline, and ``baseline`` 0 gives zeros (nothing to subtract).
+    """
+    if baseline == 0:
+        return np.zeros((y.shape[0], onsets.size))
     before = onsets[:, np.newaxis] - baseline + np.arange(baseline)
     there = before >= 0
     values = np.where(there, y[:, np.maximum(before, 0)], 0.0)

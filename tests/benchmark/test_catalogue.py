@@ -25,6 +25,7 @@ from benchmark.catalogue import (
 )
 from benchmark.catalogue.estimators import LabelEncodedClassifier, OneRuleClassifier
 from benchmark.errors import ConfigurationError
+from benchmark.sequence import SequenceLayout
 from benchmark.weka import C45Classifier, WekaIBk, WekaNaiveBayes, WekaZeroR
 
 FAMILIES = {
@@ -48,6 +49,7 @@ FAMILIES = {
     "multiclass-wrapper",
     "voting",
     "stacking",
+    "time-series",
 }
 
 
@@ -72,6 +74,20 @@ def tiny_data(seed: int = 0) -> tuple[np.ndarray, np.ndarray, dict[int, int]]:
     X = np.column_stack([numeric[:, :2], colour, numeric[:, 2:], shape]).astype(np.float64)
     X[rng.random(X.shape) < 0.08] = np.nan
     return X, y, {2: 3, 5: 4}
+
+
+def with_sequence(X: np.ndarray, y: np.ndarray, seed: int = 0) -> tuple[np.ndarray, SequenceLayout]:
+    """``X`` followed by a 2-channel sequence of 16 steps whose shape follows the class,
+    NaNs in it too: the block starts after the nominal columns 2 and 5."""
+    rng = np.random.default_rng(seed)
+    steps = np.arange(16)
+    waves = np.sin(
+        2 * np.pi * (1 + y[:, None, None]) * steps / 16 + rng.uniform(0, 6, (len(y), 2, 1))
+    )
+    block = (waves + 0.2 * rng.normal(size=waves.shape)).reshape(len(y), -1)
+    block[rng.random(block.shape) < 0.02] = np.nan
+    layout = SequenceLayout(start=X.shape[1], channels=("a", "b"), length=16)
+    return np.hstack([X, block]), layout
 
 
 def test_catalogue_has_at_least_a_hundred_configurations_with_stable_ids() -> None:
@@ -234,7 +250,12 @@ def test_spec_to_json_is_plain_data() -> None:
 def test_every_entry_fits_and_predicts_nominal_and_missing_inputs(classifier_id: str) -> None:
     X, y, nominal = tiny_data()
     spec = get_spec(classifier_id)
-    model = build_pipeline(classifier_id, nominal_features=nominal, n_features=X.shape[1])
+    sequence = None
+    if spec.needs_sequence:  # the flat columns beside the sequence reach them too
+        X, sequence = with_sequence(X, y)
+    model = build_pipeline(
+        classifier_id, nominal_features=nominal, n_features=X.shape[1], sequence=sequence
+    )
     model.fit(X[::2], y[::2])
     predicted = model.predict(X[1::2])
     assert predicted.shape == (90,)

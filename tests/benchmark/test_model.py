@@ -105,7 +105,20 @@ def test_serialised_models_load_only_with_their_digest() -> None:
         loads_model(other, sha256=model_digest(other))
 
 
-@pytest.mark.parametrize("classifier", ["rf", "extra-trees", "cart", "nb", "logistic", "cc:j48"])
+@pytest.mark.parametrize(
+    "classifier",
+    [
+        "rf",
+        "extra-trees",
+        "cart",
+        "nb",
+        "nb-gaussian",
+        "logistic",
+        "knn5",
+        "calibrated-nb",
+        "cc:j48",
+    ],
+)
 def test_codes_and_probabilities_in_one_pass_agree_with_predict(classifier: str) -> None:
     data = dataset(targets=2 if ":" in classifier else 1)
     model = fit_model(data, classifier)

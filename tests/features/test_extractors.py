@@ -219,7 +219,14 @@ def test_window_subtracts_the_mean_of_the_samples_before_the_onset() -> None:
 
 
 def test_registry_describes_every_extractor() -> None:
-    assert set(EXTRACTORS) == {"uc3m-audio", "band-peaks", "mfcc", "taxel-dft", "window"}
+    assert set(EXTRACTORS) == {
+        "uc3m-audio",
+        "band-peaks",
+        "mfcc",
+        "taxel-dft",
+        "window",
+        "sequence",
+    }
     for name, extractor_class in EXTRACTORS.items():
         extractor = make_extractor(name)
         assert extractor.name == name and extractor_class.description

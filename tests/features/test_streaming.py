@@ -105,6 +105,9 @@ RECIPES = [
     ("mfcc", "snr", {}, None),
     ("mfcc", "none", {"n_mfcc": 10}, 0.5),
     ("window", "dbscan", {"length": 40}, None),
+    ("sequence", "dbscan", {"length": 64, "baseline": 4}, None),
+    ("sequence", "snr", {"length": 50, "resample": "true", "baseline": 8}, None),
+    ("mfcc", "snr", {"frames": 12}, None),
     ("taxel-dft", "snr", {}, None),
     ("band-peaks", "none", {"bands": "0-120,500-550"}, 1.0),
 ]

@@ -39,9 +39,15 @@ def train(body: TrainRequest, service: ServiceDep) -> JobCreated:
         get_run(service.store, body.run)  # 404 now rather than a failed job later
         params = {"run": body.run, "name": body.name}
     else:
-        from app.store.datasets import find_dataset
+        from app.services.models import check_training
 
-        find_dataset(service.store, str(body.dataset))
+        assert body.classifier is not None
+        check_training(
+            service.store,
+            str(body.dataset),
+            body.classifier,
+            targets=[body.target] if body.target else None,
+        )
         params = body.model_dump(exclude={"run"})
     if body.name is not None:
         from app.store.models import check_model_name

@@ -1,0 +1,50 @@
+"""The fragment comparing runs: the runs to pick from, and for the picked ones the ranks,
+Friedman's and Holm's tests, Nemenyi's groups and the critical-difference diagram."""
+
+from __future__ import annotations
+
+from functools import partial
+from typing import Annotated
+
+from fastapi import APIRouter, Query
+from fastapi.responses import HTMLResponse
+
+from app.api.deps import StoreDep
+from app.errors import AppError
+from app.store.runs import list_runs
+from app.web.rendering import draw, render
+from benchmark.errors import BenchmarkError
+
+router = APIRouter(prefix="/fragments/compare", include_in_schema=False)
+
+
+@router.get("", response_class=HTMLResponse)
+def compare(
+    store: StoreDep,
+    runs: Annotated[list[int], Query()] = [],  # noqa: B006 (FastAPI copies it)
+    metric: Annotated[str | None, Query(max_length=100)] = None,
+    alpha: Annotated[float, Query(gt=0, lt=1)] = 0.05,
+) -> HTMLResponse:
+    """One run ranks its classifiers over its folds; several, over their data sets."""
+    from app.reports.figures import cd_figure
+    from app.reports.html import comparison_context
+    from app.services.compare import compare_runs
+
+    context: dict[str, object] = {
+        "runs": [run for run in list_runs(store) if run.n_results > 0],
+        "chosen": runs,
+        "metric": metric or "",
+        "alpha": alpha,
+        "comparison": None,
+        "plot": None,
+        "problem": None,
+    }
+    if runs:
+        try:
+            comparison = compare_runs(store, runs, metric=metric or None, alpha=alpha)
+        except (AppError, BenchmarkError) as error:  # the form stays, with what is wrong
+            context["problem"] = str(error)
+        else:
+            context["comparison"] = comparison_context(comparison)
+            context["plot"] = draw("Critical-difference diagram", partial(cd_figure, comparison))
+    return render("fragments/compare.html.j2", **context)

@@ -1,0 +1,172 @@
+"""Fragments of runs: the list, a run's progress, its leaderboard (ranked by any metric,
+marked against any baseline), its plots, one classifier's confusion matrix and folds, and
+the form that starts a run."""
+
+from __future__ import annotations
+
+from functools import partial
+from typing import TYPE_CHECKING, Annotated, Any
+
+from fastapi import APIRouter, Query
+from fastapi.responses import HTMLResponse
+
+from app.api.deps import StoreDep
+from app.errors import NotFoundError
+from app.schemas.runs import FINAL_STATUSES
+from app.services.datasets import list_datasets
+from app.services.runs import run_leaderboard
+from app.store.runs import RunInfo, get_run, list_runs
+from app.web.rendering import draw, render
+from app.web.routes.pages import Ref
+from benchmark.errors import ConfigurationError
+
+# The plots and the statistics (matplotlib, scipy) load with the first fragment that needs
+# them, so that the service starts at once.
+if TYPE_CHECKING:
+    from app.services.report import RunView
+    from benchmark.evaluation.leaderboard import Leaderboard
+
+router = APIRouter(prefix="/fragments/runs", include_in_schema=False)
+
+Metric = Annotated[str | None, Query(max_length=100)]
+Baseline = Annotated[str | None, Query(max_length=200)]
+
+
+@router.get("", response_class=HTMLResponse)
+def runs(store: StoreDep) -> HTMLResponse:
+    """Every run with its progress; polled while one is queued or running."""
+    listed = list_runs(store)
+    return render(
+        "fragments/runs.html.j2",
+        runs=listed,
+        active=any(run.status not in FINAL_STATUSES for run in listed),
+    )
+
+
+@router.get("/form", response_class=HTMLResponse)
+def run_form(
+    store: StoreDep, dataset: Annotated[str | None, Query(max_length=200)] = None
+) -> HTMLResponse:
+    """The form that starts a run: data sets with their targets, suites, classifier ids."""
+    from benchmark.catalogue import CATALOGUE, SUITES
+    from benchmark.multitarget import multitarget_configurations
+
+    return render(
+        "fragments/run_form.html.j2",
+        datasets=list_datasets(store),
+        chosen=dataset,
+        suites=SUITES,
+        catalogue=[(spec.id, spec.description) for spec in CATALOGUE.values()],
+        multitarget=multitarget_configurations(),
+    )
+
+
+@router.get("/{run_id}/progress", response_class=HTMLResponse)
+def progress(run_id: int, store: StoreDep) -> HTMLResponse:
+    """Status and tasks done; polled every second until the run is over."""
+    run = get_run(store, run_id).schema()
+    return render("fragments/progress.html.j2", run=run, final=run.status in FINAL_STATUSES)
+
+
+@router.get("/{run_id}/leaderboard", response_class=HTMLResponse)
+def leaderboard(
+    run_id: int, store: StoreDep, metric: Metric = None, baseline: Baseline = None
+) -> HTMLResponse:
+    """The run's classifiers ranked by ``metric`` with WEKA's marks against ``baseline``."""
+    try:
+        run, board = run_leaderboard(
+            store, run_id, metric=metric or None, baseline=baseline or None
+        )
+    except ConfigurationError:
+        run = get_run(store, run_id)
+        if run.n_results:
+            raise  # an unknown metric or baseline
+        return render("fragments/leaderboard.html.j2", run=run, board=None)
+    return render(
+        "fragments/leaderboard.html.j2",
+        run=run,
+        board=board,
+        table=_table(run, board, chosen_baseline=baseline or None),
+    )
+
+
+@router.get("/{run_id}/plots", response_class=HTMLResponse)
+def plots(run_id: int, store: StoreDep, metric: Metric = None) -> HTMLResponse:
+    """Every fold's score, per-target scores and class counts."""
+    from app.reports import figures
+    from app.services.report import run_view
+
+    run = get_run(store, run_id)
+    if run.n_results == 0:
+        return render("fragments/plots.html.j2", plots=[])
+    view = run_view(store, run.id, metric=metric or None)
+    drawn = [draw(f"{view.metric} of every fold", partial(figures.folds_figure, view))]
+    if view.per_target is not None:
+        drawn.append(draw("Accuracy per target", partial(figures.targets_figure, view)))
+    drawn.append(draw("Instances per class", partial(figures.classes_figure, view)))
+    return render("fragments/plots.html.j2", plots=drawn)
+
+
+@router.get("/{run_id}/classifiers/{classifier}", response_class=HTMLResponse)
+def classifier(
+    run_id: int, classifier: Ref, store: StoreDep, metric: Metric = None, baseline: Baseline = None
+) -> HTMLResponse:
+    """A classifier's confusion matrix, its scores and its folds beside the baseline's."""
+    from app.reports import figures
+    from app.reports.leaderboard import mean_std
+    from app.services.report import run_view
+
+    view = run_view(store, run_id, metric=metric or None, baseline=baseline or None)
+    if classifier not in view.run.classifiers:
+        raise NotFoundError(
+            f"run {view.run.id} has no classifier '{classifier}' "
+            f"(classifiers: {', '.join(view.run.classifiers)})"
+        )
+    row = view.board.row(classifier)
+    reference = view.board.baseline or classifier
+    shown = list(dict.fromkeys([classifier, reference]))
+    return render(
+        "fragments/classifier.html.j2",
+        view=view,
+        row=row,
+        scores=[(name, mean_std(value)) for name, value in sorted(row.metrics.items())],
+        confusion=draw(
+            f"Confusion matrix of {classifier} (normalised per true class)",
+            partial(figures.confusion_figure, view, classifier),
+        ),
+        folds=_folds(view, shown),
+        reference=reference,
+    )
+
+
+def _folds(view: RunView, shown: list[str]) -> dict[str, Any]:
+    """Per-fold scores of ``shown`` as a table and a strip plot."""
+    from app.reports import figures
+
+    table = view.fold_scores()
+    return {
+        "names": shown,
+        "rows": [
+            (block, [table.column(name)[i] for name in shown])
+            for i, block in enumerate(table.blocks)
+        ],
+        "plot": draw(f"{view.metric} of every fold", partial(figures.folds_figure, view, shown)),
+    }
+
+
+def _table(run: RunInfo, board: Leaderboard, *, chosen_baseline: str | None) -> dict[str, Any]:
+    """The leaderboard's header (metric columns sortable), rows, and the pickers' options."""
+    from app.reports.leaderboard import leaderboard_header, leaderboard_rows, metric_columns
+    from benchmark.evaluation.metrics import LOWER_IS_BETTER
+
+    columns = metric_columns(run, board)
+    metrics = sorted({name for row in board.rows for name in row.metrics})
+    return {
+        "header": leaderboard_header(board, columns),
+        "columns": columns,
+        "rows": leaderboard_rows(board, columns),
+        "metrics": metrics,
+        "baselines": [row.classifier for row in board.rows if row.n_ok],
+        "chosen_baseline": chosen_baseline,
+        "direction": "lower is better" if board.metric in LOWER_IS_BETTER else "higher is better",
+    }
