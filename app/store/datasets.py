@@ -484,6 +484,7 @@ def _value_batches(
         )
         while stored := cursor.fetchone():
             n_rows, data, weights = stored
+            _check_block(dataset_id, n_rows, n_attributes, data, weights)
             values = np.frombuffer(data, dtype=_LITTLE_F8).reshape(n_rows, n_attributes)
             scale = None if weights is None else np.frombuffer(weights, dtype=_LITTLE_F8)
             for first in range(0, n_rows, limit):
@@ -491,6 +492,19 @@ def _value_batches(
                 yield InstanceBlock(values[part], weights=None if scale is None else scale[part])
     finally:
         cursor.close()
+
+
+def _check_block(
+    dataset_id: int, n_rows: int, n_attributes: int, data: bytes, weights: bytes | None
+) -> None:
+    """A stored block whose bytes do not fit its shape was written by someone else."""
+    expected = n_rows * n_attributes * 8
+    if len(data) != expected or (weights is not None and len(weights) != n_rows * 8):
+        raise AppError(
+            f"data set {dataset_id}: a stored block of {n_rows} instances holds {len(data)} "
+            f"bytes where {n_attributes} attributes need {expected}; the store was changed "
+            "outside touchbench: import the data set again"
+        )
 
 
 def _instance_extras(

@@ -252,3 +252,16 @@ def test_stored_blocks_are_written_the_cheap_way(store: Store) -> None:
                 )
             ).all()
             assert [tuple(row) for row in storage] == [("data", "e"), ("weights", "e")]
+
+
+def test_a_block_changed_outside_touchbench_is_refused_saying_so(store: Store) -> None:
+    data = small_dataset()
+    stored, _ = add_dataset(store, data, sha256=dataset_digest(data), name="touch")
+    with store.session() as session:
+        session.execute(
+            InstanceBlockRow.__table__.update()
+            .where(InstanceBlockRow.dataset_id == stored.id)
+            .values(data=b"\x00" * 12)
+        )
+    with pytest.raises(AppError, match=r"holds 12 bytes where 5 attributes need 280"):
+        load_dataset(store, "touch")
