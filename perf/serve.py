@@ -2,7 +2,10 @@
 against the same model's in-process ``predict_proba``, and a run submitted over HTTP against
 the same run from the CLI.
 
-    .venv/bin/python perf/serve.py [--requests 400] [--seconds 10] [--run-classifiers nb,j48,rf]
+    .venv/bin/python perf/serve.py [--requests 400] [--seconds 10] [--workers 1]
+                                   [--run-classifiers nb,j48,logistic,rf]
+
+``--workers`` is ``touchbench serve --workers``: service processes sharing the port.
 
 Uses Mini (``../shared/datasets``) when present, else a synthetic data set of the same
 shape. Prints a table of figures and ratios; nothing here is asserted.
@@ -47,7 +50,7 @@ def data_file(folder: Path) -> Path:
     return touch_arff(folder / "synthetic.arff", n=2777)
 
 
-def start_service(db: str, folder: Path) -> tuple[subprocess.Popen[bytes], str]:
+def start_service(db: str, folder: Path, workers: int) -> tuple[subprocess.Popen[bytes], str]:
     port = free_port()
     environment = {
         **os.environ,
@@ -66,6 +69,8 @@ def start_service(db: str, folder: Path) -> tuple[subprocess.Popen[bytes], str]:
         str(port),
         "--log-level",
         "warning",
+        "--workers",
+        str(workers),
     ]
     process = subprocess.Popen(command, cwd=ROOT, env=environment)
     url = f"http://127.0.0.1:{port}"
@@ -161,6 +166,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--requests", type=int, default=400)
     parser.add_argument("--seconds", type=float, default=10.0)
+    parser.add_argument("--workers", type=int, default=1, help="service processes")
     parser.add_argument("--run-classifiers", default="nb,j48,logistic,rf")
     args = parser.parse_args()
 
@@ -177,7 +183,7 @@ def main() -> None:
     for classifier in ("logistic", "rf"):
         train(store, "mini", classifier, targets=["gesture"], name=f"mini-{classifier}")
     data = read_arff(source)
-    process, url = start_service(db, folder)
+    process, url = start_service(db, folder, args.workers)
     rows = []
     try:
         for classifier in ("logistic", "rf"):
@@ -230,7 +236,10 @@ def main() -> None:
         process.terminate()
         process.wait(timeout=30)
         store.dispose()
-    print(f"data: {source} ({imported.n_instances} instances); load {os.getloadavg()[0]:.1f}")
+    print(
+        f"data: {source} ({imported.n_instances} instances); {args.workers} service "
+        f"process(es); load {os.getloadavg()[0]:.1f}"
+    )
     width = max(len(row[0]) for row in rows)
     for row in rows:
         print(f"{row[0]:<{width}}  {row[1]:>16}  {row[2]:>22}  {row[3]}")

@@ -14,37 +14,42 @@ from fastapi import Depends, Header, HTTPException, Request
 from app.jobs.dispatcher import Dispatcher
 from app.settings import Settings
 from app.store.database import Store
-from app.store.models import ModelInfo, get_model
+from app.store.models import ModelInfo, model_version
 
 if TYPE_CHECKING:  # scikit-learn loads on the first prediction, not at start-up
     from benchmark.model import TrainedModel
 
 
+#: A stored model's id, artifact sha256 and name (:func:`app.store.models.model_version`).
+ModelKey = tuple[int, str, str]
+
+
 class ModelCache:
-    """Loaded models by (id, sha256), least recently used dropped first; thread-safe.
+    """Loaded models by (id, sha256, name), least recently used dropped first; thread-safe.
 
     Loading a model checks and rebuilds its artifact (tens to hundreds of milliseconds);
-    a prediction on a cached model costs one small query for the model's row.
+    a prediction on a cached model costs one indexed query for the model's id, sha256 and
+    name, so a model deleted, renamed or retrained under the same name by another process
+    is never served stale.
     """
 
     def __init__(self, size: int) -> None:
         self.size = size
-        self._models: OrderedDict[tuple[int, str], TrainedModel] = OrderedDict()
+        self._models: OrderedDict[ModelKey, tuple[ModelInfo, TrainedModel]] = OrderedDict()
         self._lock = threading.Lock()
 
     def get(self, store: Store, ref: str | int) -> tuple[ModelInfo, TrainedModel]:
-        info = get_model(store, ref)
-        key = (info.id, info.sha256)
+        key = model_version(store, ref)
         with self._lock:
-            model = self._models.get(key)
-            if model is not None:
+            cached = self._models.get(key)
+            if cached is not None:
                 self._models.move_to_end(key)
-                return info, model
+                return cached
         from app.services.models import load_model
 
-        info, model = load_model(store, info.id)
+        info, model = load_model(store, key[0])
         with self._lock:
-            self._models[(info.id, info.sha256)] = model
+            self._models[(info.id, info.sha256, info.name)] = (info, model)
             while len(self._models) > self.size:
                 self._models.popitem(last=False)
         return info, model
@@ -65,17 +70,19 @@ class Service:
     models: ModelCache
 
 
-def get_service(request: Request) -> Service:
+# The dependencies below are ``async`` only so that FastAPI calls them on the event loop
+# instead of a thread-pool hop each: none of them blocks.
+async def get_service(request: Request) -> Service:
     service = request.app.state.service
     assert isinstance(service, Service), "create_app sets the service state"
     return service
 
 
-def get_store(service: Annotated[Service, Depends(get_service)]) -> Store:
+async def get_store(service: Annotated[Service, Depends(get_service)]) -> Store:
     return service.store
 
 
-def require_api_key(
+async def require_api_key(
     service: Annotated[Service, Depends(get_service)],
     x_api_key: Annotated[str | None, Header(description="The service's API key.")] = None,
 ) -> None:

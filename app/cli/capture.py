@@ -13,6 +13,7 @@ from app.cli.extract import key_values
 from app.cli.output import info, print_json, table
 from app.cli.state import get_state
 from app.errors import AppError
+from drivers.source import LIVE_BLOCK
 
 JsonOption = Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")]
 
@@ -186,6 +187,17 @@ def live_command(
             "--samplerate", metavar="HZ", help="Device rate in Hz (default: the model's)."
         ),
     ] = None,
+    block_length: Annotated[
+        int,
+        typer.Option(
+            "--block",
+            min=16,
+            max=65536,
+            metavar="SAMPLES",
+            help="Samples per block read from the device or file; a touch is predicted once "
+            "the block holding its end is in, so smaller blocks answer sooner.",
+        ),
+    ] = LIVE_BLOCK,
     as_json: Annotated[
         bool, typer.Option("--json", help="One JSON object per touch on stdout (JSON lines).")
     ] = False,
@@ -203,7 +215,7 @@ def live_command(
     extraction = model_info.extraction
     source: Source
     if replay is not None:
-        source = FileReplaySource(replay, realtime=realtime, topic=topic, block_length=1024)
+        source = FileReplaySource(replay, realtime=realtime, topic=topic, block_length=block_length)
     else:
         assert device is not None
         recipe = extraction or {}
@@ -212,6 +224,7 @@ def live_command(
             samplerate=samplerate or recipe.get("samplerate"),
             channels=channels or recipe.get("n_channels"),
             seconds=seconds,
+            block_length=block_length,
         )
     with source:
         session = LiveSession(

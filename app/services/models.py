@@ -9,6 +9,7 @@ warning that says where.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -227,47 +228,51 @@ def dataset_from_records(schema: Schema, records: Sequence[Mapping[str, Any]]) -
             f"model needs {_quoted([a.name for a in features])}",
             source="instances",
         )
-    columns = []
+    values = np.full((len(records), len(features)), np.nan)
     attributes = []
-    for attribute in features:
-        cells = [record.get(attribute.name) for record in records]
+    for j, attribute in enumerate(features):
+        name = attribute.name
         if attribute.kind == "nominal":
             labels = list(attribute.values)
-            codes = []
-            for i, cell in enumerate(cells):
+            for i, record in enumerate(records):
+                cell = record.get(name)
                 if cell is None:
-                    codes.append(np.nan)
                     continue
                 if isinstance(cell, bool) or not isinstance(cell, str | int):
                     raise DataFormatError(
                         f"instance {i + 1}: expects a label ({_quoted(labels)}), got {cell!r}",
                         source="instances",
-                        attribute=attribute.name,
+                        attribute=name,
                     )
                 if str(cell) not in labels:
                     labels.append(str(cell))
-                codes.append(float(labels.index(str(cell))))
-            attributes.append(Attribute(attribute.name, "nominal", values=tuple(labels)))
-            columns.append(np.array(codes, dtype=np.float64))
+                values[i, j] = labels.index(str(cell))
+            attributes.append(Attribute(name, "nominal", values=tuple(labels)))
             continue
-        numbers = []
-        for i, cell in enumerate(cells):
-            if cell is not None and (
-                isinstance(cell, bool)
-                or not isinstance(cell, int | float)
-                or not np.isfinite(float(cell))
-            ):
+        for i, record in enumerate(records):
+            cell = record.get(name)
+            if cell is None:
+                continue
+            if not _is_finite_number(cell):
                 raise DataFormatError(
                     f"instance {i + 1}: expects a finite number, got {cell!r}",
                     source="instances",
-                    attribute=attribute.name,
+                    attribute=name,
                 )
-            numbers.append(np.nan if cell is None else float(cell))
+            values[i, j] = cell
         attributes.append(attribute)
-        columns.append(np.array(numbers, dtype=np.float64))
-    values = np.column_stack(columns) if columns else np.empty((len(records), 0))
     out_schema = Schema(relation="instances", attributes=tuple(attributes), target_indices=())
     return Dataset(schema=out_schema, values=values, name="instances")
+
+
+def _is_finite_number(cell: object) -> bool:
+    """A JSON number that fits a float64 and is finite (booleans are not numbers)."""
+    if isinstance(cell, bool) or not isinstance(cell, int | float):
+        return False
+    try:
+        return math.isfinite(cell)
+    except OverflowError:  # an integer beyond float range
+        return False
 
 
 def align_features(
@@ -292,12 +297,12 @@ def align_features(
         raise DataFormatError(
             f"lacks {len(missing)} attribute(s) the model needs: {shown}", source=source
         )
-    columns = []
-    for attribute in schema.features:
+    X = np.empty((data.n_instances, len(schema.features)))
+    for j, attribute in enumerate(schema.features):
         theirs = data.schema.attributes[by_name[attribute.name]]
         column = data.values[:, by_name[attribute.name]]
-        columns.append(_translate(attribute, theirs, column, source, warnings))
-    return np.column_stack(columns) if columns else np.empty((data.n_instances, 0))
+        X[:, j] = _translate(attribute, theirs, column, source, warnings)
+    return X
 
 
 def _translate(

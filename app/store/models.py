@@ -21,7 +21,7 @@ from sqlalchemy.orm import Session
 from app.errors import AppError
 from app.schemas.models import ModelSchema
 from app.store.database import Store
-from app.store.naming import find_row, free_name
+from app.store.naming import find_row, free_name, is_row_id
 from app.store.tables import DatasetRow, ModelRow
 
 #: The only artifact format that is loaded (see :mod:`benchmark.artifacts`).
@@ -147,6 +147,29 @@ def get_model(store: Store, ref: str | int) -> ModelInfo:
     """A model's description (its artifact is not read)."""
     with store.session() as session:
         return _info(session, _row(session, ref))
+
+
+def model_version(store: Store, ref: str | int) -> tuple[int, str, str]:
+    """A model's id, artifact sha256 and name, in one indexed query (no schema, no artifact).
+
+    The service's model cache asks this on every prediction to know whether the model it
+    holds is still the stored one.
+
+    Raises
+    ------
+    NotFoundError
+        As :func:`get_model` does.
+    """
+    text = str(ref)
+    columns = select(ModelRow.id, ModelRow.sha256, ModelRow.name)
+    with store.engine.connect() as connection:
+        found = connection.execute(columns.where(ModelRow.name == text)).first()
+        if found is None and is_row_id(text):
+            found = connection.execute(columns.where(ModelRow.id == int(text))).first()
+    if found is None:
+        get_model(store, ref)  # raises NotFoundError naming the known models
+        raise AssertionError("get_model found a model the version query did not")
+    return int(found[0]), str(found[1]), str(found[2])
 
 
 def load_artifact(store: Store, ref: str | int) -> tuple[ModelInfo, bytes]:

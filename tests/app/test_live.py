@@ -115,12 +115,32 @@ def test_live_bad_input_is_one_line(
         (["--replay", str(odd)], "not a recording touchbench can read"),
         (["--replay", str(wav), "--device", "0"], "exactly one of --device DEV or --replay"),
         (["--replay", str(wav), "--model", "nope"], "nope"),
+        (["--replay", str(wav), "--block", "8"], "--block"),
     ]
     for args, message in cases:
         model = [] if "--model" in args else ["--model", "touch-j48"]
         result = run_cli(capsys, store_url, "live", *model, *args)
         assert result.code == 2, (args, result.err)
         assert result.err.count("\n") == 1 and message in result.err, result.err
+
+
+def test_the_block_length_changes_when_touches_are_told_not_what_they_are(
+    capsys: pytest.CaptureFixture[str], store: Store, store_url: str, tmp_path: Path
+) -> None:
+    wav, touches = write_session(tmp_path, "s", n_touches=6, seed=4)
+    labels = write_labels(tmp_path / "l.csv", [(wav.name, *t) for t in touches])
+    extract_and_store(store, [wav], labels=labels, extractor="uc3m-audio", name="touch")
+    train(store, "touch", "j48", targets=["gesture"])
+    seen = []
+    for block in ("256", "512", "4096"):
+        result = run_cli(
+            capsys, store_url, "live", "--model", "touch-j48", "--replay", str(wav),
+            "--block", block, "--json",
+        )  # fmt: skip
+        assert result.code == 0, result.err
+        lines = [json.loads(line) for line in result.out.splitlines()]
+        seen.append([(t["start"], t["end"], t["predictions"]["gesture"]["value"]) for t in lines])
+    assert len(seen[0]) == 6 and seen[0] == seen[1] == seen[2]
 
 
 def test_live_session_takes_a_recipe_given_explicitly(

@@ -7,6 +7,8 @@ from pathlib import Path
 
 import pytest
 
+from app.store.database import Store
+from app.store.models import rename_model
 from tests.app.api.conftest import Server, finished
 from tests.app.cli_runner import run_cli
 from tests.app.synthetic import touch_arff
@@ -92,6 +94,20 @@ def test_run_leaderboard_model_and_predictions_over_http(
     assert from_file.json()["accuracy"]["gesture"] > 0.8
     cli_predicted = run_cli(capsys, server.database_url, "predict", "best", str(data), "--json")
     assert from_file.json()["predictions"] == cli_predicted.json()["predictions"]
+
+    # The service caches loaded models: what other processes do to the store still shows.
+    one = {"instances": [{"f0": 0.0, "f1": 0.0, "mic": "left"}]}
+    store = Store(server.database_url)
+    try:
+        rename_model(store, "best", "renamed")
+    finally:
+        store.dispose()
+    assert api.post("/api/models/best/predict", json=one).status_code == 404
+    renamed = api.post("/api/models/renamed/predict", json=one)
+    assert renamed.status_code == 200 and renamed.json()["model"] == "renamed"
+    assert run_cli(capsys, server.database_url, "delete-model", "renamed").code == 0
+    gone = api.post(f"/api/models/{model_id}/predict", json=one)
+    assert gone.status_code == 404 and gone.json()["error"]["type"] == "NotFoundError"
 
 
 def test_a_multi_target_run_and_model(
