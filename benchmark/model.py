@@ -203,8 +203,13 @@ def fit_model(dataset: Dataset, classifier_id: str, *, random_state: int = 0) ->
         assert spec is not None
         estimator = build_estimator(classifier_id, problem, random_state=random_state)
         estimator.fit(problem.X, problem.Y if problem.n_targets > 1 else problem.Y[:, 0])
-        params = {**spec.params, "random_state": random_state}
-        return TrainedModel(classifier_id, params, dataset.schema, estimator, _library_versions())
+        return TrainedModel(
+            classifier_id,
+            {**spec.params, "random_state": random_state},
+            dataset.schema,
+            estimator,
+            _library_versions(),
+        )
     for name, column in zip(problem.target_names, problem.Y.T, strict=True):
         if np.unique(column).size < 2:
             raise ConfigurationError(

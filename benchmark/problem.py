@@ -66,10 +66,7 @@ class Problem:
                 f"X must be (n_instances, n_features) and Y (n_instances, n_targets); "
                 f"got {X.shape} and {Y.shape}"
             )
-        if self.task == "regression":
-            Y = self._regression_targets(Y)
-        else:
-            Y = self._class_codes(Y)
+        Y = self._regression_targets(Y) if self.task == "regression" else self._class_codes(Y)
         if self.sequence is not None and (
             self.sequence.stop > X.shape[1]
             or any(self.sequence.start <= c < self.sequence.stop for c in self.nominal_features)
@@ -202,8 +199,8 @@ def problem_from_dataset(
         targets, no usable feature.
     """
     schema = dataset.schema
-    task = target_task(schema)
     coordinates = position_columns(schema, position)
+    task = target_task(schema)
     notes: list[str] = []
     unused = [a.name for a in schema.features if a.kind == "string"]
     if unused:

@@ -42,20 +42,39 @@ def classifiers_command(
             "--multi-target", help="List the multi-target configurations (META:BASE) instead."
         ),
     ] = False,
+    regressors: Annotated[
+        bool,
+        typer.Option(
+            "--regressors",
+            help="List what the ids mean on numeric targets (regression) instead.",
+        ),
+    ] = False,
 ) -> None:
     """List the classifier catalogue (id, WEKA name, family, capabilities).
 
     Classifiers marked 'sequence' read a sequence data set's windows (extract with -e
-    sequence, or -e mfcc -O frames=N) and refuse flat data sets.
+    sequence, or -e mfcc -O frames=N) and refuse flat data sets. On numeric targets the
+    same ids name regressors (--regressors lists them).
     """
     from benchmark.catalogue import CATALOGUE, get_spec, suite
 
+    if multi_target and regressors:
+        raise typer.BadParameter("give --multi-target or --regressors, not both")
     if multi_target:
         _print_multitarget(suite_name, as_json)
         return
+    if regressors:
+        from benchmark.catalogue.regressors import REGRESSORS, regression_suite
 
-    ids = suite(suite_name) if suite_name else list(CATALOGUE)
-    specs = [get_spec(i) for i in ids]
+        ids = (
+            regression_suite(suite_name, n_targets=1, n_instances=0)
+            if suite_name
+            else list(REGRESSORS)
+        )
+        specs = [REGRESSORS[i] for i in ids]
+    else:
+        ids = suite(suite_name) if suite_name else list(CATALOGUE)
+        specs = [get_spec(i) for i in ids]
     if as_json:
         print_json(
             {
@@ -81,7 +100,7 @@ def classifiers_command(
         return
     yes = "✓"
     table(
-        f"{len(specs)} classifiers",
+        f"{len(specs)} {'regressors' if regressors else 'classifiers'}",
         [
             "id",
             "WEKA",
@@ -517,7 +536,7 @@ def _print_independent(result: IndependentResult, as_json: bool) -> None:
 
 def _print_leaderboard(run: RunInfo, board: Leaderboard) -> None:
     from app.reports.leaderboard import leaderboard_header, leaderboard_rows, metric_columns
-    
+
     columns = metric_columns(run, board)
     direction = " (lower is better)" if board.lower_is_better else ""
     table(

@@ -38,7 +38,8 @@ class ModelList(Schema):
 
 class PredictionRow(Schema):
     """One instance: ``instance`` (1-based), one key per target with the predicted label (a
-    number for a regression model), and ``probabilities`` (target -> label -> probability) when the classifier gives them."""
+    number for a regression model), and ``probabilities`` (target -> label -> probability)
+    when the classifier gives them."""
 
     model_config = ConfigDict(extra="allow", ser_json_inf_nan="null")
 

@@ -19,7 +19,7 @@ import numpy as np
 from app.errors import AppError
 from app.schemas.runs import LeaderboardRowSchema, LeaderboardSchema, MarkSummary, RunStatus
 from app.store.database import Store
-from app.store.datasets import find_dataset, load_dataset
+from app.store.datasets import find_dataset, load_dataset, load_schema
 from app.store.ownership import process_owner
 from app.store.runs import (
     HEARTBEAT_INTERVAL,
@@ -607,7 +607,14 @@ def independent_runs(
 ) -> IndependentResult:
     """A multi-class run per target of a multi-target data set, and the product of the
     best scores (the comparison the UC3M paper makes with its multi-target results)."""
-    info = find_dataset(store, dataset_ref)
+    info, schema, _ = load_schema(store, dataset_ref)
+    numeric = [t.name for t in schema.targets if t.kind == "numeric"]
+    if numeric:
+        raise ConfigurationError(
+            f"--independent compares targets classified separately, but "
+            f"{', '.join(numeric)} of '{info.name}' are numeric: a regression benchmarks its "
+            "targets together (drop --independent; br:ID fits one model per target)"
+        )
     if len(info.targets) < 2:
         raise ConfigurationError(
             f"--independent compares targets classified separately, but '{info.name}' has one "

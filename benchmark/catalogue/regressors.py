@@ -156,7 +156,7 @@ _SPECS: tuple[ClassifierSpec, ...] = (
         "zeror",
         DummyRegressor,
         {"strategy": "mean"},
-        family="majority",
+        family="baseline",
         description="The training mean of each target (WEKA's ZeroR on a numeric class)",
         suites=_FAST,
     ),
@@ -377,8 +377,7 @@ def _base_spec(base: str, regressor_id: str) -> ClassifierSpec:
     known = ", ".join(REGRESSORS)
     if base in CATALOGUE:
         raise ConfigurationError(
-            f"classifier '{base}' has no regressor: the targets are numeric (regressors: "
-            f"{known})"
+            f"classifier '{base}' has no regressor: the targets are numeric (regressors: {known})"
         )
     message = unknown_classifier_message(regressor_id, REGRESSORS)
     raise ConfigurationError(f"{message} (regressors on numeric targets: {known})")

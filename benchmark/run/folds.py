@@ -4,8 +4,9 @@ One target: stratified k-fold per repeat (seed ``seed + repeat``).  Several targ
 stratified on the joint label combination when every combination is common enough, plain
 shuffled k-fold otherwise.  Numeric targets (a regression): shuffled k-fold.  With
 recording/session groups, a group never straddles training and test (group k-fold).  The
-scheme used is named in :attr:`FoldPlan.scheme`, for leaderboards to say.  When the data cannot support the requested number of folds, the
-largest feasible number is used and a warning line says so.
+scheme used is named in :attr:`FoldPlan.scheme`, for leaderboards to say.  When the data
+cannot support the requested number of folds, the largest feasible number is used and a
+warning line says so.
 """
 
 from __future__ import annotations
