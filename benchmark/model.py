@@ -62,22 +62,6 @@ class TrainedModel:
         """Whether it predicts numbers (its targets are numeric)."""
         return all(target.kind == "numeric" for target in self.schema.targets)
 
-    def predict_values(self, X: np.ndarray) -> np.ndarray:
-        """Predicted target values of a regression model.
-
-        Parameters
-        ----------
-        X : ndarray of shape (n_instances, n_features)
-            As for :meth:`predict`.
-
-        Returns
-        -------
-        ndarray of shape (n_instances, n_targets), float64
-        """
-        features = self._features(X)
-        predicted = np.asarray(self.estimator.predict(features), dtype=np.float64)
-        return predicted.reshape(features.shape[0], -1)
-
     def predict(self, X: np.ndarray) -> np.ndarray:
         """Predicted target codes (a regression model: use :meth:`predict_values`).
 
@@ -91,8 +75,16 @@ class TrainedModel:
         -------
         ndarray of shape (n_instances, n_targets), int64
         """
+        return self._predicted(X, np.int64)
+
+    def predict_values(self, X: np.ndarray) -> np.ndarray:
+        """Predicted target values of a regression model: float64 of shape (n_instances,
+        n_targets) from ``X`` as for :meth:`predict`."""
+        return self._predicted(X, np.float64)
+
+    def _predicted(self, X: np.ndarray, dtype: type[np.generic]) -> np.ndarray:
         features = self._features(X)
-        predicted = np.asarray(self.estimator.predict(features), dtype=np.int64)
+        predicted = np.asarray(self.estimator.predict(features), dtype=dtype)
         return predicted.reshape(features.shape[0], -1)
 
     def predict_proba(self, X: np.ndarray) -> list[np.ndarray]:

@@ -47,7 +47,7 @@ from sklearn.preprocessing import StandardScaler
 from sklearn.svm import SVR, LinearSVR
 from sklearn.tree import DecisionTreeRegressor
 
-from benchmark.catalogue.spec import ClassifierSpec
+from benchmark.catalogue.spec import ClassifierSpec, make_spec
 from benchmark.errors import ConfigurationError
 
 __all__ = [
@@ -119,36 +119,8 @@ def chain(base: str) -> BaseEstimator:
 _SCALED = {"svr": SVR, "linear-svr": LinearSVR, "mlp": MLPRegressor}
 
 
-def _spec(
-    id: str,
-    factory: Any,
-    params: dict[str, Any],
-    *,
-    family: str,
-    description: str,
-    scaling: str | None = None,
-    missing: bool = False,
-    nominal: bool = False,
-    cost: str = "fast",
-    suites: frozenset[str] = _DEFAULT,
-    limits: str = "",
-) -> ClassifierSpec:
-    return ClassifierSpec(
-        id=id,
-        weka_command=None,
-        family=family,
-        description=description,
-        factory=factory,
-        params=params,
-        probabilities=False,
-        needs_scaling=scaling is not None,
-        handles_missing=missing,
-        handles_nominal=nominal,
-        cost=cost,  # type: ignore[arg-type]
-        suites=suites,
-        limits=limits,
-        scaling=scaling or "standard",  # type: ignore[arg-type]
-    )
+def _spec(id: str, factory: Any, params: dict[str, Any], **fields: Any) -> ClassifierSpec:
+    return make_spec(id, factory, params, probabilities=False, **fields)
 
 
 _SPECS: tuple[ClassifierSpec, ...] = (

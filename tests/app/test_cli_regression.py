@@ -51,7 +51,9 @@ def test_bench_leaderboard_train_predict_on_numeric_targets(
 
     train = run_cli(capsys, db, "train", "contact", "-c", "ridge", "--json")
     assert train.code == 0, train.err
-    predict = run_cli(capsys, db, "predict", "contact-ridge", str(tmp_path / "contact.arff"), "--json")
+    predict = run_cli(
+        capsys, db, "predict", "contact-ridge", str(tmp_path / "contact.arff"), "--json"
+    )
     assert predict.code == 0, predict.err
     answer = predict.json()
     first = answer["predictions"][0]

@@ -178,7 +178,9 @@ def test_chains_and_per_target_models_on_several_targets() -> None:
         ("rff", 1, "did you mean 'rf'"),
     ],
 )
-def test_ids_without_a_regressor_are_refused(regressor_id: str, n_targets: int, message: str) -> None:
+def test_ids_without_a_regressor_are_refused(
+    regressor_id: str, n_targets: int, message: str
+) -> None:
     with pytest.raises(ConfigurationError, match=message):
         regressor_spec(regressor_id, n_targets=n_targets)
 
@@ -200,7 +202,9 @@ def test_regression_folds_are_shuffled_k_fold_or_group_k_fold() -> None:
     assert grouped.scheme == "group k-fold"
     for fold in grouped.folds:
         assert not set(groups[fold.train]) & set(groups[fold.test])
-    few = make_fold_plan(values, n_folds=10, regression=True, groups=np.repeat(np.arange(3), 14)[:40])
+    few = make_fold_plan(
+        values, n_folds=10, regression=True, groups=np.repeat(np.arange(3), 14)[:40]
+    )
     assert len(few.folds) == 3 and few.scheme == "group k-fold"
 
 
