@@ -184,7 +184,7 @@ def bench_command(
         typer.Option(
             "--target",
             metavar="NAME",
-            help="Benchmark this one target with the multi-class catalogue.",
+            help="Benchmark this one target (multi-class catalogue; regressors if numeric).",
         ),
     ] = None,
     classifiers: Annotated[

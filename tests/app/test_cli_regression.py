@@ -7,6 +7,8 @@ from pathlib import Path
 
 import pytest
 
+from app.services.models import predict_records
+from app.store.database import Store
 from tests.app.cli_runner import CliResult, run_cli
 from tests.app.synthetic import position_arff, touch_arff
 
@@ -61,6 +63,11 @@ def test_bench_leaderboard_train_predict_on_numeric_targets(
     assert set(answer["mae"]) == {"x", "y"} and answer["mae"]["x"] < 1.0
     shown = run_cli(capsys, db, "predict", "contact-ridge", str(tmp_path / "contact.arff"))
     assert "mean absolute error on x" in shown.err
+    served = predict_records(  # what POST /api/models/{id}/predict answers
+        Store(db), "contact-ridge", [{"f0": 1.0, "f1": 0.0, "f2": 0.0, "mic": "left"}]
+    ).to_json()
+    assert served["predictions"][0]["x"] == pytest.approx(10.0, abs=1.0)
+    assert isinstance(served["predictions"][0]["y"], float) and served["mae"] == {}
 
 
 def test_classification_leaderboards_name_their_folds_and_refuse_regression_metrics(
@@ -85,6 +92,7 @@ def test_classification_leaderboards_name_their_folds_and_refuse_regression_metr
         (("-c", "j48"), "classifier 'j48' has no regressor: the targets are numeric"),
         (("-c", "ridge", "--position", "x,mic"), "--position 'mic' is not a target"),
         (("-c", "ridge", "--metric", "euclidean_error"), "'euclidean_error' needs coordinates"),
+        (("--independent",), "a regression benchmarks its targets together"),
     ],
 )
 def test_what_does_not_fit_a_regression_is_refused_in_one_line(
