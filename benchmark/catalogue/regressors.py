@@ -47,6 +47,7 @@ from sklearn.preprocessing import StandardScaler
 from sklearn.svm import SVR, LinearSVR
 from sklearn.tree import DecisionTreeRegressor
 
+from benchmark.catalogue import CATALOGUE, SUITES, unknown_classifier_message
 from benchmark.catalogue.spec import ClassifierSpec, make_spec
 from benchmark.errors import ConfigurationError
 
@@ -325,8 +326,6 @@ def regression_suite(name: str, *, n_targets: int, n_instances: int) -> list[str
     The Gaussian process is left out above :data:`GP_MAX_INSTANCES` instances; several
     targets add the suite's regressor chains (``rc:ID``).
     """
-    from benchmark.catalogue import SUITES
-
     if name not in SUITES:
         raise ConfigurationError(f"unknown suite '{name}' (suites: {', '.join(SUITES)})")
     ids = [
@@ -342,8 +341,6 @@ def regression_suite(name: str, *, n_targets: int, n_instances: int) -> list[str
 
 
 def _base_spec(base: str, regressor_id: str) -> ClassifierSpec:
-    from benchmark.catalogue import CATALOGUE, unknown_classifier_message
-
     if base in REGRESSORS:
         return REGRESSORS[base]
     known = ", ".join(REGRESSORS)
