@@ -1,7 +1,9 @@
 """From a classifier id and a problem to an estimator: the one place that decides.
 
 A problem with one target takes a catalogue id (``rf``, ``j48``...); one with several
-targets takes a multi-target configuration (``META:BASE``, e.g. ``bcc:rf``).  The engine,
+targets takes a multi-target configuration (``META:BASE``, e.g. ``bcc:rf``); a regression
+(numeric targets) takes a regressor id (``ridge``, ``rf``, ``rc:xgb``...,
+:mod:`benchmark.catalogue.regressors`).  The engine,
 its tasks, model training and the app's checks all ask here, so the rule lives once.
 """
 
@@ -75,17 +77,24 @@ def check_classifier(
     Returns
     -------
     ClassifierSpec or None
-        The multi-class spec; ``None`` for a multi-target configuration.
+        The multi-class spec or the regressor's; ``None`` for a multi-target configuration.
 
     Raises
     ------
     ConfigurationError
         Unknown id; a multi-class id for several targets (or the reverse); a binary-only
         multi-label method on targets with more than two classes; a sequence classifier
-        (as the classifier or as a base) on flat features.
+        (as the classifier or as a base) on flat features; an id with no regressor on
+        numeric targets.
     """
     from benchmark.multitarget import check_targets, parse_config
 
+    if problem.kind == "regression":
+        from benchmark.catalogue.regressors import regressor_spec
+
+        return regressor_spec(
+            classifier_id, n_targets=problem.n_targets, n_instances=problem.n_instances
+        )
     names = ", ".join(problem.target_names)
     if is_multitarget_id(classifier_id):
         _, base = parse_config(classifier_id)
@@ -129,7 +138,8 @@ def build_estimator(
     -------
     estimator
         A scikit-learn pipeline (``fit(X, y)`` with ``y`` of shape (n_instances,)) for one
-        target; a multi-target classifier (``fit(X, Y)`` with ``Y`` of shape
+        target, or a regression's (``y`` of shape (n_instances,) for one target, (n_instances,
+        n_targets) for several); a multi-target classifier (``fit(X, Y)`` with ``Y`` of shape
         (n_instances, n_targets)) for several.
     """
     spec = check_classifier(classifier_id, problem, extra_specs)

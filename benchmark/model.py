@@ -21,7 +21,7 @@ from benchmark.artifacts import dumps_artifact, loads_artifact
 from benchmark.catalogue import get_spec
 from benchmark.dataset import Dataset, Schema
 from benchmark.errors import ConfigurationError
-from benchmark.estimators import build_estimator
+from benchmark.estimators import build_estimator, check_classifier
 from benchmark.evaluation.metrics import expand_proba
 from benchmark.problem import feature_matrix, problem_from_dataset
 
@@ -57,8 +57,13 @@ class TrainedModel:
     def n_classes(self) -> tuple[int, ...]:
         return tuple(len(target.values) for target in self.schema.targets)
 
+    @property
+    def regression(self) -> bool:
+        """Whether it predicts numbers (its targets are numeric)."""
+        return all(target.kind == "numeric" for target in self.schema.targets)
+
     def predict(self, X: np.ndarray) -> np.ndarray:
-        """Predicted target codes.
+        """Predicted target codes (a regression model: use :meth:`predict_values`).
 
         Parameters
         ----------
@@ -70,8 +75,16 @@ class TrainedModel:
         -------
         ndarray of shape (n_instances, n_targets), int64
         """
+        return self._predicted(X, np.int64)
+
+    def predict_values(self, X: np.ndarray) -> np.ndarray:
+        """Predicted target values of a regression model: float64 of shape (n_instances,
+        n_targets) from ``X`` as for :meth:`predict`."""
+        return self._predicted(X, np.float64)
+
+    def _predicted(self, X: np.ndarray, dtype: type[np.generic]) -> np.ndarray:
         features = self._features(X)
-        predicted = np.asarray(self.estimator.predict(features), dtype=np.int64)
+        predicted = np.asarray(self.estimator.predict(features), dtype=dtype)
         return predicted.reshape(features.shape[0], -1)
 
     def predict_proba(self, X: np.ndarray) -> list[np.ndarray]:
@@ -90,10 +103,10 @@ class TrainedModel:
         Raises
         ------
         NotImplementedError
-            The classifier gives no probabilities.
+            The classifier gives no probabilities (a regressor never does).
         """
         features = self._features(X)
-        if not hasattr(self.estimator, "predict_proba"):
+        if self.regression or not hasattr(self.estimator, "predict_proba"):
             raise NotImplementedError(f"classifier '{self.classifier}' gives no probabilities")
         if len(self.schema.target_indices) == 1:
             proba = self.estimator.predict_proba(features)
@@ -162,21 +175,33 @@ def fit_model(dataset: Dataset, classifier_id: str, *, random_state: int = 0) ->
     Parameters
     ----------
     dataset : Dataset
-        Training data; its targets decide between a catalogue classifier (one target)
-        and a multi-target configuration (several).
+        Training data; its targets decide between a catalogue classifier (one target),
+        a multi-target configuration (several) and a regressor (numeric targets).
     classifier_id : str
-        Catalogue id or ``META:BASE`` configuration id.
+        Catalogue id, ``META:BASE`` configuration id, or regressor id.
     random_state : int
         Seed of the classifier.
 
     Raises
     ------
     ConfigurationError
-        Unknown classifier, a target that is not nominal or has a single class, no data.
+        Unknown classifier, a nominal target with a single class, no data.
     """
     problem, _ = problem_from_dataset(dataset)
     if problem.n_instances == 0:
         raise ConfigurationError("the data set has no instance with a known target to train on")
+    if problem.kind == "regression":
+        spec = check_classifier(classifier_id, problem)
+        assert spec is not None
+        estimator = build_estimator(classifier_id, problem, random_state=random_state)
+        estimator.fit(problem.X, problem.Y if problem.n_targets > 1 else problem.Y[:, 0])
+        return TrainedModel(
+            classifier_id,
+            {**spec.params, "random_state": random_state},
+            dataset.schema,
+            estimator,
+            _library_versions(),
+        )
     for name, column in zip(problem.target_names, problem.Y.T, strict=True):
         if np.unique(column).size < 2:
             raise ConfigurationError(

@@ -42,20 +42,39 @@ def classifiers_command(
             "--multi-target", help="List the multi-target configurations (META:BASE) instead."
         ),
     ] = False,
+    regressors: Annotated[
+        bool,
+        typer.Option(
+            "--regressors",
+            help="List what the ids mean on numeric targets (regression) instead.",
+        ),
+    ] = False,
 ) -> None:
     """List the classifier catalogue (id, WEKA name, family, capabilities).
 
     Classifiers marked 'sequence' read a sequence data set's windows (extract with -e
-    sequence, or -e mfcc -O frames=N) and refuse flat data sets.
+    sequence, or -e mfcc -O frames=N) and refuse flat data sets. On numeric targets the
+    same ids name regressors (--regressors lists them).
     """
     from benchmark.catalogue import CATALOGUE, get_spec, suite
 
+    if multi_target and regressors:
+        raise typer.BadParameter("give --multi-target or --regressors, not both")
     if multi_target:
         _print_multitarget(suite_name, as_json)
         return
+    if regressors:
+        from benchmark.catalogue.regressors import REGRESSORS, regression_suite
 
-    ids = suite(suite_name) if suite_name else list(CATALOGUE)
-    specs = [get_spec(i) for i in ids]
+        ids = (
+            regression_suite(suite_name, n_targets=1, n_instances=0)
+            if suite_name
+            else list(REGRESSORS)
+        )
+        specs = [REGRESSORS[i] for i in ids]
+    else:
+        ids = suite(suite_name) if suite_name else list(CATALOGUE)
+        specs = [get_spec(i) for i in ids]
     if as_json:
         print_json(
             {
@@ -81,7 +100,7 @@ def classifiers_command(
         return
     yes = "✓"
     table(
-        f"{len(specs)} classifiers",
+        f"{len(specs)} {'regressors' if regressors else 'classifiers'}",
         [
             "id",
             "WEKA",
@@ -165,7 +184,7 @@ def bench_command(
         typer.Option(
             "--target",
             metavar="NAME",
-            help="Benchmark this one target with the multi-class catalogue.",
+            help="Benchmark this one target (multi-class catalogue; regressors if numeric).",
         ),
     ] = None,
     classifiers: Annotated[
@@ -242,6 +261,18 @@ def bench_command(
             show_default=False,
         ),
     ] = None,
+    position: Annotated[
+        str | None,
+        typer.Option(
+            "--position",
+            metavar="X,Y[,Z]",
+            help=(
+                "Numeric targets that are a position's coordinates: also score the mean "
+                "Euclidean error."
+            ),
+            show_default=False,
+        ),
+    ] = None,
     independent: Annotated[
         bool,
         typer.Option(
@@ -257,7 +288,9 @@ def bench_command(
     """Cross-validate classifiers on a data set; every finished fold is stored at once.
 
     A data set with several targets gets the multi-target configurations (META:BASE, e.g.
-    bcc:rf) unless --target picks one target for the multi-class catalogue. Ctrl-C keeps
+    bcc:rf) unless --target picks one target for the multi-class catalogue. Numeric targets
+    are a regression: regressors (linear, ridge, rf, xgb, ...; rc:ID chains several targets),
+    ranked by mean absolute error. Ctrl-C keeps
     every finished fold: `touchbench bench --resume RUN` carries out the rest.
     """
     from app.cli.progress import TaskProgress
@@ -283,6 +316,9 @@ def bench_command(
         raise typer.BadParameter("give --classifiers or --suite, not both")
     if independent and target:
         raise typer.BadParameter("--independent benchmarks every target; drop --target")
+    if position is not None and resume is not None:
+        raise typer.BadParameter("--position is kept by the run; drop it with --resume")
+    coordinates = [p.strip() for p in position.split(",") if p.strip()] if position else []
     ids = [c.strip() for c in classifiers.split(",") if c.strip()] if classifiers else None
     options = RunOptions(
         folds=folds, repeats=repeats, seed=seed, timeout=timeout or None, max_memory_mb=max_memory
@@ -316,6 +352,8 @@ def bench_command(
             options=options,
             on_warning=progress.note,
             weka=weka or (),
+            position=coordinates,
+            metric=metric,
         ).id
     try:
         with progress:
@@ -500,9 +538,11 @@ def _print_leaderboard(run: RunInfo, board: Leaderboard) -> None:
     from app.reports.leaderboard import leaderboard_header, leaderboard_rows, metric_columns
 
     columns = metric_columns(run, board)
+    direction = " (lower is better)" if board.lower_is_better else ""
     table(
         f"run {run.id}: {run.dataset_name} ({', '.join(run.targets)}), "
-        f"{run.config.get('folds')}-fold x {run.config.get('repeats')}, ranked by {board.metric}",
+        f"{run.config.get('folds')}-fold x {run.config.get('repeats')} ({run.fold_scheme}), "
+        f"ranked by {board.metric}{direction}",
         leaderboard_header(board, columns),
         leaderboard_rows(board, columns),
     )

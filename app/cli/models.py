@@ -130,7 +130,7 @@ def predict_command(
         [
             (
                 row["instance"],
-                *(row[t] for t in report.targets),
+                *(_cell(row[t]) for t in report.targets),
                 *(
                     f"{row['probabilities'][t][row[t]]:.3f}"
                     for t in report.targets
@@ -144,6 +144,13 @@ def predict_command(
         warn(warning)
     for target, accuracy in report.accuracy.items():
         info(f"accuracy on {target} (the file carries the true labels): {accuracy:.4f}")
+    for target, error in report.mae.items():
+        info(f"mean absolute error on {target} (the file carries the true values): {error:.4g}")
+
+
+def _cell(value: object) -> object:
+    """A predicted label as it is, a predicted number to 4 significant digits."""
+    return f"{value:.4g}" if isinstance(value, float) else value
 
 
 def delete_model_command(

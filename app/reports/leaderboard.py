@@ -16,6 +16,7 @@ from benchmark.evaluation.leaderboard import Leaderboard, LeaderboardRow
 TABLE_METRICS = {
     "multiclass": ["f1_weighted", "accuracy", "kappa", "roc_auc", "fit_time"],
     "multitarget": ["hamming_score", "exact_match", "hamming_loss", "fit_time"],
+    "regression": ["mae", "rmse", "r2", "euclidean_error", "fit_time"],
 }
 
 
@@ -68,8 +69,8 @@ def leaderboard_markdown(run: RunInfo, board: Leaderboard, columns: Sequence[str
         else f"no task succeeded (run {run.status})."
     )
     lines = [
-        f"Run {run.id} on {run.dataset_name} ({', '.join(run.targets)}), ranked by "
-        f"{board.metric}; {marks}",
+        f"Run {run.id} on {run.dataset_name} ({', '.join(run.targets)}), "
+        f"{run.fold_scheme}, ranked by {board.metric}; {marks}",
         "",
         "| rank | classifier | | " + " | ".join(columns) + " |",
         "|---:|---|:-:|" + "---:|" * len(columns),

@@ -15,8 +15,9 @@ from benchmark.io.arff import write_arff
 def write_results_arff(store: Store, run: RunInfo, stream: TextIO) -> None:
     """Write every successful fold of a multi-class run, one row per (run, fold, scheme)."""
     if run.kind != "multiclass":
+        what = "a regression" if run.kind == "regression" else "multi-target"
         raise ConfigurationError(
-            f"run {run.id} is multi-target; WEKA's results format holds multi-class runs "
+            f"run {run.id} is {what}; WEKA's results format holds multi-class runs "
             "(use --format csv or json)"
         )
     from app.services.runs import weka_specs

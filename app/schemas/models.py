@@ -37,8 +37,9 @@ class ModelList(Schema):
 
 
 class PredictionRow(Schema):
-    """One instance: ``instance`` (1-based), one key per target with the predicted label, and
-    ``probabilities`` (target -> label -> probability) when the classifier gives them."""
+    """One instance: ``instance`` (1-based), one key per target with the predicted label (a
+    number for a regression model), and ``probabilities`` (target -> label -> probability)
+    when the classifier gives them."""
 
     model_config = ConfigDict(extra="allow", ser_json_inf_nan="null")
 
@@ -54,6 +55,11 @@ class PredictionReport(Schema):
     predictions: list[PredictionRow]
     accuracy: dict[str, float] = Field(
         default_factory=dict, description="Per target, where the input carries the true labels."
+    )
+    mae: dict[str, float] = Field(
+        default_factory=dict,
+        description="A regression model's mean absolute error per target, where the input "
+        "carries the true values.",
     )
     warnings: list[str] = Field(
         default_factory=list, description="What was changed or counted, and where."

@@ -33,7 +33,7 @@ class RunSchema(Schema):
     id: int
     dataset: str = Field(description="Name of the data set.")
     dataset_id: int
-    kind: str = Field(description="multiclass or multitarget.")
+    kind: str = Field(description="multiclass, multitarget or regression (numeric targets).")
     targets: list[str]
     classifiers: list[str]
     config: dict[str, Any] = Field(description="Folds, repeats, seed, timeout, ...")
@@ -96,7 +96,15 @@ class LeaderboardSchema(Schema):
     kind: str
     targets: list[str]
     status: RunStatus
+    folds: str = Field(
+        default="",
+        description="How the folds were made: stratified k-fold, k-fold (shuffled), or their "
+        "group k-fold variants (recordings/sessions never straddle training and test).",
+    )
     metric: str
+    lower_is_better: bool = Field(
+        default=False, description="Whether the ranking metric is better when smaller (mae)."
+    )
     baseline: str | None = Field(description="The classifier the marks compare against.")
     summary: MarkSummary
     leaderboard: list[LeaderboardRowSchema]

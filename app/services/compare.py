@@ -125,8 +125,11 @@ def default_metric(kinds: Sequence[str]) -> str:
         return "f1_weighted"
     if distinct == {"multitarget"}:
         return "hamming_score"
+    if distinct == {"regression"}:
+        return "mae"
     raise ConfigurationError(
-        "the runs mix multi-class and multi-target problems: give --metric (one every run has)"
+        "the runs mix multi-class and multi-target problems, or classification and regression: "
+        "give --metric (one every run has)"
     )
 
 

@@ -221,8 +221,8 @@ def _check_schema(schema: Schema, source: str, notes: list[str]) -> None:
 def target_notes(schema: Schema) -> list[str]:
     """What a user should know about the targets: numeric ones are regression targets."""
     return [
-        f"target '{target.name}' is numeric: a regression target (classifiers need a "
-        "nominal one; --targets at import, --target in bench choose others)"
+        f"target '{target.name}' is numeric: a regression target (bench runs regressors and "
+        "ranks by mean absolute error; --targets at import, --target in bench choose others)"
         for target in schema.targets
         if target.kind == "numeric"
     ]

@@ -33,9 +33,9 @@ class TouchPrediction:
     ----------
     start, end : float
         Seconds from the start of the stream (the source's time origin).
-    predictions : dict of str to (str, float or None)
-        Per target, the predicted value and its probability (None when the classifier
-        gives none).
+    predictions : dict of str to (str or float, float or None)
+        Per target, the predicted label (a number from a regression model) and its
+        probability (None when the model gives none).
     latency_ms : float
         From the end of the event to the prediction: how long after its last sample
         the block holding it arrived, plus the time to extract and predict.
@@ -43,7 +43,7 @@ class TouchPrediction:
 
     start: float
     end: float
-    predictions: dict[str, tuple[str, float | None]]
+    predictions: dict[str, tuple[str | float, float | None]]
     latency_ms: float
 
     def to_json(self) -> dict[str, Any]:
@@ -172,17 +172,23 @@ class LiveSession:
         if instances.values.shape[0] == 0:
             return []
         X = instances.values[:, self.columns]
-        codes, probabilities = self.model.predict_with_proba(X)
-        codes = np.asarray(codes).reshape(X.shape[0], -1)
+        if self.model.regression:
+            values, probabilities = self.model.predict_values(X), None
+        else:
+            values, probabilities = self.model.predict_with_proba(X)
+        values = np.asarray(values).reshape(X.shape[0], -1)
         targets = self.model.schema.targets
         done = time.perf_counter()
         origin = self.origin or 0.0
         out = []
         for i, (first, last) in enumerate(instances.spans):
             behind = (self.stream.position - last) / self.samplerate
-            predictions: dict[str, tuple[str, float | None]] = {}
+            predictions: dict[str, tuple[str | float, float | None]] = {}
             for j, target in enumerate(targets):
-                code = int(codes[i, j])
+                if self.model.regression:
+                    predictions[target.name] = (float(values[i, j]), None)
+                    continue
+                code = int(values[i, j])
                 chance = None if probabilities is None else float(probabilities[j][i, code])
                 predictions[target.name] = (target.values[code], chance)
             out.append(

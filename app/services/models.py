@@ -104,8 +104,9 @@ class Predictions:
 
     Attributes
     ----------
-    labels : dict of str to list of str
-        Target name -> predicted label per instance (n_instances,).
+    labels : dict of str to list of str or list of float
+        Target name -> predicted label per instance (n_instances,); predicted numbers for a
+        regression model.
     probabilities : dict of str to ndarray of shape (n_instances, n_labels) or None
     class_labels : dict of str to list of str
         Target name -> the labels in the column order of ``probabilities``.
@@ -113,13 +114,17 @@ class Predictions:
         Per target, where the file carries the true labels.
     warnings : list of str
         What was changed on the way, and where (labels the model never saw).
+    mae : dict of str to float
+        A regression model's mean absolute error per target, where the file carries the
+        true values.
     """
 
-    labels: dict[str, list[str]]
+    labels: Mapping[str, Sequence[str | float]]
     probabilities: dict[str, np.ndarray] | None
     class_labels: dict[str, list[str]]
     accuracy: dict[str, float]
     warnings: list[str] = field(default_factory=list)
+    mae: dict[str, float] = field(default_factory=dict)
 
     def report(self, model: ModelInfo) -> PredictionReport:
         """The report ``predict --json`` prints and the API answers."""
@@ -128,6 +133,7 @@ class Predictions:
             targets=model.targets,
             predictions=[PredictionRow(**row) for row in self.to_json()],
             accuracy=self.accuracy,
+            mae=self.mae,
             warnings=self.warnings,
         )
 
@@ -154,6 +160,8 @@ def predict(model: TrainedModel, data: Dataset, *, source: str = "input") -> Pre
     """Predict every instance of ``data`` whose attributes match the model's by name."""
     warnings: list[str] = []
     X = align_features(model.schema, data, source=source, warnings=warnings)
+    if model.regression:
+        return _predict_values(model, X, data, warnings)
     predicted, probas = model.predict_with_proba(X)
     codes = np.asarray(predicted).reshape(X.shape[0], -1)
     targets = model.schema.targets
@@ -182,6 +190,33 @@ def predict(model: TrainedModel, data: Dataset, *, source: str = "input") -> Pre
         class_labels={t.name: list(t.values) for t in targets},
         accuracy=accuracy,
         warnings=warnings,
+    )
+
+
+def _predict_values(
+    model: TrainedModel, X: np.ndarray, data: Dataset, warnings: list[str]
+) -> Predictions:
+    """A regression model's predicted numbers, and its error where ``data`` has the truth."""
+    values = model.predict_values(X)
+    targets = model.schema.targets
+    mae = {}
+    names = [a.name for a in data.schema.attributes]
+    for j, target in enumerate(targets):
+        if target.name not in names:
+            continue
+        if data.schema.attributes[names.index(target.name)].kind != "numeric":
+            continue
+        truth = data.values[:, names.index(target.name)]
+        known = ~np.isnan(truth)
+        if known.any():
+            mae[target.name] = float(np.abs(values[known, j] - truth[known]).mean())
+    return Predictions(
+        labels={t.name: values[:, j].tolist() for j, t in enumerate(targets)},
+        probabilities=None,
+        class_labels={},
+        accuracy={},
+        warnings=warnings,
+        mae=mae,
     )
 
 

@@ -19,7 +19,7 @@ import numpy as np
 from app.errors import AppError
 from app.schemas.runs import LeaderboardRowSchema, LeaderboardSchema, MarkSummary, RunStatus
 from app.store.database import Store
-from app.store.datasets import find_dataset, load_dataset
+from app.store.datasets import find_dataset, load_dataset, load_schema
 from app.store.ownership import process_owner
 from app.store.runs import (
     HEARTBEAT_INTERVAL,
@@ -43,9 +43,10 @@ from benchmark.results import TaskKey, TaskResult
 if TYPE_CHECKING:  # scipy.stats (significance) loads when a leaderboard is first built
     from benchmark.catalogue import ClassifierSpec
     from benchmark.evaluation.leaderboard import Leaderboard
+    from benchmark.run.folds import FoldPlan
 
 #: Metric a leaderboard is ranked by unless asked otherwise, per kind of run.
-DEFAULT_METRIC = {"multiclass": "f1_weighted", "multitarget": "hamming_score"}
+DEFAULT_METRIC = {"multiclass": "f1_weighted", "multitarget": "hamming_score", "regression": "mae"}
 
 
 @dataclass
@@ -114,20 +115,33 @@ class RunCancelled(Exception):  # noqa: N818 (an outcome, not an error)
         self.run = run
 
 
-def prepare_problem(dataset: Dataset, targets: Sequence[str] | None = None) -> PreparedProblem:
-    """The engine's view of a data set: numeric X, integer target codes, nominal columns.
+def prepare_problem(
+    dataset: Dataset, targets: Sequence[str] | None = None, position: Sequence[str] = ()
+) -> PreparedProblem:
+    """The engine's view of a data set: numeric X, integer target codes (or target values
+    of a regression), nominal columns.
 
     Parameters
     ----------
     dataset : Dataset
     targets : sequence of str, optional
-        Target attributes to classify; the data set's own targets by default (the others
+        Target attributes to predict; the data set's own targets by default (the others
         are left out, never used as features).
+    position : sequence of str
+        2 or 3 numeric targets that are a position's coordinates (``--position x,y,z``).
     """
     if dataset.n_instances == 0:
         raise ConfigurationError(f"dataset '{dataset.name}' has no instances")
     restricted = restrict_targets(dataset, targets)
-    problem, warnings = problem_from_dataset(restricted)
+    problem, warnings = problem_from_dataset(restricted, position=position)
+    if problem.kind == "regression":
+        for column, name in zip(problem.Y.T, problem.target_names, strict=True):
+            if problem.n_instances and np.ptp(column) == 0:
+                raise ConfigurationError(
+                    f"numeric target '{name}' has a single value ({column[0]:g}): nothing to "
+                    "predict"
+                )
+        return PreparedProblem(problem, list(problem.target_names), warnings)
     for column, target in zip(problem.Y.T, restricted.schema.targets, strict=True):
         present = np.unique(column)
         if present.size < 2:
@@ -139,14 +153,24 @@ def prepare_problem(dataset: Dataset, targets: Sequence[str] | None = None) -> P
 
 
 def default_classifiers(
-    n_targets: int, suite_name: str = "default", *, sequences: bool = False
+    n_targets: int,
+    suite_name: str = "default",
+    *,
+    sequences: bool = False,
+    regression_size: int | None = None,
 ) -> list[str]:
     """The classifiers a suite means for a data set with ``n_targets`` targets.
 
     Sequence classifiers are among them only for a sequence data set (``sequences``).
+    A regression (``regression_size``: its number of instances) gets the suite's
+    regressors (:func:`benchmark.catalogue.regressors.regression_suite`).
     """
     from benchmark.estimators import reads_sequences
 
+    if regression_size is not None:
+        from benchmark.catalogue.regressors import regression_suite
+
+        return regression_suite(suite_name, n_targets=n_targets, n_instances=regression_size)
     if n_targets > 1:
         from benchmark.multitarget.suites import multitarget_suite
 
@@ -191,6 +215,8 @@ def create_run(
     options: RunOptions | None = None,
     on_warning: Callable[[str], None] | None = None,
     weka: Sequence[str] = (),
+    position: Sequence[str] = (),
+    metric: str | None = None,
 ) -> RunInfo:
     """Check a benchmark request and store it as a ``queued`` run.
 
@@ -211,12 +237,18 @@ def create_run(
     weka : sequence of str
         WEKA command lines (``"weka.classifiers.trees.J48 -C 0.1"``) to run as well, each
         as the catalogue configuration that computes what WEKA computes.
+    position : sequence of str
+        2 or 3 numeric targets that are a position's coordinates: the run also scores the
+        mean Euclidean error.
+    metric : str, optional
+        The metric its leaderboard will be ranked by, checked against the kind of run.
 
     Raises
     ------
     ConfigurationError, AppError
         Anything that would make the run fail at once: unknown data set, target or
-        classifier, a target with one class, impossible folds.
+        classifier, a target with one class, impossible folds, a position that is not
+        numeric targets, a metric of the other kind of problem.
     """
     if classifiers and suite:
         raise ConfigurationError("give classifiers or a suite, not both")
@@ -224,17 +256,24 @@ def create_run(
     _check_options(options)
     commands = weka_specs(weka)
     info = find_dataset(store, dataset_ref)
-    prepared = prepare_problem(load_dataset(store, info.id), targets)
+    prepared = prepare_problem(load_dataset(store, info.id), targets, position)
+    problem = prepared.problem
+    if metric is not None:
+        check_metric(problem.kind, metric, position=bool(position))
+    if commands and problem.kind == "regression":
+        raise ConfigurationError("--weka runs WEKA classifiers; the targets here are numeric")
     ids = list(dict.fromkeys(classifiers or ()))
     if not ids and not commands:
         ids = default_classifiers(
             len(prepared.target_names),
             suite or "default",
-            sequences=prepared.problem.sequence is not None,
+            sequences=problem.sequence is not None,
+            regression_size=problem.n_instances if problem.kind == "regression" else None,
         )
     ids = list(dict.fromkeys([*ids, *commands]))
-    check_classifiers(prepared.problem, ids, commands)
-    folds, fold_notes = _folds(prepared, options)
+    check_classifiers(problem, ids, commands)
+    plan = _folds(prepared, options)
+    folds, fold_notes = plan.folds, plan.notes
     effective = max(f.fold for f in folds) + 1
     config = {
         **options.to_json(),
@@ -246,6 +285,8 @@ def create_run(
         "n_tasks": len(ids) * len(folds),
         "n_instances": int(prepared.problem.X.shape[0]),
         "grouped": prepared.problem.groups is not None,
+        "fold_scheme": plan.scheme,
+        "position": list(position) or None,
     }
     run = store_run(
         store,
@@ -300,9 +341,11 @@ def execute_run(
     try:
         options = RunOptions.from_config(run.config)
         prepared = prepare_problem(
-            load_dataset(store, run.dataset_id), run.config.get("targets_given")
+            load_dataset(store, run.dataset_id),
+            run.config.get("targets_given"),
+            run.config.get("position") or (),
         )
-        folds, _ = _folds(prepared, options)
+        folds = _folds(prepared, options).folds
         done = finished_keys(store, run.id)
         callbacks.on_plan(len(run.classifiers) * len(folds), len(done))
 
@@ -362,6 +405,7 @@ def start_run(
     scheduler: str | None = None,
     callbacks: Callbacks | None = None,
     weka: Sequence[str] = (),
+    position: Sequence[str] = (),
 ) -> tuple[RunInfo, list[TaskResult]]:
     """Create a run and carry it out at once (the CLI's ``bench``)."""
     callbacks = callbacks or Callbacks()
@@ -374,6 +418,7 @@ def start_run(
         options=options,
         on_warning=callbacks.on_note,
         weka=weka,
+        position=position,
     )
     run = execute_run(store, run.id, jobs=jobs, scheduler=scheduler, callbacks=callbacks)
     return run, load_results(store, run.id)
@@ -413,9 +458,43 @@ def run_leaderboard(
             else f"it is {run.status}; `touchbench bench --resume {run.id}` carries it out"
         )
         raise ConfigurationError(f"run {run.id} has no results yet ({hint})")
+    if metric is not None:
+        check_metric(run.kind, metric, position=bool(run.config.get("position")), run_id=run.id)
     return run, build_leaderboard(
         results, metric=metric or DEFAULT_METRIC.get(run.kind, "f1_weighted"), baseline=baseline
     )
+
+
+def check_metric(kind: str, metric: str, *, position: bool, run_id: int | None = None) -> None:
+    """Refuse a regression metric for a classification and a classification metric for a
+    regression (costs such as ``fit_time`` rank either), and the Euclidean error without a
+    position.
+
+    Raises
+    ------
+    ConfigurationError
+        One line naming the metric, the kind of run and the metrics it has.
+    """
+    from benchmark.evaluation.metrics import COST_METRICS, REGRESSION_METRICS
+
+    run = f"run {run_id}" if run_id is not None else "this run"
+    if metric in COST_METRICS:
+        return
+    if kind == "regression" and metric not in REGRESSION_METRICS:
+        raise ConfigurationError(
+            f"'{metric}' is not a regression metric and {run} is a regression (numeric "
+            f"targets): rank by {', '.join(REGRESSION_METRICS[:3])} or a cost"
+        )
+    if kind != "regression" and metric in REGRESSION_METRICS:
+        raise ConfigurationError(
+            f"'{metric}' is a regression metric and {run} classifies nominal targets "
+            f"({kind}): rank by {DEFAULT_METRIC.get(kind, 'f1_weighted')} or another "
+            "classification metric"
+        )
+    if metric == "euclidean_error" and not position:
+        raise ConfigurationError(
+            f"'euclidean_error' needs coordinates: {run} was not given --position X,Y[,Z]"
+        )
 
 
 def leaderboard_schema(
@@ -439,7 +518,9 @@ def leaderboard_schema(
         kind=run.kind,
         targets=run.targets,
         status=run.status,
+        folds=run.fold_scheme,
         metric=data["metric"],
+        lower_is_better=data["lower_is_better"],
         baseline=data["baseline"],
         summary=MarkSummary(**data["summary"]),
         leaderboard=[LeaderboardRowSchema(**row) for row in data["leaderboard"]],
@@ -526,7 +607,14 @@ def independent_runs(
 ) -> IndependentResult:
     """A multi-class run per target of a multi-target data set, and the product of the
     best scores (the comparison the UC3M paper makes with its multi-target results)."""
-    info = find_dataset(store, dataset_ref)
+    info, schema, _ = load_schema(store, dataset_ref)
+    numeric = [t.name for t in schema.targets if t.kind == "numeric"]
+    if numeric:
+        raise ConfigurationError(
+            f"--independent compares targets classified separately, but "
+            f"{', '.join(numeric)} of '{info.name}' are numeric: a regression benchmarks its "
+            "targets together (drop --independent; br:ID fits one model per target)"
+        )
     if len(info.targets) < 2:
         raise ConfigurationError(
             f"--independent compares targets classified separately, but '{info.name}' has one "
@@ -616,17 +704,18 @@ def _bytes(megabytes: float | None) -> int | None:
     return None if megabytes is None else int(megabytes * 2**20)
 
 
-def _folds(prepared: PreparedProblem, options: RunOptions) -> tuple[list[Any], list[str]]:
-    from benchmark.run.folds import make_folds
+def _folds(prepared: PreparedProblem, options: RunOptions) -> FoldPlan:
+    from benchmark.run.folds import make_fold_plan
 
     try:
-        return make_folds(
+        return make_fold_plan(
             prepared.problem.Y,
             n_folds=options.folds,
             n_repeats=options.repeats,
             seed=options.seed,
             groups=prepared.problem.groups,
             target_names=prepared.target_names,
+            regression=prepared.problem.kind == "regression",
         )
     except ValueError as error:  # scikit-learn's splitters on data too small to split
         raise ConfigurationError(f"cannot make {options.folds} folds: {error}") from None

@@ -60,6 +60,16 @@ class RunInfo:
     def n_tasks(self) -> int:
         return int(self.config.get("n_tasks", 0))
 
+    @property
+    def fold_scheme(self) -> str:
+        """How the folds were made (``stratified k-fold``, ``group k-fold``...); runs stored
+        before it was recorded are described from their kind and whether they had groups."""
+        recorded = self.config.get("fold_scheme")
+        if recorded:
+            return str(recorded)
+        stratified = "stratified " if self.kind == "multiclass" else ""
+        return stratified + ("group " if self.config.get("grouped") else "") + "k-fold"
+
     def is_alive(self) -> bool:
         """Whether a live process is executing the run."""
         return self.status == "running" and owner_alive(self.owner, self.heartbeat_at)

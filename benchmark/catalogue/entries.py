@@ -49,7 +49,7 @@ from benchmark.catalogue.boosters import CatBoostNominalClassifier, LightGBMClas
 from benchmark.catalogue.estimators import LabelEncodedClassifier, OneRuleClassifier
 from benchmark.catalogue.model_trees import LogisticModelTree
 from benchmark.catalogue.rules import OrderedRuleClassifier
-from benchmark.catalogue.spec import ClassifierSpec
+from benchmark.catalogue.spec import ClassifierSpec, make_spec
 from benchmark.catalogue.time_series import IntervalForestClassifier, RocketClassifier
 from benchmark.catalogue.weka_schemes import weka_command
 from benchmark.weka import C45Classifier, PARTClassifier, WekaIBk, WekaNaiveBayes, WekaZeroR
@@ -226,40 +226,11 @@ _BASES = {
 # The entries -------------------------------------------------------------------------
 
 
-def _spec(
-    id: str,
-    factory: Any,
-    params: dict[str, Any],
-    *,
-    family: str,
-    description: str,
-    weka: str | None = None,
-    probabilities: bool = True,
-    scaling: str | None = None,
-    missing: bool = False,
-    nominal: bool = False,
-    cost: str = "fast",
-    suites: frozenset[str] = DEFAULT,
-    limits: str = "",
-    min_sequence: int | None = None,
-) -> ClassifierSpec:
-    return ClassifierSpec(
-        id=id,
-        weka_command=weka_command(weka, params) if weka else None,
-        family=family,
-        description=description,
-        factory=factory,
-        params=params,
-        probabilities=probabilities,
-        needs_scaling=scaling is not None,
-        handles_missing=missing,
-        handles_nominal=nominal,
-        cost=cost,  # type: ignore[arg-type]
-        suites=suites,
-        limits=limits,
-        scaling=scaling or "standard",  # type: ignore[arg-type]
-        min_sequence=min_sequence,
-    )
+def _spec(id: str, factory: Any, params: dict[str, Any], **fields: Any) -> ClassifierSpec:
+    """An entry; ``weka`` is the WEKA class whose command line it reproduces, if any."""
+    weka = fields.pop("weka", None)
+    command = weka_command(weka, params) if weka else None
+    return make_spec(id, factory, params, weka_command=command, **fields)
 
 
 W = "weka.classifiers."

@@ -116,6 +116,44 @@ class ClassifierSpec:
         }
 
 
+def make_spec(
+    id: str,
+    factory: Callable[..., BaseEstimator],
+    params: Mapping[str, Any],
+    *,
+    family: str,
+    description: str,
+    weka_command: str | None = None,
+    probabilities: bool = True,
+    scaling: str | None = None,
+    missing: bool = False,
+    nominal: bool = False,
+    cost: str = "fast",
+    suites: frozenset[str] = frozenset({"default"}),
+    limits: str = "",
+    min_sequence: int | None = None,
+) -> ClassifierSpec:
+    """A :class:`ClassifierSpec` as catalogues declare it: ``scaling`` names the scaler
+    (``None``: no scaling), ``missing`` and ``nominal`` what the estimator takes itself."""
+    return ClassifierSpec(
+        id=id,
+        weka_command=weka_command,
+        family=family,
+        description=description,
+        factory=factory,
+        params=params,
+        probabilities=probabilities,
+        needs_scaling=scaling is not None,
+        handles_missing=missing,
+        handles_nominal=nominal,
+        cost=cost,  # type: ignore[arg-type]
+        suites=suites,
+        limits=limits,
+        scaling=scaling or "standard",  # type: ignore[arg-type]
+        min_sequence=min_sequence,
+    )
+
+
 def _jsonable(value: Any) -> Any:
     if value is None or isinstance(value, bool | int | float | str):
         return value

@@ -96,6 +96,11 @@ class Leaderboard:
     summary: tuple[int, int, int]
     alpha: float = 0.05
 
+    @property
+    def lower_is_better(self) -> bool:
+        """Whether the ranking metric is better when smaller (errors, costs)."""
+        return self.metric in LOWER_IS_BETTER
+
     def row(self, classifier: str) -> LeaderboardRow:
         """The row of ``classifier``."""
         for row in self.rows:
@@ -108,6 +113,7 @@ class Leaderboard:
         better, same, worse = self.summary
         return {
             "metric": self.metric,
+            "lower_is_better": self.lower_is_better,
             "baseline": self.baseline,
             "alpha": self.alpha,
             "test": "corrected resampled t-test (Nadeau and Bengio; WEKA PairedCorrectedTTester)",

@@ -30,6 +30,10 @@ MULTICLASS_METRICS: tuple[str, ...] = (
     "log_loss",
 )
 
+#: The regression metrics of every fold (:mod:`benchmark.evaluation.regression`); the
+#: mean Euclidean error only when targets are a position's coordinates.
+REGRESSION_METRICS: tuple[str, ...] = ("mae", "rmse", "r2", "euclidean_error")
+
 #: Measurements of cost recorded with every fold.
 COST_METRICS: tuple[str, ...] = (
     "fit_time",
@@ -53,6 +57,9 @@ LOWER_IS_BETTER: frozenset[str] = frozenset(
         "model_size",
         "mean_absolute_error",
         "root_mean_squared_error",
+        "mae",
+        "rmse",
+        "euclidean_error",
         "hamming_loss",
         "zero_one_loss",
     }

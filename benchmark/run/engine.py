@@ -78,7 +78,8 @@ def run_tasks(
     ----------
     problem : Problem
         Features and targets.  One target: catalogue classifiers; several targets:
-        multi-target configurations (``META:BASE``) of :mod:`benchmark.multitarget`.
+        multi-target configurations (``META:BASE``) of :mod:`benchmark.multitarget`;
+        numeric targets: regressors (:mod:`benchmark.catalogue.regressors`).
     classifiers : sequence of str
         Classifier ids, run in this order (duplicates ignored).
     folds : sequence of Fold

@@ -2,9 +2,11 @@
 
 One target: stratified k-fold per repeat (seed ``seed + repeat``).  Several targets:
 stratified on the joint label combination when every combination is common enough, plain
-shuffled k-fold otherwise.  With recording/session groups, a group never straddles
-training and test.  When the data cannot support the requested number of folds, the
-largest feasible number is used and a warning line says so.
+shuffled k-fold otherwise.  Numeric targets (a regression): shuffled k-fold.  With
+recording/session groups, a group never straddles training and test (group k-fold).  The
+scheme used is named in :attr:`FoldPlan.scheme`, for leaderboards to say.  When the data
+cannot support the requested number of folds, the largest feasible number is used and a
+warning line says so.
 """
 
 from __future__ import annotations
@@ -39,6 +41,26 @@ class Fold:
     test: np.ndarray
 
 
+@dataclass(frozen=True)
+class FoldPlan:
+    """The folds of a run and how they were made.
+
+    Parameters
+    ----------
+    folds : list of Fold
+        ``n_repeats * k`` folds, repeat-major.
+    notes : list of str
+        One line per adjustment made (fewer folds, unstratified splits...).
+    scheme : str
+        ``"stratified k-fold"``, ``"k-fold"`` (shuffled), ``"stratified group k-fold"``
+        or ``"group k-fold"``.
+    """
+
+    folds: list[Fold]
+    notes: list[str]
+    scheme: str
+
+
 def make_folds(
     Y: np.ndarray,
     *,
@@ -47,13 +69,38 @@ def make_folds(
     seed: int = 0,
     groups: np.ndarray | None = None,
     target_names: Sequence[str] | None = None,
+    regression: bool = False,
 ) -> tuple[list[Fold], list[str]]:
+    """Repeated (stratified, group-aware) k-fold splits: :func:`make_fold_plan`'s folds and
+    notes."""
+    plan = make_fold_plan(
+        Y,
+        n_folds=n_folds,
+        n_repeats=n_repeats,
+        seed=seed,
+        groups=groups,
+        target_names=target_names,
+        regression=regression,
+    )
+    return plan.folds, plan.notes
+
+
+def make_fold_plan(
+    Y: np.ndarray,
+    *,
+    n_folds: int = 10,
+    n_repeats: int = 1,
+    seed: int = 0,
+    groups: np.ndarray | None = None,
+    target_names: Sequence[str] | None = None,
+    regression: bool = False,
+) -> FoldPlan:
     """Repeated (stratified, group-aware) k-fold splits.
 
     Parameters
     ----------
     Y : ndarray of shape (n_instances, n_targets) or (n_instances,)
-        Integer target codes.
+        Integer target codes, or target values with ``regression``.
     n_folds : int
         Requested number of folds (at least 2).
     n_repeats : int
@@ -64,13 +111,12 @@ def make_folds(
         Recording/session id per instance; instances of a group stay together.
     target_names : sequence of str, optional
         Names used in messages (default ``target 1``, ``target 2``...).
+    regression : bool
+        Numeric targets: shuffled (group) k-fold, never stratified.
 
     Returns
     -------
-    folds : list of Fold
-        ``n_repeats * k`` folds, repeat-major.
-    warnings : list of str
-        One line per adjustment made (fewer folds, unstratified splits...).
+    FoldPlan
 
     Raises
     ------
@@ -92,16 +138,16 @@ def make_folds(
             raise ConfigurationError(
                 f"groups must have one entry per instance ({n_instances}), got {groups.shape}"
             )
-    for t in range(n_targets):
-        values = np.unique(Y[:, t])
-        if values.size < 2:
-            raise ConfigurationError(
-                f"target '{names[t]}' has a single class (code {int(values[0])}) among the "
-                f"{n_instances} instances; classification needs at least two"
-            )
     notes: list[str] = []
-    strata, stratified = _strata(Y, n_folds, names, notes, grouped=groups is not None)
-    k = _feasible_folds(n_folds, strata if stratified else None, groups, notes)
+    if regression:
+        strata, stratified = np.zeros(n_instances, dtype=np.int64), False
+        k = _feasible_folds(min(n_folds, n_instances), None, groups, notes)
+        if k < n_folds and groups is None:
+            notes.append(f"only {n_instances} instances: using {k} folds instead of {n_folds}")
+    else:
+        _check_classes(Y, names)
+        strata, stratified = _strata(Y, n_folds, names, notes, grouped=groups is not None)
+        k = _feasible_folds(n_folds, strata if stratified else None, groups, notes)
     folds = [
         Fold(repeat, fold, np.sort(train).astype(np.int64), np.sort(test).astype(np.int64))
         for repeat in range(n_repeats)
@@ -109,7 +155,18 @@ def make_folds(
             _splits(k, strata, stratified, groups, seed + repeat, n_instances)
         )
     ]
-    return folds, notes
+    scheme = ("stratified " if stratified else "") + ("group " if groups is not None else "")
+    return FoldPlan(folds, notes, scheme + "k-fold")
+
+
+def _check_classes(Y: np.ndarray, names: Sequence[str]) -> None:
+    for t in range(Y.shape[1]):
+        values = np.unique(Y[:, t])
+        if values.size < 2:
+            raise ConfigurationError(
+                f"target '{names[t]}' has a single class (code {int(values[0])}) among the "
+                f"{Y.shape[0]} instances; classification needs at least two"
+            )
 
 
 def _check_parameters(n_folds: int, n_repeats: int, n_instances: int, n_targets: int) -> None:

@@ -75,6 +75,8 @@ def execute_task(context: TaskContext, key: TaskKey) -> TaskResult:
         try:
             if context.problem.kind == "multiclass":
                 result = _run_multiclass(context, key, fold)
+            elif context.problem.kind == "regression":
+                result = _run_regression(context, key, fold)
             else:
                 result = _run_multitarget(context, key, fold)
         except MemoryError as exc:
@@ -114,6 +116,36 @@ def _run_multiclass(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResul
     scores, confusion = multiclass_scores(y[fold.test], y_pred, proba, n_classes=n_classes)
     scores.update(_costs(fit_time, fit_cpu, predict_time, predict_cpu, model))
     return TaskResult(key, "ok", None, scores, confusion, int(fold.train.size), int(fold.test.size))
+
+
+def _run_regression(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResult:
+    from benchmark.evaluation.regression import regression_scores
+
+    problem = context.problem
+    model = build_estimator(key.classifier, problem, random_state=context.random_state)
+    Y = problem.Y if problem.n_targets > 1 else problem.Y[:, 0]
+    timer = _Timer()
+    model.fit(problem.X[fold.train], Y[fold.train])
+    fit_time, fit_cpu = timer.lap()
+    Y_pred = np.asarray(model.predict(problem.X[fold.test]), dtype=np.float64)
+    predict_time, predict_cpu = timer.lap()
+    metrics, per_target = regression_scores(
+        problem.Y[fold.test],
+        Y_pred.reshape(len(fold.test), -1),
+        target_names=problem.target_names,
+        coordinates=problem.coordinates,
+    )
+    metrics.update(_costs(fit_time, fit_cpu, predict_time, predict_cpu, model))
+    return TaskResult(
+        key,
+        "ok",
+        None,
+        metrics,
+        None,
+        int(fold.train.size),
+        int(fold.test.size),
+        per_target=per_target,
+    )
 
 
 def _run_multitarget(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResult:

@@ -40,3 +40,21 @@ def touch_arff(
         lines.append(",".join(row))
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path
+
+
+def position_arff(path: Path, *, n: int = 60, seed: int = 0) -> Path:
+    """Contact position (x, y in cm, the last two attributes) from 3 numeric features and a
+    nominal one: MEKA's ``-C -2`` header; x is linear in the features, y smooth."""
+    rng = np.random.default_rng(seed)
+    lines = ["@relation 'contact: -C -2'"]
+    lines += [f"@attribute f{i} numeric" for i in range(3)]
+    lines += ["@attribute mic {left, right}", "@attribute x numeric", "@attribute y numeric"]
+    lines.append("@data")
+    for i in range(n):
+        f = rng.normal(size=3)
+        x = 10.0 * f[0] - 4.0 * f[1] + rng.normal() * 0.2
+        y = 5.0 * np.tanh(f[2]) + 2.0 * (i % 2) + rng.normal() * 0.2
+        cells = [f"{v:.4f}" for v in f] + [["left", "right"][i % 2], f"{x:.3f}", f"{y:.3f}"]
+        lines.append(",".join(cells))
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path

@@ -112,7 +112,7 @@ def test_multi_target_bad_input_exits_2(
         (["bench", "touch", "-c", "bcc:rff"], "did you mean 'rf'"),
         (["bench", "touch", "-c", "bogus:rf"], "unknown multi-target method 'bogus'"),
         (["bench", "touch", "-c", "rf"], "multi-class classifier"),
-        (["bench", "n"], "numeric"),
+        (["bench", "n", "-c", "j48"], "the targets are numeric"),
         (["bench", "touch", "--independent", "--target", "place"], "--independent"),
     ]
     for args, expected in cases:

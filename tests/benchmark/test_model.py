@@ -74,7 +74,7 @@ def test_wrong_feature_count_is_refused() -> None:
     [
         ("rff", None, "unknown classifier 'rff'; did you mean 'rf'"),
         ("nb", "one_class", "target 'gesture' has a single class"),
-        ("nb", "numeric_target", "target 'level' is a numeric attribute"),
+        ("nb", "numeric_target", "classifier 'nb' has no regressor: the targets are numeric"),
     ],
 )
 def test_bad_training_requests(classifier: str, mutate: str | None, message: str) -> None:

@@ -49,6 +49,11 @@ def test_several_targets_make_a_multitarget_problem() -> None:
     assert problem.target_names == ("gesture", "colour")
 
 
-def test_a_numeric_target_is_refused() -> None:
-    with pytest.raises(ConfigurationError, match="target 'level' is a numeric attribute"):
-        problem_from_dataset(make([[0, 0, 2, 1.0, 0]], (3,)))
+def test_a_numeric_target_makes_a_regression_and_a_date_target_is_refused() -> None:
+    problem, _ = problem_from_dataset(make([[0, 0, 2, 1.5, 0], [1, 0, 1, NAN, 0]], (3,)))
+    assert problem.kind == "regression" and problem.n_classes == ()
+    np.testing.assert_array_equal(problem.Y, [[1.5]])
+    with pytest.raises(ConfigurationError, match="target 'when' is a date attribute"):
+        problem_from_dataset(make([[0, 0, 2, 1.0, 0]], (4,)))
+    with pytest.raises(ConfigurationError, match="targets mix nominal and numeric"):
+        problem_from_dataset(make([[0, 0, 2, 1.0, 0]], (0, 3)))

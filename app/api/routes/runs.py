@@ -32,6 +32,12 @@ class RunRequest(Schema):
         description='WEKA command lines, e.g. "weka.classifiers.trees.J48 -C 0.1 -M 5".',
     )
     suite: Literal["fast", "default", "all"] | None = None
+    position: list[str] | None = Field(
+        default=None,
+        min_length=2,
+        max_length=3,
+        description="Numeric targets that are a position's coordinates (mean Euclidean error).",
+    )
     folds: int = Field(default=10, ge=2, le=100)
     repeats: int = Field(default=1, ge=1, le=100)
     seed: int = Field(default=0, ge=0, le=2**31 - 1)
@@ -56,6 +62,7 @@ def start_run(body: RunRequest, service: ServiceDep) -> RunCreated:
             max_memory_mb=body.max_memory_mb,
         ),
         weka=body.weka or (),
+        position=body.position or (),
     )
     service.dispatcher.wake()
     return RunCreated(id=run.id, status=run.status)
