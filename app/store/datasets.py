@@ -350,7 +350,7 @@ def _write_block(session: Session, dataset_id: int, start: int, block: InstanceB
 
 def _bytes_of(array: np.ndarray) -> memoryview:
     """The bytes of a C-contiguous array, not copied (both drivers take any bytes-like)."""
-    return memoryview(array).cast("B")
+    return array.data.cast("B")
 
 
 def stored_rows(n_attributes: int) -> int:
