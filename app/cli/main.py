@@ -5,6 +5,7 @@ Exit status: 0 success, 2 bad input or usage (one line on stderr), 1 anything un
 
 from __future__ import annotations
 
+import gc
 import os
 import sys
 import traceback
@@ -92,6 +93,11 @@ demo_commands.register(app)
 serve_commands.register(app)
 reports_commands.register(app)
 capture_commands.register(app)
+
+# What importing the CLI made (some 100 000 objects that live as long as the process) is
+# moved out of the cyclic collector's reach: every full collection would walk it again, and
+# one more runs at exit, together a few tenths of a second of an import's CPU time.
+gc.freeze()
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -9,7 +9,6 @@ import typer
 
 from app.cli.output import info, print_json, table, warn
 from app.cli.state import get_state
-from app.store.models import list_models
 
 JsonOption = Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")]
 
@@ -70,6 +69,7 @@ def train_command(
 def models_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
     """List trained models (artifacts are not read)."""
     from app.schemas.models import ModelList
+    from app.store.models import list_models
 
     models = list_models(get_state(ctx).store)
     if as_json:

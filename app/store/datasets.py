@@ -336,8 +336,8 @@ def _write_block(session: Session, dataset_id: int, start: int, block: InstanceB
             "dataset_id": dataset_id,
             "start": start + first,
             "n_rows": min(rows, block.n_instances - first),
-            "data": values[first : first + rows].tobytes(),
-            "weights": None if weights is None else weights[first : first + rows].tobytes(),
+            "data": _bytes_of(values[first : first + rows]),
+            "weights": None if weights is None else _bytes_of(weights[first : first + rows]),
         }
         for first in range(0, block.n_instances, rows)
     ]
@@ -346,6 +346,11 @@ def _write_block(session: Session, dataset_id: int, start: int, block: InstanceB
     extras = _extras(dataset_id, start, block)
     if extras:
         session.execute(insert(InstanceRow), extras)
+
+
+def _bytes_of(array: np.ndarray) -> memoryview:
+    """The bytes of a C-contiguous array, not copied (both drivers take any bytes-like)."""
+    return array.data.cast("B")
 
 
 def stored_rows(n_attributes: int) -> int:

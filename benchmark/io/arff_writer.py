@@ -4,7 +4,9 @@ The output is what :mod:`benchmark.io.arff_reader` (and WEKA) reads back to the 
 dataset: names and values are quoted only when WEKA's tokenizer would otherwise split or
 misread them, with the escapes the reader decodes; numbers use Python's shortest
 round-trip ``repr`` (``3`` rather than ``3.0``); a sparse dataset is written as sparse
-rows; instance weights other than 1 follow their row as ``{w}``.
+rows; instance weights other than 1 follow their row as ``{w}``.  Once a writer has written
+:data:`VECTORISED_MIN_CELLS` cells, dense rows are made with Arrow
+(:mod:`benchmark.io.arff_fast_writer`), the same text four times faster.
 """
 
 from __future__ import annotations
@@ -20,7 +22,14 @@ import numpy as np
 
 from benchmark.dataset import Attribute, Dataset, Schema, resolve_targets
 from benchmark.errors import ConfigurationError, DataFormatError
+from benchmark.io.arff_fast_writer import DenseRows
 from benchmark.io.dates import DateFormat
+
+#: Cells a writer writes row by row before it hands dense rows to Arrow (whose import costs
+#: what formatting this many cells does).
+VECTORISED_MIN_CELLS = 1 << 18
+#: At most this many cells are made into text at a time by Arrow.
+_ARROW_CELLS = 1 << 20
 
 _NEEDS_QUOTES = re.compile(r"""[\x00-\x20,{}'"%\\\x7f]""")
 _TO_ESCAPE = re.compile(r"""[\x00-\x1f'"%\\\x7f]""")
@@ -177,6 +186,18 @@ class ArffWriter:
         self.rows_written = 0
         self._formatters = [_cell_formatter(attribute) for attribute in schema.attributes]
         self._strings = np.array([a.kind == "string" for a in schema.attributes], dtype=bool)
+        self._cells = 0
+        self._dense = DenseRows(
+            [
+                [quote(value) for value in a.values] if a.kind in ("nominal", "string") else None
+                for a in schema.attributes
+            ],
+            [
+                f if a.kind == "date" else None
+                for a, f in zip(schema.attributes, self._formatters, strict=True)
+            ],
+            format_number,
+        )
 
     def write_header(self) -> None:
         """Write ``@relation``, the attributes and ``@data``."""
@@ -202,13 +223,37 @@ class ArffWriter:
             outside the years 1 to 9999 (nothing of the block is written then).
         """
         _check_codes(self.schema.attributes, values, self.rows_written)
+        self._cells += values.size
+        if not self.sparse and self._cells >= VECTORISED_MIN_CELLS:
+            texts = self._arrow_text(values, weights)
+        else:
+            texts = self._python_text(values, weights)
+        for text in texts:
+            self.stream.write(text)
+        self.rows_written += values.shape[0]
+
+    def _python_text(self, values: np.ndarray, weights: np.ndarray | None) -> list[str]:
         lines = self._sparse_lines(values) if self.sparse else self._dense_lines(values)
         if weights is not None:
             for i in np.flatnonzero(weights != 1).tolist():
                 lines[i] += ",{" + format_number(float(weights[i])) + "}"
-        if lines:
-            self.stream.write("\n".join(lines) + "\n")
-        self.rows_written += values.shape[0]
+        return ["\n".join(lines) + "\n"] if lines else []
+
+    def _arrow_text(self, values: np.ndarray, weights: np.ndarray | None) -> list[str]:
+        """The text of dense rows, a part at a time, made before any is written (a date that
+        cannot be written fails the whole block)."""
+        rows = max(1, _ARROW_CELLS // max(1, values.shape[1]))
+        texts = []
+        for first in range(0, values.shape[0], rows):
+            suffixes = None
+            if weights is not None:
+                part = weights[first : first + rows]
+                suffixes = {
+                    i: ",{" + format_number(float(part[i])) + "}"
+                    for i in np.flatnonzero(part != 1).tolist()
+                }
+            texts.append(self._dense.text(values[first : first + rows], suffixes))
+        return texts
 
     def _dense_lines(self, values: np.ndarray) -> list[str]:
         columns = [
