@@ -11,10 +11,10 @@ from app.cli.output import EXIT_FAILED, EXIT_INTERRUPTED, ExitWith, info, print_
 from app.cli.state import get_state
 
 if TYPE_CHECKING:
+    from app.schemas.runs import LeaderboardSchema
     from app.services.runs import IndependentResult
     from app.store.database import Store
     from app.store.runs import RunInfo
-    from app.schemas.runs import LeaderboardSchema
     from benchmark.evaluation.leaderboard import Leaderboard
 
 # scikit-learn, the engine and Dask are imported by the commands that use them, so that

@@ -25,9 +25,9 @@ from app.schemas.runs import (
     RunStatus,
     TunedComparisonSchema,
 )
+from app.services.tuning import run_specs
 from app.store.database import Store
 from app.store.datasets import find_dataset, load_dataset
-from app.services.tuning import run_specs
 from app.store.ownership import process_owner
 from app.store.runs import (
     HEARTBEAT_INTERVAL,

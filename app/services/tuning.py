@@ -35,9 +35,9 @@ def with_tuned_twins(
         out.append(classifier)
         if is_tuned_id(classifier):
             continue
-        meta, _, base = classifier.rpartition(":") if is_multitarget_id(classifier) else ("", "", classifier)
-        if not base:
-            continue
+        meta, _, base = classifier.rpartition(":")
+        if is_multitarget_id(classifier) and not meta:
+            continue  # a META without a base (``lc``): nothing to tune
         spec = classifier_spec(base, extra_specs)
         if spec.search_space:
             tuned_spec(spec, budget_minutes)  # a space its estimator refuses fails here

@@ -29,8 +29,8 @@ from benchmark.sequence import SequenceLayout
 
 __all__ = [
     "CATALOGUE",
-    "SUITES",
     "SEARCH_SPACES",
+    "SUITES",
     "ClassifierSpec",
     "build_pipeline",
     "check_sequence_input",

@@ -180,4 +180,3 @@ def _score_method(estimator: Any) -> str:
         if hasattr(estimator, method):
             return method
     return "predict"
-
