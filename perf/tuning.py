@@ -30,7 +30,7 @@ from sklearn.metrics import f1_score
 from sklearn.model_selection import GridSearchCV, ParameterGrid, StratifiedKFold
 
 from benchmark.catalogue import build_pipeline, get_spec
-from benchmark.catalogue.tuning import CLASSIFIER_STEP, TunedClassifier, tuned_spec
+from benchmark.catalogue.tuning import CLASSIFIER_STEP, TunedClassifier, inner_folds, tuned_spec
 from benchmark.io.arff import read_arff
 
 DATASETS = Path(__file__).resolve().parents[2] / "shared/datasets/uc3m-touch"
@@ -93,7 +93,7 @@ def main() -> None:
                 clone(default),
                 grid,
                 scoring="f1_weighted",
-                cv=tuner._inner_folds(y[train]),
+                cv=inner_folds(y[train], tuner.cv, tuner.random_state),
                 error_score=np.nan,
             )
             rows["grid"].append(timed_fold(search, X, y, train, test))

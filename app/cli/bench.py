@@ -74,6 +74,7 @@ def classifiers_command(
                         "cost": s.cost,
                         "suites": sorted(s.suites),
                         "limits": s.limits,
+                        "search_space": s.to_json()["search_space"],
                     }
                     for s in specs
                 ]

@@ -149,7 +149,7 @@ class ClassifierSpec:
             "family": self.family,
             "description": self.description,
             "estimator": f"{self.factory.__module__}.{self.factory.__qualname__}",
-            "params": {name: _jsonable(value) for name, value in self.params.items()},
+            "params": {name: jsonable(value) for name, value in self.params.items()},
             "probabilities": self.probabilities,
             "needs_scaling": self.needs_scaling,
             "scaling": self.scaling if self.needs_scaling else None,
@@ -161,13 +161,17 @@ class ClassifierSpec:
             "min_sequence": self.min_sequence,
             "search_space": None
             if self.search_space is None
-            else {name: _jsonable(values) for name, values in self.search_space.items()},
+            else {name: jsonable(values) for name, values in self.search_space.items()},
         }
 
 
-def _jsonable(value: Any) -> Any:
+def jsonable(value: Any) -> Any:
+    """``value`` as JSON holds it: numbers, strings and lists as they are (numpy scalars as
+    Python ones), anything else as its ``repr``."""
     if value is None or isinstance(value, bool | int | float | str):
         return value
+    if hasattr(value, "item") and getattr(value, "ndim", None) == 0:  # numpy scalars
+        return jsonable(value.item())
     if isinstance(value, list | tuple):
-        return [_jsonable(v) for v in value]
+        return [jsonable(v) for v in value]
     return repr(value)

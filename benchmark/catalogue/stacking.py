@@ -20,9 +20,10 @@ import numpy as np
 from sklearn.base import BaseEstimator, ClassifierMixin, clone
 from sklearn.linear_model import LogisticRegression
 from sklearn.metrics import f1_score
-from sklearn.model_selection import KFold, StratifiedKFold, cross_val_predict
+from sklearn.model_selection import cross_val_predict
 
 from benchmark.catalogue.spec import ClassifierSpec, Stacking
+from benchmark.catalogue.tuning import inner_folds
 from benchmark.errors import ConfigurationError
 
 #: Inner folds of the member selection and of the stacked class scores.
@@ -126,12 +127,7 @@ class SelectedStack(ClassifierMixin, BaseEstimator):
         """
         y = np.asarray(y)
         self.classes_ = np.unique(y)
-        _, counts = np.unique(y, return_counts=True)
-        folds: KFold | StratifiedKFold = (
-            StratifiedKFold(self.cv, shuffle=True, random_state=self.random_state)
-            if counts.min() >= self.cv
-            else KFold(self.cv, shuffle=True, random_state=self.random_state)
-        )
+        folds = inner_folds(y, self.cv, self.random_state)
         scores: dict[str, np.ndarray] = {}
         self.inner_scores_ = {}
         for name, member in self.members:

@@ -191,7 +191,7 @@ class TunedClassifier(ClassifierMixin, BaseEstimator):
         y = np.asarray(y)
         grid = {name: list(values) for name, values in (self.space or {}).items()}
         size = len(ParameterGrid(grid))
-        inner = self._inner_folds(y)
+        inner = inner_folds(y, self.cv, self.random_state)
         n_candidates = min(self._plan(X, y, size), size)
         common: dict[str, Any] = {
             "factor": self.factor,
@@ -219,12 +219,6 @@ class TunedClassifier(ClassifierMixin, BaseEstimator):
         self.n_candidates_ = int(search.n_candidates_[0])
         self.classes_ = self.best_estimator_.classes_
         return self
-
-    def _inner_folds(self, y: np.ndarray) -> KFold | StratifiedKFold:
-        _, counts = np.unique(y, return_counts=True)
-        if counts.min() >= self.cv:
-            return StratifiedKFold(self.cv, shuffle=True, random_state=self.random_state)
-        return KFold(self.cv, shuffle=True, random_state=self.random_state)
 
     def _plan(self, X: np.ndarray, y: np.ndarray, size: int) -> int:
         """Candidates of the first round: the most (a power of ``factor``) whose estimated
@@ -259,6 +253,14 @@ class TunedClassifier(ClassifierMixin, BaseEstimator):
     def decision_function(self, X: np.ndarray) -> np.ndarray:
         """Decision values of the refitted best setting."""
         return np.asarray(self.best_estimator_.decision_function(X))
+
+
+def inner_folds(y: np.ndarray, cv: int, seed: int | None) -> KFold | StratifiedKFold:
+    """Shuffled inner folds of a training fold, stratified when every class has ``cv`` rows."""
+    _, counts = np.unique(y, return_counts=True)
+    if counts.min() >= cv:
+        return StratifiedKFold(cv, shuffle=True, random_state=seed)
+    return KFold(cv, shuffle=True, random_state=seed)
 
 
 def _delegate(tuned: TunedClassifier) -> Any:

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from benchmark.catalogue import ClassifierSpec
+from benchmark.catalogue.spec import jsonable
 from benchmark.estimators import build_estimator
 from benchmark.evaluation.metrics import confusion_matrix, expand_proba, multiclass_scores
 from benchmark.problem import Problem
@@ -188,17 +189,7 @@ def chosen_params(model: object) -> dict[str, Any] | None:
     chosen = getattr(final, "best_params_", None)
     if not isinstance(chosen, dict):
         return None
-    return {str(name): _jsonable(value) for name, value in chosen.items()}
-
-
-def _jsonable(value: Any) -> Any:
-    if value is None or isinstance(value, bool | int | float | str):
-        return value
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, list | tuple):
-        return [_jsonable(v) for v in value]
-    return repr(value)
+    return {str(name): jsonable(value) for name, value in chosen.items()}
 
 
 class _Timer:
