@@ -210,7 +210,8 @@ class TunedClassifier(ClassifierMixin, BaseEstimator):
                 clone(self.estimator), grid, n_candidates=n_candidates, **common
             )
         search.fit(X, y)
-        self.search_ = search
+        # the search object itself is not kept: its scorer and splitter make a stored model
+        # name types the model store does not trust, and it weighs more than the model
         self.best_estimator_ = search.best_estimator_
         self.best_params_ = {
             name.split("__", 1)[1] if name.startswith(CLASSIFIER_STEP + "__") else name: value

@@ -101,3 +101,14 @@ def test_a_space_parameter_the_estimator_lacks_exits_2(
     assert "search space of 'logistic' names 'penalty_c'" in result.err
     assert "LogisticRegression does not have" in result.err
     assert len(result.err.strip().splitlines()) == 1
+
+
+def test_a_tuned_twin_trains_and_its_stored_model_predicts(
+    capsys: pytest.CaptureFixture[str], db: str, tmp_path: Path
+) -> None:
+    args = ["train", "touch", "--classifier", "logistic+tuned", "--target", "gesture"]
+    trained = run_cli(capsys, db, *args, "--name", "tuned", "--json")
+    assert trained.code == 0, trained.err
+    path = touch_arff(tmp_path / "again.arff", n=30, seed=3)
+    predicted = run_cli(capsys, db, "predict", "tuned", str(path), "--json")
+    assert predicted.code == 0, predicted.err  # a model the store trusts: no search object
