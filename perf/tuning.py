@@ -30,7 +30,13 @@ from sklearn.metrics import f1_score
 from sklearn.model_selection import GridSearchCV, ParameterGrid, StratifiedKFold
 
 from benchmark.catalogue import build_pipeline, get_spec
-from benchmark.catalogue.tuning import CLASSIFIER_STEP, TunedClassifier, inner_folds, tuned_spec
+from benchmark.catalogue.tuning import (
+    CLASSIFIER_STEP,
+    TunedClassifier,
+    as_grid,
+    inner_folds,
+    tuned_spec,
+)
 from benchmark.io.arff import read_arff
 
 DATASETS = Path(__file__).resolve().parents[2] / "shared/datasets/uc3m-touch"
@@ -76,7 +82,7 @@ def main() -> None:
     for classifier in args.classifiers.split(","):
         spec = get_spec(classifier)
         assert spec.search_space is not None, f"{classifier} has no search space"
-        grid = {f"{CLASSIFIER_STEP}__{k}": list(v) for k, v in spec.search_space.items()}
+        grid = as_grid(spec.search_space, f"{CLASSIFIER_STEP}__")
         size = len(ParameterGrid(grid))
         default = build_pipeline(spec, n_features=X.shape[1], random_state=0)
         tuned = build_pipeline(tuned_spec(spec, args.budget), n_features=X.shape[1], random_state=0)

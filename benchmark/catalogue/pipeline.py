@@ -98,7 +98,7 @@ def pipeline_for_spec(
 def _composite(spec: ClassifierSpec, options: dict[str, Any]) -> BaseEstimator:
     """The tuned twin's search, or the stack, over whole member pipelines."""
     from benchmark.catalogue.stacking import SelectedStack
-    from benchmark.catalogue.tuning import CLASSIFIER_STEP, TunedClassifier
+    from benchmark.catalogue.tuning import CLASSIFIER_STEP, TunedClassifier, as_grid
 
     if spec.tuning is not None:
         base = spec.tuning.base
@@ -106,7 +106,7 @@ def _composite(spec: ClassifierSpec, options: dict[str, Any]) -> BaseEstimator:
         budget = spec.tuning.budget_minutes
         return TunedClassifier(
             pipeline_for_spec(base, **options),
-            space={f"{CLASSIFIER_STEP}__{name}": v for name, v in base.search_space.items()},
+            space=as_grid(base.search_space, f"{CLASSIFIER_STEP}__"),
             budget=None if budget is None else budget * 60.0,
             random_state=options["random_state"],
         )

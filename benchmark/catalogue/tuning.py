@@ -113,7 +113,7 @@ def tuned_spec(spec: ClassifierSpec, budget_minutes: float | None = None) -> Cla
         )
     check_search_space(spec)
     check_budget(budget_minutes)
-    size = len(ParameterGrid(_as_grid(spec.search_space)))
+    size = len(ParameterGrid(as_grid(spec.search_space)))
     return replace(
         spec,
         id=tuned_id(spec.id),
@@ -127,7 +127,9 @@ def tuned_spec(spec: ClassifierSpec, budget_minutes: float | None = None) -> Cla
     )
 
 
-def _as_grid(space: SearchSpace, prefix: str = "") -> dict[str, list[Any]]:
+def as_grid(space: SearchSpace, prefix: str = "") -> dict[str, list[Any]]:
+    """A search space as scikit-learn's searches take it, each name after ``prefix``
+    (``"classifier__"`` for the parameters of a catalogue pipeline's estimator)."""
     return {prefix + name: list(values) for name, values in space.items()}
 
 
