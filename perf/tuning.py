@@ -14,7 +14,10 @@ as a multiple of the default (the goal: under 10x at the default budget) and the
 cost as a multiple of the halving search.
 
     .venv/bin/python perf/tuning.py [--classifiers svm-rbf,logistic,ibk5-std] [--folds 5]
-        [--budget MINUTES] [--robot mini]
+        [--budget MINUTES] [--robot mini] [--grid-max 100]
+
+Everything runs single-threaded (as the engine's workers do); grids larger than
+``--grid-max`` settings are not searched in full (their columns print ``nan``).
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ import numpy as np
 from sklearn.base import clone
 from sklearn.metrics import f1_score
 from sklearn.model_selection import GridSearchCV, ParameterGrid, StratifiedKFold
+from threadpoolctl import threadpool_limits
 
 from benchmark.catalogue import build_pipeline, get_spec
 from benchmark.catalogue.tuning import (
@@ -67,8 +71,17 @@ def main() -> None:
     parser.add_argument("--folds", type=int, default=5)
     parser.add_argument("--budget", type=float, default=None, help="minutes (default: bench's)")
     parser.add_argument("--robot", default="mini")
+    parser.add_argument(
+        "--grid-max", type=int, default=100, help="skip full grids larger than this"
+    )
     args = parser.parse_args()
     warnings.simplefilter("ignore")
+    with threadpool_limits(limits=1):  # single-threaded, as the engine's workers run
+        compare(args)
+
+
+def compare(args: argparse.Namespace) -> None:
+    """Print the table for ``args.classifiers``."""
     X, y = load(args.robot)
     outer = list(StratifiedKFold(args.folds, shuffle=True, random_state=0).split(X, y))
     print(f"{args.robot} gesture: {len(y)} instances, {args.folds} outer folds, inner 3-fold")
@@ -95,6 +108,8 @@ def main() -> None:
             tuner = halving[-1]
             assert isinstance(tuner, TunedClassifier)
             candidates.append(tuner.n_candidates_)
+            if size > args.grid_max:
+                continue
             search = GridSearchCV(
                 clone(default),
                 grid,
@@ -103,7 +118,10 @@ def main() -> None:
                 error_score=np.nan,
             )
             rows["grid"].append(timed_fold(search, X, y, train, test))
-        mean = {name: np.mean(values, axis=0) for name, values in rows.items()}
+        mean = {
+            name: np.mean(values, axis=0) if values else np.full(2, np.nan)
+            for name, values in rows.items()
+        }
         print(
             f"{classifier:<10} {size:>5} | {mean['default'][0]:>10.4f} {mean['default'][1]:>7.2f} "
             f"| {mean['halving'][0]:>10.4f} {mean['halving'][1]:>7.2f} "

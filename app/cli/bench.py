@@ -264,7 +264,7 @@ def bench_command(
                 "With --tune: wall minutes each tuned twin's search may plan for in one outer "
                 "fold (0 < MINUTES <= 1440). Its cost is estimated from two timed fits of "
                 "the default setting and the first halving round gets as many candidates "
-                "(3, 9, 27, ...) as fit. Default: about 8 fits of the default setting on the "
+                "(3, 9, 27, ...) as fit. Default: about 6 fits of the default setting on the "
                 "whole training fold."
             ),
             show_default=False,
