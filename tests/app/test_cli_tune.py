@@ -26,7 +26,7 @@ def test_tuned_twins_sit_beside_their_defaults_with_a_test_and_their_choices(
     capsys: pytest.CaptureFixture[str], db: str
 ) -> None:
     args = ["bench", "touch", "--target", "gesture", "-c", "logistic,nb", "-k", "3"]
-    result = run_cli(capsys, db, *args, "--tune", "--budget", "0.05", "--json")
+    result = run_cli(capsys, db, *args, "--tune", "--budget", "0.01", "--json")
     assert result.code == 0, result.err
     report = result.json()
     rows = {row["classifier"]: row for row in report["leaderboard"]}

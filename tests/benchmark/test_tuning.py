@@ -76,7 +76,7 @@ def test_nested_search_never_fits_on_the_outer_test_fold(kind: str) -> None:
     spec = (
         tuned_spec(SPY, budget_minutes=0.05)
         if kind == "tuned"
-        else stacked_spec([SPY, tuned_spec(SPY), get_spec("nb-gaussian")], 2)
+        else stacked_spec([SPY, tuned_spec(SPY, 0.005), get_spec("nb-gaussian")], 2)
     )
     context = TaskContext(problem, {spec.id: spec, SPY.id: SPY}, [fold], random_state=0)
     RowSpy.seen.clear()
