@@ -12,7 +12,13 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from benchmark.catalogue import CATALOGUE, ClassifierSpec, build_pipeline, check_sequence_input
+from benchmark.catalogue import (
+    CATALOGUE,
+    ClassifierSpec,
+    build_pipeline,
+    check_sequence_input,
+    get_spec,
+)
 from benchmark.catalogue import unknown_classifier_message as _unknown_message
 from benchmark.errors import ConfigurationError
 from benchmark.problem import Problem
@@ -39,7 +45,7 @@ def reads_sequences(classifier_id: str) -> bool:
         from benchmark.multitarget import parse_config
 
         _, base = parse_config(classifier_id)
-        return bool(base) and CATALOGUE[base].needs_sequence
+        return bool(base) and get_spec(base).needs_sequence
     return classifier_spec(classifier_id).needs_sequence
 
 
@@ -53,10 +59,13 @@ def classifier_spec(
     ConfigurationError
         Unknown id, naming the closest known one.
     """
-    known = {**CATALOGUE, **(extra_specs or {})}
-    if classifier_id not in known:
-        raise ConfigurationError(_unknown_message(classifier_id, known))
-    return known[classifier_id]
+    from benchmark.catalogue.tuning import is_tuned_id
+
+    if extra_specs and classifier_id in extra_specs:
+        return extra_specs[classifier_id]
+    if classifier_id in CATALOGUE or is_tuned_id(classifier_id):
+        return get_spec(classifier_id)
+    raise ConfigurationError(_unknown_message(classifier_id, {**CATALOGUE, **(extra_specs or {})}))
 
 
 def check_classifier(
@@ -100,7 +109,7 @@ def check_classifier(
         _, base = parse_config(classifier_id)
         check_targets(classifier_id, problem.n_classes, problem.target_names)
         if base:
-            check_sequence_input(CATALOGUE[base], problem.sequence)
+            check_sequence_input(classifier_spec(base, extra_specs), problem.sequence)
         return None
     spec = classifier_spec(classifier_id, extra_specs)
     check_sequence_input(spec, problem.sequence)
@@ -160,4 +169,5 @@ def build_estimator(
         random_state=random_state,
         n_classes=problem.n_classes,
         sequence=problem.sequence,
+        extra_specs=extra_specs,
     )

@@ -53,6 +53,9 @@ class TaskResult:
         Distinct warnings the classifier emitted (convergence...), at most five.
     per_target : dict or None
         Multi-target: scores per target name.
+    params : dict or None
+        What the classifier chose on its training fold (a tuned twin's parameters, a
+        stack's members), JSON-ready; ``None`` for a classifier that chooses nothing.
     """
 
     key: TaskKey
@@ -64,6 +67,7 @@ class TaskResult:
     n_test: int
     warnings: list[str] = field(default_factory=list)
     per_target: dict[str, dict[str, float]] | None = None
+    params: dict[str, Any] | None = None
 
     @property
     def ok(self) -> bool:
@@ -88,6 +92,7 @@ class TaskResult:
                 target: {name: _json_number(v) for name, v in scores.items()}
                 for target, scores in self.per_target.items()
             },
+            "params": self.params,
         }
 
     @classmethod
@@ -108,6 +113,7 @@ class TaskResult:
                 target: {name: _from_json_number(v) for name, v in scores.items()}
                 for target, scores in per_target.items()
             },
+            params=data.get("params"),  # absent from results stored before tuning existed
         )
 
 

@@ -11,6 +11,7 @@ from app.cli.output import EXIT_FAILED, EXIT_INTERRUPTED, ExitWith, info, print_
 from app.cli.state import get_state
 
 if TYPE_CHECKING:
+    from app.schemas.runs import LeaderboardSchema
     from app.services.runs import IndependentResult
     from app.store.database import Store
     from app.store.runs import RunInfo
@@ -92,6 +93,7 @@ def classifiers_command(
                         "cost": s.cost,
                         "suites": sorted(s.suites),
                         "limits": s.limits,
+                        "search_space": s.to_json()["search_space"],
                     }
                     for s in specs
                 ]
@@ -273,6 +275,46 @@ def bench_command(
             show_default=False,
         ),
     ] = None,
+    tune: Annotated[
+        bool,
+        typer.Option(
+            "--tune",
+            help=(
+                "Add a tuned twin (ID+tuned) of every classifier that declares a search space: "
+                "successive halving with a 3-fold inner CV of each outer training fold only "
+                "(nested CV); the leaderboard compares each twin with its default."
+            ),
+        ),
+    ] = False,
+    budget: Annotated[
+        float | None,
+        typer.Option(
+            "--budget",
+            metavar="MINUTES",
+            help=(
+                "With --tune: wall minutes each tuned twin's search may plan for in one outer "
+                "fold (0 < MINUTES <= 1440). Its cost is estimated from two timed fits of "
+                "the default setting and the first halving round gets as many candidates "
+                "(3, 9, 27, ...) as fit. Default: about 6 fits of the default setting on the "
+                "whole training fold."
+            ),
+            show_default=False,
+        ),
+    ] = None,
+    stack: Annotated[
+        int | None,
+        typer.Option(
+            "--stack",
+            metavar="TOP_N",
+            help=(
+                "Add stack-topN (1 <= N <= 20, one target): in each outer training fold the N "
+                "classifiers of the run best by a 3-fold inner CV, stacked by logistic "
+                "regression. Costs about 2 fits of every classifier of the run (each at its "
+                "own cost, a tuned twin with its search) plus N refits, per outer fold."
+            ),
+            show_default=False,
+        ),
+    ] = None,
     independent: Annotated[
         bool,
         typer.Option(
@@ -319,6 +361,8 @@ def bench_command(
     if position is not None and resume is not None:
         raise typer.BadParameter("--position is kept by the run; drop it with --resume")
     coordinates = [p.strip() for p in position.split(",") if p.strip()] if position else []
+    if independent and (tune or stack is not None):
+        raise typer.BadParameter("--tune and --stack work on one run; drop --independent")
     ids = [c.strip() for c in classifiers.split(",") if c.strip()] if classifiers else None
     options = RunOptions(
         folds=folds, repeats=repeats, seed=seed, timeout=timeout or None, max_memory_mb=max_memory
@@ -354,6 +398,9 @@ def bench_command(
             weka=weka or (),
             position=coordinates,
             metric=metric,
+            tune=tune,
+            budget=budget,
+            stack=stack,
         ).id
     try:
         with progress:
@@ -425,6 +472,7 @@ def _print_run_report(
         print_json(report.to_json())
         return
     _print_leaderboard(run, board)
+    _print_tuning(report)
 
 
 def runs_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
@@ -507,6 +555,61 @@ def leaderboard_command(
         write_results_arff(store, run, sys.stdout)
     else:
         _print_leaderboard(run, board)
+        _print_tuning(report)
+
+
+def _print_tuning(report: LeaderboardSchema) -> None:
+    """Tuned twins beside their defaults, then what each fold chose (nothing without any)."""
+    if report.tuning:
+        table(
+            f"tuned against default ({report.tuning[0].metric}, corrected resampled t-test, "
+            "alpha 0.05; v tuned significantly better, * worse)",
+            ["tuned", "default", "default mean", "tuned mean", "difference", "p", "", "folds"],
+            [
+                (
+                    c.tuned,
+                    c.default,
+                    _number(c.default_mean),
+                    _number(c.tuned_mean),
+                    _number(
+                        None
+                        if c.tuned_mean is None or c.default_mean is None
+                        else c.tuned_mean - c.default_mean,
+                        signed=True,
+                    ),
+                    _number(c.p),
+                    c.mark,
+                    c.n_folds,
+                )
+                for c in report.tuning
+            ],
+        )
+    if report.choices:
+        table(
+            "chosen in each outer training fold (inner cross-validation only)",
+            ["classifier", "repeat", "fold", "chosen"],
+            [
+                (
+                    c.classifier,
+                    c.repeat + 1,
+                    c.fold + 1,
+                    ", ".join(f"{name}={_short(value)}" for name, value in c.params.items()),
+                )
+                for c in report.choices
+            ],
+        )
+
+
+def _number(value: float | None, *, signed: bool = False) -> str:
+    if value is None:
+        return ""
+    return f"{value:+.4f}" if signed else f"{value:.4f}"
+
+
+def _short(value: object) -> str:
+    if isinstance(value, list):
+        return "[" + " ".join(_short(v) for v in value) + "]"
+    return f"{value:g}" if isinstance(value, float) else str(value)
 
 
 def _print_independent(result: IndependentResult, as_json: bool) -> None:

@@ -20,9 +20,9 @@ def write_results_arff(store: Store, run: RunInfo, stream: TextIO) -> None:
             f"run {run.id} is {what}; WEKA's results format holds multi-class runs "
             "(use --format csv or json)"
         )
-    from app.services.runs import weka_specs
+    from app.services.tuning import run_specs
 
     results = load_results(store, run.id)
     name = f"{run.dataset_name}: {', '.join(run.targets)}"
-    specs = {**CATALOGUE, **weka_specs(run.config.get("weka") or {})}
+    specs = {**CATALOGUE, **run_specs(run.config, run.classifiers)}
     write_arff(results_to_dataset(results, dataset_name=name, specs=specs), stream)

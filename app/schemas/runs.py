@@ -88,6 +88,31 @@ class MarkSummary(Schema):
     worse: int
 
 
+class FoldChoiceSchema(Schema):
+    """What a tuned twin or a stack chose on one outer training fold."""
+
+    classifier: str
+    repeat: int
+    fold: int
+    params: dict[str, Any]
+
+
+class TunedComparisonSchema(Schema):
+    """A tuned twin beside its default: means over the folds both completed, and the
+    corrected resampled t-test of tuned against default."""
+
+    tuned: str
+    default: str
+    metric: str
+    tuned_mean: float | None
+    default_mean: float | None
+    n_folds: int
+    t: float | None
+    p: float | None
+    mark: Literal["v", "*", ""] = Field(description="v: tuned significantly better; *: worse.")
+    choices: list[FoldChoiceSchema]
+
+
 class LeaderboardSchema(Schema):
     """A run's ranked classifiers with WEKA's significance marks."""
 
@@ -108,3 +133,10 @@ class LeaderboardSchema(Schema):
     baseline: str | None = Field(description="The classifier the marks compare against.")
     summary: MarkSummary
     leaderboard: list[LeaderboardRowSchema]
+    tuning: list[TunedComparisonSchema] = Field(
+        default_factory=list, description="Tuned twins against their defaults (bench --tune)."
+    )
+    choices: list[FoldChoiceSchema] = Field(
+        default_factory=list,
+        description="What each tuned twin and stack chose per fold (bench --tune/--stack).",
+    )

@@ -17,7 +17,15 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from app.errors import AppError
-from app.schemas.runs import LeaderboardRowSchema, LeaderboardSchema, MarkSummary, RunStatus
+from app.schemas.runs import (
+    FoldChoiceSchema,
+    LeaderboardRowSchema,
+    LeaderboardSchema,
+    MarkSummary,
+    RunStatus,
+    TunedComparisonSchema,
+)
+from app.services.tuning import run_specs
 from app.store.database import Store
 from app.store.datasets import find_dataset, load_dataset, load_schema
 from app.store.ownership import process_owner
@@ -217,6 +225,9 @@ def create_run(
     weka: Sequence[str] = (),
     position: Sequence[str] = (),
     metric: str | None = None,
+    tune: bool = False,
+    budget: float | None = None,
+    stack: int | None = None,
 ) -> RunInfo:
     """Check a benchmark request and store it as a ``queued`` run.
 
@@ -271,7 +282,22 @@ def create_run(
             regression_size=problem.n_instances if problem.kind == "regression" else None,
         )
     ids = list(dict.fromkeys([*ids, *commands]))
-    check_classifiers(problem, ids, commands)
+    if budget is not None and not tune:
+        raise ConfigurationError("--budget bounds the tuning: give --tune as well")
+    if (tune or stack is not None) and problem.kind == "regression":
+        raise ConfigurationError(
+            "--tune and --stack work on classification runs; the targets here are numeric"
+        )
+    if tune:
+        from app.services.tuning import with_tuned_twins
+
+        ids = with_tuned_twins(ids, commands, budget)
+    if stack is not None:
+        from app.services.tuning import add_stack
+
+        ids = add_stack(ids, stack, multitarget=problem.kind == "multitarget")
+    extra = run_specs(_tuning_config(commands, tune, budget, stack), ids)
+    check_classifiers(problem, ids, extra)
     plan = _folds(prepared, options)
     folds, fold_notes = plan.folds, plan.notes
     effective = max(f.fold for f in folds) + 1
@@ -281,7 +307,7 @@ def create_run(
         "folds_requested": options.folds,
         "targets_given": list(targets) if targets else None,
         "suite": None if classifiers or weka else (suite or "default"),
-        "weka": {spec_id: spec.weka_command for spec_id, spec in commands.items()},
+        **_tuning_config(commands, tune, budget, stack),
         "n_tasks": len(ids) * len(folds),
         "n_instances": int(prepared.problem.X.shape[0]),
         "grouped": prepared.problem.groups is not None,
@@ -370,7 +396,7 @@ def execute_run(
                 on_result=persist,
                 max_memory=_bytes(options.max_memory_mb),
                 stop=stop.is_set,
-                extra_specs=weka_specs(run.config.get("weka") or {}),
+                extra_specs=run_specs(run.config, run.classifiers),
             )
         except RunStopped:
             finish_run(store, run.id, "cancelled")
@@ -502,8 +528,11 @@ def leaderboard_schema(
 ) -> tuple[RunInfo, Leaderboard, LeaderboardSchema]:
     """A run's leaderboard, and the report ``leaderboard --json`` prints and the API serves
     (multi-target rows carry ``metrics.per_target``)."""
+    from benchmark.evaluation.tuned import compare_tuned, fold_choices
+
     run, board = run_leaderboard(store, run_id, metric=metric, baseline=baseline)
-    per_target = per_target_summary(load_results(store, run.id))
+    results = load_results(store, run.id)
+    per_target = per_target_summary(results)
     data = board.to_json()
     for row in data["leaderboard"]:
         targets = per_target.get(row["classifier"])
@@ -524,6 +553,11 @@ def leaderboard_schema(
         baseline=data["baseline"],
         summary=MarkSummary(**data["summary"]),
         leaderboard=[LeaderboardRowSchema(**row) for row in data["leaderboard"]],
+        tuning=[
+            TunedComparisonSchema(**c.to_json())
+            for c in compare_tuned(results, metric=board.metric, alpha=board.alpha)
+        ],
+        choices=[FoldChoiceSchema(**c.to_json()) for c in fold_choices(results)],
     )
     return run, board, report
 
@@ -683,6 +717,17 @@ def _outcome(results: Sequence[TaskResult]) -> tuple[RunStatus, str | None]:
         reasons[reason] = reasons.get(reason, 0) + 1
     common = max(reasons, key=lambda reason: reasons[reason])
     return "failed", (f"all {len(results)} tasks failed; most often ({reasons[common]}x): {common}")
+
+
+def _tuning_config(
+    commands: Mapping[str, ClassifierSpec], tune: bool, budget: float | None, stack: int | None
+) -> dict[str, Any]:
+    """The parts of a run's config that say how to build its extra specs again."""
+    return {
+        "weka": {spec_id: spec.weka_command for spec_id, spec in commands.items()},
+        "tune": {"budget_minutes": budget} if tune else None,
+        "stack": stack,
+    }
 
 
 def _check_options(options: RunOptions) -> None:

@@ -30,6 +30,8 @@ from benchmark.results import TaskKey, TaskResult
 
 #: Multi-target folds keep their per-target scores in the metrics column under this key.
 PER_TARGET = "per_target"
+#: Key of a result's chosen parameters inside its stored metrics (absent before tuning).
+PARAMS = "params"
 #: Seconds between heartbeats of the process executing a run.
 HEARTBEAT_INTERVAL = 5.0
 
@@ -248,11 +250,7 @@ def record_result(store: Store, run_id: int, result: TaskResult) -> None:
         "fold": result.key.fold,
         "status": result.status,
         "error": result.error,
-        "metrics": (
-            {**result.metrics, PER_TARGET: result.per_target}
-            if result.per_target
-            else result.metrics
-        ),
+        "metrics": _stored_metrics(result),
         "confusion": result.confusion,
         "n_train": result.n_train,
         "n_test": result.n_test,
@@ -299,6 +297,7 @@ def load_results(store: Store, run_id: int) -> list[TaskResult]:
         for classifier, repeat, fold, status, error, stored, confusion, n_train, n_test in rows:
             metrics = dict(stored)
             per_target = metrics.pop(PER_TARGET, None)
+            params = metrics.pop(PARAMS, None)
             results.append(
                 TaskResult(
                     key=TaskKey(classifier, repeat, fold),
@@ -309,9 +308,20 @@ def load_results(store: Store, run_id: int) -> list[TaskResult]:
                     n_train=n_train,
                     n_test=n_test,
                     per_target=per_target,
+                    params=params,
                 )
             )
         return results
+
+
+def _stored_metrics(result: TaskResult) -> dict[str, Any]:
+    """The metrics column: scores, and per-target scores and chosen parameters when any."""
+    stored: dict[str, Any] = dict(result.metrics)
+    if result.per_target:
+        stored[PER_TARGET] = result.per_target
+    if result.params is not None:
+        stored[PARAMS] = result.params
+    return stored
 
 
 def _keys(session: Session, run_id: int) -> set[tuple[str, int, int]]:

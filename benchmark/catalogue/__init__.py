@@ -18,15 +18,18 @@ from types import MappingProxyType
 
 from sklearn.pipeline import Pipeline
 
-from benchmark.catalogue.entries import SPECS
+from benchmark.catalogue.entries import SPECS as _ENTRIES
 from benchmark.catalogue.pipeline import check_sequence_input, pipeline_for_spec
+from benchmark.catalogue.spaces import SEARCH_SPACES
 from benchmark.catalogue.spec import ClassifierSpec
+from benchmark.catalogue.tuning import TUNED_SUFFIX, is_tuned_id, tuned_spec
 from benchmark.catalogue.weka_schemes import scheme_for, split_command
 from benchmark.errors import ConfigurationError
 from benchmark.sequence import SequenceLayout
 
 __all__ = [
     "CATALOGUE",
+    "SEARCH_SPACES",
     "SUITES",
     "ClassifierSpec",
     "build_pipeline",
@@ -36,18 +39,26 @@ __all__ = [
     "suite",
 ]
 
+SPECS: tuple[ClassifierSpec, ...] = tuple(
+    replace(spec, search_space=SEARCH_SPACES[spec.id]) if spec.id in SEARCH_SPACES else spec
+    for spec in _ENTRIES
+)
 CATALOGUE: Mapping[str, ClassifierSpec] = MappingProxyType({spec.id: spec for spec in SPECS})
 SUITES: tuple[str, ...] = ("fast", "default", "all")
 
 
 def get_spec(classifier_id: str) -> ClassifierSpec:
-    """The catalogue entry called ``classifier_id``.
+    """The catalogue entry called ``classifier_id``; ``ID+tuned`` is the tuned twin of ``ID``
+    at the default budget.
 
     Raises
     ------
     ConfigurationError
-        For an unknown id, naming the closest known one.
+        For an unknown id, naming the closest known one; a tuned twin of an entry without
+        a search space.
     """
+    if is_tuned_id(classifier_id):
+        return tuned_spec(get_spec(classifier_id.removesuffix(TUNED_SUFFIX)))
     try:
         return CATALOGUE[classifier_id]
     except KeyError:

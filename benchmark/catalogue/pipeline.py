@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import Any
 
+from sklearn.base import BaseEstimator
 from sklearn.pipeline import Pipeline
 
 from benchmark.catalogue.spec import ClassifierSpec
@@ -49,6 +51,15 @@ def pipeline_for_spec(
         integer labels y of shape (n_samples,).
     """
     check_sequence_input(spec, sequence)
+    options = {
+        "nominal_features": nominal_features,
+        "n_features": n_features,
+        "random_state": random_state,
+        "sequence": sequence,
+    }
+    if spec.tuning is not None or spec.stacking is not None:
+        # the preprocessing lives inside each candidate, learnt on inner training folds
+        return Pipeline([("preprocess", "passthrough"), ("classifier", _composite(spec, options))])
     nominal = dict(nominal_features or {})
     estimator = spec.make_estimator()
     takes_labels = "nominal_features" in estimator.get_params(deep=False)
@@ -82,6 +93,26 @@ def pipeline_for_spec(
             sequence=(sequence.start - moved, sequence.n_channels, sequence.length)
         )
     return Pipeline([("preprocess", preprocessor), ("classifier", estimator)])
+
+
+def _composite(spec: ClassifierSpec, options: dict[str, Any]) -> BaseEstimator:
+    """The tuned twin's search, or the stack, over whole member pipelines."""
+    from benchmark.catalogue.stacking import SelectedStack
+    from benchmark.catalogue.tuning import CLASSIFIER_STEP, TunedClassifier, as_grid
+
+    if spec.tuning is not None:
+        base = spec.tuning.base
+        assert base.search_space is not None
+        budget = spec.tuning.budget_minutes
+        return TunedClassifier(
+            pipeline_for_spec(base, **options),
+            space=as_grid(base.search_space, f"{CLASSIFIER_STEP}__"),
+            budget=None if budget is None else budget * 60.0,
+            random_state=options["random_state"],
+        )
+    assert spec.stacking is not None
+    members = [(m.id, pipeline_for_spec(m, **options)) for m in spec.stacking.members]
+    return SelectedStack(members, spec.stacking.top_n, random_state=options["random_state"])
 
 
 def check_sequence_input(spec: ClassifierSpec, sequence: SequenceLayout | None) -> None:

@@ -11,6 +11,41 @@ from sklearn.base import BaseEstimator
 Cost = Literal["fast", "slow"]
 Scaling = Literal["standard", "minmax"]
 
+#: Estimator parameter (as ``get_params(deep=True)`` names it) to the values to try.
+SearchSpace = Mapping[str, tuple[Any, ...]]
+
+
+@dataclass(frozen=True)
+class Tuning:
+    """How a tuned twin is made: its entry's search space, searched within each training fold.
+
+    Parameters
+    ----------
+    base : ClassifierSpec
+        The entry tuned (its ``search_space`` is searched).
+    budget_minutes : float or None
+        Minutes the search may plan for in one training fold; ``None``: about
+        :data:`benchmark.catalogue.tuning.DEFAULT_FITS` fits of the default setting.
+    """
+
+    base: ClassifierSpec
+    budget_minutes: float | None = None
+
+
+@dataclass(frozen=True)
+class Stacking:
+    """How a stack is made: the members it may choose from and how many it keeps.
+
+    Parameters
+    ----------
+    members : tuple of ClassifierSpec
+        Candidates; each training fold keeps the ``top_n`` best by inner cross-validation.
+    top_n : int
+    """
+
+    members: tuple[ClassifierSpec, ...]
+    top_n: int
+
 
 @dataclass(frozen=True)
 class ClassifierSpec:
@@ -56,6 +91,14 @@ class ClassifierSpec:
         ``None`` for a classifier of flat feature vectors; otherwise it reads a sequence
         data set's windows (:mod:`benchmark.sequence`) through its ``sequence`` parameter,
         and needs at least this many time steps per channel.
+    search_space : mapping of str to tuple, or None
+        Values to try per estimator parameter (names as the estimator's
+        ``get_params(deep=True)`` gives them), for ``bench --tune``
+        (:mod:`benchmark.catalogue.spaces`).
+    tuning : Tuning or None
+        Set on a tuned twin (``rf+tuned``): the pipeline searches ``tuning.base``'s space.
+    stacking : Stacking or None
+        Set on a stack (``stack-top3``): the pipeline stacks the best of its members.
     """
 
     id: str
@@ -73,6 +116,9 @@ class ClassifierSpec:
     limits: str = ""
     scaling: Scaling = "standard"
     min_sequence: int | None = None
+    search_space: SearchSpace | None = None
+    tuning: Tuning | None = None
+    stacking: Stacking | None = None
 
     @property
     def needs_sequence(self) -> bool:
@@ -103,7 +149,7 @@ class ClassifierSpec:
             "family": self.family,
             "description": self.description,
             "estimator": f"{self.factory.__module__}.{self.factory.__qualname__}",
-            "params": {name: _jsonable(value) for name, value in self.params.items()},
+            "params": {name: jsonable(value) for name, value in self.params.items()},
             "probabilities": self.probabilities,
             "needs_scaling": self.needs_scaling,
             "scaling": self.scaling if self.needs_scaling else None,
@@ -113,6 +159,9 @@ class ClassifierSpec:
             "suites": sorted(self.suites | {"all"}),
             "limits": self.limits,
             "min_sequence": self.min_sequence,
+            "search_space": None
+            if self.search_space is None
+            else {name: jsonable(values) for name, values in self.search_space.items()},
         }
 
 
@@ -154,9 +203,13 @@ def make_spec(
     )
 
 
-def _jsonable(value: Any) -> Any:
+def jsonable(value: Any) -> Any:
+    """``value`` as JSON holds it: numbers, strings and lists as they are (numpy scalars as
+    Python ones), anything else as its ``repr``."""
     if value is None or isinstance(value, bool | int | float | str):
         return value
+    if hasattr(value, "item") and getattr(value, "ndim", None) == 0:  # numpy scalars
+        return jsonable(value.item())
     if isinstance(value, list | tuple):
-        return [_jsonable(v) for v in value]
+        return [jsonable(v) for v in value]
     return repr(value)

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any
 
-from benchmark.catalogue import build_pipeline, get_spec
+from benchmark.catalogue import ClassifierSpec, build_pipeline, get_spec
 from benchmark.errors import ConfigurationError
 from benchmark.multitarget._base import MultiTargetClassifier
 from benchmark.multitarget._targets import all_binary
@@ -309,6 +309,7 @@ def build_multitarget(
     random_state: int | None = 0,
     n_classes: Sequence[int] | None = None,
     sequence: SequenceLayout | None = None,
+    extra_specs: Mapping[str, ClassifierSpec] | None = None,
 ) -> MultiTargetClassifier:
     """A fresh, unfitted estimator for a configuration id.
 
@@ -328,6 +329,8 @@ def build_multitarget(
     sequence : SequenceLayout or None
         Where a sequence data set's windows lie among the feature columns, for a
         sequence classifier as the base.
+    extra_specs : mapping of str to ClassifierSpec, optional
+        Base specs outside the catalogue (a run's tuned twins at its budget), by id.
 
     Returns
     -------
@@ -342,7 +345,7 @@ def build_multitarget(
     spec = META_METHODS[meta]
     nominal = {} if nominal_features is None else dict(nominal_features)
     pipeline = build_pipeline(
-        base or PREPROCESSING_SOURCE,
+        (extra_specs or {}).get(base) or base or PREPROCESSING_SOURCE,
         nominal_features=nominal,
         n_features=n_features,
         random_state=random_state,

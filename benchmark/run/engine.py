@@ -181,7 +181,8 @@ def plan_tasks(
     Returns
     -------
     specs : dict of str to ClassifierSpec
-        The multi-class specs the workers need (empty for multi-target problems).
+        The multi-class specs the workers need: the run's multi-class classifiers and
+        every extra spec.
     tasks : list of TaskKey
         Classifier-major, without the keys in ``skip``.
     """
@@ -190,7 +191,8 @@ def plan_tasks(
         raise ConfigurationError("no classifiers to run")
     if not folds:
         raise ConfigurationError("no folds to run the classifiers on")
-    specs: dict[str, ClassifierSpec] = {}
+    # extra specs travel too: a multi-target configuration may take one as its base
+    specs: dict[str, ClassifierSpec] = dict(extra_specs or {})
     for classifier in ids:
         spec = check_classifier(classifier, problem, extra_specs)
         if spec is not None:

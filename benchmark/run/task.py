@@ -14,10 +14,12 @@ import traceback
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from benchmark.catalogue import ClassifierSpec
+from benchmark.catalogue.spec import jsonable
 from benchmark.estimators import build_estimator
 from benchmark.evaluation.metrics import confusion_matrix, expand_proba, multiclass_scores
 from benchmark.problem import Problem
@@ -115,7 +117,16 @@ def _run_multiclass(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResul
     predict_time, predict_cpu = timer.lap()
     scores, confusion = multiclass_scores(y[fold.test], y_pred, proba, n_classes=n_classes)
     scores.update(_costs(fit_time, fit_cpu, predict_time, predict_cpu, model))
-    return TaskResult(key, "ok", None, scores, confusion, int(fold.train.size), int(fold.test.size))
+    return TaskResult(
+        key,
+        "ok",
+        None,
+        scores,
+        confusion,
+        int(fold.train.size),
+        int(fold.test.size),
+        params=chosen_params(model),
+    )
 
 
 def _run_regression(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResult:
@@ -152,7 +163,9 @@ def _run_multitarget(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResu
     from benchmark.multitarget import multitarget_scores
 
     problem = context.problem
-    model = build_estimator(key.classifier, problem, random_state=context.random_state)
+    model = build_estimator(
+        key.classifier, problem, random_state=context.random_state, extra_specs=context.specs
+    )
     timer = _Timer()
     model.fit(problem.X[fold.train], problem.Y[fold.train])
     fit_time, fit_cpu = timer.lap()
@@ -192,6 +205,23 @@ def _run_multitarget(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResu
         int(fold.test.size),
         per_target=per_target,
     )
+
+
+def chosen_params(model: object) -> dict[str, Any] | None:
+    """What a tuned twin or a stack chose on its training fold, as JSON-ready data.
+
+    Returns
+    -------
+    dict or None
+        The final step's ``best_params_`` (values that JSON cannot hold as their ``repr``);
+        ``None`` for a classifier that chooses nothing.
+    """
+    steps = getattr(model, "steps", None)
+    final = steps[-1][1] if steps else model
+    chosen = getattr(final, "best_params_", None)
+    if not isinstance(chosen, dict):
+        return None
+    return {str(name): jsonable(value) for name, value in chosen.items()}
 
 
 class _Timer:

@@ -43,6 +43,15 @@ class RunRequest(Schema):
     seed: int = Field(default=0, ge=0, le=2**31 - 1)
     timeout: float | None = Field(default=600.0, gt=0, le=7 * 24 * 3600)
     max_memory_mb: float | None = Field(default=None, gt=0)
+    tune: bool = Field(
+        default=False, description="Add tuned twins (ID+tuned), searched inside each fold."
+    )
+    budget: float | None = Field(
+        default=None, description="With tune: minutes per tuned twin and outer fold."
+    )
+    stack: int | None = Field(
+        default=None, description="Add stack-topN over the run's N best by inner CV."
+    )
 
 
 @router.post("", status_code=status.HTTP_202_ACCEPTED, response_model=RunCreated)
@@ -63,6 +72,9 @@ def start_run(body: RunRequest, service: ServiceDep) -> RunCreated:
         ),
         weka=body.weka or (),
         position=body.position or (),
+        tune=body.tune,
+        budget=body.budget,
+        stack=body.stack,
     )
     service.dispatcher.wake()
     return RunCreated(id=run.id, status=run.status)

@@ -1,0 +1,104 @@
+"""A run's tuned twins (``bench --tune``) and stack (``bench --stack``): which ids they add,
+and the specs the engine needs to build them again from the run's stored config.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
+
+from benchmark.errors import ConfigurationError
+
+if TYPE_CHECKING:
+    from benchmark.catalogue import ClassifierSpec
+
+
+def with_tuned_twins(
+    ids: Sequence[str], extra_specs: Mapping[str, ClassifierSpec], budget_minutes: float | None
+) -> list[str]:
+    """``ids`` with each tunable one followed by its tuned twin (``rf``, ``rf+tuned``).
+
+    A multi-target configuration ``META:BASE`` is tunable when its base is.
+
+    Raises
+    ------
+    ConfigurationError
+        No id of the run declares a search space; a budget out of range.
+    """
+    from benchmark.catalogue import SEARCH_SPACES
+    from benchmark.catalogue.tuning import check_budget, is_tuned_id, tuned_id, tuned_spec
+    from benchmark.estimators import classifier_spec, is_multitarget_id
+
+    check_budget(budget_minutes)
+    out: list[str] = []
+    for classifier in ids:
+        out.append(classifier)
+        if is_tuned_id(classifier):
+            continue
+        meta, _, base = classifier.rpartition(":")
+        if is_multitarget_id(classifier) and not meta:
+            continue  # a META without a base (``lc``): nothing to tune
+        spec = classifier_spec(base, extra_specs)
+        if spec.search_space:
+            tuned_spec(spec, budget_minutes)  # a space its estimator refuses fails here
+            out.append(f"{meta}:{tuned_id(base)}" if meta else tuned_id(base))
+    if len(out) == len(ids):
+        raise ConfigurationError(
+            "--tune: no classifier of this run declares a search space (those that do: "
+            f"{', '.join(SEARCH_SPACES)})"
+        )
+    return list(dict.fromkeys(out))
+
+
+def run_specs(config: Mapping[str, Any], classifiers: Sequence[str]) -> dict[str, ClassifierSpec]:
+    """Every spec outside the catalogue that a run's classifiers need, by id.
+
+    Parameters
+    ----------
+    config : mapping
+        The run's stored config: ``weka`` (id -> WEKA command), ``tune`` (``{"budget_minutes":
+        float or None}`` or absent) and ``stack`` (TOP_N or absent).
+    classifiers : sequence of str
+        The run's classifier ids.
+    """
+    from benchmark.catalogue import parse_weka_command
+    from benchmark.catalogue.stacking import stack_id, stacked_spec
+    from benchmark.catalogue.tuning import TUNED_SUFFIX, is_tuned_id, tuned_spec
+    from benchmark.estimators import classifier_spec
+
+    specs: dict[str, ClassifierSpec] = {}
+    for text in (config.get("weka") or {}).values():
+        if text:
+            spec = parse_weka_command(text)
+            specs[spec.id] = spec
+    tune = config.get("tune")
+    if tune is not None:
+        for classifier in classifiers:
+            base = classifier.rpartition(":")[2]
+            if is_tuned_id(base):
+                untuned = classifier_spec(base.removesuffix(TUNED_SUFFIX), specs)
+                specs[base] = tuned_spec(untuned, tune.get("budget_minutes"))
+    top_n = config.get("stack")
+    if top_n:
+        name = stack_id(int(top_n))
+        members = [classifier_spec(c, specs) for c in classifiers if c != name]
+        specs[name] = stacked_spec(members, int(top_n))
+    return specs
+
+
+def add_stack(ids: Sequence[str], top_n: int, *, multitarget: bool) -> list[str]:
+    """``ids`` and the stack over them.
+
+    Raises
+    ------
+    ConfigurationError
+        A multi-target run, or ``top_n`` out of range.
+    """
+    from benchmark.catalogue.stacking import check_top_n, stack_id
+
+    if multitarget:
+        raise ConfigurationError(
+            "--stack stacks multi-class classifiers: pick one target with --target NAME"
+        )
+    check_top_n(top_n, len(ids))
+    return [*ids, stack_id(top_n)]

@@ -1,0 +1,311 @@
+"""Tuned twins of catalogue entries: successive halving inside each training fold.
+
+``rf+tuned`` is ``rf`` whose parameters are chosen, in every outer training fold, by
+scikit-learn's successive halving search with an inner cross-validation of that fold
+only: nested cross-validation, so the outer test fold never takes part in the choice.
+
+The plan. Successive halving (``factor`` 3) starts all candidates on a small sample of the
+training rows and keeps the best third on three times the rows until the rows run out
+(``min_resources="exhaust"``). Its cost is estimated before it starts, from two timed
+fits and predictions of the default setting (on a 27th and a ninth of the rows:
+``a + b * rows`` seconds), and the first round gets the most candidates (3, 9, 27, ...)
+whose estimated search plus the final refit fits the budget: by default
+:data:`DEFAULT_FITS` fits of the default setting on all the training rows, or a number
+of minutes per outer fold (``bench --budget``).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+from sklearn.base import BaseEstimator, ClassifierMixin, clone
+from sklearn.experimental import enable_halving_search_cv  # noqa: F401 (enables the import)
+from sklearn.model_selection import (
+    HalvingGridSearchCV,
+    HalvingRandomSearchCV,
+    KFold,
+    ParameterGrid,
+    StratifiedKFold,
+)
+from sklearn.utils.metaestimators import available_if
+
+from benchmark.catalogue.spec import ClassifierSpec, SearchSpace, Tuning
+from benchmark.errors import ConfigurationError
+
+#: Suffix of a tuned twin's id: ``rf+tuned``.
+TUNED_SUFFIX = "+tuned"
+#: The default budget, in fits of the default setting on all the training rows.
+DEFAULT_FITS = 6.0
+#: Most candidates a budget may buy.
+MAX_CANDIDATES = 729
+#: Largest budget accepted, in minutes (per tuned entry and outer fold).
+MAX_BUDGET_MINUTES = 1440.0
+#: Step of the pipeline a space's parameters belong to.
+CLASSIFIER_STEP = "classifier"
+
+
+def tuned_id(classifier_id: str) -> str:
+    """``"rf"`` -> ``"rf+tuned"``."""
+    return classifier_id + TUNED_SUFFIX
+
+
+def is_tuned_id(classifier_id: str) -> bool:
+    """Whether ``classifier_id`` names a tuned twin."""
+    return classifier_id.endswith(TUNED_SUFFIX)
+
+
+def check_budget(budget_minutes: float | None) -> None:
+    """Refuse a budget outside (0, :data:`MAX_BUDGET_MINUTES`] minutes."""
+    if budget_minutes is None:
+        return
+    if not 0 < budget_minutes <= MAX_BUDGET_MINUTES:
+        raise ConfigurationError(
+            f"--budget must be more than 0 and at most {MAX_BUDGET_MINUTES:g} minutes, "
+            f"got {budget_minutes:g}"
+        )
+
+
+def check_search_space(spec: ClassifierSpec) -> None:
+    """Refuse a search space that names a parameter the entry's estimator does not have.
+
+    Raises
+    ------
+    ConfigurationError
+        One line naming the entry, the parameter and the closest parameters it has, or an
+        empty list of values.
+    """
+    if not spec.search_space:
+        return
+    estimator = spec.make_estimator()
+    known = estimator.get_params(deep=True)
+    for name, values in spec.search_space.items():
+        if name not in known:
+            import difflib
+
+            close = difflib.get_close_matches(name, list(known), n=3, cutoff=0.5)
+            hint = f"; did you mean {', '.join(close)}?" if close else ""
+            raise ConfigurationError(
+                f"search space of '{spec.id}' names '{name}', which "
+                f"{type(estimator).__name__} does not have{hint}"
+            )
+        if len(tuple(values)) == 0:
+            raise ConfigurationError(f"search space of '{spec.id}' gives no value for '{name}'")
+
+
+def tuned_spec(spec: ClassifierSpec, budget_minutes: float | None = None) -> ClassifierSpec:
+    """The tuned twin of an entry that declares a search space.
+
+    Raises
+    ------
+    ConfigurationError
+        The entry has no search space, its space names a parameter its estimator lacks,
+        or the budget is out of range.
+    """
+    if not spec.search_space:
+        raise ConfigurationError(
+            f"classifier '{spec.id}' declares no search space, so it has no tuned twin "
+            "(`touchbench classifiers --json` lists the spaces)"
+        )
+    check_search_space(spec)
+    check_budget(budget_minutes)
+    size = len(ParameterGrid(as_grid(spec.search_space)))
+    return replace(
+        spec,
+        id=tuned_id(spec.id),
+        weka_command=None,
+        description=f"{spec.description}; tuned in each training fold by successive "
+        f"halving over {size} settings",
+        cost="slow",
+        suites=frozenset(),
+        search_space=None,
+        tuning=Tuning(spec, budget_minutes),
+    )
+
+
+def as_grid(space: SearchSpace, prefix: str = "") -> dict[str, list[Any]]:
+    """A search space as scikit-learn's searches take it, each name after ``prefix``
+    (``"classifier__"`` for the parameters of a catalogue pipeline's estimator)."""
+    return {prefix + name: list(values) for name, values in space.items()}
+
+
+class TunedClassifier(ClassifierMixin, BaseEstimator):
+    """A classifier whose parameters successive halving chooses on its training data.
+
+    Parameters
+    ----------
+    estimator : estimator
+        The classifier (a pipeline) to tune; cloned, never fitted itself.
+    space : mapping of str to sequence
+        Parameter of ``estimator`` (``classifier__C``) to the values to try.
+    budget : float or None
+        Seconds the search may plan for; ``None`` for :data:`DEFAULT_FITS` default fits.
+    cv : int
+        Inner folds (stratified when every class has as many rows).
+    factor : int
+        Halving factor: each round keeps a 1/factor of the candidates on factor x the rows.
+    scoring : str
+        scikit-learn scorer name of the inner cross-validation.
+    random_state : int or None
+        Seed of the inner folds, the candidates drawn and the row samples.
+
+    Attributes
+    ----------
+    best_params_ : dict
+        The chosen setting, named as in the entry's search space.
+    best_estimator_ : estimator
+        ``estimator`` with ``best_params_``, refitted on all the training rows.
+    n_candidates_ : int
+        Settings of the first round.
+    classes_ : ndarray of shape (n_classes,)
+    """
+
+    def __init__(
+        self,
+        estimator: Any = None,
+        space: Mapping[str, Any] | None = None,
+        budget: float | None = None,
+        cv: int = 3,
+        factor: int = 3,
+        scoring: str = "f1_weighted",
+        random_state: int | None = None,
+    ) -> None:
+        self.estimator = estimator
+        self.space = space
+        self.budget = budget
+        self.cv = cv
+        self.factor = factor
+        self.scoring = scoring
+        self.random_state = random_state
+
+    def fit(self, X: np.ndarray, y: np.ndarray) -> TunedClassifier:
+        """Search the space with an inner cross-validation of ``(X, y)`` and refit the best.
+
+        Parameters
+        ----------
+        X : ndarray of shape (n_samples, n_features)
+        y : ndarray of shape (n_samples,)
+        """
+        y = np.asarray(y)
+        grid = {name: list(values) for name, values in (self.space or {}).items()}
+        size = len(ParameterGrid(grid))
+        inner = inner_folds(y, self.cv, self.random_state)
+        n_candidates = min(self._plan(X, y, size), size)
+        common: dict[str, Any] = {
+            "factor": self.factor,
+            "cv": inner,
+            "scoring": self.scoring,
+            "min_resources": "exhaust",
+            "random_state": self.random_state,
+            "error_score": np.nan,
+            "refit": True,
+        }
+        search: Any
+        if n_candidates >= size:
+            search = HalvingGridSearchCV(clone(self.estimator), grid, **common)
+        else:
+            search = HalvingRandomSearchCV(
+                clone(self.estimator), grid, n_candidates=n_candidates, **common
+            )
+        search.fit(X, y)
+        # the search object itself is not kept: its scorer and splitter make a stored model
+        # name types the model store does not trust, and it weighs more than the model
+        self.best_estimator_ = search.best_estimator_
+        self.best_params_ = {
+            name.split("__", 1)[1] if name.startswith(CLASSIFIER_STEP + "__") else name: value
+            for name, value in search.best_params_.items()
+        }
+        self.n_candidates_ = int(search.n_candidates_[0])
+        self.classes_ = self.best_estimator_.classes_
+        return self
+
+    def _plan(self, X: np.ndarray, y: np.ndarray, size: int) -> int:
+        """Candidates of the first round: the most (a power of ``factor``) whose estimated
+        cost fits the budget, at least ``factor``.
+
+        Costs are estimated as ``a + b * rows`` from two timed fits (and predictions) of
+        the default setting, on a 27th and a ninth of the rows; the default budget is
+        :data:`DEFAULT_FITS` fits on all the rows. Candidates may cost more than the
+        default setting (more trees, deeper), hence the margin below 10.
+        """
+        n = len(y)
+        cost = _fit_cost(self.estimator, X, y, self.random_state)
+        budget = DEFAULT_FITS * cost(n) if self.budget is None else self.budget
+        smallest = 2 * self.cv * len(np.unique(y))
+        chosen = self.factor
+        while chosen < min(size, MAX_CANDIDATES):
+            more = chosen * self.factor
+            if _search_cost(more, n, smallest, self.factor, self.cv, cost) + cost(n) > budget:
+                break
+            chosen = more
+        return chosen
+
+    def predict(self, X: np.ndarray) -> np.ndarray:
+        """Predictions of the refitted best setting, shape (n_samples,)."""
+        return np.asarray(self.best_estimator_.predict(X))
+
+    @available_if(lambda self: hasattr(_delegate(self), "predict_proba"))
+    def predict_proba(self, X: np.ndarray) -> np.ndarray:
+        """Class probabilities, shape (n_samples, n_classes)."""
+        return np.asarray(self.best_estimator_.predict_proba(X))
+
+    @available_if(lambda self: hasattr(_delegate(self), "decision_function"))
+    def decision_function(self, X: np.ndarray) -> np.ndarray:
+        """Decision values of the refitted best setting."""
+        return np.asarray(self.best_estimator_.decision_function(X))
+
+
+def inner_folds(y: np.ndarray, cv: int, seed: int | None) -> KFold | StratifiedKFold:
+    """Shuffled inner folds of a training fold, stratified when every class has ``cv`` rows."""
+    _, counts = np.unique(y, return_counts=True)
+    if counts.min() >= cv:
+        return StratifiedKFold(cv, shuffle=True, random_state=seed)
+    return KFold(cv, shuffle=True, random_state=seed)
+
+
+def _delegate(tuned: TunedClassifier) -> Any:
+    return getattr(tuned, "best_estimator_", tuned.estimator)
+
+
+def _fit_cost(
+    estimator: Any, X: np.ndarray, y: np.ndarray, seed: int | None
+) -> Callable[[float], float]:
+    """Seconds to fit ``estimator`` on so many rows and predict as many, ``a + b * rows``
+    from two timed fits."""
+    n = len(y)
+    order = np.random.default_rng(seed).permutation(n)
+    sizes = (max(n // 27, 10), max(n // 9, 20))
+    seconds = []
+    for rows in sizes:
+        sample = order[: min(rows, n)]
+        started = time.perf_counter()
+        # scoring predicts too (it dominates for nearest neighbours): the sample itself
+        clone(estimator).fit(X[sample], y[sample]).predict(X[sample])
+        seconds.append(time.perf_counter() - started)
+    slope = max((seconds[1] - seconds[0]) / max(sizes[1] - sizes[0], 1), 0.0)
+    fixed = max(seconds[0] - slope * sizes[0], 0.0)
+    return lambda rows: fixed + slope * rows
+
+
+def _search_cost(
+    n_candidates: int,
+    n: int,
+    smallest: int,
+    factor: int,
+    cv: int,
+    cost: Callable[[float], float],
+) -> float:
+    """Estimated seconds of a halving search, following scikit-learn's ``"exhaust"`` plan."""
+    required = 1 + math.floor(math.log(n_candidates, factor) + 1e-9)
+    first = max(smallest, n // factor ** (required - 1))
+    possible = 1 + math.floor(math.log(max(n // first, 1), factor) + 1e-9)
+    total = 0.0
+    for i in range(min(required, possible)):
+        candidates = math.ceil(n_candidates / factor**i)
+        rows = min(first * factor**i, n)
+        total += cv * candidates * cost(rows * (cv - 1) / cv)
+    return total
