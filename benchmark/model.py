@@ -23,6 +23,7 @@ from benchmark.dataset import Dataset, Schema
 from benchmark.errors import ConfigurationError
 from benchmark.estimators import build_estimator, check_classifier
 from benchmark.evaluation.metrics import expand_proba
+from benchmark.forest_inference import forest_proba
 from benchmark.problem import feature_matrix, problem_from_dataset
 
 #: Libraries whose versions are recorded with a model.
@@ -109,7 +110,9 @@ class TrainedModel:
         if self.regression or not hasattr(self.estimator, "predict_proba"):
             raise NotImplementedError(f"classifier '{self.classifier}' gives no probabilities")
         if len(self.schema.target_indices) == 1:
-            proba = self.estimator.predict_proba(features)
+            proba = forest_proba(self.estimator, features)
+            if proba is None:
+                proba = self.estimator.predict_proba(features)
             return [expand_proba(proba, self.estimator.classes_, n_classes=self.n_classes[0])]
         return [np.asarray(p, dtype=np.float64) for p in self.estimator.predict_proba(features)]
 
