@@ -37,7 +37,7 @@ from app.schemas.datasets import (
 from app.store import datasets as stored
 from app.store.database import Store
 from app.store.datasets import DatasetInfo, DatasetInMemory, InstanceSource
-from app.store.naming import check_name, default_name
+from app.store.naming import check_name, default_name, is_decimal
 from benchmark.dataset import Dataset, InstanceBlock, Schema
 from benchmark.errors import DataFormatError, DataWarning
 from benchmark.io.arff import ArffWriter, open_arff, read_arff
@@ -54,7 +54,7 @@ def parse_targets(text: str | None) -> int | list[str] | None:
     if text is None or not text.strip():
         return None
     stripped = text.strip()
-    if stripped.lstrip("-").isdigit():
+    if is_decimal(stripped.removeprefix("-")):
         return int(stripped)
     return [name.strip() for name in stripped.split(",") if name.strip()]
 

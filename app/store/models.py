@@ -21,7 +21,7 @@ from sqlalchemy.orm import Session
 from app.errors import AppError
 from app.schemas.models import ModelSchema
 from app.store.database import Store
-from app.store.naming import find_row, free_name, is_row_id
+from app.store.naming import find_row, free_name, is_decimal, is_row_id
 from app.store.tables import DatasetRow, ModelRow
 
 #: The only artifact format that is loaded (see :mod:`benchmark.artifacts`).
@@ -127,7 +127,7 @@ def check_model_name(name: str) -> None:
     """Refuse names that cannot be told from ids or do not print."""
     if not name.strip():
         raise AppError("a model name cannot be empty")
-    if name.isdigit():
+    if is_decimal(name):
         raise AppError(f"a model name cannot be a number ('{name}' would read as an id)")
     if len(name) > 200:
         raise AppError(f"a model name has at most 200 characters, got {len(name)}")

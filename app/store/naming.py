@@ -31,9 +31,15 @@ RowT = TypeVar("RowT", bound=Named)
 MAX_ROW_ID = 2**31 - 1
 
 
+def is_decimal(text: str) -> bool:
+    """Whether ``text`` is ASCII digits only (``str.isdigit`` also takes ``"²"``, which
+    ``int`` refuses, and ``int`` takes other scripts' digits, which no id is written in)."""
+    return text.isascii() and text.isdigit()
+
+
 def is_row_id(text: str) -> bool:
     """Whether ``text`` can be the id of a row (so that looking it up cannot fail)."""
-    return text.isdigit() and len(text) <= 10 and 0 < int(text) <= MAX_ROW_ID
+    return is_decimal(text) and len(text) <= 10 and 0 < int(text) <= MAX_ROW_ID
 
 
 def find_row(session: Session, model: type[RowT], ref: str | int, *, kind: str, hint: str) -> RowT:
@@ -88,7 +94,7 @@ def check_name(name: str, *, kind: str) -> str:
         )
     if name != name.strip():
         raise AppError(f"a {kind} name cannot start or end with spaces: '{name}'")
-    if name.isdigit():
+    if is_decimal(name):
         raise AppError(f"a {kind} name cannot be a number ('{name}' would read as an id)")
     return name
 
@@ -97,7 +103,7 @@ def default_name(text: str, *, fallback: str = "dataset") -> str:
     """A valid name made from ``text`` (a file stem, a relation): unsafe characters folded
     to ``_``, cut to leave room for a numeric suffix, a number given a ``fallback-`` prefix."""
     base = _UNSAFE.sub("_", text).strip("_")[: MAX_NAME - 10] or fallback
-    return f"{fallback}-{base}" if base.isdigit() else base
+    return f"{fallback}-{base}" if is_decimal(base) else base
 
 
 def free_name(session: Session, model: type[Named], base: str) -> str:

@@ -15,6 +15,8 @@ from typing import Any
 from sqlalchemy import select, update
 from sqlalchemy.orm import Session
 
+from app.store.naming import is_decimal
+
 #: A running item whose heartbeat is older than this has lost its process.
 STALE_AFTER = 30.0
 
@@ -32,7 +34,7 @@ def owner_alive(owner: str | None, heartbeat_at: datetime | None) -> bool:
         return False
     host, _, rest = owner.partition(":")
     pid_text, _, start = rest.partition("@")
-    if host == socket.gethostname() and pid_text.isdigit():
+    if host == socket.gethostname() and is_decimal(pid_text):
         return start == _start_ticks(int(pid_text)) != ""
     if heartbeat_at is None:
         return False

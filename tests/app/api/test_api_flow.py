@@ -162,3 +162,38 @@ def test_cancel_and_resume_over_http(
     assert (run["status"], run["tasks_done"]) == ("done", 60)
     again = api.post(f"/api/runs/{run_id}/resume")
     assert again.status_code == 409 and again.json()["error"]["type"] == "ConflictError"
+
+
+def test_a_tuned_and_stacked_run_over_http_is_the_clis(
+    capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path
+) -> None:
+    _import(capsys, server.database_url, touch_arff(tmp_path / "t.arff", n=90), "touch")
+    api = server.client
+    request = {
+        "dataset": "touch",
+        "target": "gesture",
+        "classifiers": ["logistic", "nb"],
+        "folds": 3,
+        "tune": True,
+        "budget": 0.01,
+        "stack": 2,
+    }
+    started = api.post("/api/runs", json=request)
+    assert started.status_code == 202, started.text
+    run = server.wait_for(f"/api/runs/{started.json()['id']}", finished)
+    assert (run["status"], run["tasks_done"], run["tasks_failed"]) == ("done", 12, 0)
+    board = api.get(f"/api/runs/{run['id']}/leaderboard").json()
+    assert {row["classifier"] for row in board["leaderboard"]} == {
+        "logistic",
+        "logistic+tuned",
+        "nb",
+        "stack-top2",
+    }
+    assert [c["tuned"] for c in board["tuning"]] == ["logistic+tuned"]
+    assert {c["classifier"] for c in board["choices"]} == {"logistic+tuned", "stack-top2"}
+    cli_board = run_cli(capsys, server.database_url, "leaderboard", str(run["id"]), "--json")
+    assert board == cli_board.json()
+    for bad, message in (({"budget": 0.01, "tune": False}, "--tune"), ({"stack": 0}, "stack")):
+        refused = api.post("/api/runs", json={**request, **bad})
+        assert refused.status_code in (400, 422), refused.text
+        assert message in str(refused.json()["error"]), refused.text

@@ -110,3 +110,33 @@ def test_schemathesis_finds_no_server_error(
 
         given(strategy)(exercise)()
     assert not failures, "\n".join(failures[:10])
+
+
+def test_references_in_other_digits_are_names_not_ids(
+    capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path
+) -> None:
+    # "²" passes str.isdigit but not int(); "١" (Arabic-Indic one) passes int() as 1.
+    run_cli(capsys, server.database_url, "import", str(touch_arff(tmp_path / "touch.arff")))
+    run_cli(capsys, server.database_url, "train", "touch", "-c", "nb", "--target", "gesture")
+    api = server.client
+    for method, path in (
+        ("GET", "/api/datasets/%C2%B3/arff"),
+        ("GET", "/api/datasets/%D9%A1"),
+        ("DELETE", "/api/models/%C2%B2"),
+        ("POST", "/api/models/%D9%A1/predict"),
+    ):
+        body = {"instances": [{"f0": 1.0}]} if method == "POST" else None
+        answer = api.request(method, path, json=body)
+        assert answer.status_code == 404, (path, answer.text)
+        assert answer.json()["error"]["type"] == "NotFoundError"
+    assert api.get("/api/datasets/1").status_code == 200
+    assert len(api.get("/api/models").json()["models"]) == 1
+
+
+def test_target_counts_and_names_are_told_apart() -> None:
+    from app.services.datasets import parse_targets
+    from app.store.naming import is_row_id
+
+    assert (parse_targets("2"), parse_targets("-2"), parse_targets("²")) == (2, -2, ["²"])
+    assert parse_targets("--2") == ["--2"] and parse_targets("a, b") == ["a", "b"]
+    assert [is_row_id(t) for t in ("7", "²", "١", "0", "99999999999")] == [True] + [False] * 4
