@@ -21,7 +21,7 @@ from sqlalchemy.orm import Session
 from app.errors import AppError
 from app.schemas.models import ModelSchema
 from app.store.database import Store
-from app.store.naming import find_row, free_name, is_decimal, is_row_id
+from app.store.naming import find_row, free_name, is_decimal, is_row_id, may_be_name
 from app.store.tables import DatasetRow, ModelRow
 
 #: The only artifact format that is loaded (see :mod:`benchmark.artifacts`).
@@ -163,7 +163,9 @@ def model_version(store: Store, ref: str | int) -> tuple[int, str, str]:
     text = str(ref)
     columns = select(ModelRow.id, ModelRow.sha256, ModelRow.name)
     with store.engine.connect() as connection:
-        found = connection.execute(columns.where(ModelRow.name == text)).first()
+        found = None
+        if may_be_name(text):
+            found = connection.execute(columns.where(ModelRow.name == text)).first()
         if found is None and is_row_id(text):
             found = connection.execute(columns.where(ModelRow.id == int(text))).first()
     if found is None:

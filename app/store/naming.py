@@ -42,6 +42,19 @@ def is_row_id(text: str) -> bool:
     return is_decimal(text) and len(text) <= 10 and 0 < int(text) <= MAX_ROW_ID
 
 
+def may_be_name(text: str) -> bool:
+    """Whether some stored row could be called ``text``: names hold no control characters
+    and are valid UTF-8 (so a NUL or a lone surrogate, which PostgreSQL refuses in a
+    query, is never sent to the database)."""
+    if _CONTROL.search(text):
+        return False
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        return False
+    return True
+
+
 def find_row(session: Session, model: type[RowT], ref: str | int, *, kind: str, hint: str) -> RowT:
     """The row called ``ref``, else the one with id ``ref``.
 
@@ -53,7 +66,9 @@ def find_row(session: Session, model: type[RowT], ref: str | int, *, kind: str, 
     """
     text = str(ref)
     name_column: InstrumentedAttribute[str] = model.name
-    row = session.scalars(select(model).where(name_column == text)).first()
+    row = None
+    if may_be_name(text):
+        row = session.scalars(select(model).where(name_column == text)).first()
     if row is None and is_row_id(text):
         row = session.get(model, int(text))
     if row is None:

@@ -18,9 +18,16 @@ function apiHeaders(extra = {}) {
   return key ? { ...extra, "X-API-Key": key } : extra;
 }
 
+// Whether the key a request was sent with is still the tab's key: an answer to an older key
+// (a region still loading when a new key was entered) must not overwrite the newer state.
+const keyStill = (sent) => sessionStorage.getItem(KEY) === sent;
+
 async function call(url, options = {}) {
+  const sent = sessionStorage.getItem(KEY);
   const response = await fetch(url, { ...options, headers: apiHeaders(options.headers) });
-  if (response.status === 401 || response.status === 403) showKeyState(response.status);
+  if ((response.status === 401 || response.status === 403) && keyStill(sent)) {
+    showKeyState(response.status);
+  }
   return response;
 }
 
@@ -70,9 +77,11 @@ const timers = new Map();
 
 async function load(region) {
   clearTimeout(timers.get(region));
+  const sent = sessionStorage.getItem(KEY);
   let response;
   try {
     response = await call(regionUrl(region));
+    if (!keyStill(sent)) return; // the key changed meanwhile: its own load is underway
   } catch (error) {
     message(region, `The service did not answer (${error.message}); retrying.`);
     timers.set(region, setTimeout(() => load(region), 3000));

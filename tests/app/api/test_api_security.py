@@ -112,7 +112,7 @@ def test_schemathesis_finds_no_server_error(
     assert not failures, "\n".join(failures[:10])
 
 
-def test_references_in_other_digits_are_names_not_ids(
+def test_references_that_no_row_can_have_are_404_on_both_stores(
     capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path
 ) -> None:
     # "²" passes str.isdigit but not int(); "١" (Arabic-Indic one) passes int() as 1.
@@ -124,11 +124,15 @@ def test_references_in_other_digits_are_names_not_ids(
         ("GET", "/api/datasets/%D9%A1"),
         ("DELETE", "/api/models/%C2%B2"),
         ("POST", "/api/models/%D9%A1/predict"),
+        ("GET", "/api/datasets/a%00b"),  # PostgreSQL refuses NUL in a query
+        ("DELETE", "/api/models/%09"),
     ):
         body = {"instances": [{"f0": 1.0}]} if method == "POST" else None
         answer = api.request(method, path, json=body)
         assert answer.status_code == 404, (path, answer.text)
         assert answer.json()["error"]["type"] == "NotFoundError"
+    run = api.post("/api/runs", json={"dataset": "touch\u0000", "classifiers": ["nb"]})
+    assert run.status_code == 404 and run.json()["error"]["type"] == "NotFoundError"
     assert api.get("/api/datasets/1").status_code == 200
     assert len(api.get("/api/models").json()["models"]) == 1
 
