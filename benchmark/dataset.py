@@ -12,6 +12,7 @@ from __future__ import annotations
 import re
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 from typing import Any, Literal
 
 import numpy as np
@@ -111,24 +112,24 @@ class Schema:
     def n_attributes(self) -> int:
         return len(self.attributes)
 
-    @property
+    @cached_property
     def feature_indices(self) -> tuple[int, ...]:
         targets = set(self.target_indices)
         return tuple(i for i in range(len(self.attributes)) if i not in targets)
 
-    @property
+    @cached_property
     def targets(self) -> tuple[Attribute, ...]:
         return tuple(self.attributes[i] for i in self.target_indices)
 
-    @property
+    @cached_property
     def features(self) -> tuple[Attribute, ...]:
         return tuple(self.attributes[i] for i in self.feature_indices)
 
-    @property
+    @cached_property
     def target_names(self) -> tuple[str, ...]:
         return tuple(a.name for a in self.targets)
 
-    @property
+    @cached_property
     def feature_names(self) -> tuple[str, ...]:
         return tuple(a.name for a in self.features)
 

@@ -3,9 +3,13 @@ against the same model's in-process ``predict_proba``, and a run submitted over 
 the same run from the CLI.
 
     .venv/bin/python perf/serve.py [--requests 400] [--seconds 10] [--workers 1]
-                                   [--run-classifiers nb,j48,logistic,rf]
+                                   [--client wrk|httpx] [--run-classifiers nb,j48,logistic,rf]
 
 ``--workers`` is ``touchbench serve --workers``: service processes sharing the port.
+``--client``: the HTTP client that measures. ``wrk`` (Debian's package; the default when it
+is installed) is a load generator in C: it takes little of the two cores the service runs on,
+so the figures are the service's. ``httpx`` clients in Python threads take about a core of
+their own and a millisecond per request: its figures are the service's plus the client's.
 
 Uses Mini (``../shared/datasets``) when present, else a synthetic data set of the same
 shape. Prints a table of figures and ratios; nothing here is asserted.
@@ -14,7 +18,10 @@ shape. Prints a table of figures and ratios; nothing here is asserted.
 from __future__ import annotations
 
 import argparse
+import json
 import os
+import re
+import shutil
 import socket
 import statistics
 import subprocess
@@ -96,6 +103,40 @@ def latency(url: str, model: str, record: dict[str, object], n: int) -> list[flo
     return times
 
 
+def wrk_script(folder: Path, record: dict[str, object]) -> Path:
+    """A wrk script that POSTs one instance as JSON."""
+    body = json.dumps({"instances": [record]})
+    script = folder / "predict.lua"
+    script.write_text(
+        'wrk.method = "POST"\n'
+        'wrk.headers["Content-Type"] = "application/json"\n'
+        f"wrk.body = [==[{body}]==]\n"
+    )
+    return script
+
+
+def wrk(url: str, script: Path, clients: int, seconds: float) -> tuple[float, float, float]:
+    """``wrk`` with ``clients`` connections on one thread: (p50 ms, p99 ms, requests/s)."""
+    done = subprocess.run(
+        ["wrk", "-t1", f"-c{clients}", f"-d{seconds:g}s", "--latency", "-s", str(script), url],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout
+    if "Non-2xx" in done or "Socket errors" in done:
+        raise SystemExit(f"wrk saw failed requests:\n{done}")
+
+    def milliseconds(percent: str) -> float:
+        found = re.search(rf"^\s*{percent}%\s+([\d.]+)(us|ms|s)\s*$", done, re.MULTILINE)
+        assert found, done
+        scale = {"us": 1e-3, "ms": 1.0, "s": 1e3}[found.group(2)]
+        return float(found.group(1)) * scale
+
+    rate = re.search(r"Requests/sec:\s+([\d.]+)", done)
+    assert rate, done
+    return milliseconds("50"), milliseconds("99"), float(rate.group(1))
+
+
 def in_process(trained: object, X: np.ndarray, n: int) -> list[float]:
     times = []
     for _ in range(20):
@@ -168,6 +209,12 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=10.0)
     parser.add_argument("--workers", type=int, default=1, help="service processes")
     parser.add_argument("--run-classifiers", default="nb,j48,logistic,rf")
+    parser.add_argument(
+        "--client",
+        choices=("wrk", "httpx"),
+        default="wrk" if shutil.which("wrk") else "httpx",
+        help="the measuring client (default: wrk when installed)",
+    )
     args = parser.parse_args()
 
     from app.services.datasets import import_file
@@ -189,25 +236,35 @@ def main() -> None:
         for classifier in ("logistic", "rf"):
             info, trained = load_model(store, f"mini-{classifier}")
             X = align_features(trained.schema, data)[:1]
-            record = {
+            record: dict[str, object] = {
                 attribute.name: (float(value) if np.isfinite(value) else None)
                 for attribute, value in zip(trained.schema.features, X[0], strict=True)
             }
-            http_times = latency(url, info.name, record, args.requests)
             local_times = in_process(trained, X, args.requests)
-            overhead = percentile(http_times, 50) - percentile(local_times, 50)
+            path = f"{url}/api/models/{info.name}/predict"
+            latency(url, info.name, record, 20)  # load the model, open a connection
+            if args.client == "wrk":
+                script = wrk_script(folder, record)
+                wrk(path, script, 8, 2.0)  # warm-up: every service process loads the model
+                p50, p99, _ = wrk(path, script, 1, args.seconds)
+            else:
+                http_times = latency(url, info.name, record, args.requests)
+                p50, p99 = percentile(http_times, 50), percentile(http_times, 99)
             rows.append(
                 (
                     f"{classifier} one instance: HTTP p50 / p99 (ms)",
-                    f"{percentile(http_times, 50):.2f} / {percentile(http_times, 99):.2f}",
+                    f"{p50:.2f} / {p99:.2f}",
                     f"in-process {percentile(local_times, 50):.2f} / "
                     f"{percentile(local_times, 99):.2f}",
-                    f"overhead p50 {overhead:.2f} ms",
+                    f"overhead p50 {p50 - percentile(local_times, 50):.2f} ms",
                 )
             )
             local_rate = 1.0 / statistics.mean(local_times)
             for clients in (8, 32):
-                rate = throughput(url, info.name, record, clients, args.seconds)
+                if args.client == "wrk":
+                    rate = wrk(path, script, clients, args.seconds)[2]
+                else:
+                    rate = throughput(url, info.name, record, clients, args.seconds)
                 rows.append(
                     (
                         f"{classifier} throughput, {clients} clients (req/s)",
@@ -238,7 +295,7 @@ def main() -> None:
         store.dispose()
     print(
         f"data: {source} ({imported.n_instances} instances); {args.workers} service "
-        f"process(es); load {os.getloadavg()[0]:.1f}"
+        f"process(es); client {args.client}; load {os.getloadavg()[0]:.1f}"
     )
     width = max(len(row[0]) for row in rows)
     for row in rows:

@@ -2,7 +2,8 @@
 # Sets touchbench up on a fresh Debian machine with Python >= 3.11: the system libraries it
 # needs (PortAudio for sound-card capture, libsndfile for audio files; WEKA and a Java
 # runtime, which the tests run to check the WEKA-named classifiers; Chromium, which the
-# web-page tests drive through Playwright), a .venv/ at the repository root, and touchbench
+# web-page tests drive through Playwright; wrk, the HTTP load generator of perf/serve.py),
+# a .venv/ at the repository root, and touchbench
 # with its test tools installed (editable) inside it.
 # Safe to run again: it only does what is missing.
 set -euo pipefail
@@ -29,7 +30,7 @@ if ! "$PYTHON" -c 'import sys; sys.exit(sys.version_info < (3, 11))' 2>/dev/null
   exit 2
 fi
 
-apt_install libportaudio2 libsndfile1 weka default-jre-headless chromium
+apt_install libportaudio2 libsndfile1 weka default-jre-headless chromium wrk
 "$PYTHON" -c 'import ensurepip, venv' 2>/dev/null || apt_install python3-venv
 
 [ -x .venv/bin/python ] || "$PYTHON" -m venv .venv

@@ -24,19 +24,49 @@ if TYPE_CHECKING:  # scikit-learn loads on the first prediction, not at start-up
 ModelKey = tuple[int, str, str]
 
 
+#: A prediction expected to take at most this many seconds runs on the event loop: a hop to
+#: a worker thread costs more than it saves there (the GIL runs one of them at a time) and
+#: holds nothing up for long. Slower ones (large ensembles, many instances) go to a thread.
+INLINE_SECONDS = 0.005
+
+
 class ModelCache:
     """Loaded models by (id, sha256, name), least recently used dropped first; thread-safe.
 
     Loading a model checks and rebuilds its artifact (tens to hundreds of milliseconds);
     a prediction on a cached model costs one indexed query for the model's id, sha256 and
     name, so a model deleted, renamed or retrained under the same name by another process
-    is never served stale.
+    is never served stale. The cache also keeps how long each model's predictions take
+    (:meth:`record`), which decides where the next one runs (:meth:`runs_inline`).
     """
 
     def __init__(self, size: int) -> None:
         self.size = size
         self._models: OrderedDict[ModelKey, tuple[ModelInfo, TrainedModel]] = OrderedDict()
+        self._seconds: dict[int, float] = {}  # model id -> seconds per instance
         self._lock = threading.Lock()
+
+    def runs_inline(self, ref: str, n_instances: int) -> bool:
+        """Whether predicting ``n_instances`` with the model ``ref`` is known to be quick:
+        the model is loaded and its predictions so far took under :data:`INLINE_SECONDS`
+        for that many instances."""
+        with self._lock:
+            for model_id, _, name in self._models:
+                if ref in (name, str(model_id)):
+                    seconds = self._seconds.get(model_id)
+                    return seconds is not None and seconds * n_instances <= INLINE_SECONDS
+        return False
+
+    def record(self, model_id: int, seconds: float, n_instances: int) -> None:
+        """Note that a prediction of ``n_instances`` took ``seconds``: an average that
+        follows a slower call at once, so one slow prediction moves the model off the loop."""
+        per_instance = seconds / max(1, n_instances)
+        with self._lock:
+            known = self._seconds.get(model_id)
+            if known is None or per_instance > known:
+                self._seconds[model_id] = per_instance
+            else:
+                self._seconds[model_id] = 0.9 * known + 0.1 * per_instance
 
     def get(self, store: Store, ref: str | int) -> tuple[ModelInfo, TrainedModel]:
         key = model_version(store, ref)
@@ -58,6 +88,7 @@ class ModelCache:
         with self._lock:
             for key in [key for key in self._models if key[0] == model_id]:
                 del self._models[key]
+            self._seconds.pop(model_id, None)
 
 
 @dataclass

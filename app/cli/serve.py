@@ -63,6 +63,7 @@ def serve_command(
             param_hint="--host",
         )
     state.store  # noqa: B018 (open and migrate the store once, before the workers start)
+    pin_native_threads()
     uvicorn.run(
         "app.api.main:create_app",
         factory=True,
@@ -73,6 +74,28 @@ def serve_command(
         proxy_headers=False,
         server_header=False,
     )
+
+
+#: Variables that set the thread count of numpy's BLAS and of OpenMP (scikit-learn, xgboost).
+NATIVE_THREADS = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS", "OMP_NUM_THREADS")
+
+
+def pin_native_threads() -> None:
+    """One BLAS and OpenMP thread in this process and the workers it starts, unless one of
+    :data:`NATIVE_THREADS` is set (then the environment decides).
+
+    A service worker answers one prediction at a time: a team of native threads in each
+    would only contend for the cores the other workers and the job processes use.
+    Libraries loaded from now on read the variables; those loaded already (numpy's BLAS)
+    are limited through threadpoolctl.
+    """
+    if any(name in os.environ for name in NATIVE_THREADS):
+        return
+    for name in NATIVE_THREADS:
+        os.environ[name] = "1"
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(1)
 
 
 def _loopback(host: str) -> bool:

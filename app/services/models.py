@@ -323,7 +323,10 @@ def align_features(
     model never saw becomes missing (NaN), which every pipeline imputes, and is reported
     in ``warnings``.
     """
-    by_name = {a.name: i for i, a in enumerate(data.schema.attributes)}
+    given, wanted = data.schema.attributes, schema.features
+    if len(given) == len(wanted) and all(a is b for a, b in zip(given, wanted, strict=True)):
+        return data.values  # built from the model's own attributes (dataset_from_records)
+    by_name = {a.name: i for i, a in enumerate(given)}
     missing = [a.name for a in schema.features if a.name not in by_name]
     if missing:
         shown = ", ".join(missing[:5]) + (

@@ -12,11 +12,11 @@ from sqlalchemy import create_engine, func, select, text
 from app.errors import NotFoundError
 from app.store.database import Store
 from app.store.models import (
-    save_model,
     delete_model,
     load_artifact,
     model_version,
     rename_model,
+    save_model,
 )
 from app.store.tables import ModelArtifactRow
 from tests.app.test_store import _alembic

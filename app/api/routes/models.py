@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import tempfile
+import time
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
-from fastapi import APIRouter, File, UploadFile, status
+from fastapi import APIRouter, File, Response, UploadFile, status
+from starlette.concurrency import run_in_threadpool
 
-from app.api.deps import ServiceDep, StoreDep
+from app.api.deps import Service, ServiceDep, StoreDep
 from app.api.uploads import save_upload
 from app.errors import AppError
 from app.schemas.jobs import JobCreated
@@ -76,16 +79,29 @@ def remove(model_ref: str, service: ServiceDep) -> ModelSchema:
 
 
 @router.post("/{model_ref}/predict", response_model=PredictionReport)
-def predict_instances(
-    model_ref: str, body: PredictRequest, service: ServiceDep
-) -> PredictionReport:
+async def predict_instances(model_ref: str, body: PredictRequest, service: ServiceDep) -> Response:
     """Predict instances given as ``{attribute: value}`` (matched to the model by name):
     per instance and target the predicted label and the class probabilities."""
+    if service.models.runs_inline(model_ref, len(body.instances)):
+        content = _predict_records(service, model_ref, body.instances)
+    else:
+        content = await run_in_threadpool(_predict_records, service, model_ref, body.instances)
+    return Response(content, media_type="application/json")
+
+
+def _predict_records(
+    service: Service, model_ref: str, records: Sequence[Mapping[str, Any]]
+) -> bytes:
+    """The prediction report as JSON: written here once, not validated again by FastAPI
+    against the response model it was built from."""
     from app.services.models import dataset_from_records, predict
 
     info, trained = service.models.get(service.store, model_ref)
-    data = dataset_from_records(trained.schema, body.instances)
-    return predict(trained, data, source="instances").report(info)
+    start = time.perf_counter()
+    data = dataset_from_records(trained.schema, records)
+    report = predict(trained, data, source="instances").report(info)
+    service.models.record(info.id, time.perf_counter() - start, len(records))
+    return report.model_dump_json().encode()
 
 
 @router.post("/{model_ref}/predict/file", response_model=PredictionReport)

@@ -1,0 +1,86 @@
+"""Where a served prediction runs: on the event loop when the model is known to be quick,
+in a worker thread otherwise; the same answer either way."""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from fastapi.testclient import TestClient
+
+from app.api.deps import INLINE_SECONDS, ModelCache
+from app.api.main import create_app
+from app.services.datasets import import_file
+from app.services.models import predict_records, train
+from app.settings import Settings
+from app.store.database import Store
+from tests.app.synthetic import touch_arff
+
+
+def test_a_model_runs_inline_only_once_it_is_known_to_be_quick() -> None:
+    cache = ModelCache(4)
+    assert not cache.runs_inline("m", 1)  # not loaded
+    cache._models[(7, "sha", "m")] = (None, None)  # type: ignore[assignment]
+    assert not cache.runs_inline("m", 1)  # loaded, never timed
+    cache.record(7, INLINE_SECONDS / 10, 1)
+    assert cache.runs_inline("m", 1) and cache.runs_inline("7", 1)
+    assert not cache.runs_inline("m", 20)  # twenty instances: about twice the budget
+    assert not cache.runs_inline("other", 1)
+    cache.record(7, INLINE_SECONDS * 3, 1)  # one slow call moves it off the loop at once
+    assert not cache.runs_inline("m", 1)
+    for _ in range(200):  # quick again for long enough: back on the loop
+        cache.record(7, INLINE_SECONDS / 10, 1)
+    assert cache.runs_inline("m", 1)
+    cache.forget(7)
+    assert not cache.runs_inline("m", 1)
+
+
+@pytest.fixture
+def client(tmp_path: Path, store_url: str) -> Iterator[TestClient]:
+    store = Store(store_url)
+    import_file(store, touch_arff(tmp_path / "touch.arff", with_place=False), name="touch")
+    train(store, "touch", "nb", targets=["gesture"], name="quick")
+    store.dispose()
+    settings = Settings(database_url=store_url, work_dir=tmp_path / "work")
+    with TestClient(create_app(settings)) as test_client:
+        yield test_client
+
+
+def test_the_first_prediction_runs_in_a_thread_and_later_ones_on_the_loop(
+    client: TestClient, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    service = client.app.state.service  # type: ignore[attr-defined]
+    threads: list[int] = []
+    record = service.models.record
+
+    def spy(model_id: int, seconds: float, n: int) -> None:
+        """Where the call ran; the time recorded as a tenth of the budget per instance, so
+        that the placement does not depend on this machine's load."""
+        threads.append(threading.get_ident())
+        record(model_id, n * INLINE_SECONDS / 10, n)
+
+    monkeypatch.setattr(service.models, "record", spy)
+    instance = {"f0": 0.1, "f1": -0.2, "f2": 0.3, "f3": None, "mic": "left"}
+    answers = [
+        client.post("/api/models/quick/predict", json={"instances": [instance]}) for _ in range(3)
+    ]
+    assert [answer.status_code for answer in answers] == [200, 200, 200]
+    assert answers[0].json() == answers[2].json()
+    loop_thread = threads[-1]
+    assert threads[0] != loop_thread and threads[1] == loop_thread  # a thread, then the loop
+    expected = predict_records(service.store, "quick", [instance]).to_json()
+    assert answers[2].json() == expected
+    assert answers[2].headers["content-type"] == "application/json"
+    many = client.post("/api/models/quick/predict", json={"instances": [instance] * 5000})
+    assert many.status_code == 200 and len(many.json()["predictions"]) == 5000
+    assert threads[-1] != loop_thread  # five thousand instances are not quick
+
+
+def test_an_unknown_model_is_a_404_on_either_path(client: TestClient) -> None:
+    client.post("/api/models/quick/predict", json={"instances": [{"f0": 1.0}]})
+    client.post("/api/models/quick/predict", json={"instances": [{"f0": 1.0}]})
+    answer = client.post("/api/models/nothing/predict", json={"instances": [{"f0": 1.0}]})
+    assert answer.status_code == 404
+    assert "no model 'nothing'" in answer.json()["error"]["message"]
