@@ -2,11 +2,11 @@
 
 Most of a real data section is lines such as ``'tap','head',459.375,0,?``: numbers,
 nominal labels (quoted or not) and ``?``, separated by single commas.  On such a block
-WEKA's tokenizer and a CSV parser read the same fields, so Arrow's multi-threaded C++
-reader reads the block at C speed.  :func:`read_plain_block` first proves, with numpy over
-the block's bytes, that Arrow cannot read it differently without saying so, and gives up
-(returns ``None``) otherwise, leaving the block to the exact reader
-(:mod:`benchmark.io.arff_data`):
+WEKA's tokenizer and a CSV parser read the same fields, so Arrow's C++ reader reads the
+block at C speed (in threads of its own, unless blocks are already read side by side).
+:func:`read_plain_block` first proves, with numpy over the block's bytes, that Arrow cannot
+read it differently without saying so, and gives up (returns ``None``) otherwise, leaving
+the block to the exact reader (:mod:`benchmark.io.arff_data`):
 
 - no double quote, backslash, brace, ``%``, and no whitespace or control character but
   the line breaks (``\\n``, or ``\\r\\n`` throughout);

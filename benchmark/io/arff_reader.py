@@ -12,7 +12,9 @@ size.  Each block of lines is read the fastest way that is exact for it:
    (:mod:`benchmark.io.tokens`), which also locates every error by line and attribute.
 
 All three give the same values, bit for bit: ``parser="tokenizer"`` reads every row the
-third way, the reference the others are tested against.
+third way, the reference the others are tested against.  Arrow reads plain blocks in
+threads, a few blocks ahead of the one handed on (:mod:`benchmark.io.read_ahead`); the
+other ways read in order, in the thread that iterates :meth:`ArffReader.blocks`.
 """
 
 from __future__ import annotations
