@@ -2,11 +2,11 @@
 
 Most of a real data section is lines such as ``'tap','head',459.375,0,?``: numbers,
 nominal labels (quoted or not) and ``?``, separated by single commas.  On such a block
-WEKA's tokenizer and a CSV parser read the same fields, so Arrow's multi-threaded C++
-reader reads the block at C speed.  :func:`read_plain_block` first proves, with numpy over
-the block's bytes, that Arrow cannot read it differently without saying so, and gives up
-(returns ``None``) otherwise, leaving the block to the exact reader
-(:mod:`benchmark.io.arff_data`):
+WEKA's tokenizer and a CSV parser read the same fields, so Arrow's C++ reader reads the
+block at C speed (in threads of its own, unless blocks are already read side by side).
+:func:`read_plain_block` first proves, with numpy over the block's bytes, that Arrow cannot
+read it differently without saying so, and gives up (returns ``None``) otherwise, leaving
+the block to the exact reader (:mod:`benchmark.io.arff_data`):
 
 - no double quote, backslash, brace, ``%``, and no whitespace or control character but
   the line breaks (``\\n``, or ``\\r\\n`` throughout);
@@ -83,7 +83,7 @@ def plain_plan(attributes: Sequence[Attribute]) -> PlainPlan | None:
 
 
 def read_plain_block(
-    block: bytes, plan: PlainPlan, *, encoding: str
+    block: bytes, plan: PlainPlan, *, encoding: str, threads: bool = True
 ) -> tuple[np.ndarray, np.ndarray] | None:
     """The rows of a block of whole lines, if the block is plain.
 
@@ -95,6 +95,9 @@ def read_plain_block(
         The attributes.
     encoding : str
         The file's encoding (``utf-8`` or ``latin-1``).
+    threads : bool
+        Whether Arrow reads the block in threads of its own (not worth it when blocks
+        are already read side by side).
 
     Returns
     -------
@@ -110,7 +113,7 @@ def read_plain_block(
         return None
     if rows.size == 0:
         return np.empty((0, plan.n_columns)), rows
-    table = _parse(block, plan, encoding)
+    table = _parse(block, plan, encoding, threads)
     if table is None or table.num_rows != rows.size:
         return None
     values = np.empty((rows.size, plan.n_columns))
@@ -188,7 +191,7 @@ def _quotes_enclose_fields(data: np.ndarray, quotes: np.ndarray, breaks: np.ndar
     return bool(np.all(np.searchsorted(breaks, opening) == np.searchsorted(breaks, closing)))
 
 
-def _parse(block: bytes, plan: PlainPlan, encoding: str) -> Any | None:
+def _parse(block: bytes, plan: PlainPlan, encoding: str, threads: bool) -> Any | None:
     """The block as an Arrow table, ``None`` if Arrow cannot read it as planned."""
     import pyarrow as pa
     import pyarrow.csv as csv
@@ -200,7 +203,9 @@ def _parse(block: bytes, plan: PlainPlan, encoding: str) -> Any | None:
     try:
         return csv.read_csv(
             pa.py_buffer(block),
-            read_options=csv.ReadOptions(column_names=names, encoding=encoding, use_threads=True),
+            read_options=csv.ReadOptions(
+                column_names=names, encoding=encoding, use_threads=threads
+            ),
             parse_options=csv.ParseOptions(
                 delimiter=",", quote_char="'", double_quote=False, escape_char=False
             ),

@@ -12,7 +12,9 @@ size.  Each block of lines is read the fastest way that is exact for it:
    (:mod:`benchmark.io.tokens`), which also locates every error by line and attribute.
 
 All three give the same values, bit for bit: ``parser="tokenizer"`` reads every row the
-third way, the reference the others are tested against.
+third way, the reference the others are tested against.  Arrow reads plain blocks in
+threads, a few blocks ahead of the one handed on (:mod:`benchmark.io.read_ahead`); the
+other ways read in order, in the thread that iterates :meth:`ArffReader.blocks`.
 """
 
 from __future__ import annotations
@@ -24,11 +26,14 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from typing import BinaryIO, Literal
 
+import numpy as np
+
 from benchmark.dataset import Dataset, InstanceBlock, Schema, join_blocks, resolve_targets
 from benchmark.errors import ConfigurationError, DataFormatError
 from benchmark.io.arff_data import DataSection
 from benchmark.io.arff_fast import plain_plan, read_plain_block
 from benchmark.io.arff_header import Header, HeaderParser
+from benchmark.io.read_ahead import ordered_ahead
 from benchmark.io.textfile import (
     BLOCK_BYTES,
     SNIFF_BYTES,
@@ -140,8 +145,10 @@ class ArffReader:
         DataFormatError
             At the first wrong line, naming it and the attribute.
         """
-        for block, first_line in self._lines.blocks():
-            yield self._read_block(block, first_line)
+        for (block, first_line), parsed in ordered_ahead(
+            self._lines.blocks(), self._read_plain, self._is_for_arrow
+        ):
+            yield self._read_block(block, first_line, None if parsed is None else parsed.result())
         self._finished = True
 
     def read(self) -> Dataset:
@@ -162,14 +169,27 @@ class ArffReader:
                 break
         return parser.finish()
 
-    def _read_block(self, block: bytes, first_line: int) -> InstanceBlock:
-        if self._plan is not None and (
-            self.parser == "vectorised" or len(block) >= VECTORISED_MIN_BYTES
-        ):
-            plain = read_plain_block(block, self._plan, encoding=self._lines.encoding)
-            if plain is not None:
-                values, rows = plain
-                return InstanceBlock(values, lines=first_line + rows)
+    def _is_for_arrow(self, numbered: tuple[bytes, int]) -> bool:
+        """Whether a block (with its first line's number) is one Arrow reads if plain."""
+        return self._plan is not None and (
+            self.parser == "vectorised" or len(numbered[0]) >= VECTORISED_MIN_BYTES
+        )
+
+    def _read_plain(self, numbered: tuple[bytes, int]) -> tuple[np.ndarray, np.ndarray] | None:
+        """:func:`read_plain_block` of a block, in one of the threads that read ahead (so
+        Arrow's own threads are not wanted: blocks are already read side by side)."""
+        assert self._plan is not None
+        return read_plain_block(
+            numbered[0], self._plan, encoding=self._lines.encoding, threads=False
+        )
+
+    def _read_block(
+        self, block: bytes, first_line: int, plain: tuple[np.ndarray, np.ndarray] | None
+    ) -> InstanceBlock:
+        """The instances of a block: ``plain`` if Arrow read it, else read line by line."""
+        if plain is not None:
+            values, rows = plain
+            return InstanceBlock(values, lines=first_line + rows)
         lines = split_lines(self._lines.decode(block))
         if lines and lines[-1] == "" and block.endswith((b"\n", b"\r")):
             lines.pop()  # the line break that ends the block starts no line of its own
