@@ -48,8 +48,8 @@ class ModelCache:
 
     def runs_inline(self, ref: str, n_instances: int) -> bool:
         """Whether predicting ``n_instances`` with the model ``ref`` is known to be quick:
-        the model is loaded and its predictions so far took under :data:`INLINE_SECONDS`
-        for that many instances."""
+        the model is loaded and its recent predictions took under :data:`INLINE_SECONDS`
+        of CPU time for that many instances."""
         with self._lock:
             for model_id, _, name in self._models:
                 if ref in (name, str(model_id)):
@@ -58,15 +58,15 @@ class ModelCache:
         return False
 
     def record(self, model_id: int, seconds: float, n_instances: int) -> None:
-        """Note that a prediction of ``n_instances`` took ``seconds``: an average that
-        follows a slower call at once, so one slow prediction moves the model off the loop."""
+        """Note that a prediction of ``n_instances`` took ``seconds`` of its thread's CPU
+        time (not wall time, which waits on other processes and on the GIL, and would keep
+        a model measured in a thread looking slow); kept as a moving average."""
         per_instance = seconds / max(1, n_instances)
         with self._lock:
             known = self._seconds.get(model_id)
-            if known is None or per_instance > known:
-                self._seconds[model_id] = per_instance
-            else:
-                self._seconds[model_id] = 0.9 * known + 0.1 * per_instance
+            self._seconds[model_id] = (
+                per_instance if known is None else 0.8 * known + 0.2 * per_instance
+            )
 
     def get(self, store: Store, ref: str | int) -> tuple[ModelInfo, TrainedModel]:
         key = model_version(store, ref)
