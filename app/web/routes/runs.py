@@ -14,7 +14,7 @@ from app.api.deps import StoreDep
 from app.errors import NotFoundError
 from app.schemas.runs import FINAL_STATUSES
 from app.services.datasets import list_datasets
-from app.services.runs import run_leaderboard
+from app.services.runs import leaderboard_schema
 from app.store.runs import RunInfo, get_run, list_runs
 from app.web.rendering import draw, render
 from app.web.routes.pages import Ref
@@ -73,8 +73,10 @@ def leaderboard(
     run_id: int, store: StoreDep, metric: Metric = None, baseline: Baseline = None
 ) -> HTMLResponse:
     """The run's classifiers ranked by ``metric`` with WEKA's marks against ``baseline``."""
+    from app.reports.run_tables import run_tables
+
     try:
-        run, board = run_leaderboard(
+        run, board, report = leaderboard_schema(
             store, run_id, metric=metric or None, baseline=baseline or None
         )
     except ConfigurationError:
@@ -87,6 +89,7 @@ def leaderboard(
         run=run,
         board=board,
         table=_table(run, board, chosen_baseline=baseline or None),
+        tables=run_tables(report),
     )
 
 
