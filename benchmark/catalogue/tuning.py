@@ -166,6 +166,9 @@ class TunedClassifier(ClassifierMixin, BaseEstimator):
         ``estimator`` with ``best_params_``, refitted on all the training rows.
     n_candidates_ : int
         Settings of the first round.
+    n_resources_ : int
+        Training rows (inner training and test folds together) of the last round: all the
+        rows unless the budget could not pay for ``factor`` candidates on them.
     classes_ : ndarray of shape (n_classes,)
     """
 
@@ -199,9 +202,11 @@ class TunedClassifier(ClassifierMixin, BaseEstimator):
         grid = {name: list(values) for name, values in (self.space or {}).items()}
         size = len(ParameterGrid(grid))
         inner = inner_folds(y, self.cv, self.random_state)
-        n_candidates = min(self._plan(X, y, size), size)
+        n_candidates, rows = self._plan(X, y, grid, size)
+        n_candidates = min(n_candidates, size)
         common: dict[str, Any] = {
             "factor": self.factor,
+            "max_resources": rows,
             "cv": inner,
             "scoring": self.scoring,
             "min_resources": "exhaust",
@@ -228,34 +233,51 @@ class TunedClassifier(ClassifierMixin, BaseEstimator):
             for name, value in search.best_params_.items()
         }
         self.n_candidates_ = int(search.n_candidates_[0])
+        self.n_resources_ = int(search.n_resources_[-1])
         self.classes_ = self.best_estimator_.classes_
         return self
 
-    def _plan(self, X: np.ndarray, y: np.ndarray, size: int) -> int:
-        """Candidates of the first round: the most (a power of ``factor``) whose estimated
-        cost fits the budget, at least ``factor``.
+    def _plan(
+        self, X: np.ndarray, y: np.ndarray, grid: dict[str, list[Any]], size: int
+    ) -> tuple[int, int]:
+        """Candidates of the first round and rows of the last: the most candidates (a power
+        of ``factor``, at least ``factor``) whose estimated cost fits the budget, on all the
+        rows; when even ``factor`` candidates do not fit, on a ``factor``-th of the rows, a
+        ninth, ... (no fewer than ``factor`` times the first round's smallest sample).
 
         Costs are estimated as ``a + b * rows`` from two timed fits (and predictions) of
-        the default setting, on a 27th and a ninth of the rows, plus the search's own
-        :func:`evaluation_overhead` per candidate and inner fold; the estimate counts the
-        two timing fits and the final refit too. The default budget is
-        :data:`DEFAULT_FITS` fits on all the rows.
+        the default setting, on a 27th and a ninth of the rows, times the ratio of two
+        random settings' cost to the default's on the ninth (forests with more features
+        per split, deeper trees), plus the search's own :func:`evaluation_overhead` per
+        candidate and inner fold; the estimate counts the timing fits and the final refit
+        too. The default budget is :data:`DEFAULT_FITS` fits of the default on all rows.
         """
         n = len(y)
         started = time.perf_counter()
         cost = _fit_cost(self.estimator, X, y, self.random_state)
+        ratio = _space_ratio(self.estimator, grid, X, y, self.random_state, cost)
         spent = time.perf_counter() - started
         budget = DEFAULT_FITS * cost(n) if self.budget is None else self.budget
         overhead = evaluation_overhead()
         smallest = 2 * self.cv * len(np.unique(y))
+
+        def total(candidates: int, rows: int) -> float:
+            search = _search_cost(
+                candidates, rows, smallest, self.factor, self.cv, lambda r: ratio * cost(r),
+                overhead,
+            )  # fmt: skip
+            return spent + search + ratio * cost(n)
+
+        rows = n
+        while total(self.factor, rows) > budget and rows // self.factor >= self.factor * smallest:
+            rows //= self.factor
         chosen = self.factor
-        while chosen < min(size, MAX_CANDIDATES):
+        while rows == n and chosen < min(size, MAX_CANDIDATES):
             more = chosen * self.factor
-            search = _search_cost(more, n, smallest, self.factor, self.cv, cost, overhead)
-            if spent + search + cost(n) > budget:
+            if total(more, n) > budget:
                 break
             chosen = more
-        return chosen
+        return chosen, rows
 
     def predict(self, X: np.ndarray) -> np.ndarray:
         """Predictions of the refitted best setting, shape (n_samples,)."""
@@ -337,6 +359,35 @@ def _fit_cost(
     slope = max((seconds[1] - seconds[0]) / max(sizes[1] - sizes[0], 1), 0.0)
     fixed = max(seconds[0] - slope * sizes[0], 0.0)
     return lambda rows: fixed + slope * rows
+
+
+def _space_ratio(
+    estimator: Any,
+    grid: dict[str, list[Any]],
+    X: np.ndarray,
+    y: np.ndarray,
+    seed: int | None,
+    cost: Callable[[float], float],
+    draws: int = 2,
+) -> float:
+    """Mean cost of ``draws`` random settings of ``grid`` over the default's (at least 0.5),
+    from fits and predictions on a ninth of the rows."""
+    from sklearn.model_selection import ParameterSampler
+
+    n = len(y)
+    rows = max(n // 9, 20)
+    sample = np.random.default_rng(seed).permutation(n)[: min(rows, n)]
+    seconds = []
+    for setting in ParameterSampler(grid, min(draws, len(ParameterGrid(grid))), random_state=seed):
+        started = time.perf_counter()
+        try:
+            clone(estimator).set_params(**setting).fit(X[sample], y[sample]).predict(X[sample])
+        except Exception:  # the search scores a failing setting NaN: it costs nothing here
+            continue
+        seconds.append(time.perf_counter() - started)
+    if not seconds:
+        return 1.0
+    return max(float(np.mean(seconds)) / max(cost(rows), 1e-9), 0.5)
 
 
 def _search_cost(
