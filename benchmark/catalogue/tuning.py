@@ -5,18 +5,20 @@ scikit-learn's successive halving search with an inner cross-validation of that 
 only: nested cross-validation, so the outer test fold never takes part in the choice.
 
 The plan. Successive halving (``factor`` 3) starts all candidates on a small sample of the
-training rows and keeps the best third on three times the rows until the rows run out
-(``min_resources="exhaust"``). Its cost is estimated before it starts, from two timed
-fits and predictions of the default setting (on a 27th and a ninth of the rows:
-``a + b * rows`` seconds) and from what the search itself spends on each candidate and
-inner fold besides the estimator (cloning, splitting, scoring, bookkeeping: measured once
-per process, see :func:`evaluation_overhead`), which dominates for the cheapest
-estimators. The first round gets the most candidates (3, 9, 27, ...) whose estimated
-search, plus the two timing fits and the final refit, fits the budget: by default
-:data:`DEFAULT_FITS` fits of the default setting on all the training rows, or a number
-of minutes per outer fold (``bench --budget``). The plan counts every candidate at the
-default's cost, so the spaces (:mod:`benchmark.catalogue.spaces`) hold no setting that
-costs much more than the default.
+training rows and keeps the best third on three times the rows; the rounds end with
+``factor`` candidates on a ``factor``-th of the rows (:func:`schedule`: scikit-learn's
+``"exhaust"`` plan would go on with one candidate on all the rows, a round that chooses
+nothing). Its cost is estimated before it starts, from two timed fits and predictions of
+the default setting (on a 27th and a ninth of the rows: ``a + b * rows`` seconds), two
+random settings of the space timed against the default, and what the search itself
+spends on each candidate and inner fold besides the estimator (cloning, splitting,
+scoring, bookkeeping: measured once per process, see :func:`evaluation_overhead`), which
+dominates for the cheapest estimators. The first round gets the most candidates (3, 9,
+27, ...) whose estimated search, plus the timing fits and the final refit, fits the
+budget: by default :data:`DEFAULT_FITS` fits of the default setting on all the training
+rows, or a number of minutes per outer fold (``bench --budget``). The spaces
+(:mod:`benchmark.catalogue.spaces`) hold no setting that costs much more than the
+default, since even the fewest candidates (3) and the refit of the chosen one must fit.
 """
 
 from __future__ import annotations
@@ -50,6 +52,8 @@ DEFAULT_FITS = 6.0
 MAX_CANDIDATES = 729
 #: Largest budget accepted, in minutes (per tuned entry and outer fold).
 MAX_BUDGET_MINUTES = 1440.0
+#: Least cost of the space's settings assumed, as a multiple of the default's.
+MIN_RATIO = 0.5
 #: Step of the pipeline a space's parameters belong to.
 CLASSIFIER_STEP = "classifier"
 
@@ -167,8 +171,8 @@ class TunedClassifier(ClassifierMixin, BaseEstimator):
     n_candidates_ : int
         Settings of the first round.
     n_resources_ : int
-        Training rows (inner training and test folds together) of the last round: all the
-        rows unless the budget could not pay for ``factor`` candidates on them.
+        Rows (inner training and test folds together) of the last round (see
+        :func:`schedule`).
     classes_ : ndarray of shape (n_classes,)
     """
 
@@ -202,14 +206,14 @@ class TunedClassifier(ClassifierMixin, BaseEstimator):
         grid = {name: list(values) for name, values in (self.space or {}).items()}
         size = len(ParameterGrid(grid))
         inner = inner_folds(y, self.cv, self.random_state)
-        n_candidates, rows = self._plan(X, y, grid, size)
-        n_candidates = min(n_candidates, size)
+        n_candidates = min(self._plan(X, y, grid, size), size)
+        first, last = schedule(n_candidates, len(y), _smallest(y, self.cv), self.factor)
         common: dict[str, Any] = {
             "factor": self.factor,
-            "max_resources": rows,
+            "min_resources": first,
+            "max_resources": last,
             "cv": inner,
             "scoring": self.scoring,
-            "min_resources": "exhaust",
             "random_state": self.random_state,
             "error_score": np.nan,
             "refit": True,
@@ -237,47 +241,42 @@ class TunedClassifier(ClassifierMixin, BaseEstimator):
         self.classes_ = self.best_estimator_.classes_
         return self
 
-    def _plan(
-        self, X: np.ndarray, y: np.ndarray, grid: dict[str, list[Any]], size: int
-    ) -> tuple[int, int]:
-        """Candidates of the first round and rows of the last: the most candidates (a power
-        of ``factor``, at least ``factor``) whose estimated cost fits the budget, on all the
-        rows; when even ``factor`` candidates do not fit, on a ``factor``-th of the rows, a
-        ninth, ... (no fewer than ``factor`` times the first round's smallest sample).
+    def _plan(self, X: np.ndarray, y: np.ndarray, grid: dict[str, list[Any]], size: int) -> int:
+        """Candidates of the first round: the most (a power of ``factor``) whose estimated
+        cost fits the budget, at least ``factor``.
 
         Costs are estimated as ``a + b * rows`` from two timed fits (and predictions) of
         the default setting, on a 27th and a ninth of the rows, times the ratio of two
-        random settings' cost to the default's on the ninth (forests with more features
-        per split, deeper trees), plus the search's own :func:`evaluation_overhead` per
+        random settings' cost to the default's on the ninth (fewer boosting rounds, more
+        features per split), plus the search's own :func:`evaluation_overhead` per
         candidate and inner fold; the estimate counts the timing fits and the final refit
         too. The default budget is :data:`DEFAULT_FITS` fits of the default on all rows.
         """
         n = len(y)
         started = time.perf_counter()
         cost = _fit_cost(self.estimator, X, y, self.random_state)
-        ratio = _space_ratio(self.estimator, grid, X, y, self.random_state, cost)
-        spent = time.perf_counter() - started
         budget = DEFAULT_FITS * cost(n) if self.budget is None else self.budget
         overhead = evaluation_overhead()
-        smallest = 2 * self.cv * len(np.unique(y))
+        smallest = _smallest(y, self.cv)
 
-        def total(candidates: int, rows: int) -> float:
-            search = _search_cost(
-                candidates, rows, smallest, self.factor, self.cv, lambda r: ratio * cost(r),
-                overhead,
-            )  # fmt: skip
-            return spent + search + ratio * cost(n)
+        def most(ratio: float, spent: float) -> int:
+            chosen = self.factor
+            while chosen < min(size, MAX_CANDIDATES):
+                more = chosen * self.factor
+                search = _search_cost(
+                    more, n, smallest, self.factor, self.cv, lambda r: ratio * cost(r), overhead
+                )
+                if spent + search + ratio * cost(n) > budget:
+                    break
+                chosen = more
+            return chosen
 
-        rows = n
-        while total(self.factor, rows) > budget and rows // self.factor >= self.factor * smallest:
-            rows //= self.factor
-        chosen = self.factor
-        while rows == n and chosen < min(size, MAX_CANDIDATES):
-            more = chosen * self.factor
-            if total(more, n) > budget:
-                break
-            chosen = more
-        return chosen, rows
+        # the settings' cost is timed only when it may change the plan: not when even the
+        # cheapest ratio buys no more than the fewest candidates (forests' fixed costs)
+        if most(MIN_RATIO, time.perf_counter() - started) == self.factor:
+            return self.factor
+        ratio = _space_ratio(self.estimator, grid, X, y, self.random_state, cost)
+        return most(ratio, time.perf_counter() - started)
 
     def predict(self, X: np.ndarray) -> np.ndarray:
         """Predictions of the refitted best setting, shape (n_samples,)."""
@@ -370,8 +369,8 @@ def _space_ratio(
     cost: Callable[[float], float],
     draws: int = 2,
 ) -> float:
-    """Mean cost of ``draws`` random settings of ``grid`` over the default's (at least 0.5),
-    from fits and predictions on a ninth of the rows."""
+    """Mean cost of ``draws`` random settings of ``grid`` over the default's (at least
+    :data:`MIN_RATIO`), from fits and predictions on a ninth of the rows."""
     from sklearn.model_selection import ParameterSampler
 
     n = len(y)
@@ -387,7 +386,35 @@ def _space_ratio(
         seconds.append(time.perf_counter() - started)
     if not seconds:
         return 1.0
-    return max(float(np.mean(seconds)) / max(cost(rows), 1e-9), 0.5)
+    return max(float(np.mean(seconds)) / max(cost(rows), 1e-9), MIN_RATIO)
+
+
+def schedule(n_candidates: int, n: int, smallest: int, factor: int) -> tuple[int, int]:
+    """Rows of the first and the last round of a halving search of ``n_candidates``.
+
+    scikit-learn's ``"exhaust"`` plan halves down to one candidate, which it then fits and
+    scores on all ``n`` rows: a round that chooses nothing (the refit follows anyway), and
+    the dearest. Here the rounds stop one earlier, with ``factor`` candidates on a
+    ``factor``-th of the rows, which is where the exhaust plan makes its last choice too:
+    the same choice for a third of the cost (``factor`` candidates: one round on a third of
+    the rows). Too few rows for that: scikit-learn's own plan.
+
+    Returns
+    -------
+    first, last : int
+        ``min_resources`` and ``max_resources`` of the search.
+    """
+    required = 1 + math.floor(math.log(n_candidates, factor) + 1e-9)
+    last = n // factor
+    first = last // factor ** max(required - 2, 0)
+    if required < 2 or first < smallest:
+        return max(smallest, n // factor ** (required - 1)), n
+    return first, last
+
+
+def _smallest(y: np.ndarray, cv: int) -> int:
+    """scikit-learn's ``"smallest"`` rows of a round: two per class and inner fold."""
+    return 2 * cv * len(np.unique(y))
 
 
 def _search_cost(
@@ -399,14 +426,14 @@ def _search_cost(
     cost: Callable[[float], float],
     overhead: float = 0.0,
 ) -> float:
-    """Estimated seconds of a halving search, following scikit-learn's ``"exhaust"`` plan,
-    ``overhead`` seconds added to each candidate's fit and score on each inner fold."""
+    """Estimated seconds of a halving search on :func:`schedule`'s rounds, ``overhead``
+    seconds added to each candidate's fit and score on each inner fold."""
     required = 1 + math.floor(math.log(n_candidates, factor) + 1e-9)
-    first = max(smallest, n // factor ** (required - 1))
-    possible = 1 + math.floor(math.log(max(n // first, 1), factor) + 1e-9)
+    first, last = schedule(n_candidates, n, smallest, factor)
+    possible = 1 + math.floor(math.log(max(last // first, 1), factor) + 1e-9)
     total = 0.0
     for i in range(min(required, possible)):
         candidates = math.ceil(n_candidates / factor**i)
-        rows = min(first * factor**i, n)
+        rows = min(first * factor**i, last)
         total += cv * candidates * (overhead + cost(rows * (cv - 1) / cv))
     return total
