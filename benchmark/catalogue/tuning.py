@@ -246,16 +246,17 @@ class TunedClassifier(ClassifierMixin, BaseEstimator):
         cost fits the budget, at least ``factor``.
 
         Costs are estimated as ``a + b * rows`` from two timed fits (and predictions) of
-        the default setting, on a 27th and a ninth of the rows, times the ratio of two
-        random settings' cost to the default's on the ninth (fewer boosting rounds, more
-        features per split), plus the search's own :func:`evaluation_overhead` per
-        candidate and inner fold; the estimate counts the timing fits and the final refit
-        too. The default budget is :data:`DEFAULT_FITS` fits of the default on all rows.
+        the default setting, on a 27th and a ninth of the rows (see :func:`_fit_cost`),
+        times the ratio of two random settings' cost to the default's on the ninth (fewer
+        boosting rounds, more features per split), plus the search's own
+        :func:`evaluation_overhead` per candidate and inner fold; the estimate counts the
+        timing fits and the final refit too. The default budget is :data:`DEFAULT_FITS`
+        fits of the default on all the rows.
         """
         n = len(y)
         started = time.perf_counter()
-        cost = _fit_cost(self.estimator, X, y, self.random_state)
-        budget = DEFAULT_FITS * cost(n) if self.budget is None else self.budget
+        cost, default = _fit_cost(self.estimator, X, y, self.random_state)
+        budget = DEFAULT_FITS * default if self.budget is None else self.budget
         overhead = evaluation_overhead()
         smallest = _smallest(y, self.cv)
 
@@ -342,9 +343,13 @@ def _delegate(tuned: TunedClassifier) -> Any:
 
 def _fit_cost(
     estimator: Any, X: np.ndarray, y: np.ndarray, seed: int | None
-) -> Callable[[float], float]:
+) -> tuple[Callable[[float], float], float]:
     """Seconds to fit ``estimator`` on so many rows and predict as many, ``a + b * rows``
-    from two timed fits."""
+    from two timed fits on a 27th and a ninth of the rows; and the default's cost on all
+    the rows, the budget's unit: the smaller of that line's and of the power law's
+    (``c * rows ** k``) through the same two points. The line overestimates it for the
+    estimators whose fixed costs dominate small samples (boosting hundreds of rounds), and
+    the budget must not grow with that error."""
     n = len(y)
     order = np.random.default_rng(seed).permutation(n)
     sizes = (max(n // 27, 10), max(n // 9, 20))
@@ -357,7 +362,11 @@ def _fit_cost(
         seconds.append(time.perf_counter() - started)
     slope = max((seconds[1] - seconds[0]) / max(sizes[1] - sizes[0], 1), 0.0)
     fixed = max(seconds[0] - slope * sizes[0], 0.0)
-    return lambda rows: fixed + slope * rows
+    whole = fixed + slope * n
+    if seconds[0] > 0 and seconds[1] > seconds[0] and sizes[1] > sizes[0]:
+        power = math.log(seconds[1] / seconds[0]) / math.log(sizes[1] / sizes[0])
+        whole = min(whole, seconds[1] * (n / sizes[1]) ** power)
+    return (lambda rows: fixed + slope * rows), whole
 
 
 def _space_ratio(

@@ -208,3 +208,33 @@ def test_a_multi_target_model_records_what_each_inner_search_chose() -> None:
     }
     plain = ClassRelevance(build_pipeline(get_spec("ibk5-std"), n_features=3)).fit(X, Y)
     assert chosen_params(plain, names) is None
+
+
+@pytest.mark.parametrize("n_candidates", [3, 9, 27])
+def test_the_planned_rounds_are_the_rounds_the_search_runs(n_candidates: int) -> None:
+    from sklearn.dummy import DummyClassifier
+    from sklearn.experimental import enable_halving_search_cv  # noqa: F401
+    from sklearn.model_selection import HalvingGridSearchCV, StratifiedKFold
+
+    from benchmark.catalogue.tuning import _search_cost, schedule
+
+    rng = np.random.default_rng(3)
+    X = rng.normal(size=(540, 2))
+    y = (X[:, 0] > 0).astype(int)
+    first, last = schedule(n_candidates, 540, 12, 3)
+    search = HalvingGridSearchCV(
+        DummyClassifier(strategy="stratified"),
+        {"random_state": list(range(n_candidates))},
+        factor=3,
+        cv=StratifiedKFold(3),
+        min_resources=first,
+        max_resources=last,
+    ).fit(X, y)
+    assert search.n_candidates_[-1] == 3  # no last round of one candidate, which chooses nothing
+    assert search.n_resources_[-1] == 540 // 3
+    # each candidate's fit and score on each inner fold, as the plan counts them
+    evaluations = _search_cost(n_candidates, 540, 12, 3, 3, lambda rows: 0.0, overhead=1.0)
+    assert evaluations == 3 * sum(search.n_candidates_)
+    rows = _search_cost(n_candidates, 540, 12, 3, 3, lambda rows: rows)
+    rounds = zip(search.n_candidates_, search.n_resources_, strict=True)
+    assert rows == pytest.approx(sum(3 * k * r * 2 / 3 for k, r in rounds))
