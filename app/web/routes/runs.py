@@ -12,6 +12,7 @@ from fastapi.responses import HTMLResponse
 
 from app.api.deps import StoreDep
 from app.errors import NotFoundError
+from app.reports.run_tables import run_tables
 from app.schemas.runs import FINAL_STATUSES
 from app.services.datasets import list_datasets
 from app.services.runs import leaderboard_schema
@@ -73,8 +74,6 @@ def leaderboard(
     run_id: int, store: StoreDep, metric: Metric = None, baseline: Baseline = None
 ) -> HTMLResponse:
     """The run's classifiers ranked by ``metric`` with WEKA's marks against ``baseline``."""
-    from app.reports.run_tables import run_tables
-
     try:
         run, board, report = leaderboard_schema(
             store, run_id, metric=metric or None, baseline=baseline or None
