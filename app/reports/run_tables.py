@@ -127,7 +127,8 @@ def target_tables(report: LeaderboardSchema) -> list[RunTable]:
             tables.append(
                 RunTable(
                     key="target",
-                    title=f"target {target} (mean ±std over folds; mae and rmse lower is better)",
+                    title=f"target {target} (mean ±std over folds; mae and rmse lower is "
+                    "better, r2 higher)",
                     header=("classifier", *REGRESSION_TARGET_METRICS),
                     rows=rows,
                     numeric=(False, True, True, True),
