@@ -294,9 +294,9 @@ def bench_command(
             help=(
                 "With --tune: wall minutes each tuned twin's search may plan for in one outer "
                 "fold (0 < MINUTES <= 1440). Its cost is estimated from two timed fits of "
-                "the default setting and the first halving round gets as many candidates "
-                "(3, 9, 27, ...) as fit. Default: about 6 fits of the default setting on the "
-                "whole training fold."
+                "the default setting and the search's own overhead, and the first halving "
+                "round gets as many candidates (3, 9, 27, ...) as fit. Default: about 6 fits "
+                "of the default setting on the whole training fold."
             ),
             show_default=False,
         ),
