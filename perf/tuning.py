@@ -10,8 +10,10 @@ For each chosen catalogue entry, on the same outer folds of the UC3M Mini gestur
 - a full ``GridSearchCV`` of the same space with the same inner folds and scorer.
 
 It prints, per entry, the mean score and seconds per fold of each, the tuned twin's cost
-as a multiple of the default (the goal: under 10x at the default budget) and the grid's
-cost as a multiple of the halving search.
+as a multiple of the default (the goal: under 10x at the default budget), the candidates
+of its first round and the rows of its last (fewer than the training fold's when the
+budget cannot pay for 3 candidates on all of them), and the grid's cost as a multiple of
+the halving search; and the machine's load average before and after.
 
     .venv/bin/python perf/tuning.py [--classifiers svm-rbf,logistic,ibk5-std] [--folds 5]
         [--budget MINUTES] [--robot mini] [--grid-max 100]
@@ -23,6 +25,7 @@ Everything runs single-threaded (as the engine's workers do); grids larger than
 from __future__ import annotations
 
 import argparse
+import os
 import time
 import warnings
 from pathlib import Path
@@ -85,9 +88,10 @@ def compare(args: argparse.Namespace) -> None:
     X, y = load(args.robot)
     outer = list(StratifiedKFold(args.folds, shuffle=True, random_state=0).split(X, y))
     print(f"{args.robot} gesture: {len(y)} instances, {args.folds} outer folds, inner 3-fold")
+    print(f"load average before: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
     header = (
         f"{'entry':<10} {'grid':>5} | {'default F1':>10} {'s/fold':>7} | {'halving F1':>10} "
-        f"{'s/fold':>7} {'x default':>9} {'cands':>5} | {'grid F1':>8} {'s/fold':>7} "
+        f"{'s/fold':>7} {'x default':>9} {'cands':>5} {'rows':>5} | {'grid F1':>8} {'s/fold':>7} "
         f"{'x halving':>9}"
     )
     print(header)
@@ -100,7 +104,7 @@ def compare(args: argparse.Namespace) -> None:
         default = build_pipeline(spec, n_features=X.shape[1], random_state=0)
         tuned = build_pipeline(tuned_spec(spec, args.budget), n_features=X.shape[1], random_state=0)
         rows: dict[str, list[tuple[float, float]]] = {"default": [], "halving": [], "grid": []}
-        candidates = []
+        candidates, rows_used = [], []
         for train, test in outer:
             rows["default"].append(timed_fold(clone(default), X, y, train, test))
             halving = clone(tuned)
@@ -108,6 +112,7 @@ def compare(args: argparse.Namespace) -> None:
             tuner = halving[-1]
             assert isinstance(tuner, TunedClassifier)
             candidates.append(tuner.n_candidates_)
+            rows_used.append(tuner.n_resources_ / len(train))
             if size > args.grid_max:
                 continue
             search = GridSearchCV(
@@ -126,10 +131,12 @@ def compare(args: argparse.Namespace) -> None:
             f"{classifier:<10} {size:>5} | {mean['default'][0]:>10.4f} {mean['default'][1]:>7.2f} "
             f"| {mean['halving'][0]:>10.4f} {mean['halving'][1]:>7.2f} "
             f"{mean['halving'][1] / mean['default'][1]:>9.1f} {np.mean(candidates):>5.0f} "
+            f"{np.mean(rows_used):>5.2f} "
             f"| {mean['grid'][0]:>8.4f} {mean['grid'][1]:>7.2f} "
             f"{mean['grid'][1] / mean['halving'][1]:>9.1f}",
             flush=True,
         )
+    print(f"load average after: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
 
 
 if __name__ == "__main__":

@@ -294,9 +294,9 @@ def bench_command(
             help=(
                 "With --tune: wall minutes each tuned twin's search may plan for in one outer "
                 "fold (0 < MINUTES <= 1440). Its cost is estimated from two timed fits of "
-                "the default setting and the first halving round gets as many candidates "
-                "(3, 9, 27, ...) as fit. Default: about 6 fits of the default setting on the "
-                "whole training fold."
+                "the default setting and the search's own overhead, and the first halving "
+                "round gets as many candidates (3, 9, 27, ...) as fit. Default: about 6 fits "
+                "of the default setting on the whole training fold."
             ),
             show_default=False,
         ),
@@ -472,7 +472,7 @@ def _print_run_report(
         print_json(report.to_json())
         return
     _print_leaderboard(run, board)
-    _print_tuning(report)
+    _print_run_tables(report)
 
 
 def runs_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
@@ -555,61 +555,21 @@ def leaderboard_command(
         write_results_arff(store, run, sys.stdout)
     else:
         _print_leaderboard(run, board)
-        _print_tuning(report)
+        _print_run_tables(report)
 
 
-def _print_tuning(report: LeaderboardSchema) -> None:
-    """Tuned twins beside their defaults, then what each fold chose (nothing without any)."""
-    if report.tuning:
+def _print_run_tables(report: LeaderboardSchema) -> None:
+    """Tuned twins beside their defaults, what each fold chose, and a multi-target
+    regression's scores per target (nothing of what the run lacks)."""
+    from app.reports.run_tables import run_tables
+
+    for shown in run_tables(report):
         table(
-            f"tuned against default ({report.tuning[0].metric}, corrected resampled t-test, "
-            "alpha 0.05; v tuned significantly better, * worse)",
-            ["tuned", "default", "default mean", "tuned mean", "difference", "p", "", "folds"],
-            [
-                (
-                    c.tuned,
-                    c.default,
-                    _number(c.default_mean),
-                    _number(c.tuned_mean),
-                    _number(
-                        None
-                        if c.tuned_mean is None or c.default_mean is None
-                        else c.tuned_mean - c.default_mean,
-                        signed=True,
-                    ),
-                    _number(c.p),
-                    c.mark,
-                    c.n_folds,
-                )
-                for c in report.tuning
-            ],
+            shown.title,
+            shown.header,
+            shown.rows,
+            justify=["right" if numeric else "left" for numeric in shown.numeric],
         )
-    if report.choices:
-        table(
-            "chosen in each outer training fold (inner cross-validation only)",
-            ["classifier", "repeat", "fold", "chosen"],
-            [
-                (
-                    c.classifier,
-                    c.repeat + 1,
-                    c.fold + 1,
-                    ", ".join(f"{name}={_short(value)}" for name, value in c.params.items()),
-                )
-                for c in report.choices
-            ],
-        )
-
-
-def _number(value: float | None, *, signed: bool = False) -> str:
-    if value is None:
-        return ""
-    return f"{value:+.4f}" if signed else f"{value:.4f}"
-
-
-def _short(value: object) -> str:
-    if isinstance(value, list):
-        return "[" + " ".join(_short(v) for v in value) + "]"
-    return f"{value:g}" if isinstance(value, float) else str(value)
 
 
 def _print_independent(result: IndependentResult, as_json: bool) -> None:

@@ -21,8 +21,10 @@ from matplotlib.figure import Figure
 from app.reports import figures
 from app.reports.leaderboard import leaderboard_header, leaderboard_rows, metric_columns
 from app.reports.plots import svg_text
+from app.reports.run_tables import run_tables
 from app.services.compare import Comparison
 from app.services.report import Report, RunView
+from app.services.runs import leaderboard_report
 from benchmark.errors import BenchmarkError
 
 TEMPLATES = Path(__file__).with_name("templates")
@@ -201,6 +203,7 @@ def _run(report: Report, view: RunView, plots: list[_Plot]) -> dict[str, Any]:
         "plots": run_plots,
         "confusions": confusions,
         "fold_note": ranked if isinstance(ranked, str) else None,
+        "tables": run_tables(leaderboard_report(run, board, view.results)),
     }
 
 

@@ -528,10 +528,17 @@ def leaderboard_schema(
 ) -> tuple[RunInfo, Leaderboard, LeaderboardSchema]:
     """A run's leaderboard, and the report ``leaderboard --json`` prints and the API serves
     (multi-target rows carry ``metrics.per_target``)."""
+    run, board = run_leaderboard(store, run_id, metric=metric, baseline=baseline)
+    return run, board, leaderboard_report(run, board, load_results(store, run.id))
+
+
+def leaderboard_report(
+    run: RunInfo, board: Leaderboard, results: Sequence[TaskResult]
+) -> LeaderboardSchema:
+    """The report of a run's leaderboard ``board`` built from its ``results``: rows with
+    their per-target scores, tuned twins against their defaults, the choices per fold."""
     from benchmark.evaluation.tuned import compare_tuned, fold_choices
 
-    run, board = run_leaderboard(store, run_id, metric=metric, baseline=baseline)
-    results = load_results(store, run.id)
     per_target = per_target_summary(results)
     data = board.to_json()
     for row in data["leaderboard"]:
@@ -541,7 +548,7 @@ def leaderboard_schema(
                 target: {name: {"mean": mean, "std": std} for name, (mean, std) in scores.items()}
                 for target, scores in targets.items()
             }
-    report = LeaderboardSchema(
+    return LeaderboardSchema(
         run_id=run.id,
         dataset=run.dataset_name,
         kind=run.kind,
@@ -559,7 +566,6 @@ def leaderboard_schema(
         ],
         choices=[FoldChoiceSchema(**c.to_json()) for c in fold_choices(results)],
     )
-    return run, board, report
 
 
 PerTargetSummary = dict[str, dict[str, dict[str, tuple[float, float]]]]

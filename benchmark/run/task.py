@@ -14,16 +14,15 @@ import traceback
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
 from benchmark.catalogue import ClassifierSpec
-from benchmark.catalogue.spec import jsonable
 from benchmark.estimators import build_estimator
 from benchmark.evaluation.metrics import confusion_matrix, expand_proba, multiclass_scores
 from benchmark.problem import Problem
 from benchmark.results import Status, TaskKey, TaskResult
+from benchmark.run.choices import chosen_params
 from benchmark.run.folds import Fold
 
 #: At most this many distinct warnings are kept per task.
@@ -204,24 +203,8 @@ def _run_multitarget(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResu
         int(fold.train.size),
         int(fold.test.size),
         per_target=per_target,
+        params=chosen_params(model, problem.target_names),
     )
-
-
-def chosen_params(model: object) -> dict[str, Any] | None:
-    """What a tuned twin or a stack chose on its training fold, as JSON-ready data.
-
-    Returns
-    -------
-    dict or None
-        The final step's ``best_params_`` (values that JSON cannot hold as their ``repr``);
-        ``None`` for a classifier that chooses nothing.
-    """
-    steps = getattr(model, "steps", None)
-    final = steps[-1][1] if steps else model
-    chosen = getattr(final, "best_params_", None)
-    if not isinstance(chosen, dict):
-        return None
-    return {str(name): jsonable(value) for name, value in chosen.items()}
 
 
 class _Timer:

@@ -42,6 +42,30 @@ def test_tuned_twins_sit_beside_their_defaults_with_a_test_and_their_choices(
     assert "tuned against default" in table.out and "C=" in table.out
 
 
+def test_a_multi_target_twin_records_each_targets_choice_per_fold(
+    capsys: pytest.CaptureFixture[str], db: str
+) -> None:
+    args = ["bench", "touch", "-c", "cr:logistic", "-k", "3", "--tune", "--budget", "0.01"]
+    result = run_cli(capsys, db, *args, "--json")
+    assert result.code == 0, result.err
+    report = result.json()
+    (comparison,) = report["tuning"]
+    assert (comparison["tuned"], comparison["default"]) == ("cr:logistic+tuned", "cr:logistic")
+    choices = comparison["choices"]
+    assert choices == [c for c in report["choices"] if c["classifier"] == "cr:logistic+tuned"]
+    assert [c["fold"] for c in choices] == [0, 1, 2]
+    for choice in choices:
+        assert set(choice["params"]) == {"gesture", "place"}
+        assert all(set(chosen) == {"C"} for chosen in choice["params"].values())
+    table = run_cli(capsys, db, "leaderboard", "1")
+    assert table.code == 0, table.err
+    lines = [line.replace("│", " ").split() for line in table.out.splitlines()]
+    first = choices[0]["params"]
+    for target in ("gesture", "place"):
+        shown = ["cr:logistic+tuned", "1", "1", target, f"C={first[target]['C']:g}"]
+        assert shown in lines, table.out
+
+
 def test_a_stack_records_the_members_each_fold_chose(
     capsys: pytest.CaptureFixture[str], db: str
 ) -> None:

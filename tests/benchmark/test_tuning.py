@@ -168,3 +168,73 @@ def test_chosen_parameters_round_trip_through_json_and_older_results_still_read(
     old = result.to_json()
     del old["params"]
     assert TaskResult.from_json(old).params is None
+
+
+def test_a_multi_target_model_records_what_each_inner_search_chose() -> None:
+    from benchmark.multitarget import (
+        ClassRelevance,
+        EnsembleClassifierChains,
+        LabelCombination,
+        RAkELd,
+    )
+    from benchmark.run.choices import chosen_params
+
+    rng = np.random.default_rng(2)
+    X = rng.normal(size=(120, 3))
+    Y = np.column_stack([(X[:, 0] > 0) + (X[:, 0] > 1), X[:, 1] > 0, np.zeros(120)]).astype(int)
+    names = ("gesture", "place", "constant")
+    space = set(SEARCH_SPACES["ibk5-std"])
+
+    def tuned() -> Any:
+        return build_pipeline(tuned_spec(get_spec("ibk5-std"), 0.01), n_features=3)
+
+    relevance = ClassRelevance(tuned()).fit(X, Y)
+    chosen = chosen_params(relevance, names)
+    assert chosen is not None and set(chosen) == {"gesture", "place"}  # constant: no search
+    assert all(set(params) == space for params in chosen.values())
+    assert chosen["gesture"] == relevance.estimators_[0].estimator_[-1].best_params_
+    assert chosen_params(relevance) is None  # without target names: a single-target reading
+
+    joint = chosen_params(LabelCombination(tuned()).fit(X, Y), names)
+    assert joint is not None and set(joint) == {"joint"}
+    rakel = RAkELd(tuned(), subset_size=2, random_state=0).fit(X, Y[:, :2])
+    assert set(chosen_params(rakel, names) or {}) == {"gesture+place"}
+    chains = EnsembleClassifierChains(tuned(), n_estimators=2, random_state=0).fit(X, Y[:, :2])
+    assert set(chosen_params(chains, names) or {}) == {
+        "member 1/gesture",
+        "member 1/place",
+        "member 2/gesture",
+        "member 2/place",
+    }
+    plain = ClassRelevance(build_pipeline(get_spec("ibk5-std"), n_features=3)).fit(X, Y)
+    assert chosen_params(plain, names) is None
+
+
+@pytest.mark.parametrize("n_candidates", [3, 9, 27])
+def test_the_planned_rounds_are_the_rounds_the_search_runs(n_candidates: int) -> None:
+    from sklearn.dummy import DummyClassifier
+    from sklearn.experimental import enable_halving_search_cv  # noqa: F401
+    from sklearn.model_selection import HalvingGridSearchCV, StratifiedKFold
+
+    from benchmark.catalogue.tuning import _search_cost, schedule
+
+    rng = np.random.default_rng(3)
+    X = rng.normal(size=(540, 2))
+    y = (X[:, 0] > 0).astype(int)
+    first, last = schedule(n_candidates, 540, 12, 3)
+    search = HalvingGridSearchCV(
+        DummyClassifier(strategy="stratified"),
+        {"random_state": list(range(n_candidates))},
+        factor=3,
+        cv=StratifiedKFold(3),
+        min_resources=first,
+        max_resources=last,
+    ).fit(X, y)
+    assert search.n_candidates_[-1] == 3  # no last round of one candidate, which chooses nothing
+    assert search.n_resources_[-1] == 540 // 3
+    # each candidate's fit and score on each inner fold, as the plan counts them
+    evaluations = _search_cost(n_candidates, 540, 12, 3, 3, lambda rows: 0.0, overhead=1.0)
+    assert evaluations == 3 * sum(search.n_candidates_)
+    rows = _search_cost(n_candidates, 540, 12, 3, 3, lambda rows: rows)
+    rounds = zip(search.n_candidates_, search.n_resources_, strict=True)
+    assert rows == pytest.approx(sum(3 * k * r * 2 / 3 for k, r in rounds))

@@ -12,9 +12,10 @@ from fastapi.responses import HTMLResponse
 
 from app.api.deps import StoreDep
 from app.errors import NotFoundError
+from app.reports.run_tables import run_tables
 from app.schemas.runs import FINAL_STATUSES
 from app.services.datasets import list_datasets
-from app.services.runs import run_leaderboard
+from app.services.runs import leaderboard_schema
 from app.store.runs import RunInfo, get_run, list_runs
 from app.web.rendering import draw, render
 from app.web.routes.pages import Ref
@@ -74,7 +75,7 @@ def leaderboard(
 ) -> HTMLResponse:
     """The run's classifiers ranked by ``metric`` with WEKA's marks against ``baseline``."""
     try:
-        run, board = run_leaderboard(
+        run, board, report = leaderboard_schema(
             store, run_id, metric=metric or None, baseline=baseline or None
         )
     except ConfigurationError:
@@ -87,6 +88,7 @@ def leaderboard(
         run=run,
         board=board,
         table=_table(run, board, chosen_baseline=baseline or None),
+        tables=run_tables(report),
     )
 
 
