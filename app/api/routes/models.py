@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import tempfile
 import time
 from collections.abc import Mapping, Sequence
@@ -9,7 +10,6 @@ from pathlib import Path
 from typing import Annotated, Any
 
 from fastapi import APIRouter, File, Response, UploadFile, status
-from starlette.concurrency import run_in_threadpool
 
 from app.api.deps import Service, ServiceDep, StoreDep
 from app.api.uploads import save_upload
@@ -82,10 +82,11 @@ def remove(model_ref: str, service: ServiceDep) -> ModelSchema:
 async def predict_instances(model_ref: str, body: PredictRequest, service: ServiceDep) -> Response:
     """Predict instances given as ``{attribute: value}`` (matched to the model by name):
     per instance and target the predicted label and the class probabilities."""
-    if service.models.runs_inline(model_ref, len(body.instances)):
-        content = _predict_records(service, model_ref, body.instances)
-    else:
-        content = await run_in_threadpool(_predict_records, service, model_ref, body.instances)
+    content = await service.models.run(
+        model_ref,
+        len(body.instances),
+        functools.partial(_predict_records, service, model_ref, body.instances),
+    )
     return Response(content, media_type="application/json")
 
 

@@ -3,7 +3,9 @@ in a worker thread otherwise; the same answer either way."""
 
 from __future__ import annotations
 
+import asyncio
 import threading
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -36,6 +38,30 @@ def test_a_model_runs_inline_only_once_it_is_known_to_be_quick() -> None:
     assert cache.runs_inline("m", 1)
     cache.forget(7)
     assert not cache.runs_inline("m", 1)
+
+
+def test_a_quick_model_waits_its_turn_in_a_thread_when_another_prediction_is_under_way() -> None:
+    cache = ModelCache(4)
+    cache._models[(7, "sha", "quick")] = (None, None)  # type: ignore[assignment]
+    cache._models[(8, "sha", "slow")] = (None, None)  # type: ignore[assignment]
+    cache.record(7, INLINE_SECONDS / 10, 1)
+    cache.record(8, INLINE_SECONDS * 10, 1)
+
+    def where() -> int:
+        time.sleep(0.05)
+        return threading.get_ident()
+
+    async def both() -> tuple[int, int, int]:
+        slow, quick = await asyncio.gather(
+            cache.run("slow", 1, where), cache.run("quick", 1, where)
+        )
+        alone = await cache.run("quick", 1, where)
+        return slow, quick, alone
+
+    loop_thread = threading.get_ident()
+    slow, quick, alone = asyncio.run(both())
+    assert slow != loop_thread and quick != loop_thread  # both in threads
+    assert alone == loop_thread  # alone, the quick model runs on the loop
 
 
 @pytest.fixture
