@@ -52,6 +52,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
             yield
         finally:
             dispatcher.stop()
+            app.state.service.models.close()
             store.dispose()
 
     app = FastAPI(
