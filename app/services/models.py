@@ -238,8 +238,17 @@ def predict_records(
     ``null`` is a missing value.
     """
     info, model = load_model(store, model_ref)
-    data = dataset_from_records(model.schema, records)
-    return predict(model, data, source="instances").report(info)
+    return records_report(info, model, records)
+
+
+def records_report(
+    info: ModelInfo, model: TrainedModel, records: Sequence[Mapping[str, Any]]
+) -> PredictionReport:
+    """The prediction report of a loaded model for JSON-like records (see
+    :func:`predict_records`)."""
+    return predict(model, dataset_from_records(model.schema, records), source="instances").report(
+        info
+    )
 
 
 def dataset_from_records(schema: Schema, records: Sequence[Mapping[str, Any]]) -> Dataset:

@@ -13,10 +13,10 @@ from importlib import metadata
 import numpy as np
 
 from app.services.compare import Comparison, compare_runs
-from app.services.runs import PerTargetSummary, per_target_summary, run_leaderboard
+from app.services.runs import PerTargetSummary, per_target_summary, run_results
 from app.store.database import Store
 from app.store.datasets import load_schema
-from app.store.runs import RunInfo, load_results
+from app.store.runs import RunInfo
 from benchmark.errors import BenchmarkError, ConfigurationError
 from benchmark.evaluation.leaderboard import Leaderboard
 from benchmark.evaluation.score_table import MissingPolicy, ScoreTable, fold_score_table
@@ -177,13 +177,12 @@ def run_view(
 ) -> RunView:
     """A run with its leaderboard (marks against ``baseline``, default the best), results
     and class labels."""
-    run, board = run_leaderboard(store, run_ref, metric=metric, baseline=baseline)
+    run, results, board = run_results(store, run_ref, metric=metric, baseline=baseline)
     _, schema, _ = load_schema(store, run.dataset_id)
     labels = {}
     for target in run.targets:
         attribute = schema.attributes[schema.index(target)]
         labels[target] = list(attribute.values)
-    results = load_results(store, run.id)
     per_target = None
     if run.kind == "multitarget":
         summary = per_target_summary(results)

@@ -473,6 +473,15 @@ def run_leaderboard(
     ConfigurationError
         The run has no result yet; an unknown metric or baseline.
     """
+    run, _, board = run_results(store, run_id, metric=metric, baseline=baseline)
+    return run, board
+
+
+def run_results(
+    store: Store, run_id: int | str, *, metric: str | None = None, baseline: str | None = None
+) -> tuple[RunInfo, list[TaskResult], Leaderboard]:
+    """A run, its stored results (read once) and its leaderboard, for callers that need
+    the results too; raises as :func:`run_leaderboard` does."""
     from benchmark.evaluation.leaderboard import build_leaderboard
 
     run = get_run(store, run_id)
@@ -486,9 +495,10 @@ def run_leaderboard(
         raise ConfigurationError(f"run {run.id} has no results yet ({hint})")
     if metric is not None:
         check_metric(run.kind, metric, position=bool(run.config.get("position")), run_id=run.id)
-    return run, build_leaderboard(
+    board = build_leaderboard(
         results, metric=metric or DEFAULT_METRIC.get(run.kind, "f1_weighted"), baseline=baseline
     )
+    return run, results, board
 
 
 def check_metric(kind: str, metric: str, *, position: bool, run_id: int | None = None) -> None:
@@ -528,8 +538,8 @@ def leaderboard_schema(
 ) -> tuple[RunInfo, Leaderboard, LeaderboardSchema]:
     """A run's leaderboard, and the report ``leaderboard --json`` prints and the API serves
     (multi-target rows carry ``metrics.per_target``)."""
-    run, board = run_leaderboard(store, run_id, metric=metric, baseline=baseline)
-    return run, board, leaderboard_report(run, board, load_results(store, run.id))
+    run, results, board = run_results(store, run_id, metric=metric, baseline=baseline)
+    return run, board, leaderboard_report(run, board, results)
 
 
 def leaderboard_report(

@@ -61,7 +61,7 @@ class LeaderboardRow:
             "classifier": self.classifier,
             "mark": self.mark,
             "metrics": {
-                name: {"mean": _finite(mean), "std": _finite(std)}
+                name: {"mean": finite(mean), "std": finite(std)}
                 for name, (mean, std) in self.metrics.items()
             },
             "n_ok": self.n_ok,
@@ -181,7 +181,7 @@ def build_leaderboard(
         raise ConfigurationError(
             f"baseline '{baseline}' is not in this run (classifiers: {', '.join(by_classifier)})"
         )
-    base_scores = _scores(by_classifier[baseline], metric)
+    base_scores = scores_by_fold(by_classifier[baseline], metric)
     if not base_scores:
         raise ConfigurationError(f"baseline '{baseline}' has no successful fold with {metric}")
     counts = {"v": 0, "": 0, "*": 0}
@@ -189,21 +189,45 @@ def build_leaderboard(
     for row in rows:
         if row.classifier == baseline:
             continue
-        scores = _scores(by_classifier[row.classifier], metric)
+        scores = scores_by_fold(by_classifier[row.classifier], metric)
         paired = sorted(set(scores) & set(base_scores))
         if len(paired) < 2:
             continue
-        _, _, sign = corrected_resampled_ttest(
+        _, _, row.mark = mark_against(
             np.array([scores[k] for k in paired]),
             np.array([base_scores[k] for k in paired]),
             test_train_ratio=ratio,
             alpha=alpha,
+            lower_is_better=lower,
         )
-        if lower:
-            sign = -sign
-        row.mark = "v" if sign > 0 else "*" if sign < 0 else ""
         counts[row.mark] += 1
     return Leaderboard(metric, baseline, rows, (counts["v"], counts[""], counts["*"]), alpha)
+
+
+def mark_against(
+    scores: np.ndarray,
+    others: np.ndarray,
+    *,
+    test_train_ratio: float,
+    alpha: float,
+    lower_is_better: bool,
+) -> tuple[float, float, Mark]:
+    """The corrected resampled t-test of paired per-fold ``scores`` against ``others``
+    (both of shape (n_folds,)), and WEKA's mark: ``v`` significantly better, ``*`` worse,
+    in the metric's own direction.
+
+    Returns
+    -------
+    t, p : float
+        NaN below two folds.
+    mark : {"v", "*", ""}
+    """
+    t, p, sign = corrected_resampled_ttest(
+        scores, others, test_train_ratio=test_train_ratio, alpha=alpha
+    )
+    if lower_is_better:
+        sign = -sign
+    return t, p, "v" if sign > 0 else "*" if sign < 0 else ""
 
 
 def _summarise(classifier: str, results: list[TaskResult], names: list[str]) -> LeaderboardRow:
@@ -255,7 +279,7 @@ def _assign_ranks(rows: list[LeaderboardRow], metric: str) -> None:
         previous = mean
 
 
-def _scores(results: list[TaskResult], metric: str) -> dict[tuple[int, int], float]:
+def scores_by_fold(results: Sequence[TaskResult], metric: str) -> dict[tuple[int, int], float]:
     """Metric per (repeat, fold) of the successful tasks that have it."""
     return {
         (r.key.repeat, r.key.fold): r.metrics[metric]
@@ -270,5 +294,6 @@ def _test_train_ratio(results: Sequence[TaskResult]) -> float:
     return float(np.mean(ratios)) if ratios else 0.0
 
 
-def _finite(value: float) -> float | None:
+def finite(value: float) -> float | None:
+    """``value``, or ``None`` for NaN (JSON has none)."""
     return None if math.isnan(value) else value

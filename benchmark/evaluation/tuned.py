@@ -15,8 +15,8 @@ from typing import Any
 
 import numpy as np
 
+from benchmark.evaluation.leaderboard import finite, mark_against, scores_by_fold
 from benchmark.evaluation.metrics import LOWER_IS_BETTER
-from benchmark.evaluation.significance import corrected_resampled_ttest
 from benchmark.results import TaskResult
 
 #: Suffix of a tuned twin's id (as :data:`benchmark.catalogue.tuning.TUNED_SUFFIX`; the
@@ -80,11 +80,11 @@ class TunedComparison:
             "tuned": self.tuned,
             "default": self.default,
             "metric": self.metric,
-            "tuned_mean": _finite(self.tuned_mean),
-            "default_mean": _finite(self.default_mean),
+            "tuned_mean": finite(self.tuned_mean),
+            "default_mean": finite(self.default_mean),
             "n_folds": self.n_folds,
-            "t": _finite(self.t),
-            "p": _finite(self.p),
+            "t": finite(self.t),
+            "p": finite(self.p),
             "mark": self.mark,
             "choices": [choice.to_json() for choice in self.choices],
         }
@@ -116,29 +116,29 @@ def compare_tuned(
     alpha : float
         Significance level of the marks.
     """
-    scores: dict[str, dict[tuple[int, int], float]] = defaultdict(dict)
+    by_classifier: dict[str, list[TaskResult]] = defaultdict(list)
     ratios: dict[str, float] = {}
     for r in results:
-        value = r.metrics.get(metric, math.nan) if r.ok else math.nan
-        if not math.isnan(value):
-            scores[r.key.classifier][(r.key.repeat, r.key.fold)] = value
+        by_classifier[r.key.classifier].append(r)
         if r.n_train > 0:
             ratios[r.key.classifier] = r.n_test / r.n_train
+    scores = {c: scores_by_fold(rs, metric) for c, rs in by_classifier.items()}
     choices = fold_choices(results)
-    order = list(dict.fromkeys(r.key.classifier for r in results))
     comparisons = []
-    for tuned in order:
+    for tuned in by_classifier:
         default = tuned.removesuffix(TUNED_SUFFIX)
-        if tuned == default or default not in order:
+        if tuned == default or default not in by_classifier:
             continue
         paired = sorted(set(scores[tuned]) & set(scores[default]))
         a = np.array([scores[tuned][k] for k in paired])
         b = np.array([scores[default][k] for k in paired])
-        t, p, sign = corrected_resampled_ttest(
-            a, b, test_train_ratio=ratios.get(tuned, 0.0), alpha=alpha
+        t, p, mark = mark_against(
+            a,
+            b,
+            test_train_ratio=ratios.get(tuned, 0.0),
+            alpha=alpha,
+            lower_is_better=metric in LOWER_IS_BETTER,
         )
-        if metric in LOWER_IS_BETTER:
-            sign = -sign
         comparisons.append(
             TunedComparison(
                 tuned=tuned,
@@ -149,12 +149,8 @@ def compare_tuned(
                 n_folds=len(paired),
                 t=t,
                 p=p,
-                mark="v" if sign > 0 else "*" if sign < 0 else "",
+                mark=mark,
                 choices=[c for c in choices if c.classifier == tuned],
             )
         )
     return comparisons
-
-
-def _finite(value: float) -> float | None:
-    return None if math.isnan(value) else value

@@ -95,12 +95,11 @@ def _predict_records(
 ) -> bytes:
     """The prediction report as JSON: written here once, not validated again by FastAPI
     against the response model it was built from."""
-    from app.services.models import dataset_from_records, predict
+    from app.services.models import records_report
 
     info, trained = service.models.get(service.store, model_ref)
     start = time.thread_time()
-    data = dataset_from_records(trained.schema, records)
-    report = predict(trained, data, source="instances").report(info)
+    report = records_report(info, trained, records)
     service.models.record(info.id, time.thread_time() - start, len(records))
     return report.model_dump_json().encode()
 
