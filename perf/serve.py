@@ -179,16 +179,18 @@ def throughput(
     return done / seconds
 
 
-def run_over_http(url: str, request: dict[str, object]) -> float:
+def run_over_http(url: str, request: dict[str, object]) -> tuple[float, int]:
+    """Submit the run and poll until it ends: (wall seconds, run id)."""
     with httpx.Client(base_url=url, timeout=60) as client:
         start = time.perf_counter()
-        run_id = client.post("/api/runs", json=request).json()["id"]
+        run_id = int(client.post("/api/runs", json=request).json()["id"])
         while client.get(f"/api/runs/{run_id}").json()["status"] in ("queued", "running"):
-            time.sleep(0.2)
-        return time.perf_counter() - start
+            time.sleep(0.05)
+        return time.perf_counter() - start, run_id
 
 
-def run_from_cli(db: str, request: dict[str, object]) -> float:
+def run_from_cli(db: str, request: dict[str, object]) -> tuple[float, int]:
+    """``touchbench bench`` in a new process: (wall seconds, run id)."""
     command = [
         sys.executable,
         "-m",
@@ -206,8 +208,52 @@ def run_from_cli(db: str, request: dict[str, object]) -> float:
         "--json",
     ]
     start = time.perf_counter()
-    subprocess.run(command, cwd=ROOT, check=True, stdout=subprocess.DEVNULL)
-    return time.perf_counter() - start
+    printed = subprocess.run(command, cwd=ROOT, check=True, capture_output=True, text=True)
+    seconds = time.perf_counter() - start
+    return seconds, int(json.loads(printed.stdout)["run_id"])
+
+
+def compare_runs(store: object, url: str, db: str, request: dict[str, object], rounds: int):
+    """The same run over HTTP and from the CLI, ``rounds`` times in alternating order.
+
+    Returns rows of the table: wall time, and the part of it the engine ran (the run's
+    ``started_at`` to ``finished_at`` in the store); medians of the rounds.
+    """
+    from app.store.runs import get_run
+
+    def executing(run_id: int) -> float:
+        run = get_run(store, run_id)  # type: ignore[arg-type]
+        assert run.status == "done", (run_id, run.status, run.error)
+        assert run.started_at is not None and run.finished_at is not None
+        return (run.finished_at - run.started_at).total_seconds()
+
+    walls: dict[str, list[float]] = {"HTTP": [], "CLI": []}
+    engine: dict[str, list[float]] = {"HTTP": [], "CLI": []}
+    sides = {"HTTP": lambda: run_over_http(url, request), "CLI": lambda: run_from_cli(db, request)}
+    for number in range(rounds):
+        for side in ("HTTP", "CLI") if number % 2 == 0 else ("CLI", "HTTP"):
+            seconds, run_id = sides[side]()
+            walls[side].append(seconds)
+            engine[side].append(executing(run_id))
+    ratio = statistics.median(h / c for h, c in zip(walls["HTTP"], walls["CLI"], strict=True))
+    engine_ratio = statistics.median(
+        h / c for h, c in zip(engine["HTTP"], engine["CLI"], strict=True)
+    )
+    label = f"run {','.join(request['classifiers'])} x {request['folds']} folds"  # type: ignore[arg-type]
+    return [
+        (
+            f"{label}, wall (s)",
+            f"HTTP {statistics.median(walls['HTTP']):.1f}",
+            f"CLI {statistics.median(walls['CLI']):.1f}",
+            f"ratio {ratio:.3f}",
+        ),
+        (
+            f"{label}, in the engine (s)",
+            f"HTTP {statistics.median(engine['HTTP']):.1f}",
+            f"CLI {statistics.median(engine['CLI']):.1f}",
+            f"ratio {engine_ratio:.3f}",
+        ),
+    ]
 
 
 def main() -> None:
@@ -225,6 +271,17 @@ def main() -> None:
         "--run-classifiers",
         default="nb,j48,logistic,rf",
         help="the run compared over HTTP and from the CLI ('' leaves it out)",
+    )
+    parser.add_argument(
+        "--run-rounds",
+        type=int,
+        default=3,
+        help="runs on each side, in alternating order (medians are shown)",
+    )
+    parser.add_argument(
+        "--no-predictions",
+        action="store_true",
+        help="leave the prediction latency and throughput out (the run comparison only)",
     )
     parser.add_argument(
         "--client",
@@ -250,7 +307,7 @@ def main() -> None:
     process, url = start_service(db, folder, args.workers)
     rows = []
     try:
-        for classifier in ("logistic", "rf"):
+        for classifier in () if args.no_predictions else ("logistic", "rf"):
             info, trained = load_model(store, f"mini-{classifier}")
             X = align_features(trained.schema, data)[:1]
             record: dict[str, object] = {
@@ -310,16 +367,7 @@ def main() -> None:
                 "classifiers": args.run_classifiers.split(","),
                 "folds": 10,
             }
-            http_seconds = run_over_http(url, request)
-            cli_seconds = run_from_cli(db, request)
-            rows.append(
-                (
-                    f"run {args.run_classifiers} x 10 folds (s)",
-                    f"HTTP {http_seconds:.1f}",
-                    f"CLI {cli_seconds:.1f}",
-                    f"ratio {http_seconds / cli_seconds:.3f}",
-                )
-            )
+            rows += compare_runs(store, url, db, request, args.run_rounds)
     finally:
         process.terminate()
         process.wait(timeout=30)

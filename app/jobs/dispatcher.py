@@ -1,23 +1,35 @@
 """The dispatcher a service process runs: it hands queued runs and jobs to worker processes.
 
-Every ``poll`` seconds it looks in the store for queued work and, while fewer than
-``job_workers`` of its worker processes are busy, starts ``python -m app.jobs.process`` for
-the oldest item.  Worker processes claim items atomically, so several service processes
-(``touchbench serve --workers N``, or several hosts on one PostgreSQL store) can dispatch
-from the same queue; upload folders are on one host's disk, so extraction jobs are only
-taken by a dispatcher on the host that received them.
+Every ``POLL`` seconds, and at once when a request queues something, it looks in the store
+for queued work and, while fewer than ``job_workers`` of its worker processes are busy,
+starts ``python -m app.jobs.process`` for the oldest item.
+
+On one host, one service process per store dispatches: the one that holds the store's
+dispatch address (an abstract Unix socket named after the store, released by the kernel
+when its process ends, kill -9 included).  The others queue work and wake it through that
+address, and take its place within ``POLL`` seconds when it ends.  So ``touchbench serve
+--workers N`` runs at most ``job_workers`` jobs at once, not N times as many, and never
+starts two processes for one run.  Worker processes still claim items atomically, as
+several hosts on one PostgreSQL store each have a dispatcher; upload folders are on one
+host's disk, so extraction jobs are only taken by a dispatcher on the host that received
+them.
 """
 
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import logging
 import os
+import select
 import socket
 import subprocess
 import sys
 import threading
 from dataclasses import dataclass
+from pathlib import Path
+
+from sqlalchemy.engine import make_url
 
 from app.settings import Settings
 from app.store.database import Store
@@ -53,20 +65,38 @@ class Dispatcher:
         self._active: list[_Active] = []
         self._stop = threading.Event()
         self._wake = threading.Event()
+        self._address = dispatch_address(store)
+        self._inbox: socket.socket | None = None
         self._thread = threading.Thread(target=self._loop, daemon=True, name="dispatcher")
 
     def start(self) -> None:
         self._thread.start()
 
     def wake(self) -> None:
-        """Look at the queue now (a request just queued something)."""
+        """Look at the queue now (a request just queued something), whichever service
+        process on this host dispatches for the store."""
         self._wake.set()
+        if self._address is not None:
+            with (
+                contextlib.suppress(OSError),
+                socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM) as sender,
+            ):
+                sender.setblocking(False)
+                sender.sendto(b"!", self._address)
+
+    @property
+    def leading(self) -> bool:
+        """Whether this process dispatches for the store on this host."""
+        return self._address is None or self._inbox is not None
 
     def stop(self) -> None:
         """Stop dispatching and end the worker processes (their runs become resumable)."""
         self._stop.set()
-        self._wake.set()
+        self.wake()
         self._thread.join(timeout=10)
+        if self._inbox is not None:
+            self._inbox.close()
+            self._inbox = None
         for active in self._active:
             with contextlib.suppress(ProcessLookupError):
                 active.process.terminate()
@@ -78,19 +108,46 @@ class Dispatcher:
         mark_lost_runs(self.store)
         mark_lost_jobs(self.store)
 
-    @property
-    def busy(self) -> int:
-        return len(self._active)
-
     def _loop(self) -> None:
         while not self._stop.is_set():
+            if not self.leading and not self._lead():
+                self._wake.wait(POLL)
+                self._wake.clear()
+                continue
             try:
                 self._reap()
                 self._dispatch()
             except Exception as error:  # a busy or unreachable store: try again later
                 log.warning("dispatcher: %s: %s", type(error).__name__, error)
+            self._wait()
+
+    def _lead(self) -> bool:
+        """Take the store's dispatch address if no other process on this host holds it."""
+        assert self._address is not None  # else this process always leads
+        inbox = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
+        try:
+            inbox.bind(self._address)
+        except OSError:
+            inbox.close()
+            return False
+        inbox.setblocking(False)
+        self._inbox = inbox
+        log.info("dispatching for %s", self.store.engine.url.render_as_string())
+        return True
+
+    def _wait(self) -> None:
+        """Wait up to ``POLL`` seconds for a wake-up."""
+        if self._inbox is None:
             self._wake.wait(POLL)
             self._wake.clear()
+            return
+        ready, _, _ = select.select([self._inbox], [], [], POLL)
+        while ready:
+            try:
+                self._inbox.recv(64)
+            except BlockingIOError:
+                break
+        self._wake.clear()
 
     def _reap(self) -> None:
         finished = [a for a in self._active if a.process.poll() is not None]
@@ -144,3 +201,22 @@ class Dispatcher:
             environment[name] = "1"
         log.info("starting %s %s", kind, item_id)
         return subprocess.Popen(command, env=environment, stdin=subprocess.DEVNULL)
+
+
+def dispatch_address(store: Store) -> str | None:
+    """The abstract Unix socket address naming ``store``'s dispatcher on this host, or None
+    where every service process dispatches for itself: not Linux (no abstract sockets), or
+    an in-memory SQLite store (one per process).
+
+    SQLite files are named by their absolute path, so two stores with the same relative
+    URL in different folders are two stores.
+    """
+    url = make_url(store.url)
+    if url.get_backend_name() == "sqlite":
+        if url.database in (None, "", ":memory:") or "mode=memory" in str(url):
+            return None
+        url = url.set(database=str(Path(url.database).resolve()))
+    if not sys.platform.startswith("linux"):
+        return None
+    key = url.render_as_string(hide_password=False).encode()
+    return "\0touchbench-dispatch-" + hashlib.sha256(key).hexdigest()[:32]

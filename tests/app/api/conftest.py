@@ -36,6 +36,7 @@ class Server:
     environment: dict[str, str]
     process: subprocess.Popen[bytes] | None = None
     log: Path | None = None
+    arguments: tuple[str, ...] = ()
     client: httpx.Client = field(init=False)
 
     def start(self, *, timeout: float = 120.0) -> None:
@@ -52,6 +53,7 @@ class Server:
             port,
             "--log-level",
             "warning",
+            *self.arguments,
         ]
         self.process = subprocess.Popen(
             command,
@@ -113,7 +115,7 @@ def finished(body: dict[str, Any]) -> bool:
 def _servers(database_url: str, tmp_path: Path) -> Iterator[Callable[..., Server]]:
     servers: list[Server] = []
 
-    def build(**settings: str) -> Server:
+    def build(*, arguments: tuple[str, ...] = (), **settings: str) -> Server:
         environment = {
             **os.environ,
             "PYTHONPATH": str(ROOT),
@@ -128,6 +130,7 @@ def _servers(database_url: str, tmp_path: Path) -> Iterator[Callable[..., Server
             work_dir=tmp_path / "work",
             environment=environment,
             log=tmp_path / f"service-{len(servers)}.log",
+            arguments=arguments,
         )
         servers.append(server)
         server.start()

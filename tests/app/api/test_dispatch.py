@@ -1,0 +1,113 @@
+"""One dispatcher per store on a host: several service processes queue work, one starts
+the worker processes, at most ``job_workers`` at once and one per run; the others wake it
+and take its place when it ends."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterator
+from datetime import datetime
+from itertools import pairwise
+from pathlib import Path
+
+import pytest
+
+from app.jobs import dispatcher as dispatching
+from app.jobs.dispatcher import Dispatcher, dispatch_address
+from app.services.datasets import import_file
+from app.services.runs import RunOptions, create_run
+from app.settings import Settings
+from app.store.database import Store
+from app.store.runs import get_run
+from tests.app.api.conftest import Server, finished
+from tests.app.synthetic import touch_arff
+
+
+def test_two_service_processes_run_one_job_at_a_time_each_once(
+    make_sqlite_server: Callable[..., Server], tmp_path: Path
+) -> None:
+    server = make_sqlite_server(job_workers="1", arguments=("--workers", "2"))
+    with touch_arff(tmp_path / "t.arff", n=90).open("rb") as handle:
+        uploaded = server.client.post(
+            "/api/datasets", files={"file": ("t.arff", handle)}, data={"name": "touch"}
+        )
+    assert uploaded.status_code == 201, uploaded.text
+    request = {"dataset": "touch", "target": "gesture", "classifiers": ["nb"], "folds": 2}
+    ids = []
+    for seed in range(4):
+        started = server.client.post("/api/runs", json={**request, "seed": seed})
+        assert started.status_code == 202, started.text
+        ids.append(started.json()["id"])
+    runs = [server.wait_for(f"/api/runs/{run_id}", finished) for run_id in ids]
+
+    assert [run["status"] for run in runs] == ["done"] * 4
+    spans = sorted(
+        (datetime.fromisoformat(run["started_at"]), datetime.fromisoformat(run["finished_at"]))
+        for run in runs
+    )
+    for (_, earlier_end), (later_start, _) in pairwise(spans):
+        assert later_start >= earlier_end, spans  # job_workers=1 holds for the host
+    assert server.log is not None
+    assert "is being executed by" not in server.log.read_text()  # no second process per run
+
+
+@pytest.fixture
+def sqlite_store(tmp_path: Path) -> Iterator[Store]:
+    store = Store(f"sqlite:///{tmp_path / 'touchbench.db'}")
+    import_file(store, touch_arff(tmp_path / "t.arff", n=60), name="touch")
+    yield store
+    store.dispose()
+
+
+def _wait_done(store: Store, run_id: int, timeout: float = 120.0) -> None:
+    deadline = time.monotonic() + timeout
+    while get_run(store, run_id).status != "done":
+        assert time.monotonic() < deadline, get_run(store, run_id)
+        time.sleep(0.1)
+
+
+def test_the_leader_hears_a_wake_from_another_process_and_is_replaced_when_it_stops(
+    sqlite_store: Store, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Polling only every 10 minutes: a run is dispatched within the test only if the
+    # wake-up reaches the leader.
+    monkeypatch.setattr(dispatching, "POLL", 600.0)
+    settings = Settings(database_url=sqlite_store.url, job_workers=1, work_dir=tmp_path / "w")
+    first, second = Dispatcher(sqlite_store, settings), Dispatcher(sqlite_store, settings)
+    first.start()
+    deadline = time.monotonic() + 30
+    while not first.leading:
+        assert time.monotonic() < deadline
+        time.sleep(0.01)
+    second.start()
+    try:
+        options = RunOptions(folds=2)
+        run = create_run(sqlite_store, "touch", ["nb"], targets=["gesture"], options=options)
+        second.wake()
+        _wait_done(sqlite_store, run.id)
+        assert not second.leading
+
+        first.stop()
+        later = create_run(sqlite_store, "touch", ["nb"], targets=["gesture"], options=options)
+        second.wake()
+        _wait_done(sqlite_store, later.id)
+        assert second.leading
+    finally:
+        first.stop()
+        second.stop()
+
+
+def test_dispatch_addresses_name_the_store(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    addresses = []
+    for folder in ("a", "b", "a"):
+        monkeypatch.chdir(tmp_path / folder)
+        store = Store("sqlite:///relative.db")
+        addresses.append(dispatch_address(store))
+        store.dispose()
+    assert addresses[0] is not None and addresses[0].startswith("\0touchbench-dispatch-")
+    assert addresses[0] == addresses[2] != addresses[1]  # the same file, another file
+    memory = Store("sqlite://")
+    assert dispatch_address(memory) is None  # a store of its own in every process
+    memory.dispose()
