@@ -185,7 +185,7 @@ def run_over_http(url: str, request: dict[str, object]) -> tuple[float, int]:
         start = time.perf_counter()
         run_id = int(client.post("/api/runs", json=request).json()["id"])
         while client.get(f"/api/runs/{run_id}").json()["status"] in ("queued", "running"):
-            time.sleep(0.05)
+            time.sleep(0.2)
         return time.perf_counter() - start, run_id
 
 
@@ -235,6 +235,11 @@ def compare_runs(store: object, url: str, db: str, request: dict[str, object], r
             seconds, run_id = sides[side]()
             walls[side].append(seconds)
             engine[side].append(executing(run_id))
+            print(
+                f"round {number + 1}, {side}: {seconds:.1f} s, {engine[side][-1]:.1f} s in the "
+                f"engine",
+                file=sys.stderr,
+            )
     ratio = statistics.median(h / c for h, c in zip(walls["HTTP"], walls["CLI"], strict=True))
     engine_ratio = statistics.median(
         h / c for h, c in zip(engine["HTTP"], engine["CLI"], strict=True)
