@@ -151,15 +151,21 @@ async def require_api_key(
     x_api_key: Annotated[str | None, Header(description="The service's API key.")] = None,
 ) -> None:
     """401 without the key, 403 with a wrong one (compared in constant time)."""
-    expected = service.settings.api_key
+    check_api_key(service.settings, x_api_key)
+
+
+def check_api_key(settings: Settings, given: str | None) -> None:
+    """Raise 401 when the service has an API key and ``given`` is None, 403 when ``given``
+    is not it (compared in constant time)."""
+    expected = settings.api_key
     if expected is None:
         return
-    if x_api_key is None:
+    if given is None:
         raise HTTPException(
             401, "this service needs an API key in the X-API-Key header",
             headers={"WWW-Authenticate": "X-API-Key"},
         )  # fmt: skip
-    if not hmac.compare_digest(x_api_key.encode(), expected.get_secret_value().encode()):
+    if not hmac.compare_digest(given.encode(), expected.get_secret_value().encode()):
         raise HTTPException(403, "wrong API key")
 
 

@@ -75,6 +75,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         datasets.router,
         runs.router,
         models.router,
+        models.predictions,
         jobs.router,
     ):
         app.include_router(router, dependencies=protected, responses=errors.ERROR_RESPONSES)

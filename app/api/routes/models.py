@@ -12,6 +12,7 @@ from typing import Annotated, Any
 from fastapi import APIRouter, File, Response, UploadFile, status
 
 from app.api.deps import Service, ServiceDep, StoreDep
+from app.api.direct import DirectRoute
 from app.api.uploads import save_upload
 from app.errors import AppError
 from app.schemas.jobs import JobCreated
@@ -26,6 +27,9 @@ from app.services.jobs import submit_training
 from app.store.models import delete_model, get_model, list_models
 
 router = APIRouter(prefix="/api/models", tags=["models"])
+#: Predictions of JSON instances: documented by FastAPI, answered by a direct handler (the
+#: request costs FastAPI more than a quick model's prediction; see ``app.api.direct``).
+predictions = APIRouter(prefix="/api/models", tags=["models"], route_class=DirectRoute)
 
 
 @router.post("", status_code=status.HTTP_202_ACCEPTED, response_model=JobCreated)
@@ -78,7 +82,7 @@ def remove(model_ref: str, service: ServiceDep) -> ModelSchema:
     return gone.to_schema()
 
 
-@router.post("/{model_ref}/predict", response_model=PredictionReport)
+@predictions.post("/{model_ref}/predict", response_model=PredictionReport)
 async def predict_instances(model_ref: str, body: PredictRequest, service: ServiceDep) -> Response:
     """Predict instances given as ``{attribute: value}`` (matched to the model by name):
     per instance and target the predicted label and the class probabilities."""

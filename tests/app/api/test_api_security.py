@@ -3,6 +3,7 @@ server error and no answer that breaks its own schema."""
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from pathlib import Path
 
@@ -28,6 +29,13 @@ def test_the_api_key_guards_everything_but_health_and_docs(
         wrong = bare.get("/api/datasets", headers={"X-API-Key": "s3cret-kez"})
         assert wrong.status_code == 403 and wrong.json()["error"]["type"] == "Forbidden"
         assert bare.post("/api/runs", json={"dataset": "x"}).status_code == 401
+        # Every operation the OpenAPI document lists, the direct prediction route included.
+        operations = bare.get("/openapi.json").json()["paths"]
+        for path, methods in operations.items():
+            for method in set(methods) - ({"get"} if path == "/healthz" else set()):
+                answer = bare.request(method.upper(), re.sub(r"\{\w+\}", "1", path))
+                assert answer.status_code == 401, (method, path, answer.text)
+        assert "/api/models/{model_ref}/predict" in operations
     finally:
         bare.close()
     assert server.client.get("/api/runs").status_code == 200  # the client sends the key
