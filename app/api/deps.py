@@ -7,7 +7,7 @@ import asyncio
 import hmac
 import threading
 from collections import OrderedDict
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Annotated, TypeVar
@@ -35,6 +35,14 @@ INLINE_SECONDS = 0.005
 Result = TypeVar("Result")
 
 
+def request_size(instances: Sequence[Mapping[str, object]]) -> int:
+    """The size of a prediction request, which its cost is taken to grow with: one per
+    instance and one per attribute value.  Values count, not only instances: one instance
+    carrying a million attributes the model does not know costs as much as thousands of
+    ordinary ones."""
+    return len(instances) + sum(len(instance) for instance in instances)
+
+
 class ModelCache:
     """Loaded models by (id, sha256, name), least recently used dropped first; thread-safe.
 
@@ -48,14 +56,14 @@ class ModelCache:
     def __init__(self, size: int) -> None:
         self.size = size
         self._models: OrderedDict[ModelKey, tuple[ModelInfo, TrainedModel]] = OrderedDict()
-        self._seconds: dict[int, float] = {}  # model id -> seconds per instance
+        self._seconds: dict[int, float] = {}  # model id -> seconds per unit of size
         self._lock = threading.Lock()
         self._in_flight = 0  # predictions under way in this process (changed on the loop only)
         self._thread = ThreadPoolExecutor(1, thread_name_prefix="predict")
 
-    async def run(self, ref: str, n_instances: int, work: Callable[[], Result]) -> Result:
-        """Run a prediction, ``work()``, on the event loop or in this process's prediction
-        thread.
+    async def run(self, ref: str, size: int, work: Callable[[], Result]) -> Result:
+        """Run a prediction of ``size`` (:func:`request_size`), ``work()``, on the event
+        loop or in this process's prediction thread.
 
         On the loop when the model is known to be quick (:meth:`runs_inline`) and no other
         prediction is under way in this process: a hop to a thread would cost more than the
@@ -69,7 +77,7 @@ class ModelCache:
         self._in_flight += 1
         try:
             await asyncio.sleep(0)  # requests that arrived with this one count themselves first
-            if self._in_flight == 1 and self.runs_inline(ref, n_instances):
+            if self._in_flight == 1 and self.runs_inline(ref, size):
                 return work()
             return await asyncio.get_running_loop().run_in_executor(self._thread, work)
         finally:
@@ -79,27 +87,25 @@ class ModelCache:
         """End the prediction thread (after the prediction it may be running)."""
         self._thread.shutdown(wait=True, cancel_futures=True)
 
-    def runs_inline(self, ref: str, n_instances: int) -> bool:
-        """Whether predicting ``n_instances`` with the model ``ref`` is known to be quick:
-        the model is loaded and its recent predictions took under :data:`INLINE_SECONDS`
-        of CPU time for that many instances."""
+    def runs_inline(self, ref: str, size: int) -> bool:
+        """Whether a prediction of ``size`` (:func:`request_size`) with the model ``ref`` is
+        known to be quick: the model is loaded and its recent predictions took under
+        :data:`INLINE_SECONDS` of CPU time for that size."""
         with self._lock:
             for model_id, _, name in self._models:
                 if ref in (name, str(model_id)):
                     seconds = self._seconds.get(model_id)
-                    return seconds is not None and seconds * n_instances <= INLINE_SECONDS
+                    return seconds is not None and seconds * size <= INLINE_SECONDS
         return False
 
-    def record(self, model_id: int, seconds: float, n_instances: int) -> None:
-        """Note that a prediction of ``n_instances`` took ``seconds`` of its thread's CPU
-        time (not wall time, which waits on other processes and on the GIL, and would keep
-        a model measured in a thread looking slow); kept as a moving average."""
-        per_instance = seconds / max(1, n_instances)
+    def record(self, model_id: int, seconds: float, size: int) -> None:
+        """Note that a prediction of ``size`` (:func:`request_size`) took ``seconds`` of its
+        thread's CPU time (not wall time, which waits on other processes and on the GIL, and
+        would keep a model measured in a thread looking slow); kept as a moving average."""
+        per_unit = seconds / max(1, size)
         with self._lock:
             known = self._seconds.get(model_id)
-            self._seconds[model_id] = (
-                per_instance if known is None else 0.8 * known + 0.2 * per_instance
-            )
+            self._seconds[model_id] = per_unit if known is None else 0.8 * known + 0.2 * per_unit
 
     def get(self, store: Store, ref: str | int) -> tuple[ModelInfo, TrainedModel]:
         key = model_version(store, ref)

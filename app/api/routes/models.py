@@ -11,7 +11,7 @@ from typing import Annotated, Any
 
 from fastapi import APIRouter, File, Response, UploadFile, status
 
-from app.api.deps import Service, ServiceDep, StoreDep
+from app.api.deps import Service, ServiceDep, StoreDep, request_size
 from app.api.direct import DirectRoute
 from app.api.uploads import save_upload
 from app.errors import AppError
@@ -86,10 +86,9 @@ def remove(model_ref: str, service: ServiceDep) -> ModelSchema:
 async def predict_instances(model_ref: str, body: PredictRequest, service: ServiceDep) -> Response:
     """Predict instances given as ``{attribute: value}`` (matched to the model by name):
     per instance and target the predicted label and the class probabilities."""
+    size = request_size(body.instances)
     content = await service.models.run(
-        model_ref,
-        len(body.instances),
-        functools.partial(_predict_records, service, model_ref, body.instances),
+        model_ref, size, functools.partial(_predict_records, service, model_ref, body.instances)
     )
     return Response(content, media_type="application/json")
 
@@ -104,7 +103,7 @@ def _predict_records(
     info, trained = service.models.get(service.store, model_ref)
     start = time.thread_time()
     report = records_report(info, trained, records)
-    service.models.record(info.id, time.thread_time() - start, len(records))
+    service.models.record(info.id, time.thread_time() - start, request_size(records))
     return report.model_dump_json().encode()
 
 

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 from fastapi.testclient import TestClient
 
-from app.api.deps import INLINE_SECONDS, ModelCache
+from app.api.deps import INLINE_SECONDS, ModelCache, request_size
 from app.api.main import create_app
 from app.services.datasets import import_file
 from app.services.models import predict_records, train
@@ -28,7 +28,7 @@ def test_a_model_runs_inline_only_once_it_is_known_to_be_quick() -> None:
     assert not cache.runs_inline("m", 1)  # loaded, never timed
     cache.record(7, INLINE_SECONDS / 10, 1)
     assert cache.runs_inline("m", 1) and cache.runs_inline("7", 1)
-    assert not cache.runs_inline("m", 20)  # twenty instances: about twice the budget
+    assert not cache.runs_inline("m", 20)  # twenty times the size: twice the budget
     assert not cache.runs_inline("other", 1)
     for _ in range(5):  # a model that turns slow leaves the loop within a few calls
         cache.record(7, INLINE_SECONDS * 10, 1)
@@ -83,11 +83,12 @@ def test_the_first_prediction_runs_in_a_thread_and_later_ones_on_the_loop(
     threads: list[int] = []
     record = service.models.record
 
-    def spy(model_id: int, seconds: float, n: int) -> None:
-        """Where the call ran; the time recorded as a tenth of the budget per instance, so
-        that the placement does not depend on this machine's load."""
+    def spy(model_id: int, seconds: float, size: int) -> None:
+        """Where the call ran; the time recorded as a tenth of the budget per unit of size
+        (an instance of five values is six), so that the placement does not depend on this
+        machine's load."""
         threads.append(threading.get_ident())
-        record(model_id, n * INLINE_SECONDS / 10, n)
+        record(model_id, size * INLINE_SECONDS / 10, size)
 
     monkeypatch.setattr(service.models, "record", spy)
     instance = {"f0": 0.1, "f1": -0.2, "f2": 0.3, "f3": None, "mic": "left"}
@@ -104,6 +105,18 @@ def test_the_first_prediction_runs_in_a_thread_and_later_ones_on_the_loop(
     many = client.post("/api/models/quick/predict", json={"instances": [instance] * 5000})
     assert many.status_code == 200 and len(many.json()["predictions"]) == 5000
     assert threads[-1] != loop_thread  # five thousand instances are not quick
+    client.post("/api/models/quick/predict", json={"instances": [instance]})
+    assert threads[-1] == loop_thread
+    junk = {**instance, **{f"unknown{i}": 1.0 for i in range(1000)}}
+    one = client.post("/api/models/quick/predict", json={"instances": [junk]})
+    assert one.status_code == 200 and len(one.json()["predictions"]) == 1
+    assert threads[-1] != loop_thread  # one instance, but a thousand values: not quick
+
+
+def test_a_request_is_as_large_as_its_instances_and_values() -> None:
+    assert request_size([]) == 0
+    assert request_size([{}, {}]) == 2  # empty instances still cost a row each
+    assert request_size([{"a": 1, "b": None}, {"c": "x"}]) == 5
 
 
 def test_an_unknown_model_is_a_404_on_either_path(client: TestClient) -> None:
