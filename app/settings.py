@@ -26,8 +26,9 @@ class Settings(BaseSettings):
         Largest upload (data set, recording session, file to predict), enforced while the
         body streams in.
     job_workers : int
-        Jobs (runs, extractions, trainings) one service process carries out at once, each in
-        a worker process of its own.
+        Jobs (runs, extractions, trainings) carried out at once on this host for the store,
+        each in a worker process of its own (one service process dispatches them, however
+        many ``touchbench serve --workers`` starts).
     run_jobs : int
         Engine worker processes per run.
     dask_scheduler : str or None
