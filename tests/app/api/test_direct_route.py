@@ -182,3 +182,17 @@ def test_a_direct_route_refuses_what_it_cannot_provide(
     with pytest.raises(TypeError, match=problem):
         router.post("/m/{model_ref}/predict")(endpoint)
     router.post("/m/{model_ref}/predict")(_supported)  # what the prediction route asks
+
+
+def test_the_upload_limit_holds_on_the_direct_route(tmp_path: Path) -> None:
+    settings = Settings(
+        database_url=f"sqlite:///{tmp_path / 'touchbench.db'}",
+        work_dir=tmp_path / "work",
+        max_upload_mb=0.001,
+    )
+    with TestClient(create_app(settings)) as small:
+        answer = small.post(
+            DIRECT.format(model="any"), json={"instances": [{f"a{i}": 1.0 for i in range(200)}]}
+        )
+    assert answer.status_code == 413, answer.text
+    assert answer.json()["error"]["where"] == "body"
