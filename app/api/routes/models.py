@@ -88,22 +88,24 @@ async def predict_instances(model_ref: str, body: PredictRequest, service: Servi
     per instance and target the predicted label and the class probabilities."""
     size = request_size(body.instances)
     content = await service.models.run(
-        model_ref, size, functools.partial(_predict_records, service, model_ref, body.instances)
+        model_ref,
+        size,
+        functools.partial(_predict_records, service, model_ref, body.instances, size),
     )
     return Response(content, media_type="application/json")
 
 
 def _predict_records(
-    service: Service, model_ref: str, records: Sequence[Mapping[str, Any]]
+    service: Service, model_ref: str, records: Sequence[Mapping[str, Any]], size: int
 ) -> bytes:
-    """The prediction report as JSON: written here once, not validated again by FastAPI
-    against the response model it was built from."""
+    """The prediction report as JSON (written here once, not validated again against the
+    response model it was built from); its CPU time is recorded for ``size``."""
     from app.services.models import records_report
 
     info, trained = service.models.get(service.store, model_ref)
     start = time.thread_time()
     report = records_report(info, trained, records)
-    service.models.record(info.id, time.thread_time() - start, request_size(records))
+    service.models.record(info.id, time.thread_time() - start, size)
     return report.model_dump_json().encode()
 
 
