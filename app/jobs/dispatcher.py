@@ -7,7 +7,9 @@ starts ``python -m app.jobs.process`` for the oldest item.
 On one host, one service process per store dispatches: the one that holds the store's
 dispatch address (an abstract Unix socket named after the store, released by the kernel
 when its process ends, kill -9 included).  The others queue work and wake it through that
-address, and take its place within ``POLL`` seconds when it ends.  So ``touchbench serve
+address, and take its place within ``POLL`` seconds when it ends.  Abstract sockets have
+no permissions, so anyone on the host can take the address: a process finding it held by
+another user's process dispatches for itself, as every process did before.  So ``touchbench serve
 --workers N`` runs at most ``job_workers`` jobs at once, not N times as many, and never
 starts two processes for one run.  Worker processes still claim items atomically, as
 several hosts on one PostgreSQL store each have a dispatcher; upload folders are on one
@@ -20,12 +22,15 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import logging
+import math
 import os
 import select
 import socket
+import struct
 import subprocess
 import sys
 import threading
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -40,6 +45,9 @@ log = logging.getLogger("touchbench.jobs")
 
 #: Seconds between looks at the queue.
 POLL = 0.5
+
+#: Seconds between checks of who holds the dispatch address, by the processes that do not.
+HOLDER_CHECK = 10.0
 
 
 @dataclass
@@ -67,6 +75,8 @@ class Dispatcher:
         self._wake = threading.Event()
         self._address = dispatch_address(store)
         self._inbox: socket.socket | None = None
+        self._holder_ours = True  # whether the address's holder runs as this user
+        self._holder_checked = -math.inf  # time.monotonic() of the last check
         self._thread = threading.Thread(target=self._loop, daemon=True, name="dispatcher")
 
     def start(self) -> None:
@@ -79,10 +89,10 @@ class Dispatcher:
         if self._address is not None:
             with (
                 contextlib.suppress(OSError),
-                socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM) as sender,
+                socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as caller,
             ):
-                sender.setblocking(False)
-                sender.sendto(b"!", self._address)
+                caller.setblocking(False)
+                caller.connect(self._address)  # the leader's select sees the connection
 
     @property
     def leading(self) -> bool:
@@ -110,13 +120,11 @@ class Dispatcher:
 
     def _loop(self) -> None:
         while not self._stop.is_set():
-            if not self.leading and not self._lead():
-                self._wake.wait(POLL)
-                self._wake.clear()
-                continue
+            dispatching = self.leading or self._lead() or not self._trust_holder()
             try:
                 self._reap()
-                self._dispatch()
+                if dispatching:
+                    self._dispatch()
             except Exception as error:  # a busy or unreachable store: try again later
                 log.warning("dispatcher: %s: %s", type(error).__name__, error)
             self._wait()
@@ -124,9 +132,10 @@ class Dispatcher:
     def _lead(self) -> bool:
         """Take the store's dispatch address if no other process on this host holds it."""
         assert self._address is not None  # else this process always leads
-        inbox = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
+        inbox = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
         try:
             inbox.bind(self._address)
+            inbox.listen(64)
         except OSError:
             inbox.close()
             return False
@@ -144,10 +153,36 @@ class Dispatcher:
         ready, _, _ = select.select([self._inbox], [], [], POLL)
         while ready:
             try:
-                self._inbox.recv(64)
+                self._inbox.accept()[0].close()
             except BlockingIOError:
                 break
         self._wake.clear()
+
+    def _trust_holder(self) -> bool:
+        """Whether the process holding the dispatch address dispatches for this one: it runs
+        as this user (checked every ``HOLDER_CHECK`` seconds)."""
+        if time.monotonic() - self._holder_checked >= HOLDER_CHECK:
+            ours = self._holder_is_ours()
+            if self._holder_ours and not ours:
+                log.warning("another user holds the dispatch address: dispatching from here")
+            self._holder_ours, self._holder_checked = ours, time.monotonic()
+        return self._holder_ours
+
+    def _holder_is_ours(self) -> bool:
+        """Whether the process holding the dispatch address runs as this user (one that
+        cannot be reached is not trusted)."""
+        assert self._address is not None
+        with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as probe:
+            probe.settimeout(1.0)
+            try:
+                probe.connect(self._address)
+                credentials = probe.getsockopt(
+                    socket.SOL_SOCKET, socket.SO_PEERCRED, struct.calcsize("3i")
+                )
+            except OSError:
+                return False
+        _, uid, _ = struct.unpack("3i", credentials)
+        return bool(uid == os.getuid())
 
     def _reap(self) -> None:
         finished = [a for a in self._active if a.process.poll() is not None]

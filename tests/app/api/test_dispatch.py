@@ -4,6 +4,9 @@ and take its place when it ends."""
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 import time
 from collections.abc import Callable, Iterator
 from datetime import datetime
@@ -111,3 +114,41 @@ def test_dispatch_addresses_name_the_store(tmp_path: Path, monkeypatch: pytest.M
     memory = Store("sqlite://")
     assert dispatch_address(memory) is None  # a store of its own in every process
     memory.dispose()
+
+
+#: Binds an address as user ``nobody`` and waits: a neighbour on the host squatting it.
+SQUATTER = """
+import os, socket, sys, time
+os.setuid(65534)
+squat = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+squat.bind("\\0" + sys.argv[1])
+squat.listen()
+print("bound", flush=True)
+time.sleep(120)
+"""
+
+
+@pytest.mark.skipif(os.getuid() != 0, reason="needs root to run a squatter as another user")
+def test_an_address_held_by_another_user_does_not_stop_dispatching(
+    sqlite_store: Store, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(dispatching, "POLL", 600.0)  # only a wake-up dispatches in time
+    address = dispatch_address(sqlite_store)
+    assert address is not None
+    squatter = subprocess.Popen(
+        [sys.executable, "-c", SQUATTER, address[1:]], stdout=subprocess.PIPE, text=True
+    )
+    settings = Settings(database_url=sqlite_store.url, job_workers=1, work_dir=tmp_path / "w")
+    dispatcher = Dispatcher(sqlite_store, settings)
+    try:
+        assert squatter.stdout is not None and squatter.stdout.readline().strip() == "bound"
+        dispatcher.start()
+        options = RunOptions(folds=2)
+        run = create_run(sqlite_store, "touch", ["nb"], targets=["gesture"], options=options)
+        dispatcher.wake()
+        _wait_done(sqlite_store, run.id)
+        assert not dispatcher.leading  # the squatter still holds the address
+    finally:
+        dispatcher.stop()
+        squatter.kill()
+        squatter.wait()
