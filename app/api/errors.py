@@ -17,7 +17,7 @@ from fastapi.responses import JSONResponse
 from pydantic import Field
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
-from app.errors import USER_ERRORS, ConflictError, NotFoundError
+from app.errors import USER_ERRORS, ConflictError, FieldError, NotFoundError
 from app.schemas.base import Schema
 from benchmark.errors import DataFormatError
 
@@ -60,6 +60,8 @@ def error_body(kind: str, message: str, where: str | None = None) -> dict[str, A
 
 
 def status_of(error: Exception) -> int:
+    if isinstance(error, FieldError):
+        return 422
     if isinstance(error, NotFoundError):
         return 404
     if isinstance(error, ConflictError):
@@ -68,6 +70,8 @@ def status_of(error: Exception) -> int:
 
 
 def where_of(error: Exception) -> str | None:
+    if isinstance(error, FieldError):
+        return f"body.{error.field}"
     if isinstance(error, DataFormatError):
         parts = []
         if error.source is not None:

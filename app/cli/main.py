@@ -23,8 +23,9 @@ from app.cli import models as models_commands
 from app.cli import reports as reports_commands
 from app.cli import serve as serve_commands
 from app.cli.output import EXIT_FAILED, EXIT_INTERRUPTED, ExitWith
+from app.cli.requests import describe, reset
 from app.cli.state import CliState
-from app.errors import USER_ERRORS
+from app.errors import USER_ERRORS, FieldError
 from app.settings import get_settings
 
 EXIT_USAGE = 2
@@ -103,6 +104,7 @@ gc.freeze()
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; returns (and, as a console script, exits with) the status."""
     command = typer.main.get_command(app)
+    reset()
     try:
         returned = command.main(args=argv, prog_name="touchbench", standalone_mode=False)
     except typer.Exit as done:
@@ -120,7 +122,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"touchbench: error: {message}{hint}", file=sys.stderr)
         return _exit(EXIT_USAGE)
     except USER_ERRORS as error:
-        print(f"touchbench: error: {error}", file=sys.stderr)
+        message = describe(error) if isinstance(error, FieldError) else str(error)
+        print(f"touchbench: error: {message}", file=sys.stderr)
         return _exit(EXIT_USAGE)
     except KeyboardInterrupt:
         print("touchbench: interrupted", file=sys.stderr)

@@ -27,6 +27,17 @@ class Schema(BaseModel):
         return finite(self.model_dump(mode="json"))
 
 
+class Request(BaseModel):
+    """The base of every request type: one use case's input, its defaults, bounds and rules
+    across fields said once.  The API takes it as its body, the CLI builds it from its
+    options (:func:`app.cli.requests.build_request`), the service takes nothing else.
+
+    Unknown fields are refused and numbers must be finite.
+    """
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+
+
 def finite(data: Any) -> Any:
     """``data`` with every NaN or infinite float replaced by ``None``, recursively."""
     if isinstance(data, float) and not math.isfinite(data):
