@@ -407,8 +407,9 @@ def bench_command(
             run = execute_run(
                 store, run_id, jobs=jobs, scheduler=scheduler, callbacks=progress.callbacks()
             )
-    except KeyboardInterrupt:
-        raise ExitWith(_kept_message(store, run_id, "interrupted"), EXIT_INTERRUPTED) from None
+    except KeyboardInterrupt as interrupt:  # Ctrl-C or SIGTERM (app.cli.signals)
+        code = getattr(interrupt, "exit_code", EXIT_INTERRUPTED)
+        raise ExitWith(_kept_message(store, run_id, "interrupted"), code) from None
     except RunCancelled as cancelled:
         raise ExitWith(_kept_message(store, cancelled.run.id, "cancelled"), EXIT_FAILED) from None
     _print_run_report(store, run.id, metric, baseline, as_json)

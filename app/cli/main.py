@@ -24,6 +24,7 @@ from app.cli import reports as reports_commands
 from app.cli import serve as serve_commands
 from app.cli.output import EXIT_FAILED, EXIT_INTERRUPTED, ExitWith
 from app.cli.requests import describe, reset
+from app.cli.signals import interrupts
 from app.cli.state import CliState
 from app.errors import USER_ERRORS, FieldError
 from app.settings import get_settings
@@ -106,15 +107,16 @@ def main(argv: list[str] | None = None) -> int:
     command = typer.main.get_command(app)
     reset()
     try:
-        returned = command.main(args=argv, prog_name="touchbench", standalone_mode=False)
+        with interrupts():
+            returned = command.main(args=argv, prog_name="touchbench", standalone_mode=False)
     except typer.Exit as done:
         return _exit(done.exit_code)
     except ExitWith as outcome:
         print(f"touchbench: {outcome}", file=sys.stderr)
         return outcome.exit_code
-    except typer.Abort:
+    except typer.Abort as abort:  # click's wrapping of a KeyboardInterrupt
         print("touchbench: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        return getattr(abort.__cause__, "exit_code", EXIT_INTERRUPTED)
     except typer.TyperException as error:  # typer's (vendored click's) usage errors
         context = getattr(error, "ctx", None)
         hint = f" (see '{context.command_path} --help')" if context is not None else ""
@@ -125,9 +127,9 @@ def main(argv: list[str] | None = None) -> int:
         message = describe(error) if isinstance(error, FieldError) else str(error)
         print(f"touchbench: error: {message}", file=sys.stderr)
         return _exit(EXIT_USAGE)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as interrupt:
         print("touchbench: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        return getattr(interrupt, "exit_code", EXIT_INTERRUPTED)
     except Exception as error:  # anything else is a bug: say so in one line, trace on request
         if os.environ.get("TOUCHBENCH_DEBUG"):
             traceback.print_exc()

@@ -34,6 +34,9 @@ PER_TARGET = "per_target"
 PARAMS = "params"
 #: Seconds between heartbeats of the process executing a run.
 HEARTBEAT_INTERVAL = 5.0
+#: Seconds between the executing process's looks for a cancel request: one read of the run's
+#: row by its primary key, cheap enough on either store to take a few times a second.
+CANCEL_POLL = 0.2
 
 
 @dataclass(frozen=True)
@@ -183,17 +186,28 @@ def claim_run(store: Store, run_id: int, *, owner: str | None = None) -> RunInfo
 
 
 def heartbeat(store: Store, run_id: int, owner: str) -> bool:
-    """Say that ``owner`` still executes the run; returns whether a cancel was requested
-    (or the run was taken away from this owner)."""
+    """Say that ``owner`` still executes the run; returns whether it should stop (see
+    :func:`should_stop`)."""
     with store.session() as session:
         session.execute(
             update(RunRow)
             .where(RunRow.id == run_id, RunRow.owner == owner, RunRow.status == "running")
             .values(heartbeat_at=utcnow())
         )
-        row = session.execute(
-            select(RunRow.cancel_requested, RunRow.owner, RunRow.status).where(RunRow.id == run_id)
-        ).one_or_none()
+        return _should_stop(session, run_id, owner)
+
+
+def should_stop(store: Store, run_id: int, owner: str) -> bool:
+    """Whether the process ``owner`` executing the run should stop: a cancel was requested,
+    or the run was taken away from it (deleted, claimed by another process)."""
+    with store.session() as session:
+        return _should_stop(session, run_id, owner)
+
+
+def _should_stop(session: Session, run_id: int, owner: str) -> bool:
+    row = session.execute(
+        select(RunRow.cancel_requested, RunRow.owner, RunRow.status).where(RunRow.id == run_id)
+    ).one_or_none()
     if row is None:
         return True
     cancel, current_owner, status = row
