@@ -95,7 +95,7 @@ def test_rates_and_topics_that_do_not_apply(tmp_path: Path) -> None:
     soundfile.write(path, np.zeros((100, 1)), 8000)
     with pytest.raises(DriverError, match="sampled at 8000 Hz, but samplerate=16000"):
         FileReplaySource(path, samplerate=16000)
-    with pytest.raises(DriverError, match="--topic applies to ROS bags only"):
+    with pytest.raises(DriverError, match="`topic` applies to ROS bags only"):
         FileReplaySource(path, topic="/audio")
     np.save(tmp_path / "b.npy", np.zeros(10))
     with pytest.raises(DriverError, match="no sample rate"):
