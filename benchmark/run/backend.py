@@ -44,7 +44,7 @@ class Backend(Protocol):
     """Runs a plan's tasks and reports each one as it starts and as it ends.
 
     A backend is built with what its tasks share (the run's pickled context, the time and
-    memory limits of a task) and may be run once.
+    memory limits of a task); running it holds no state between runs.
     """
 
     def run(
@@ -54,7 +54,7 @@ class Backend(Protocol):
         deliver: ResultCallback,
         stop: StopCheck,
     ) -> None:
-        """Run every task of ``tasks``, in the calling thread's control.
+        """Run every task of ``tasks``; the callbacks are called in the calling thread.
 
         Parameters
         ----------
