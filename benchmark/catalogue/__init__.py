@@ -70,7 +70,7 @@ def get_spec(classifier_id: str) -> ClassifierSpec:
 def unknown_classifier_message(classifier_id: str, known: Mapping[str, object]) -> str:
     """``unknown classifier 'rff'; did you mean 'rf'?`` (or a pointer to the listing)."""
     close = difflib.get_close_matches(classifier_id.lower(), list(known), n=1, cutoff=0.5)
-    hint = f"did you mean '{close[0]}'?" if close else "see `touchbench classifiers`"
+    hint = f"did you mean '{close[0]}'?" if close else "see the classifier listing"
     return f"unknown classifier '{classifier_id}'; {hint}"
 
 
