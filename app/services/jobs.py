@@ -13,14 +13,12 @@ import socket
 from pathlib import Path
 from typing import Any
 
-from app.errors import USER_ERRORS, AppError, ConflictError
+from app.errors import USER_ERRORS, AppError
 from app.schemas.jobs import JobSchema
 from app.store.database import Store
 from app.store.jobs import claim_job, create_job, finish_job, get_job
-from app.store.runs import RunInfo, finish_run, get_run
 
 #: Statuses from which a run can be put back in the queue.
-REQUEUEABLE = frozenset({"queued", "interrupted", "cancelled", "failed"})
 
 
 def submit_extraction(
@@ -61,25 +59,6 @@ def submit_training(store: Store, params: dict[str, Any]) -> JobSchema:
     """Queue training: ``{"dataset", "classifier", "target", "name", "seed"}`` or
     ``{"run", "name"}`` (the run's best classifier)."""
     return create_job(store, "train", {**params, "host": socket.gethostname()})
-
-
-def requeue_run(store: Store, run_id: int | str) -> RunInfo:
-    """Put an interrupted, cancelled or failed run back in the queue (to be resumed).
-
-    Raises
-    ------
-    ConflictError
-        The run is running or done.
-    """
-    run = get_run(store, run_id)
-    if run.status == "running" and run.is_alive():
-        raise ConflictError(f"run {run.id} is running; nothing to resume")
-    if run.status == "done":
-        raise ConflictError(f"run {run.id} is done; nothing to resume")
-    if run.status not in REQUEUEABLE and run.status != "running":
-        raise AppError(f"run {run.id} is {run.status}; it cannot be resumed")
-    finish_run(store, run.id, "queued")
-    return get_run(store, run.id)
 
 
 def execute_job(store: Store, job_id: int) -> JobSchema | None:

@@ -156,7 +156,7 @@ def test_cancel_and_resume_over_http(
     server.wait_for(f"/api/runs/{run_id}", lambda body: body["tasks_done"] >= 1)
     gate.wait_started(2)  # the second task waits at the gate while the cancel comes
     cancelled = api.post(f"/api/runs/{run_id}/cancel")
-    assert cancelled.status_code == 200
+    assert (cancelled.status_code, cancelled.json()["status"]) == (200, "cancelling")
     run = server.wait_for(f"/api/runs/{run_id}", finished)
     assert (run["status"], run["tasks_done"]) == ("cancelled", 1)
     resumed = api.post(f"/api/runs/{run_id}/resume")
@@ -164,8 +164,9 @@ def test_cancel_and_resume_over_http(
     gate.open()
     run = server.wait_for(f"/api/runs/{run_id}", finished, timeout=600)
     assert (run["status"], run["tasks_done"]) == ("done", 20)
-    again = api.post(f"/api/runs/{run_id}/resume")
-    assert again.status_code == 409 and again.json()["error"]["type"] == "ConflictError"
+    for refused in ("resume", "cancel"):
+        again = api.post(f"/api/runs/{run_id}/{refused}")
+        assert again.status_code == 409 and again.json()["error"]["type"] == "ConflictError"
 
 
 def test_a_tuned_and_stacked_run_over_http_is_the_clis(
