@@ -13,7 +13,7 @@ import pytest
 from fastapi.testclient import TestClient
 
 from app.api.deps import INLINE_SECONDS, ModelCache, request_size
-from app.api.main import create_app
+from app.main import create_app
 from app.services.datasets import import_file
 from app.services.models import predict_records, train
 from app.settings import Settings
