@@ -12,9 +12,11 @@ from contextlib import asynccontextmanager
 from importlib import metadata
 
 from fastapi import Depends, FastAPI
+from starlette.middleware.cors import CORSMiddleware
 
 from app.api import main as api
 from app.api.deps import ModelCache, Service, require_api_key
+from app.api.trust import Trust
 from app.jobs.dispatcher import Dispatcher
 from app.settings import Settings, get_settings
 from app.store.database import Store
@@ -31,8 +33,15 @@ def _warm_up() -> None:
 
 
 def create_app(settings: Settings | None = None) -> FastAPI:
-    """The FastAPI application for ``settings`` (default: from the environment)."""
+    """The FastAPI application for ``settings`` (default: from the environment).
+
+    Raises
+    ------
+    app.settings.SettingsError
+        A key, allowed host or allowed origin cannot be used.
+    """
     settings = settings or get_settings()
+    settings.check_trust()
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
@@ -67,4 +76,13 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     )
     api.install(app, settings)
     install_web_page(app, dependencies=[Depends(require_api_key)])
+    if settings.origins:  # CORS stays closed unless origins are listed
+        app.add_middleware(
+            CORSMiddleware,
+            allow_origins=sorted(settings.origins),
+            allow_methods=["GET", "POST", "PUT", "PATCH", "DELETE"],
+            allow_headers=["X-API-Key", "Content-Type"],
+        )
+    # outermost: a request for another host name or from a foreign page goes no further
+    app.add_middleware(Trust, hosts=settings.hosts, origins=settings.origins)
     return app

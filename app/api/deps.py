@@ -1,10 +1,11 @@
 """What routes depend on: the service's state (settings, store, dispatcher, model cache), the
-API key check, and a cache of loaded models for fast predictions."""
+API key check with the keys' roles, and a cache of loaded models for fast predictions."""
 
 from __future__ import annotations
 
 import asyncio
 import hmac
+import logging
 import threading
 from collections import OrderedDict
 from collections.abc import Callable, Mapping, Sequence
@@ -15,7 +16,7 @@ from typing import TYPE_CHECKING, Annotated, TypeVar
 from fastapi import Depends, Header, HTTPException, Request
 
 from app.jobs.dispatcher import Dispatcher
-from app.settings import Settings
+from app.settings import Role, Settings
 from app.store.database import Store
 from app.store.models import ModelInfo, model_version
 
@@ -25,6 +26,8 @@ if TYPE_CHECKING:  # scikit-learn loads on the first prediction, not at start-up
 
 #: A stored model's id, artifact sha256 and name (:func:`app.store.models.model_version`).
 ModelKey = tuple[int, str, str]
+
+log = logging.getLogger("touchbench.api")
 
 
 #: A prediction expected to take at most this many seconds of CPU time may run on the event
@@ -153,26 +156,94 @@ async def get_store(service: Annotated[Service, Depends(get_service)]) -> Store:
 
 
 async def require_api_key(
+    request: Request,
     service: Annotated[Service, Depends(get_service)],
     x_api_key: Annotated[str | None, Header(description="The service's API key.")] = None,
 ) -> None:
-    """401 without the key, 403 with a wrong one (compared in constant time)."""
-    check_api_key(service.settings, x_api_key)
+    """401 without a key, 403 with a wrong one or one whose role does not allow the route
+    (:func:`needed_role`); a change of state is logged with the key's name."""
+    route = request.scope.get("route")
+    template = getattr(route, "path", request.url.path)
+    check_api_key(
+        service.settings,
+        x_api_key,
+        needed_role(request.method, template),
+        action=f"{request.method} {request.url.path}",
+    )
 
 
-def check_api_key(settings: Settings, given: str | None) -> None:
-    """Raise 401 when the service has an API key and ``given`` is None, 403 when ``given``
-    is not it (compared in constant time)."""
-    expected = settings.api_key
-    if expected is None:
-        return
+#: Routes a ``predict`` key may call besides every GET: predictions and uploads (the live
+#: WebSocket checks its key itself, with the same role).  Any other change needs ``write``.
+PREDICT_ROUTES = frozenset(
+    {
+        ("POST", "/api/models/{model_ref}/predict"),
+        ("POST", "/api/models/{model_ref}/predict/file"),
+        ("POST", "/api/datasets"),
+        ("POST", "/api/datasets/recordings"),
+    }
+)
+
+
+def needed_role(method: str, route: str) -> Role:
+    """The role a key needs for ``method`` on the route whose path template is ``route``."""
+    if method in ("GET", "HEAD"):
+        return "read"
+    return "predict" if (method, route) in PREDICT_ROUTES else "write"
+
+
+class KeyRefused(Exception):  # noqa: N818 (a refusal, answered 401 or 403)
+    """The request's key is missing (``status`` 401), wrong, or lacks the role (403)."""
+
+    def __init__(self, status: int, message: str) -> None:
+        super().__init__(message)
+        self.status = status
+
+
+def key_name(settings: Settings, given: str | None, role: Role) -> str | None:
+    """The name of the key ``given`` when it allows ``role``; None when the service has no
+    key.
+
+    Every key is compared, each in constant time, so that the answer's timing does not
+    tell how much of a key was right nor which key it was near; an empty key never matches.
+
+    Raises
+    ------
+    KeyRefused
+        401 without a key, 403 with a wrong one or one whose role is below ``role``.
+    """
+    keys = settings.keyring
+    if not keys:
+        return None
     if given is None:
-        raise HTTPException(
-            401, "this service needs an API key in the X-API-Key header",
-            headers={"WWW-Authenticate": "X-API-Key"},
-        )  # fmt: skip
-    if not hmac.compare_digest(given.encode(), expected.get_secret_value().encode()):
-        raise HTTPException(403, "wrong API key")
+        raise KeyRefused(401, "this service needs an API key in the X-API-Key header")
+    sent = given.encode()
+    found = None
+    for key in keys:
+        if hmac.compare_digest(sent, key.secret):
+            found = key
+    if found is None or not given:  # no key is empty (see app.settings.MIN_KEY_LENGTH)
+        raise KeyRefused(403, "wrong API key")
+    if not found.may(role):
+        raise KeyRefused(
+            403, f"the API key '{found.name}' is a {found.role} key; this needs a {role} key"
+        )
+    return found.name
+
+
+def check_api_key(
+    settings: Settings, given: str | None, role: Role, *, action: str | None = None
+) -> None:
+    """Raise the HTTP error of :func:`key_name`'s refusal; when ``action`` (``METHOD
+    path``) changes state, log it with the key's name (never the key)."""
+    try:
+        name = key_name(settings, given, role)
+    except KeyRefused as refused:
+        headers = {"WWW-Authenticate": "X-API-Key"} if refused.status == 401 else None
+        raise HTTPException(refused.status, str(refused), headers=headers) from None
+    if action is not None and not action.startswith(("GET ", "HEAD ", "OPTIONS ")):
+        log.info(
+            "%s by key %s", action, "(none: the service has no key)" if name is None else repr(name)
+        )
 
 
 ServiceDep = Annotated[Service, Depends(get_service)]

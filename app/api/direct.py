@@ -6,8 +6,8 @@ the path), parses the JSON body in Python and validates it again in pydantic; fo
 one-instance prediction of a logistic model that is more CPU time than the prediction
 (measured with ``perf/serve.py``).  :class:`DirectRoute` keeps the route's OpenAPI
 description (its body, response model, path parameters and the API key header) and answers
-with a handler that does the same things directly: the API key check of every protected
-route (:func:`app.api.deps.check_api_key`), the body validated from its bytes in one pass
+with a handler that does the same things directly: the API key and role check of every
+protected route (:func:`app.api.deps.check_api_key`), the body validated from its bytes in one pass
 (``model_validate_json``), errors raised as FastAPI raises them, so the service's error
 handlers answer them as for any route.
 """
@@ -25,7 +25,7 @@ from pydantic import BaseModel, ValidationError
 from starlette.requests import Request
 from starlette.responses import Response
 
-from app.api.deps import check_api_key, get_service, require_api_key
+from app.api.deps import check_api_key, get_service, needed_role, require_api_key
 
 #: The dependencies a direct route knows how to provide.
 _SUPPORTED = {get_service, require_api_key}
@@ -55,10 +55,16 @@ class DirectRoute(APIRoute):
     def get_route_handler(self) -> Callable[[Request], Coroutine[Any, Any, Response]]:
         plan = _plan(self)
         endpoint = self.endpoint
+        template = self.path
 
         async def handle(request: Request) -> Response:
             service = await get_service(request)
-            check_api_key(service.settings, request.headers.get("x-api-key"))
+            check_api_key(
+                service.settings,
+                request.headers.get("x-api-key"),
+                needed_role(request.method, template),
+                action=f"{request.method} {request.url.path}",
+            )
             arguments: dict[str, Any] = {name: request.path_params[name] for name in plan.path}
             arguments[plan.body] = await _body(request, plan.model)
             arguments.update(dict.fromkeys(plan.service, service))

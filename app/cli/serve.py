@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+import copy
 import ipaddress
 import os
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
@@ -44,9 +45,10 @@ def serve_command(
     """Serve the REST API (data sets, recording uploads, runs, leaderboards, models,
     predictions) at http://HOST:PORT/api, its documentation at /docs.
 
-    Settings come from TOUCHBENCH_* variables: TOUCHBENCH_API_KEY (required beyond
-    loopback), TOUCHBENCH_JOB_WORKERS, TOUCHBENCH_RUN_JOBS, TOUCHBENCH_DASK_SCHEDULER,
-    TOUCHBENCH_MAX_UPLOAD_MB, TOUCHBENCH_RESUME_ON_START.
+    Settings come from TOUCHBENCH_* variables: TOUCHBENCH_API_KEY or TOUCHBENCH_API_KEYS
+    (required beyond loopback), TOUCHBENCH_ALLOWED_HOSTS (required beyond loopback),
+    TOUCHBENCH_ALLOWED_ORIGINS, TOUCHBENCH_JOB_WORKERS, TOUCHBENCH_RUN_JOBS,
+    TOUCHBENCH_DASK_SCHEDULER, TOUCHBENCH_MAX_UPLOAD_MB, TOUCHBENCH_RESUME_ON_START.
     """
     import uvicorn
 
@@ -56,10 +58,18 @@ def serve_command(
     os.environ["TOUCHBENCH_DATABASE_URL"] = state.database_url
     get_settings.cache_clear()
     settings = get_settings()
-    if settings.api_key is None and not _loopback(host) and not insecure:
+    settings.check_trust()  # a bad key, host or origin: one line, exit 2
+    if not settings.keyring and not _loopback(host) and not insecure:
         raise typer.BadParameter(
             f"{host} is reachable from other machines and TOUCHBENCH_API_KEY is not set: set "
             "a key, listen on 127.0.0.1, or pass --insecure",
+            param_hint="--host",
+        )
+    if not settings.allowed_hosts.strip() and not _loopback(host):
+        raise typer.BadParameter(
+            f"{host} is reachable from other machines and TOUCHBENCH_ALLOWED_HOSTS is not set: "
+            "name the host names or addresses clients reach the service by "
+            "(comma-separated), or listen on 127.0.0.1",
             param_hint="--host",
         )
     state.store  # noqa: B018 (open and migrate the store once, before the workers start)
@@ -71,6 +81,7 @@ def serve_command(
         port=port,
         workers=workers,
         log_level=log_level,
+        log_config=_log_config(log_level),
         proxy_headers=False,
         server_header=False,
     )
@@ -96,6 +107,20 @@ def pin_native_threads() -> None:
     from threadpoolctl import threadpool_limits
 
     threadpool_limits(1)
+
+
+def _log_config(level: str) -> dict[str, Any]:
+    """uvicorn's logging, and the service's own log (``touchbench.*``: which key made each
+    change of state, unexpected errors) through uvicorn's handler at ``level``."""
+    from uvicorn.config import LOGGING_CONFIG
+
+    config = copy.deepcopy(LOGGING_CONFIG)
+    config["loggers"]["touchbench"] = {
+        "handlers": ["default"],
+        "level": level.upper(),
+        "propagate": False,
+    }
+    return config
 
 
 def _loopback(host: str) -> bool:

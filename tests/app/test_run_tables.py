@@ -126,7 +126,7 @@ def test_report_and_web_page_show_tuning_and_per_target_tables(
     assert not [t for t in tables(report) if t["key"] == "target" and "logistic" in str(t)]
 
     settings = Settings(database_url=db, work_dir=tmp_path / "work")
-    with TestClient(create_app(settings)) as client:
+    with TestClient(create_app(settings), base_url="http://localhost") as client:
         page = client.get("/fragments/runs/1/leaderboard")
         assert page.status_code == 200, page.text
         _check_tuning(tables(page.text), tuned)

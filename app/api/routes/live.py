@@ -12,7 +12,6 @@ missing or wrong key or a model that cannot run live, 1007 for a malformed heade
 from __future__ import annotations
 
 import asyncio
-import hmac
 import json
 from typing import Any
 
@@ -20,7 +19,7 @@ import numpy as np
 from fastapi import APIRouter, WebSocket, WebSocketDisconnect
 from starlette.concurrency import run_in_threadpool
 
-from app.api.deps import Service
+from app.api.deps import KeyRefused, Service, key_name
 from app.errors import USER_ERRORS
 from drivers.errors import DriverError
 from drivers.pcm import SAMPLE_FORMATS, decode_pcm
@@ -112,14 +111,14 @@ def _json(text: str | None) -> dict[str, Any]:
 
 
 def _check_key(service: Service, websocket: WebSocket, header: dict[str, Any]) -> None:
-    expected = service.settings.api_key
-    if expected is None:
-        return
+    """A live session predicts: it needs a key with the ``predict`` role (when the service
+    has keys), from the handshake's ``X-API-Key`` header or the header message."""
     given = websocket.headers.get("x-api-key") or header.get("api_key")
-    if not isinstance(given, str):
-        raise _Closed(POLICY, "this service needs an API key (X-API-Key or api_key)")
-    if not hmac.compare_digest(given.encode(), expected.get_secret_value().encode()):
-        raise _Closed(POLICY, "wrong API key")
+    try:
+        key_name(service.settings, given if isinstance(given, str) else None, "predict")
+    except KeyRefused as refused:
+        reason = "this service needs an API key (X-API-Key or api_key)"
+        raise _Closed(POLICY, reason if refused.status == 401 else str(refused)) from None
 
 
 def _stream_format(header: dict[str, Any]) -> tuple[float, int, str]:

@@ -86,13 +86,13 @@ def test_live_over_a_websocket_says_what_live_says(
     tmp_path: Path,
 ) -> None:
     name, unseen = live_model
-    server = make_server(api_key="live-key")
+    server = make_server(api_key="live-key-of-the-lab")
     rate, channels, blocks = _pcm_blocks(unseen)
     messages, code, reason = _stream(
         _ws_url(server, name),
         {"samplerate": rate, "channels": channels, "format": "S16LE"},
         blocks,
-        headers={"X-API-Key": "live-key"},
+        headers={"X-API-Key": "live-key-of-the-lab"},
     )
     assert (code, reason) == (1000, "stream ended")
     # the CLI on the same samples (as 16-bit PCM, as the socket received them)
@@ -120,14 +120,14 @@ def test_bad_streams_are_closed_with_a_reason(
     make_server: Callable[..., Server], live_model: tuple[str, Path]
 ) -> None:
     name, _ = live_model
-    server = make_server(api_key="live-key")
+    server = make_server(api_key="live-key-of-the-lab")
     url = _ws_url(server, name)
-    key = {"X-API-Key": "live-key"}
+    key = {"X-API-Key": "live-key-of-the-lab"}
     good = {"samplerate": 44100, "channels": 3, "format": "S16LE"}
     cases: list[tuple[dict[str, Any], list[bytes], dict[str, str], int, str]] = [
         (good, [], {}, 1008, "API key"),
         ({**good, "api_key": "wrong"}, [], {}, 1008, "wrong API key"),
-        ({**good, "api_key": "live-key", "channels": 2}, [], {}, 1008, "3-channel"),
+        ({**good, "api_key": "live-key-of-the-lab", "channels": 2}, [], {}, 1008, "3-channel"),
         ({**good, "samplerate": "fast"}, [], key, 1007, "samplerate"),
         ({**good, "format": "MP3"}, [], key, 1007, "format"),
         (good, [b"\x00" * 7], key, 1007, "frames"),

@@ -18,7 +18,7 @@ from tests.app.synthetic import touch_arff
 def test_the_api_key_guards_everything_but_health_and_docs(
     make_server: Callable[..., Server],
 ) -> None:
-    server = make_server(api_key="s3cret-key")
+    server = make_server(api_key="s3cret-key-of-the-lab")
     bare = httpx.Client(base_url=server.url, timeout=30)
     try:
         assert bare.get("/healthz").status_code == 200
@@ -26,7 +26,7 @@ def test_the_api_key_guards_everything_but_health_and_docs(
         assert bare.get("/docs").status_code == 200
         missing = bare.get("/api/runs")
         assert missing.status_code == 401 and missing.json()["error"]["type"] == "Unauthorized"
-        wrong = bare.get("/api/datasets", headers={"X-API-Key": "s3cret-kez"})
+        wrong = bare.get("/api/datasets", headers={"X-API-Key": "s3cret-key-of-the-lac"})
         assert wrong.status_code == 403 and wrong.json()["error"]["type"] == "Forbidden"
         assert bare.post("/api/runs", json={"dataset": "x"}).status_code == 401
         # Every operation the OpenAPI document lists, the direct prediction route included.

@@ -134,7 +134,11 @@ def test_the_compose_stack_as_processes(
     postgres_database: str, dask_cluster: str, tmp_path: Path
 ) -> None:
     services = _compose()["services"]
-    variables = {"TOUCHBENCH_DB_PASSWORD": "postgres", "TOUCHBENCH_API_KEY": "stack-key"}
+    variables = {
+        "TOUCHBENCH_DB_PASSWORD": "postgres",
+        "TOUCHBENCH_API_KEY": "stack-key-of-the-lab",
+        "TOUCHBENCH_ALLOWED_HOSTS": "localhost",
+    }
     settings = {
         key: _expand(str(value), variables) for key, value in services["api"]["environment"].items()
     }

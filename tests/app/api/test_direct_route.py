@@ -28,7 +28,7 @@ from tests.app.synthetic import touch_arff
 
 DIRECT = "/api/models/{model}/predict"
 THROUGH_FASTAPI = "/fastapi/models/{model}/predict"
-KEY = "k3y-of-the-lab"
+KEY = "k3y-of-the-lab-2026"
 
 
 @pytest.fixture
@@ -49,7 +49,7 @@ def client(tmp_path: Path) -> Iterator[TestClient]:
         response_model=PredictionReport,
         dependencies=[Depends(require_api_key)],
     )
-    with TestClient(app, headers={"X-API-Key": KEY}) as test_client:
+    with TestClient(app, base_url="http://localhost", headers={"X-API-Key": KEY}) as test_client:
         yield test_client
 
 
@@ -190,7 +190,7 @@ def test_the_upload_limit_holds_on_the_direct_route(tmp_path: Path) -> None:
         work_dir=tmp_path / "work",
         max_upload_mb=0.001,
     )
-    with TestClient(create_app(settings)) as small:
+    with TestClient(create_app(settings), base_url="http://localhost") as small:
         answer = small.post(
             DIRECT.format(model="any"), json={"instances": [{f"a{i}": 1.0 for i in range(200)}]}
         )

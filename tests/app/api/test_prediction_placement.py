@@ -72,7 +72,7 @@ def client(tmp_path: Path, store_url: str) -> Iterator[TestClient]:
     train(store, "touch", "nb", targets=["gesture"], name="quick")
     store.dispose()
     settings = Settings(database_url=store_url, work_dir=tmp_path / "work")
-    with TestClient(create_app(settings)) as test_client:
+    with TestClient(create_app(settings), base_url="http://localhost") as test_client:
         yield test_client
 
 

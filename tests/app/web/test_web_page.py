@@ -185,7 +185,7 @@ def test_the_page_with_an_api_key(
     tab: Tab,
     tmp_path: Path,
 ) -> None:
-    key = "s3cret-page-key"
+    key = "s3cret-page-key-of-the-lab"
     server = make_sqlite_server(api_key=key)
     data = touch_arff(tmp_path / "touch.arff", n=60)
     assert run_cli(capsys, server.database_url, "import", str(data), "--name", "guarded").code == 0
