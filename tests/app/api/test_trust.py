@@ -76,7 +76,7 @@ def test_allowed_hosts_are_answered_besides_loopback(
         _refused(answer, 400, "DisallowedHost", "headers.Host")
 
 
-def _cancelled_run(capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path) -> int:
+def cancelled_run(capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path) -> int:
     """A run of the gate classifier cancelled before any fold: resuming it changes it."""
     path = touch_arff(tmp_path / "touch.arff", n=60)
     assert run_cli(capsys, server.database_url, "import", str(path), "--name", "touch").code == 0
@@ -99,7 +99,7 @@ def test_state_changes_from_a_foreign_origin_are_refused_and_from_its_own_accept
 ) -> None:
     server = make_server()  # no key: the case where any page could write
     api = server.client
-    run_id = _cancelled_run(capsys, server, tmp_path)
+    run_id = cancelled_run(capsys, server, tmp_path)
     data = touch_arff(tmp_path / "other.arff", n=30, seed=2)
     for foreign in (FOREIGN, "http://evil.example", "null", "http://localhost:1"):
         error = _refused(
