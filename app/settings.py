@@ -269,6 +269,8 @@ def _key(where: str, name: str, role: str, secret: SecretStr | str) -> ApiKey:
 def _keys(value: str) -> list[ApiKey]:
     """The keys of ``TOUCHBENCH_API_KEYS``: ``name:role:key`` entries or a key file."""
     where = "TOUCHBENCH_API_KEYS"
+    if not value.strip():
+        raise SettingsError(f"{where}: empty; give name:role:key entries or a key file")
     if ":" not in value.split(",", 1)[0]:
         return _key_file(Path(value.strip()).expanduser())
     keys = []

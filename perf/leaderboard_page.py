@@ -146,7 +146,7 @@ def main() -> None:
         )
         store.dispose()
         settings = Settings(database_url=url, work_dir=folder / "work")
-        with TestClient(create_app(settings)) as client:
+        with TestClient(create_app(settings), base_url="http://localhost") as client:
             second = list(CATALOGUE)[1]
             paths = {
                 "JSON /api/runs/{id}/leaderboard": f"/api/runs/{run_id}/leaderboard",

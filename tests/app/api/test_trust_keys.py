@@ -71,6 +71,8 @@ def test_bad_keys_and_hosts_stop_the_service_in_one_line(tmp_path: Path) -> None
             READ,
         ),
         ((), {"api_keys": str(tmp_path / "absent")}, "cannot be read", None),
+        ((), {"api_keys": " "}, "TOUCHBENCH_API_KEYS: empty", None),
+        ((), {"api_keys": f"robot:read:{READ},robot:write:{WRITE}"}, "'robot' is used twice", READ),
         ((), {"allowed_hosts": "http://lab.example"}, "TOUCHBENCH_ALLOWED_HOSTS:", None),
         ((), {"allowed_origins": "lab.example"}, "TOUCHBENCH_ALLOWED_ORIGINS:", None),
         (
