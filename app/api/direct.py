@@ -7,9 +7,9 @@ one-instance prediction of a logistic model that is more CPU time than the predi
 (measured with ``perf/serve.py``).  :class:`DirectRoute` keeps the route's OpenAPI
 description (its body, response model, path parameters and the API key header) and answers
 with a handler that does the same things directly: the API key and role check of every
-protected route (:func:`app.api.deps.check_api_key`), the body validated from its bytes in one pass
-(``model_validate_json``), errors raised as FastAPI raises them, so the service's error
-handlers answer them as for any route.
+protected route (:func:`app.api.deps.check_api_key`), the body validated from its bytes in
+one pass (``model_validate_json``), errors raised as FastAPI raises them, so the service's
+error handlers answer them as for any route.
 """
 
 from __future__ import annotations

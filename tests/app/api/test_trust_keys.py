@@ -223,3 +223,27 @@ def test_without_keys_changes_are_logged_as_keyless(
     assert (
         "DELETE /api/datasets/none by key (none: the service has no key)" in server.log.read_text()
     )
+
+
+def test_every_route_a_predict_key_may_change_exists_and_lets_it_in(tmp_path: Path) -> None:
+    from fastapi.testclient import TestClient
+
+    from app.api.deps import PREDICT_ROUTES
+    from app.main import create_app
+    from app.settings import Settings
+
+    settings = Settings(
+        database_url=f"sqlite:///{tmp_path / 's.db'}",
+        work_dir=tmp_path / "work",
+        api_keys=f"arm:predict:{PREDICT},robot:read:{READ}",
+    )
+    app = create_app(settings)
+    paths = app.openapi()["paths"]
+    for method, path in PREDICT_ROUTES:
+        assert method.lower() in paths.get(path, {}), (method, path)
+    with TestClient(app, base_url="http://localhost") as client:
+        for method, path in sorted(PREDICT_ROUTES):
+            url = path.replace("{model_ref}", "nope")
+            for key, allowed in ((PREDICT, True), (READ, False)):
+                answer = client.request(method, url, headers={"X-API-Key": key})
+                assert (answer.status_code != 403) is allowed, (key, path, answer.text)
