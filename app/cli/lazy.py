@@ -1,12 +1,11 @@
 """A command group whose commands' modules are imported only when a command is chosen.
 
-The commands' modules import SQLAlchemy, NumPy, pydantic and the store, together half a
-second; ``touchbench --version``, ``touchbench --help`` and each command should pay only for
-what they use.  :class:`LazyGroup` knows its commands from a table of :class:`Subcommand`
-(name, module, one-line help): it lists them from the table alone, and imports a module, then
-builds its commands as typer does, the first time one of them is looked up (to be run, or to
-show its own help).
-"""
+The commands' modules import SQLAlchemy, NumPy, pydantic and the store; ``touchbench
+--version``, ``touchbench --help`` and each command should pay only for what it uses.
+:class:`LazyGroup` knows its commands from a table of :class:`Subcommand` (name, module,
+one-line help): it lists them from the table alone, and the first time a command is looked up
+(to be run, or to show its own help) it imports the command's module and builds the command
+as typer does."""
 
 from __future__ import annotations
 
@@ -17,7 +16,8 @@ from typing import TYPE_CHECKING, Any, ClassVar, NamedTuple
 
 import typer
 from typer.core import TyperCommand, TyperGroup
-from typer.main import get_command_from_info
+from typer.main import get_command_from_info, get_command_name
+from typer.models import CommandInfo
 
 if TYPE_CHECKING:
     from typer._click import Command  # the click that typer vendors and builds commands of
@@ -43,7 +43,8 @@ class Subcommand(NamedTuple):
 
 
 class LazyCommands(MutableMapping[str, "Command"]):
-    """A group's commands by name, in the table's order; looking one up imports its module.
+    """A group's commands by name, in the table's order; looking one up imports its module
+    (once) and builds that command (once).
 
     Parameters
     ----------
@@ -56,12 +57,21 @@ class LazyCommands(MutableMapping[str, "Command"]):
     def __init__(self, subcommands: tuple[Subcommand, ...], rich_markup_mode: Any) -> None:
         self._modules = {command.name: command.module for command in subcommands}
         self._rich_markup_mode = rich_markup_mode
+        self._registered: dict[str, CommandInfo] = {}
         self._built: dict[str, Command] = {}
 
     def __getitem__(self, name: str) -> Command:
-        if name not in self._built:
-            self._built.update(self._build(self._modules[name]))
-        return self._built[name]
+        command = self._built.get(name)
+        if command is None:
+            if name not in self._registered:
+                self._register(self._modules[name])
+            command = get_command_from_info(
+                self._registered[name],
+                pretty_exceptions_short=True,  # typer's default (app.cli.main prints errors itself)
+                rich_markup_mode=self._rich_markup_mode,
+            )
+            self._built[name] = command
+        return command
 
     def __setitem__(self, name: str, command: Command) -> None:
         self._built[name] = command
@@ -77,8 +87,8 @@ class LazyCommands(MutableMapping[str, "Command"]):
     def __len__(self) -> int:
         return len(self._modules.keys() | self._built.keys())
 
-    def _build(self, module_name: str) -> dict[str, Command]:
-        """The commands that ``module_name`` registers, built as typer builds a group's."""
+    def _register(self, module_name: str) -> None:
+        """Import ``module_name`` and keep what its ``register`` adds, by command name."""
         first_import = module_name not in sys.modules
         # As an import statement does (importlib.import_module would not show the module
         # itself in ``python -X importtime``, the tool to read start-up with).
@@ -90,15 +100,9 @@ class LazyCommands(MutableMapping[str, "Command"]):
             gc.freeze()
         holder = typer.Typer()
         module.register(holder)
-        built = {}
         for info in holder.registered_commands:
-            command = get_command_from_info(
-                info,
-                pretty_exceptions_short=holder.pretty_exceptions_short,
-                rich_markup_mode=self._rich_markup_mode,
-            )
-            built[str(command.name)] = command
-        return built
+            assert info.callback is not None, f"{module_name} registers a command without code"
+            self._registered[info.name or get_command_name(info.callback.__name__)] = info
 
 
 class LazyGroup(TyperGroup):
