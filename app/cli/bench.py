@@ -18,7 +18,7 @@ if TYPE_CHECKING:
     from benchmark.evaluation.leaderboard import Leaderboard
 
 # scikit-learn, the engine and Dask are imported by the commands that use them, so that
-# `touchbench datasets` and `--help` start at once.
+# this module's other commands (runs, leaderboard, cancel) start without them.
 
 JsonOption = Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")]
 FORMATS = ("table", "json", "csv", "markdown", "arff")

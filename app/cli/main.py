@@ -18,6 +18,7 @@ from app.cli.exits import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_USAGE, ExitWith
 from app.cli.lazy import LazyGroup, Subcommand
 from app.cli.signals import interrupts
 from app.cli.state import CliState
+from app.environment import database_url
 
 EXIT_UNEXPECTED = EXIT_FAILED
 
@@ -194,12 +195,7 @@ def root(
         ),
     ] = False,
 ) -> None:
-    if not db:
-        # loaded when a command runs: start-up time (pydantic-settings, for --help and --version)
-        from app.settings import get_settings
-
-        db = get_settings().database_url
-    ctx.obj = CliState(database_url=db)
+    ctx.obj = CliState(database_url=db or database_url())
 
 
 # What importing the CLI made (objects that live as long as the process) is moved out of the

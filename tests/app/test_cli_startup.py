@@ -16,7 +16,9 @@ import typer
 
 import app.cli
 from app.cli.lazy import LazyGroup
-from app.cli.main import COMMANDS
+from app.cli.main import COMMANDS, main
+from app.environment import DEFAULT_DATABASE_URL, database_url
+from app.settings import Settings
 from tests.app.cli_runner import run_cli
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -81,6 +83,43 @@ def test_a_misspelt_command_is_refused_with_a_suggestion(
     )
 
 
+@pytest.mark.parametrize(
+    "environment",
+    [
+        {},
+        {"TOUCHBENCH_DATABASE_URL": "sqlite:///upper.db"},
+        {"touchbench_database_url": "sqlite:///lower.db"},
+        {"Touchbench_Database_Url": "sqlite:///mixed.db"},
+        {"TOUCHBENCH_DATABASE_URL": "sqlite:///a.db", "touchbench_database_url": "sqlite:///b.db"},
+        {"touchbench_database_url": "sqlite:///b.db", "TOUCHBENCH_DATABASE_URL": "sqlite:///a.db"},
+        {"TOUCHBENCH_DATABASE_URL": ""},
+        {"TOUCHBENCH_DATABASE_URLS": "sqlite:///not-this.db"},
+    ],
+)
+def test_the_commands_read_the_store_url_as_the_settings_do(
+    environment: dict[str, str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    for name in [name for name in os.environ if name.upper().startswith("TOUCHBENCH_")]:
+        monkeypatch.delenv(name)
+    for name, value in environment.items():
+        monkeypatch.setenv(name, value)
+    assert database_url() == Settings().database_url
+    if not environment:
+        assert database_url() == DEFAULT_DATABASE_URL
+
+
+def test_without_db_a_command_uses_the_environment_then_the_current_folder(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delenv("TOUCHBENCH_DATABASE_URL", raising=False)
+    assert main(["datasets", "--json"]) == 0
+    assert (tmp_path / "touchbench.db").is_file()
+    monkeypatch.setenv("TOUCHBENCH_DATABASE_URL", f"sqlite:///{tmp_path / 'elsewhere.db'}")
+    assert main(["datasets", "--json"]) == 0
+    assert (tmp_path / "elsewhere.db").is_file()
+
+
 def _imported(*args: str, cwd: Path, program: tuple[str, ...] = (str(TOUCHBENCH),)) -> set[str]:
     """The modules that the console script ``touchbench ARGS`` (or ``program ARGS``)
     imports, from Python's own import log (``-X importtime``), in a fresh process."""
@@ -113,11 +152,11 @@ def test_version_and_help_import_no_command(option: str, tmp_path: Path) -> None
 
 
 def test_a_command_imports_its_own_module_only(tmp_path: Path) -> None:
-    url = f"sqlite:///{tmp_path / 'store.db'}"
-    imported = _imported("--db", url, "datasets", cwd=tmp_path)
+    imported = _imported("datasets", cwd=tmp_path)  # the store in the current folder
     assert "app.cli.datasets" in imported and "sqlalchemy" in imported
     assert imported & set(COMMAND_MODULES) == {"app.cli.datasets"}
-    help_only = _imported("--db", url, "train", "--help", cwd=tmp_path)
+    assert "pydantic_settings" not in imported  # the store's URL is all a command reads
+    help_only = _imported("train", "--help", cwd=tmp_path)
     assert help_only & set(COMMAND_MODULES) == {"app.cli.models"}
 
 
