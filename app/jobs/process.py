@@ -18,8 +18,7 @@ import sys
 import threading
 import time
 
-#: The variable holding the store's URL.
-DATABASE_URL_VARIABLE = "TOUCHBENCH_DATABASE_URL"
+from app.environment import DATABASE_URL_VARIABLE
 
 #: Seconds between checks that the parent service is alive.
 PARENT_CHECK_INTERVAL = 1.0
