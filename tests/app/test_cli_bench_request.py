@@ -5,22 +5,12 @@ before a run row exists; what it takes is stored with the run."""
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import pytest
-from sqlalchemy import create_engine, text
 
 from tests.app.cli_runner import CliResult, run_cli
+from tests.app.rows import count_rows
 from tests.app.synthetic import position_arff, touch_arff
-
-
-def _run_rows(url: str) -> Any:
-    engine = create_engine(url.replace("postgresql://", "postgresql+psycopg://", 1))
-    try:
-        with engine.connect() as connection:
-            return connection.execute(text("SELECT count(*) FROM runs")).scalar()
-    finally:
-        engine.dispose()
 
 
 @pytest.fixture
@@ -60,7 +50,7 @@ def test_what_independent_runs_cannot_honour_is_refused_naming_the_option(
     assert result.code == 2, result.err
     assert result.err.startswith(f"touchbench: error: {option}: is not used with --independent")
     assert reason in result.err and len(result.err.strip().splitlines()) == 1, result.err
-    assert _run_rows(db) == 0
+    assert count_rows(db, "runs") == 0
 
 
 def test_the_issues_independent_command_is_refused_at_its_first_dropped_option(
@@ -76,7 +66,7 @@ def test_the_issues_independent_command_is_refused_at_its_first_dropped_option(
     regression = run_cli(capsys, db, "bench", "contact", "--independent", "-c", "ridge")
     assert regression.code == 2
     assert regression.err.startswith("touchbench: error: --independent: compares targets")
-    assert _run_rows(db) == 0
+    assert count_rows(db, "runs") == 0
 
 
 @pytest.mark.parametrize(
@@ -107,7 +97,7 @@ def test_run_options_out_of_bounds_are_refused_before_a_run_exists(
     assert result.code == 2, result.err
     assert result.err.startswith(f"touchbench: error: {line}"), result.err
     assert len(result.err.strip().splitlines()) == 1 and "Traceback" not in result.err
-    assert _run_rows(db) == 0
+    assert count_rows(db, "runs") == 0
 
 
 @pytest.mark.parametrize(
@@ -124,7 +114,7 @@ def test_what_a_regression_cannot_take_names_its_option(
     result = run_cli(capsys, db, "bench", "contact", "-c", "ridge,linear", *extra)
     assert result.code == 2, result.err
     assert result.err.startswith(f"touchbench: error: {line}"), result.err
-    assert _run_rows(db) == 0
+    assert count_rows(db, "runs") == 0
 
 
 def test_a_resumed_run_keeps_its_options_and_refuses_new_ones(
@@ -145,7 +135,7 @@ def test_a_resumed_run_keeps_its_options_and_refuses_new_ones(
     assert board.code == 0 and board.json()["metric"] == "accuracy"  # what the run asked for
     other = run_cli(capsys, db, "leaderboard", "1", "--metric", "f1_weighted", "--json")
     assert other.json()["metric"] == "f1_weighted"
-    assert _run_rows(db) == 1
+    assert count_rows(db, "runs") == 1
 
 
 def test_independent_runs_take_the_request_and_check_every_target_first(
@@ -160,7 +150,7 @@ def test_independent_runs_take_the_request_and_check_every_target_first(
     assert run_cli(capsys, db, "import", str(lopsided)).code == 0
     refused = run_cli(capsys, db, "bench", "lopsided", "--independent", "-c", "zeror", "-k", "3")
     assert refused.code == 2 and "target 'b' has a single class" in refused.err, refused.err
-    assert _run_rows(db) == 0  # not even target a's run
+    assert count_rows(db, "runs") == 0  # not even target a's run
     done = run_cli(
         capsys, db, "bench", "touch", "--independent", "-c", "zeror,nb", "-k", "3", "-r", "2"
     )

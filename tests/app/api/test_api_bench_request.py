@@ -9,25 +9,16 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from sqlalchemy import create_engine, text
 
 from tests.app.api.conftest import Server, finished
 from tests.app.cli_runner import run_cli
+from tests.app.rows import count_rows
 from tests.app.synthetic import position_arff, touch_arff
 
 #: A command-line word: an option (``--budget``) or a command (``touchbench bench``).
 CLI_WORDS = re.compile(r"(^|[\s\"'`(])--[a-z]|touchbench [a-z]")
 
 BASE = {"dataset": "touch", "classifiers": ["zeror", "nb"], "folds": 3}
-
-
-def _run_rows(url: str) -> Any:
-    engine = create_engine(url.replace("postgresql://", "postgresql+psycopg://", 1))
-    try:
-        with engine.connect() as connection:
-            return connection.execute(text("SELECT count(*) FROM runs")).scalar()
-    finally:
-        engine.dispose()
 
 
 REFUSALS: list[tuple[dict[str, Any], str, str]] = [
@@ -80,7 +71,7 @@ def test_every_refusal_names_its_field_and_leaves_no_run(
         assert error["where"] == f"body.{field}", (change, error)
         assert words in error["message"], (change, error)
         assert not CLI_WORDS.search(error["message"]), (change, error)
-    assert _run_rows(server.database_url) == 0
+    assert count_rows(server.database_url, "runs") == 0
     assert api.get("/api/runs").json() == {"runs": []}
 
     # what is taken is stored: 0 means no time limit, the metric ranks the leaderboard
