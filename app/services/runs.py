@@ -29,7 +29,7 @@ from app.schemas.runs import (
 )
 from app.services.tuning import run_specs
 from app.store.database import Store
-from app.store.datasets import find_dataset, load_dataset, load_schema
+from app.store.datasets import load_dataset, load_schema
 from app.store.ownership import process_owner
 from app.store.runs import (
     CANCEL_POLL,
@@ -284,14 +284,15 @@ def create_run(
     Raises
     ------
     FieldError
-        A field the data set refuses: a metric of the other kind of problem, ``tune``,
+        A field the data set refuses: a target it lacks, a metric of the other kind of
+        problem, ``tune``,
         ``stack`` or ``weka`` on numeric targets, a stack on several targets, a baseline
         that is not one of the run's classifiers, impossible folds, ``independent``.
     NotFoundError
         An unknown data set.
     ConfigurationError
-        Anything else that would make the run fail at once: an unknown target, a target
-        with one class, a position that is not numeric targets.
+        Anything else that would make the run fail at once: a target with one class, a
+        position that is not numeric targets.
     """
     if request.independent:
         raise FieldError(
@@ -308,7 +309,12 @@ def _plan_run(store: Store, request: BenchRequest) -> _Plan:
     commands = weka_specs(request.weka or ())
     targets = [request.target] if request.target else None
     position = list(request.position or ())
-    info = find_dataset(store, request.dataset)
+    info, schema, _ = load_schema(store, request.dataset)
+    if request.target is not None:
+        try:
+            schema.index(request.target)
+        except ConfigurationError as error:
+            raise FieldError("target", str(error)) from None
     prepared = prepare_problem(load_dataset(store, info.id), targets, position)
     problem = prepared.problem
     if request.metric is not None:

@@ -88,6 +88,7 @@ def test_the_issues_independent_command_is_refused_at_its_first_dropped_option(
             "--baseline: 'rf' is not a classifier of this run (classifiers: zeror, nb)",
         ),
         (["--weka", "weka.classifiers.Nope"], "--weka: "),
+        (["--target", "nope"], "--target: no attribute named 'nope'"),
     ],
 )
 def test_run_options_out_of_bounds_are_refused_before_a_run_exists(

@@ -48,6 +48,7 @@ REFUSALS: list[tuple[dict[str, Any], str, str]] = [
     ({"target": "gesture", "baseline": "rf"}, "baseline", "'rf' is not a classifier"),
     ({"target": "gesture", "metric": "mae"}, "metric", "'mae' is a regression metric"),
     ({"classifiers": ["nbx"], "target": "gesture"}, "classifiers", "unknown classifier 'nbx'"),
+    ({"target": "nope"}, "target", "no attribute named 'nope'"),
     ({"dataset": "contact", "classifiers": ["ridge"], "stack": 1}, "stack", "numeric"),
     ({"dataset": "contact", "classifiers": ["ridge"], "tune": True}, "tune", "numeric"),
     ({"dataset": "contact", "weka": ["J48"], "classifiers": None}, "weka", "numeric"),
