@@ -521,7 +521,7 @@ def _ranked(store: Store, run_id: int, metric: str | None, baseline: str | None)
         return run_leaderboard(store, run_id, metric=metric, baseline=baseline)
     except NoResultsError as missing:
         run = missing.run
-        if run.status == "running":
+        if missing.under_way:
             raise
         raise AppError(
             f"run {run.id} has no results yet (it is {run.status}; "

@@ -479,17 +479,28 @@ def execute_run(
     return get_run(store, run.id)
 
 
+#: Why a run has no results yet, when it is under way.
+_UNDER_WAY = {
+    "queued": "it waits for a worker",
+    "running": "it is still running",
+    "cancelling": "it is being cancelled",
+}
+
+
 class NoResultsError(ConfigurationError):
-    """A run without a stored result has no leaderboard yet."""
+    """A run without a stored result has no leaderboard yet.
+
+    Attributes
+    ----------
+    under_way : bool
+        The run is queued, running or being cancelled (resuming it would not help).
+    """
 
     def __init__(self, run: RunInfo) -> None:
-        hint = (
-            "it is still running"
-            if run.status == "running"
-            else f"it is {run.status}; resuming it carries it out"
-        )
+        hint = _UNDER_WAY.get(run.status, f"it is {run.status}; resuming it carries it out")
         super().__init__(f"run {run.id} has no results yet ({hint})")
         self.run = run
+        self.under_way = run.status in _UNDER_WAY
 
 
 @dataclass(frozen=True)

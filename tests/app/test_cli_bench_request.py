@@ -8,6 +8,9 @@ from pathlib import Path
 
 import pytest
 
+from app.schemas.runs import BenchRequest
+from app.services.runs import NoResultsError, create_run, run_leaderboard
+from app.store.database import Store
 from tests.app.cli_runner import CliResult, run_cli
 from tests.app.rows import count_rows
 from tests.app.synthetic import position_arff, touch_arff
@@ -160,3 +163,28 @@ def test_independent_runs_take_the_request_and_check_every_target_first(
     assert [r["targets"] for r in runs] == [["gesture"], ["place"]]
     assert all((r["config"]["folds"], r["config"]["repeats"]) == (3, 2) for r in runs)
     assert all(r["config"]["timeout"] == 600 for r in runs)  # the request's default
+
+
+def test_a_run_without_results_says_how_to_carry_it_out_in_the_adapters_words(
+    capsys: pytest.CaptureFixture[str], db: str
+) -> None:
+    store = Store(db)
+    try:
+        request = BenchRequest(dataset="touch", target="gesture", classifiers=["nb"], folds=3)
+        run = create_run(store, request)
+        queued = run_cli(capsys, db, "leaderboard", str(run.id))
+        _refused(queued, f"run {run.id} has no results yet (it waits for a worker)")
+        assert run_cli(capsys, db, "cancel", str(run.id)).code == 0
+        cancelled = run_cli(capsys, db, "leaderboard", str(run.id))
+        _refused(
+            cancelled,
+            f"run {run.id} has no results yet (it is cancelled; "
+            f"`touchbench bench --resume {run.id}` carries it out)",
+        )
+        with pytest.raises(NoResultsError) as service:
+            run_leaderboard(store, run.id)
+        assert str(service.value) == (
+            f"run {run.id} has no results yet (it is cancelled; resuming it carries it out)"
+        )
+    finally:
+        store.dispose()
