@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
 from app.cli.output import EXIT_FAILED, EXIT_INTERRUPTED, ExitWith, info, print_json, table
 from app.cli.state import get_state
+from app.schemas.runs import BenchRequest
 
 if TYPE_CHECKING:
     from app.schemas.runs import LeaderboardSchema
@@ -23,6 +24,11 @@ if TYPE_CHECKING:
 
 JsonOption = Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")]
 FORMATS = ("table", "json", "csv", "markdown", "arff")
+
+
+def _default(field: str) -> Any:
+    """A run option's default, as the request type says it (shown in ``--help``)."""
+    return BenchRequest.model_fields[field].default
 
 
 def register(app: typer.Typer) -> None:
@@ -201,19 +207,30 @@ def bench_command(
     folds: Annotated[
         int | None,
         typer.Option(
-            "--folds", "-k", metavar="K", help="Folds per repeat (2-100).", show_default=False
+            "--folds",
+            "-k",
+            metavar="K",
+            help=f"Folds per repeat (2-100; default {_default('folds')}).",
+            show_default=False,
         ),
     ] = None,
     repeats: Annotated[
         int | None,
         typer.Option(
-            "--repeats", "-r", metavar="R", help="Repeats of k-fold (1-100).", show_default=False
+            "--repeats",
+            "-r",
+            metavar="R",
+            help=f"Repeats of k-fold (1-100; default {_default('repeats')}).",
+            show_default=False,
         ),
     ] = None,
     seed: Annotated[
         int | None,
         typer.Option(
-            "--seed", metavar="S", help="Seed of folds and classifiers.", show_default=False
+            "--seed",
+            metavar="S",
+            help=f"Seed of folds and classifiers (default {_default('seed')}).",
+            show_default=False,
         ),
     ] = None,
     jobs: Annotated[
@@ -239,7 +256,10 @@ def bench_command(
         typer.Option(
             "--timeout",
             metavar="SECONDS",
-            help="Seconds per task before it is stopped (0: no limit).",
+            help=(
+                "Seconds per task before it is stopped (0: no limit; default "
+                f"{_default('timeout'):g})."
+            ),
             show_default=False,
         ),
     ] = None,
@@ -350,7 +370,6 @@ def bench_command(
     from app.cli.progress import TaskProgress
     from app.cli.requests import build_request
     from app.errors import ConflictError
-    from app.schemas.runs import BenchRequest
     from app.services.runs import RunCancelled, create_run, execute_run, independent_runs
     from app.store.run_states import RunBusy
 
