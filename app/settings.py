@@ -18,9 +18,8 @@ from urllib.parse import urlsplit
 from pydantic import Field, SecretStr
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
+from app.environment import DEFAULT_DATABASE_URL, ENV_PREFIX
 from app.errors import AppError
-
-DEFAULT_DATABASE_URL = "sqlite:///touchbench.db"
 
 #: What a key may do, each role including the ones before it: ``read`` every GET;
 #: ``predict`` also predictions (JSON, file, the live WebSocket) and uploads of data sets
@@ -97,7 +96,7 @@ class Settings(BaseSettings):
         Loaded models kept in memory per service process for predictions.
     """
 
-    model_config = SettingsConfigDict(env_prefix="TOUCHBENCH_", extra="ignore")
+    model_config = SettingsConfigDict(env_prefix=ENV_PREFIX, extra="ignore")
 
     database_url: str = DEFAULT_DATABASE_URL
     api_key: SecretStr | None = None

@@ -3,25 +3,32 @@
 from __future__ import annotations
 
 import sys
-from typing import TYPE_CHECKING, Annotated
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
 from app.cli.output import EXIT_FAILED, EXIT_INTERRUPTED, ExitWith, info, print_json, table
 from app.cli.state import get_state
+from app.schemas.runs import BenchRequest
 
 if TYPE_CHECKING:
     from app.schemas.runs import LeaderboardSchema
-    from app.services.runs import IndependentResult
+    from app.services.runs import IndependentResult, RunLeaderboard
     from app.store.database import Store
     from app.store.runs import RunInfo
     from benchmark.evaluation.leaderboard import Leaderboard
 
 # scikit-learn, the engine and Dask are imported by the commands that use them, so that
-# `touchbench datasets` and `--help` start at once.
+# this module's other commands (runs, leaderboard, cancel) start without them.
 
 JsonOption = Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")]
 FORMATS = ("table", "json", "csv", "markdown", "arff")
+
+
+def _default(field: str) -> Any:
+    """A run option's default, as the request type says it (shown in ``--help``)."""
+    return BenchRequest.model_fields[field].default
 
 
 def register(app: typer.Typer) -> None:
@@ -198,14 +205,34 @@ def bench_command(
         typer.Option("--suite", metavar="NAME", help="fast, default or all (default: default)."),
     ] = None,
     folds: Annotated[
-        int, typer.Option("--folds", "-k", min=2, metavar="K", help="Folds per repeat.")
-    ] = 10,
+        int | None,
+        typer.Option(
+            "--folds",
+            "-k",
+            metavar="K",
+            help=f"Folds per repeat (2-100; default {_default('folds')}).",
+            show_default=False,
+        ),
+    ] = None,
     repeats: Annotated[
-        int, typer.Option("--repeats", "-r", min=1, metavar="R", help="Repeats of k-fold.")
-    ] = 1,
+        int | None,
+        typer.Option(
+            "--repeats",
+            "-r",
+            metavar="R",
+            help=f"Repeats of k-fold (1-100; default {_default('repeats')}).",
+            show_default=False,
+        ),
+    ] = None,
     seed: Annotated[
-        int, typer.Option("--seed", metavar="S", help="Seed of folds and classifiers.")
-    ] = 0,
+        int | None,
+        typer.Option(
+            "--seed",
+            metavar="S",
+            help=f"Seed of folds and classifiers (default {_default('seed')}).",
+            show_default=False,
+        ),
+    ] = None,
     jobs: Annotated[
         int,
         typer.Option(
@@ -225,16 +252,21 @@ def bench_command(
         typer.Option("--scheduler", metavar="tcp://HOST:PORT", help="Run on a Dask cluster."),
     ] = None,
     timeout: Annotated[
-        float,
+        float | None,
         typer.Option(
-            "--timeout", min=0.0, metavar="SECONDS", help="Seconds per task before it is stopped."
+            "--timeout",
+            metavar="SECONDS",
+            help=(
+                "Seconds per task before it is stopped (0: no limit; default "
+                f"{_default('timeout'):g})."
+            ),
+            show_default=False,
         ),
-    ] = 600.0,
+    ] = None,
     max_memory: Annotated[
         float | None,
         typer.Option(
             "--max-memory",
-            min=1.0,
             metavar="MB",
             help="Megabytes one task may allocate (beyond its copy of the data) before it fails.",
             show_default=False,
@@ -336,74 +368,54 @@ def bench_command(
     every finished fold: `touchbench bench --resume RUN` carries out the rest.
     """
     from app.cli.progress import TaskProgress
+    from app.cli.requests import build_request
     from app.errors import ConflictError
-    from app.services.runs import (
-        RunCancelled,
-        RunOptions,
-        create_run,
-        execute_run,
-        independent_runs,
-    )
+    from app.services.runs import RunCancelled, create_run, execute_run, independent_runs
     from app.store.run_states import RunBusy
 
     store = get_state(ctx).store
+    values = {
+        "dataset": dataset,
+        "target": target,
+        "classifiers": _split(classifiers),
+        "suite": suite_name,
+        "folds": folds,
+        "repeats": repeats,
+        "seed": seed,
+        "timeout": timeout,
+        "max_memory_mb": max_memory,
+        "metric": metric,
+        "baseline": baseline,
+        "weka": weka or None,
+        "position": _split(position),
+        "tune": tune,
+        "budget": budget,
+        "stack": stack,
+        "independent": independent,
+    }
+    if resume is not None:
+        _check_resume(values)
+    elif dataset is None:
+        raise typer.BadParameter("missing DATASET (or --resume RUN)")
+    request = None if resume is not None else build_request(BenchRequest, BENCH_OPTIONS, **values)
     jobs = _check_jobs(jobs, oversubscribe)
     if scheduler is not None:
         from benchmark.run.dask_backend import connect
 
         connect(scheduler).close()  # fail before a run exists, not after
-    if resume is not None and dataset is not None:
-        raise typer.BadParameter("give either DATASET or --resume RUN, not both")
-    if resume is None and dataset is None:
-        raise typer.BadParameter("missing DATASET (or --resume RUN)")
-    if classifiers and suite_name:
-        raise typer.BadParameter("give --classifiers or --suite, not both")
-    if independent and target:
-        raise typer.BadParameter("--independent benchmarks every target; drop --target")
-    if position is not None and resume is not None:
-        raise typer.BadParameter("--position is kept by the run; drop it with --resume")
-    coordinates = [p.strip() for p in position.split(",") if p.strip()] if position else []
-    if independent and (tune or stack is not None):
-        raise typer.BadParameter("--tune and --stack work on one run; drop --independent")
-    ids = [c.strip() for c in classifiers.split(",") if c.strip()] if classifiers else None
-    options = RunOptions(
-        folds=folds, repeats=repeats, seed=seed, timeout=timeout or None, max_memory_mb=max_memory
-    )
     progress = TaskProgress(enabled=False if as_json else None)
-    if independent:
-        assert dataset is not None
+    if request is not None and request.independent:
         with progress:
             result = independent_runs(
-                store,
-                dataset,
-                ids,
-                suite=suite_name,
-                options=options,
-                jobs=jobs,
-                scheduler=scheduler,
-                callbacks=progress.callbacks(),
+                store, request, jobs=jobs, scheduler=scheduler, callbacks=progress.callbacks()
             )
         _print_independent(result, as_json)
         return
-    if resume is not None:
+    if request is None:
+        assert resume is not None
         run_id = resume
     else:
-        assert dataset is not None
-        run_id = create_run(
-            store,
-            dataset,
-            ids,
-            suite=suite_name,
-            targets=[target] if target else None,
-            options=options,
-            on_warning=progress.note,
-            weka=weka or (),
-            position=coordinates,
-            metric=metric,
-            tune=tune,
-            budget=budget,
-            stack=stack,
-        ).id
+        run_id = create_run(store, request, on_warning=progress.note).id
     try:
         with progress:
             run = execute_run(
@@ -422,6 +434,46 @@ def bench_command(
             f"run {run.id} failed: {run.error} (`touchbench leaderboard {run.id}` lists why)",
             EXIT_FAILED,
         )
+
+
+#: The option of each field of :class:`app.schemas.runs.BenchRequest`.
+BENCH_OPTIONS = {
+    "dataset": "DATASET",
+    "target": "--target",
+    "classifiers": "--classifiers",
+    "suite": "--suite",
+    "folds": "--folds",
+    "repeats": "--repeats",
+    "seed": "--seed",
+    "timeout": "--timeout",
+    "max_memory_mb": "--max-memory",
+    "metric": "--metric",
+    "baseline": "--baseline",
+    "weka": "--weka",
+    "position": "--position",
+    "tune": "--tune",
+    "budget": "--budget",
+    "stack": "--stack",
+    "independent": "--independent",
+}
+#: Fields that only say how ``bench`` prints the leaderboard of a resumed run.
+_REPORT_FIELDS = ("metric", "baseline")
+
+
+def _split(text: str | None) -> list[str] | None:
+    """``a, b,c`` as ``["a", "b", "c"]``; ``None`` when not given."""
+    return None if text is None else [part.strip() for part in text.split(",") if part.strip()]
+
+
+def _check_resume(values: Mapping[str, object]) -> None:
+    """A resumed run keeps what it was asked: refuse options that would change it."""
+    if values["dataset"] is not None:
+        raise typer.BadParameter("give either DATASET or --resume RUN, not both")
+    for field, value in values.items():
+        if field not in _REPORT_FIELDS and value is not None and value is not False:
+            raise typer.BadParameter(
+                f"{BENCH_OPTIONS[field]} is kept by the run; drop it with --resume"
+            )
 
 
 def cancel_command(
@@ -470,14 +522,30 @@ def _kept_message(store: Store, run_id: int, what: str) -> str:
 def _print_run_report(
     store: Store, run_id: int, metric: str | None, baseline: str | None, as_json: bool
 ) -> None:
-    from app.services.runs import leaderboard_schema
-
-    run, board, report = leaderboard_schema(store, run_id, metric=metric, baseline=baseline)
+    ranked = _ranked(store, run_id, metric, baseline)
+    report = ranked.report()
     if as_json:
         print_json(report.to_json())
         return
-    _print_leaderboard(run, board)
+    _print_leaderboard(ranked.run, ranked.board)
     _print_run_tables(report)
+
+
+def _ranked(store: Store, run_id: int, metric: str | None, baseline: str | None) -> RunLeaderboard:
+    """A run's leaderboard; a run without results says how to carry it out."""
+    from app.errors import AppError
+    from app.services.runs import NoResultsError, run_leaderboard
+
+    try:
+        return run_leaderboard(store, run_id, metric=metric, baseline=baseline)
+    except NoResultsError as missing:
+        run = missing.run
+        if missing.under_way:
+            raise
+        raise AppError(
+            f"run {run.id} has no results yet (it is {run.status}; "
+            f"`touchbench bench --resume {run.id}` carries it out)"
+        ) from None
 
 
 def runs_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
@@ -543,13 +611,13 @@ def leaderboard_command(
         leaderboard_markdown,
         metric_columns,
     )
-    from app.services.runs import leaderboard_schema
 
     store = get_state(ctx).store
-    run, board, report = leaderboard_schema(store, run_id, metric=metric, baseline=baseline)
+    ranked = _ranked(store, run_id, metric, baseline)
+    run, board = ranked.run, ranked.board
     columns = metric_columns(run, board)
     if output_format == "json":
-        print_json(report.to_json())
+        print_json(ranked.report().to_json())
     elif output_format == "csv":
         sys.stdout.write(leaderboard_csv(board, columns))
     elif output_format == "markdown":
@@ -560,7 +628,7 @@ def leaderboard_command(
         write_results_arff(store, run, sys.stdout)
     else:
         _print_leaderboard(run, board)
-        _print_run_tables(report)
+        _print_run_tables(ranked.report())
 
 
 def _print_run_tables(report: LeaderboardSchema) -> None:

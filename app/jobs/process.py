@@ -18,8 +18,7 @@ import sys
 import threading
 import time
 
-#: The variable holding the store's URL.
-DATABASE_URL_VARIABLE = "TOUCHBENCH_DATABASE_URL"
+from app.environment import DATABASE_URL_VARIABLE
 
 #: Seconds between checks that the parent service is alive.
 PARENT_CHECK_INTERVAL = 1.0
@@ -46,6 +45,8 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"no store: set {DATABASE_URL_VARIABLE} or pass --db")
     threading.Thread(target=_exit_with_parent, args=(os.getppid(),), daemon=True).start()
 
+    # loaded once the arguments are read and the parent is watched: start-up time (``--help``
+    # and a bad argument need none of it; a service that dies meanwhile ends this process)
     from app.errors import AppError
     from app.services.jobs import execute_job
     from app.services.runs import RunCancelled, execute_run

@@ -24,7 +24,6 @@ from app.reports.plots import svg_text
 from app.reports.run_tables import run_tables
 from app.services.compare import Comparison
 from app.services.report import Report, RunView
-from app.services.runs import leaderboard_report
 from benchmark.errors import BenchmarkError
 
 TEMPLATES = Path(__file__).with_name("templates")
@@ -110,7 +109,7 @@ def _plan(plots: list[_Plot], caption: str, build: Callable[[], Figure]) -> _Plo
 def _title(report: Report) -> str:
     names = ", ".join(dict.fromkeys(view.run.dataset_name for view in report.views))
     runs = ", ".join(str(view.run.id) for view in report.views)
-    return f"touchbench report: run{'s' if len(report.views) > 1 else ''} {runs} ({names})"
+    return f"Report on run{'s' if len(report.views) > 1 else ''} {runs} ({names}) · touchbench"
 
 
 def comparison_context(comparison: Comparison) -> dict[str, Any]:
@@ -203,7 +202,7 @@ def _run(report: Report, view: RunView, plots: list[_Plot]) -> dict[str, Any]:
         "plots": run_plots,
         "confusions": confusions,
         "fold_note": ranked if isinstance(ranked, str) else None,
-        "tables": run_tables(leaderboard_report(run, board, view.results)),
+        "tables": run_tables(view.report()),
     }
 
 

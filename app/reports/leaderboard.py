@@ -1,5 +1,5 @@
 """Leaderboards as people and other tools read them: table rows, CSV and Markdown (the JSON
-report is :func:`app.services.runs.leaderboard_schema`)."""
+report is :meth:`app.services.runs.RunLeaderboard.report`)."""
 
 from __future__ import annotations
 

@@ -18,7 +18,7 @@ def write_results_arff(store: Store, run: RunInfo, stream: TextIO) -> None:
         what = "a regression" if run.kind == "regression" else "multi-target"
         raise ConfigurationError(
             f"run {run.id} is {what}; WEKA's results format holds multi-class runs "
-            "(use --format csv or json)"
+            "(the csv and json formats hold every kind)"
         )
     from app.services.tuning import run_specs
 

@@ -1,20 +1,21 @@
 """Runs and their leaderboards, as ``touchbench runs/bench/leaderboard --json`` print them
-and the API answers them."""
+and the API answers them; and the request that starts a run (:class:`BenchRequest`)."""
 
 from __future__ import annotations
 
 from datetime import datetime
 from typing import Any, Literal
 
-from pydantic import Field
+from pydantic import Field, field_validator, model_validator
 
-from app.schemas.base import Schema
+from app.errors import FieldError
+from app.schemas.base import Request, Schema
 
 #: Where a run is in its life (the rules: :mod:`app.store.run_states`): ``queued`` (created,
 #: waiting for a worker), ``running``, ``cancelling`` (its process was asked to stop),
 #: ``done`` (every task has a result), ``failed`` (every task failed, or the run could not
 #: be carried out), ``cancelled`` (on request), ``interrupted`` (its process stopped: Ctrl-C,
-#: kill -9, a crash; ``--resume`` finishes it).
+#: kill -9, a crash; resuming it finishes it).
 RunStatus = Literal["queued", "running", "cancelling", "done", "failed", "cancelled", "interrupted"]
 RUN_STATUSES: tuple[RunStatus, ...] = (
     "queued",
@@ -136,9 +137,147 @@ class LeaderboardSchema(Schema):
     summary: MarkSummary
     leaderboard: list[LeaderboardRowSchema]
     tuning: list[TunedComparisonSchema] = Field(
-        default_factory=list, description="Tuned twins against their defaults (bench --tune)."
+        default_factory=list, description="Tuned twins against their defaults (a run with `tune`)."
     )
     choices: list[FoldChoiceSchema] = Field(
         default_factory=list,
-        description="What each tuned twin and stack chose per fold (bench --tune/--stack).",
+        description="What each tuned twin and stack chose per fold (`tune`, `stack`).",
     )
+
+
+#: The suites of classifiers a run may name instead of classifier ids.
+Suite = Literal["fast", "default", "all"]
+
+#: Largest memory cap of a task, in megabytes (1 TiB): finite, and a limit the OS can set.
+MAX_MEMORY_MB = 2**20
+#: Longest time limit of a task, in seconds (a week).
+MAX_TIMEOUT = 7 * 24 * 3600.0
+
+#: Fields that a benchmark of each target on its own (``independent``) cannot honour.
+_NOT_INDEPENDENT = {
+    "target": "benchmarks every target",
+    "weka": "runs the catalogue's multi-class classifiers on each target",
+    "position": "classifies each target on its own, with no coordinates",
+    "tune": "compares each target's plain classifiers",
+    "budget": "compares each target's plain classifiers",
+    "stack": "compares each target's plain classifiers",
+    "metric": "picks each target's best classifier by weighted F1",
+    "baseline": "picks each target's best classifier by weighted F1",
+}
+
+
+class BenchRequest(Request):
+    """A benchmark run: what to cross-validate, how, and what to add to the classifiers.
+
+    Every default, bound and rule across fields of a run is said here once; the rules
+    that need the data set (a regression takes no `tune`, `stack` or `weka`, a stack
+    needs one target, `independent` needs several nominal targets) are the service's
+    (:func:`app.services.runs.create_run`) and name their field too.
+    """
+
+    dataset: str = Field(min_length=1, description="Data set name or id.")
+    target: str | None = Field(
+        default=None,
+        min_length=1,
+        description="Benchmark this one target (the multi-class catalogue; regressors if "
+        "numeric); default: the data set's own targets.",
+    )
+    classifiers: list[str] | None = Field(
+        default=None, min_length=1, max_length=500, description="Classifier ids to run."
+    )
+    suite: Suite | None = Field(
+        default=None,
+        description="A suite of classifiers instead of `classifiers`; `default` when neither "
+        "is given (and no `weka`).",
+    )
+    weka: list[str] | None = Field(
+        default=None,
+        max_length=50,
+        description='WEKA command lines to run as well, e.g. "weka.classifiers.trees.J48 -C '
+        '0.1 -M 5" (J48, PART, NaiveBayes, IBk, ZeroR).',
+    )
+    position: list[str] | None = Field(
+        default=None,
+        min_length=2,
+        max_length=3,
+        description="2 or 3 numeric targets that are a position's coordinates: the run also "
+        "scores the mean Euclidean error.",
+    )
+    folds: int = Field(default=10, ge=2, le=100, description="k of k-fold cross-validation.")
+    repeats: int = Field(default=1, ge=1, le=100, description="Repeats of the whole k-fold.")
+    seed: int = Field(default=0, ge=0, le=2**31 - 1, description="Seed of folds and classifiers.")
+    timeout: float | None = Field(
+        default=600.0,
+        ge=0,
+        le=MAX_TIMEOUT,
+        description="Seconds one task may take before its worker is stopped; 0 or null: no limit.",
+    )
+    max_memory_mb: float | None = Field(
+        default=None,
+        ge=1,
+        le=MAX_MEMORY_MB,
+        description="Megabytes one task may allocate beyond its copy of the data; null: no limit.",
+    )
+    metric: str | None = Field(
+        default=None,
+        min_length=1,
+        max_length=100,
+        description="The metric the run's leaderboard ranks by; default: weighted F1, the "
+        "Hamming score (several targets) or the mean absolute error (numeric targets).",
+    )
+    baseline: str | None = Field(
+        default=None,
+        min_length=1,
+        max_length=200,
+        description="The classifier the leaderboard's t-test compares against (one of the "
+        "run's); default: the best.",
+    )
+    tune: bool = Field(
+        default=False,
+        description="Add a tuned twin (ID+tuned) of every classifier with a search space, "
+        "searched inside each outer training fold (nested cross-validation).",
+    )
+    budget: float | None = Field(
+        default=None,
+        gt=0,
+        le=1440,
+        description="With `tune`: wall minutes each tuned twin's search may plan for in one "
+        "outer fold; default: about 6 fits of the default setting.",
+    )
+    stack: int | None = Field(
+        default=None,
+        ge=1,
+        le=20,
+        description="Add stack-topN: in each outer training fold the run's N best "
+        "classifiers by inner cross-validation, stacked by logistic regression (one target).",
+    )
+    independent: bool = Field(
+        default=False,
+        description="Several targets: benchmark each target on its own with multi-class "
+        "classifiers, one run per target, carried out at once rather than queued.",
+    )
+
+    @field_validator("dataset", mode="before")
+    @classmethod
+    def _id_as_text(cls, value: Any) -> Any:
+        """A data set's numeric id is one of its names."""
+        if isinstance(value, int) and not isinstance(value, bool):
+            return str(value)
+        return value
+
+    @field_validator("timeout", mode="after")
+    @classmethod
+    def _zero_is_no_limit(cls, value: float | None) -> float | None:
+        return value or None
+
+    @model_validator(mode="after")
+    def _rules_across_fields(self) -> BenchRequest:
+        if self.independent:
+            for name, reason in _NOT_INDEPENDENT.items():
+                if getattr(self, name) not in (None, False):
+                    raise FieldError(name, f"is not used with `independent`, which {reason}")
+        if self.classifiers and self.suite:
+            raise FieldError("suite", "is not used with `classifiers`: give one or the other")
+        if self.budget is not None and not self.tune:
+            raise FieldError("budget", "is only meaningful with `tune`")
+        return self

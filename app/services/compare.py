@@ -142,7 +142,7 @@ def default_metric(kinds: Sequence[str]) -> str:
         return "mae"
     raise ConfigurationError(
         "the runs mix multi-class and multi-target problems, or classification and regression: "
-        "give --metric (one every run has)"
+        "name a metric every run has"
     )
 
 
@@ -285,8 +285,8 @@ def _check_enough(completed: CompletedTable, policy: str) -> None:
     cells = ", ".join(f"{m.classifier} on {m.block}" for m in completed.missing[:4])
     more = f" and {len(completed.missing) - 4} more" if len(completed.missing) > 4 else ""
     raise ConfigurationError(
-        f"with --missing {policy}, {table.shape[1]} classifier(s) on {table.shape[0]} block(s) "
-        f"remain (missing scores: {cells}{more}); try another --missing policy"
+        f"with the missing-score policy {policy}, {table.shape[1]} classifier(s) on "
+        f"{table.shape[0]} block(s) remain (missing scores: {cells}{more}); try another policy"
     )
 
 

@@ -12,10 +12,11 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from app.schemas.runs import BenchRequest
 from app.services.extraction import extract_dataset
 from app.services.live import TouchPrediction, open_live
 from app.services.models import Predictions, load_model, predict, train
-from app.services.runs import RunOptions, default_classifiers, run_leaderboard, start_run
+from app.services.runs import create_run, default_classifiers, execute_run, run_leaderboard
 from app.services.simulation import write_labels, write_session
 from app.store.database import Store
 from app.store.datasets import DatasetInfo, add_dataset, dataset_digest
@@ -79,10 +80,9 @@ def run_demo(
 
     classifiers = default_classifiers(len(dataset.targets), "fast")
     say(f"3. cross-validating {len(classifiers)} classifiers (every fold stored as it ends)")
-    run, _ = start_run(
-        store, str(dataset.id), classifiers, options=RunOptions(folds=folds), jobs=jobs
-    )
-    run, board = run_leaderboard(store, run.id)
+    request = BenchRequest(dataset=str(dataset.id), classifiers=classifiers, folds=folds)
+    run = execute_run(store, create_run(store, request).id, jobs=jobs)
+    board = run_leaderboard(store, run.id).board
 
     best = board.rows[0].classifier
     say(f"4. training {best} on every instance and predicting a session it never saw")

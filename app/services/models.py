@@ -76,7 +76,8 @@ def train_best(store: Store, run_id: int | str, *, name: str | None = None) -> M
     """Train the best classifier of a finished run on its whole data set and targets."""
     from app.services.runs import run_leaderboard
 
-    run, board = run_leaderboard(store, run_id)
+    ranked = run_leaderboard(store, run_id)
+    run, board = ranked.run, ranked.board
     if board.baseline is None:
         raise AppError(f"run {run.id} has no successful classifier to train")
     best = board.rows[0].classifier

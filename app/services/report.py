@@ -13,12 +13,16 @@ from importlib import metadata
 import numpy as np
 
 from app.services.compare import Comparison, compare_runs
-from app.services.runs import PerTargetSummary, per_target_summary, run_results
+from app.services.runs import (
+    PerTargetSummary,
+    RunLeaderboard,
+    per_target_summary,
+    run_leaderboard,
+)
 from app.store.database import Store
 from app.store.datasets import load_schema
 from app.store.runs import RunInfo
 from benchmark.errors import BenchmarkError, ConfigurationError
-from benchmark.evaluation.leaderboard import Leaderboard
 from benchmark.evaluation.score_table import MissingPolicy, ScoreTable, fold_score_table
 from benchmark.results import TaskResult
 
@@ -62,8 +66,8 @@ class Confusion:
 
 
 @dataclass(frozen=True)
-class RunView:
-    """One run as the plots and the report see it.
+class RunView(RunLeaderboard):
+    """One run as the plots and the report see it: its leaderboard and what they add.
 
     Attributes
     ----------
@@ -77,9 +81,6 @@ class RunView:
         order; ``None`` for multi-class runs.
     """
 
-    run: RunInfo
-    board: Leaderboard
-    results: list[TaskResult]
     labels: dict[str, list[str]]
     per_target: PerTargetSummary | None = None
 
@@ -177,7 +178,8 @@ def run_view(
 ) -> RunView:
     """A run with its leaderboard (marks against ``baseline``, default the best), results
     and class labels."""
-    run, results, board = run_results(store, run_ref, metric=metric, baseline=baseline)
+    ranked = run_leaderboard(store, run_ref, metric=metric, baseline=baseline)
+    run, board, results = ranked.run, ranked.board, ranked.results
     _, schema, _ = load_schema(store, run.dataset_id)
     labels = {}
     for target in run.targets:
@@ -222,7 +224,9 @@ def build_report(
     if not run_refs:
         raise ConfigurationError("give at least one run to report")
     if confusions < 0:
-        raise ConfigurationError(f"--confusions must be >= 0, got {confusions}")
+        raise ConfigurationError(
+            f"the number of confusion matrices must be at least 0, got {confusions}"
+        )
     views = []
     fold_ranks: dict[int, Comparison | str] = {}
     for ref in run_refs:

@@ -17,8 +17,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from app.errors import AppError
+from app.errors import AppError, FieldError
 from app.schemas.runs import (
+    BenchRequest,
     FoldChoiceSchema,
     LeaderboardRowSchema,
     LeaderboardSchema,
@@ -28,7 +29,7 @@ from app.schemas.runs import (
 )
 from app.services.tuning import run_specs
 from app.store.database import Store
-from app.store.datasets import find_dataset, load_dataset, load_schema
+from app.store.datasets import load_dataset, load_schema
 from app.store.ownership import process_owner
 from app.store.runs import (
     CANCEL_POLL,
@@ -60,25 +61,27 @@ if TYPE_CHECKING:  # scipy.stats (significance) loads when a leaderboard is firs
 DEFAULT_METRIC = {"multiclass": "f1_weighted", "multitarget": "hamming_score", "regression": "mae"}
 
 
-@dataclass
+@dataclass(frozen=True)
 class RunOptions:
-    """How to cross-validate: the same options a resumed run gets back from the store.
+    """How a run cross-validates, as its stored config says: what a resumed run gets back.
+
+    The defaults and bounds are the request's (:class:`app.schemas.runs.BenchRequest`).
 
     Attributes
     ----------
     folds, repeats, seed : int
         k of k-fold, repetitions of the whole partition, seed of folds and classifiers.
     timeout : float or None
-        Seconds one task may take before its worker process is killed.
+        Seconds one task may take before its worker process is killed; ``None``: no limit.
     max_memory_mb : float or None
         Megabytes one task may allocate beyond its worker's copy of the data.
     """
 
-    folds: int = 10
-    repeats: int = 1
-    seed: int = 0
-    timeout: float | None = 600.0
-    max_memory_mb: float | None = None
+    folds: int
+    repeats: int
+    seed: int
+    timeout: float | None
+    max_memory_mb: float | None
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -88,6 +91,16 @@ class RunOptions:
             "timeout": self.timeout,
             "max_memory_mb": self.max_memory_mb,
         }
+
+    @classmethod
+    def from_request(cls, request: BenchRequest) -> RunOptions:
+        return cls(
+            folds=request.folds,
+            repeats=request.repeats,
+            seed=request.seed,
+            timeout=request.timeout,
+            max_memory_mb=request.max_memory_mb,
+        )
 
     @classmethod
     def from_config(cls, config: dict[str, Any]) -> RunOptions:
@@ -139,7 +152,7 @@ def prepare_problem(
         Target attributes to predict; the data set's own targets by default (the others
         are left out, never used as features).
     position : sequence of str
-        2 or 3 numeric targets that are a position's coordinates (``--position x,y,z``).
+        2 or 3 numeric targets that are a position's coordinates.
     """
     if dataset.n_instances == 0:
         raise ConfigurationError(f"dataset '{dataset.name}' has no instances")
@@ -197,136 +210,180 @@ def check_classifiers(
     problem: Problem,
     classifiers: Sequence[str],
     extra_specs: Mapping[str, ClassifierSpec] | None = None,
+    *,
+    asked: Sequence[str] = (),
 ) -> None:
-    """Refuse, before a run exists, ids that are unknown or do not fit the problem."""
+    """Refuse, before a run exists, ids that are unknown or do not fit the problem.
+
+    Raises
+    ------
+    FieldError
+        For ``classifiers``: one of the ids the user asked for (``asked``) is refused.
+    ConfigurationError
+        No classifiers; an id the run added (a suite's, a twin) does not fit.
+    """
     from benchmark.estimators import check_classifier
 
     if not classifiers:
         raise ConfigurationError("no classifiers to run")
     for classifier in classifiers:
-        check_classifier(classifier, problem, extra_specs)
+        try:
+            check_classifier(classifier, problem, extra_specs)
+        except ConfigurationError as error:
+            if classifier in asked:
+                raise FieldError("classifiers", str(error)) from None
+            raise
 
 
 def weka_specs(commands: Sequence[str] | Mapping[str, str | None]) -> dict[str, ClassifierSpec]:
-    """The catalogue configurations of WEKA command lines, by id (a run's ``--weka``)."""
+    """The catalogue configurations of WEKA command lines, by id (a run's ``weka``).
+
+    Raises
+    ------
+    FieldError
+        For ``weka``: a command line the catalogue cannot compute.
+    """
     from benchmark.catalogue import parse_weka_command
 
     texts = commands.values() if isinstance(commands, Mapping) else commands
-    specs = [parse_weka_command(text) for text in texts if text]
+    try:
+        specs = [parse_weka_command(text) for text in texts if text]
+    except ConfigurationError as error:
+        raise FieldError("weka", str(error)) from None
     return {spec.id: spec for spec in specs}
 
 
+@dataclass(frozen=True)
+class _Plan:
+    """A checked run, ready to be stored: what :func:`create_run` stores."""
+
+    dataset_id: int
+    kind: str
+    targets: list[str]
+    classifiers: list[str]
+    config: dict[str, Any]
+    notes: list[str]
+
+
 def create_run(
-    store: Store,
-    dataset_ref: str,
-    classifiers: Sequence[str] | None = None,
-    *,
-    suite: str | None = None,
-    targets: Sequence[str] | None = None,
-    options: RunOptions | None = None,
-    on_warning: Callable[[str], None] | None = None,
-    weka: Sequence[str] = (),
-    position: Sequence[str] = (),
-    metric: str | None = None,
-    tune: bool = False,
-    budget: float | None = None,
-    stack: int | None = None,
+    store: Store, request: BenchRequest, *, on_warning: Callable[[str], None] | None = None
 ) -> RunInfo:
-    """Check a benchmark request and store it as a ``queued`` run.
+    """Check a benchmark request against its data set and store it as a ``queued`` run.
+
+    The command line carries the run out at once (:func:`execute_run`), the service's
+    workers later; a benchmark of each target on its own is :func:`independent_runs`.
 
     Parameters
     ----------
     store : Store
-    dataset_ref : str
-        Data set name or id.
-    classifiers : sequence of str, optional
-        Classifier ids; default: the suite's (``default`` unless ``suite`` says).
-    suite : str, optional
-        ``fast``, ``default`` or ``all``; not together with ``classifiers``.
-    targets : sequence of str, optional
-        Targets to classify (one: the multi-class catalogue); default the data set's own.
-    options : RunOptions, optional
+    request : BenchRequest
+        The run's data set, classifiers and protocol, checked on their own already.
     on_warning : callable, optional
         Hears adjustments made (fewer folds than asked, unstratified folds, ...).
-    weka : sequence of str
-        WEKA command lines (``"weka.classifiers.trees.J48 -C 0.1"``) to run as well, each
-        as the catalogue configuration that computes what WEKA computes.
-    position : sequence of str
-        2 or 3 numeric targets that are a position's coordinates: the run also scores the
-        mean Euclidean error.
-    metric : str, optional
-        The metric its leaderboard will be ranked by, checked against the kind of run.
 
     Raises
     ------
-    ConfigurationError, AppError
-        Anything that would make the run fail at once: unknown data set, target or
-        classifier, a target with one class, impossible folds, a position that is not
-        numeric targets, a metric of the other kind of problem.
+    FieldError
+        A field the data set refuses: a target it lacks, a metric of the other kind of
+        problem, ``tune``,
+        ``stack`` or ``weka`` on numeric targets, a stack on several targets, a baseline
+        that is not one of the run's classifiers, impossible folds, ``independent``.
+    NotFoundError
+        An unknown data set.
+    ConfigurationError
+        Anything else that would make the run fail at once: a target with one class, a
+        position that is not numeric targets.
     """
-    if classifiers and suite:
-        raise ConfigurationError("give classifiers or a suite, not both")
-    options = options or RunOptions()
-    _check_options(options)
-    commands = weka_specs(weka)
-    info = find_dataset(store, dataset_ref)
+    if request.independent:
+        raise FieldError(
+            "independent",
+            "asks for one run per target, carried out at once rather than queued: "
+            "queue a run per `target` instead",
+        )
+    return _store_plan(store, _plan_run(store, request), on_warning)
+
+
+def _plan_run(store: Store, request: BenchRequest) -> _Plan:
+    """Everything :func:`create_run` checks, and the run it would store."""
+    options = RunOptions.from_request(request)
+    commands = weka_specs(request.weka or ())
+    targets = [request.target] if request.target else None
+    position = list(request.position or ())
+    info, schema, _ = load_schema(store, request.dataset)
+    if request.target is not None:
+        try:
+            schema.index(request.target)
+        except ConfigurationError as error:
+            raise FieldError("target", str(error)) from None
     prepared = prepare_problem(load_dataset(store, info.id), targets, position)
     problem = prepared.problem
-    if metric is not None:
-        check_metric(problem.kind, metric, position=bool(position))
-    if commands and problem.kind == "regression":
-        raise ConfigurationError("--weka runs WEKA classifiers; the targets here are numeric")
-    ids = list(dict.fromkeys(classifiers or ()))
+    if request.metric is not None:
+        try:
+            check_metric(problem.kind, request.metric, position=bool(position))
+        except ConfigurationError as error:
+            raise FieldError("metric", str(error)) from None
+    numeric = problem.kind == "regression"
+    for name in ("weka", "tune", "stack"):
+        if numeric and getattr(request, name):
+            raise FieldError(name, "works on classification runs; the targets here are numeric")
+    ids = list(dict.fromkeys(request.classifiers or ()))
     if not ids and not commands:
         ids = default_classifiers(
             len(prepared.target_names),
-            suite or "default",
+            request.suite or "default",
             sequences=problem.sequence is not None,
-            regression_size=problem.n_instances if problem.kind == "regression" else None,
+            regression_size=problem.n_instances if numeric else None,
         )
     ids = list(dict.fromkeys([*ids, *commands]))
-    if budget is not None and not tune:
-        raise ConfigurationError("--budget bounds the tuning: give --tune as well")
-    if (tune or stack is not None) and problem.kind == "regression":
-        raise ConfigurationError(
-            "--tune and --stack work on classification runs; the targets here are numeric"
-        )
-    if tune:
+    tuning = _tuning_config(commands, request.tune, request.budget, request.stack)
+    if request.tune:
         from app.services.tuning import with_tuned_twins
 
-        ids = with_tuned_twins(ids, commands, budget)
-    if stack is not None:
+        ids = with_tuned_twins(ids, commands, request.budget)
+    if request.stack is not None:
         from app.services.tuning import add_stack
 
-        ids = add_stack(ids, stack, multitarget=problem.kind == "multitarget")
-    extra = run_specs(_tuning_config(commands, tune, budget, stack), ids)
-    check_classifiers(problem, ids, extra)
+        ids = add_stack(ids, request.stack, multitarget=problem.kind == "multitarget")
+    check_classifiers(problem, ids, run_specs(tuning, ids), asked=request.classifiers or ())
+    if request.baseline is not None and request.baseline not in ids:
+        raise FieldError(
+            "baseline",
+            f"'{request.baseline}' is not a classifier of this run (classifiers: {', '.join(ids)})",
+        )
     plan = _folds(prepared, options)
-    folds, fold_notes = plan.folds, plan.notes
-    effective = max(f.fold for f in folds) + 1
     config = {
         **options.to_json(),
-        "folds": effective,
+        "folds": max(f.fold for f in plan.folds) + 1,
         "folds_requested": options.folds,
-        "targets_given": list(targets) if targets else None,
-        "suite": None if classifiers or weka else (suite or "default"),
-        **_tuning_config(commands, tune, budget, stack),
-        "n_tasks": len(ids) * len(folds),
-        "n_instances": int(prepared.problem.X.shape[0]),
-        "grouped": prepared.problem.groups is not None,
+        "targets_given": targets,
+        "suite": None if request.classifiers or request.weka else (request.suite or "default"),
+        **tuning,
+        "n_tasks": len(ids) * len(plan.folds),
+        "n_instances": int(problem.X.shape[0]),
+        "grouped": problem.groups is not None,
         "fold_scheme": plan.scheme,
-        "position": list(position) or None,
+        "position": position or None,
+        "metric": request.metric,
+        "baseline": request.baseline,
     }
+    return _Plan(
+        info.id, problem.kind, prepared.target_names, ids, config, prepared.warnings + plan.notes
+    )
+
+
+def _store_plan(
+    store: Store, plan: _Plan, on_warning: Callable[[str], None] | None = None
+) -> RunInfo:
     run = store_run(
         store,
-        dataset_id=info.id,
-        kind=prepared.problem.kind,
-        targets=prepared.target_names,
-        classifiers=ids,
-        config=config,
+        dataset_id=plan.dataset_id,
+        kind=plan.kind,
+        targets=plan.targets,
+        classifiers=plan.classifiers,
+        config=plan.config,
     )
     if on_warning is not None:
-        for message in prepared.warnings + fold_notes:
+        for message in plan.notes:
             on_warning(message)
     return run
 
@@ -422,86 +479,115 @@ def execute_run(
     return get_run(store, run.id)
 
 
-def start_run(
-    store: Store,
-    dataset_ref: str,
-    classifiers: Sequence[str] | None = None,
-    *,
-    suite: str | None = None,
-    targets: Sequence[str] | None = None,
-    options: RunOptions | None = None,
-    jobs: int = 1,
-    scheduler: str | None = None,
-    callbacks: Callbacks | None = None,
-    weka: Sequence[str] = (),
-    position: Sequence[str] = (),
-) -> tuple[RunInfo, list[TaskResult]]:
-    """Create a run and carry it out at once (the CLI's ``bench``)."""
-    callbacks = callbacks or Callbacks()
-    run = create_run(
-        store,
-        dataset_ref,
-        classifiers,
-        suite=suite,
-        targets=targets,
-        options=options,
-        on_warning=callbacks.on_note,
-        weka=weka,
-        position=position,
-    )
-    run = execute_run(store, run.id, jobs=jobs, scheduler=scheduler, callbacks=callbacks)
-    return run, load_results(store, run.id)
+#: Why a run has no results yet, when it is under way.
+_UNDER_WAY = {
+    "queued": "it waits for a worker",
+    "running": "it is still running",
+    "cancelling": "it is being cancelled",
+}
 
 
-def resume_run(
-    store: Store,
-    run_id: int | str,
-    *,
-    jobs: int = 1,
-    scheduler: str | None = None,
-    callbacks: Callbacks | None = None,
-) -> tuple[RunInfo, list[TaskResult]]:
-    """Finish a run that was interrupted: only the tasks without a result are carried out."""
-    run = execute_run(store, run_id, jobs=jobs, scheduler=scheduler, callbacks=callbacks)
-    return run, load_results(store, run.id)
+class NoResultsError(ConfigurationError):
+    """A run without a stored result has no leaderboard yet.
+
+    Attributes
+    ----------
+    under_way : bool
+        The run is queued, running or being cancelled (resuming it would not help).
+    """
+
+    def __init__(self, run: RunInfo) -> None:
+        hint = _UNDER_WAY.get(run.status, f"it is {run.status}; resuming it carries it out")
+        super().__init__(f"run {run.id} has no results yet ({hint})")
+        self.run = run
+        self.under_way = run.status in _UNDER_WAY
+
+
+@dataclass(frozen=True)
+class RunLeaderboard:
+    """A run, its stored results and their leaderboard.
+
+    Attributes
+    ----------
+    run : RunInfo
+    board : Leaderboard
+        The run's classifiers ranked, with WEKA's marks against a baseline.
+    results : list of TaskResult
+        Every stored fold result of the run, read once.
+    """
+
+    run: RunInfo
+    board: Leaderboard
+    results: list[TaskResult]
+
+    def report(self) -> LeaderboardSchema:
+        """What ``leaderboard --json`` prints and the API serves: rows with their per-target
+        scores, tuned twins against their defaults, the choices per fold."""
+        from benchmark.evaluation.tuned import compare_tuned, fold_choices
+
+        run, board, results = self.run, self.board, self.results
+        per_target = per_target_summary(results)
+        data = board.to_json()
+        for row in data["leaderboard"]:
+            targets = per_target.get(row["classifier"])
+            if targets:
+                row["metrics"]["per_target"] = {
+                    target: {
+                        name: {"mean": mean, "std": std} for name, (mean, std) in scores.items()
+                    }
+                    for target, scores in targets.items()
+                }
+        return LeaderboardSchema(
+            run_id=run.id,
+            dataset=run.dataset_name,
+            kind=run.kind,
+            targets=run.targets,
+            status=run.status,
+            folds=run.fold_scheme,
+            metric=data["metric"],
+            lower_is_better=data["lower_is_better"],
+            baseline=data["baseline"],
+            summary=MarkSummary(**data["summary"]),
+            leaderboard=[LeaderboardRowSchema(**row) for row in data["leaderboard"]],
+            tuning=[
+                TunedComparisonSchema(**c.to_json())
+                for c in compare_tuned(results, metric=board.metric, alpha=board.alpha)
+            ],
+            choices=[FoldChoiceSchema(**c.to_json()) for c in fold_choices(results)],
+        )
 
 
 def run_leaderboard(
     store: Store, run_id: int | str, *, metric: str | None = None, baseline: str | None = None
-) -> tuple[RunInfo, Leaderboard]:
+) -> RunLeaderboard:
     """A run's leaderboard from its stored results.
+
+    Parameters
+    ----------
+    metric, baseline : str, optional
+        Rank by this metric, mark against this classifier; default: what the run was
+        asked to rank by, else its kind's metric and its best classifier.
 
     Raises
     ------
+    NoResultsError
+        The run has no result yet.
     ConfigurationError
-        The run has no result yet; an unknown metric or baseline.
+        A metric of the other kind of problem; an unknown metric or baseline.
     """
-    run, _, board = run_results(store, run_id, metric=metric, baseline=baseline)
-    return run, board
-
-
-def run_results(
-    store: Store, run_id: int | str, *, metric: str | None = None, baseline: str | None = None
-) -> tuple[RunInfo, list[TaskResult], Leaderboard]:
-    """A run, its stored results (read once) and its leaderboard, for callers that need
-    the results too; raises as :func:`run_leaderboard` does."""
     from benchmark.evaluation.leaderboard import build_leaderboard
 
     run = get_run(store, run_id)
     results = load_results(store, run.id)
     if not results:
-        hint = (
-            "it is still running"
-            if run.status == "running"
-            else f"it is {run.status}; `touchbench bench --resume {run.id}` carries it out"
-        )
-        raise ConfigurationError(f"run {run.id} has no results yet ({hint})")
+        raise NoResultsError(run)
     if metric is not None:
         check_metric(run.kind, metric, position=bool(run.config.get("position")), run_id=run.id)
+    metric = metric or run.config.get("metric") or DEFAULT_METRIC.get(run.kind, "f1_weighted")
     board = build_leaderboard(
-        results, metric=metric or DEFAULT_METRIC.get(run.kind, "f1_weighted"), baseline=baseline
+        results, metric=metric, baseline=baseline or run.config.get("baseline")
     )
-    return run, results, board
+    return RunLeaderboard(run, board, results)
 
 
 def check_metric(kind: str, metric: str, *, position: bool, run_id: int | None = None) -> None:
@@ -532,53 +618,9 @@ def check_metric(kind: str, metric: str, *, position: bool, run_id: int | None =
         )
     if metric == "euclidean_error" and not position:
         raise ConfigurationError(
-            f"'euclidean_error' needs coordinates: {run} was not given --position X,Y[,Z]"
+            f"'euclidean_error' needs coordinates: {run} has no position (2 or 3 numeric "
+            "targets that are coordinates)"
         )
-
-
-def leaderboard_schema(
-    store: Store, run_id: int | str, *, metric: str | None = None, baseline: str | None = None
-) -> tuple[RunInfo, Leaderboard, LeaderboardSchema]:
-    """A run's leaderboard, and the report ``leaderboard --json`` prints and the API serves
-    (multi-target rows carry ``metrics.per_target``)."""
-    run, results, board = run_results(store, run_id, metric=metric, baseline=baseline)
-    return run, board, leaderboard_report(run, board, results)
-
-
-def leaderboard_report(
-    run: RunInfo, board: Leaderboard, results: Sequence[TaskResult]
-) -> LeaderboardSchema:
-    """The report of a run's leaderboard ``board`` built from its ``results``: rows with
-    their per-target scores, tuned twins against their defaults, the choices per fold."""
-    from benchmark.evaluation.tuned import compare_tuned, fold_choices
-
-    per_target = per_target_summary(results)
-    data = board.to_json()
-    for row in data["leaderboard"]:
-        targets = per_target.get(row["classifier"])
-        if targets:
-            row["metrics"]["per_target"] = {
-                target: {name: {"mean": mean, "std": std} for name, (mean, std) in scores.items()}
-                for target, scores in targets.items()
-            }
-    return LeaderboardSchema(
-        run_id=run.id,
-        dataset=run.dataset_name,
-        kind=run.kind,
-        targets=run.targets,
-        status=run.status,
-        folds=run.fold_scheme,
-        metric=data["metric"],
-        lower_is_better=data["lower_is_better"],
-        baseline=data["baseline"],
-        summary=MarkSummary(**data["summary"]),
-        leaderboard=[LeaderboardRowSchema(**row) for row in data["leaderboard"]],
-        tuning=[
-            TunedComparisonSchema(**c.to_json())
-            for c in compare_tuned(results, metric=board.metric, alpha=board.alpha)
-        ],
-        choices=[FoldChoiceSchema(**c.to_json()) for c in fold_choices(results)],
-    )
 
 
 PerTargetSummary = dict[str, dict[str, dict[str, tuple[float, float]]]]
@@ -649,44 +691,49 @@ class IndependentResult:
 
 def independent_runs(
     store: Store,
-    dataset_ref: str,
-    classifiers: Sequence[str] | None = None,
+    request: BenchRequest,
     *,
-    suite: str | None = None,
-    options: RunOptions | None = None,
     jobs: int = 1,
     scheduler: str | None = None,
     callbacks: Callbacks | None = None,
 ) -> IndependentResult:
-    """A multi-class run per target of a multi-target data set, and the product of the
-    best scores (the comparison the UC3M paper makes with its multi-target results)."""
-    info, schema, _ = load_schema(store, dataset_ref)
+    """A multi-class run per target of a multi-target data set, carried out at once, and
+    the product of the best scores (the comparison the UC3M paper makes with its
+    multi-target results).
+
+    Every target's run is checked before the first one is stored.
+
+    Raises
+    ------
+    FieldError
+        For ``independent``: the data set has one target, or numeric ones.
+    """
+    callbacks = callbacks or Callbacks()
+    info, schema, _ = load_schema(store, request.dataset)
     numeric = [t.name for t in schema.targets if t.kind == "numeric"]
     if numeric:
-        raise ConfigurationError(
-            f"--independent compares targets classified separately, but "
-            f"{', '.join(numeric)} of '{info.name}' are numeric: a regression benchmarks its "
-            "targets together (drop --independent; br:ID fits one model per target)"
+        raise FieldError(
+            "independent",
+            f"compares targets classified separately, but {', '.join(numeric)} of "
+            f"'{info.name}' are numeric: a regression benchmarks its targets together "
+            "(br:ID fits one model per target)",
         )
     if len(info.targets) < 2:
-        raise ConfigurationError(
-            f"--independent compares targets classified separately, but '{info.name}' has one "
-            f"target ({', '.join(info.targets)})"
+        raise FieldError(
+            "independent",
+            f"compares targets classified separately, but '{info.name}' has one target "
+            f"({', '.join(info.targets)})",
         )
+    fields = request.model_dump(exclude={"independent", "target"}, exclude_defaults=True)
+    plans = {
+        target: _plan_run(store, BenchRequest(**fields, target=target)) for target in info.targets
+    }
     runs: dict[str, tuple[RunInfo, Leaderboard]] = {}
-    for target in info.targets:
-        run, _ = start_run(
-            store,
-            str(info.id),
-            classifiers,
-            suite=suite,
-            targets=[target],
-            options=options,
-            jobs=jobs,
-            scheduler=scheduler,
-            callbacks=callbacks,
-        )
-        runs[target] = run_leaderboard(store, run.id)
+    for target, plan in plans.items():
+        run = _store_plan(store, plan, callbacks.on_note)
+        execute_run(store, run.id, jobs=jobs, scheduler=scheduler, callbacks=callbacks)
+        ranked = run_leaderboard(store, run.id)
+        runs[target] = (ranked.run, ranked.board)
     product = {}
     for name in ("accuracy", "f1_weighted"):
         value = 1.0
@@ -761,21 +808,6 @@ def _tuning_config(
     }
 
 
-def _check_options(options: RunOptions) -> None:
-    if options.folds < 2:
-        raise ConfigurationError(f"folds must be at least 2, got {options.folds}")
-    if options.repeats < 1:
-        raise ConfigurationError(f"repeats must be at least 1, got {options.repeats}")
-    if options.timeout is not None and not options.timeout > 0:
-        raise ConfigurationError(
-            f"timeout must be a positive number of seconds, got {options.timeout}"
-        )
-    if options.max_memory_mb is not None and not options.max_memory_mb > 0:
-        raise ConfigurationError(
-            f"max_memory must be a positive number of megabytes, got {options.max_memory_mb}"
-        )
-
-
 def _bytes(megabytes: float | None) -> int | None:
     return None if megabytes is None else int(megabytes * 2**20)
 
@@ -794,4 +826,4 @@ def _folds(prepared: PreparedProblem, options: RunOptions) -> FoldPlan:
             regression=prepared.problem.kind == "regression",
         )
     except ValueError as error:  # scikit-learn's splitters on data too small to split
-        raise ConfigurationError(f"cannot make {options.folds} folds: {error}") from None
+        raise FieldError("folds", f"cannot make {options.folds} folds: {error}") from None

@@ -1,4 +1,4 @@
-"""A run's tuned twins (``bench --tune``) and stack (``bench --stack``): which ids they add,
+"""A run's tuned twins (its request's ``tune``) and stack (``stack``): which ids they add,
 and the specs the engine needs to build them again from the run's stored config.
 """
 
@@ -7,7 +7,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
-from benchmark.errors import ConfigurationError
+from app.errors import FieldError
 
 if TYPE_CHECKING:
     from benchmark.catalogue import ClassifierSpec
@@ -22,8 +22,10 @@ def with_tuned_twins(
 
     Raises
     ------
+    FieldError
+        For ``tune``: no id of the run declares a search space.
     ConfigurationError
-        No id of the run declares a search space; a budget out of range.
+        A search space that its estimator refuses; a budget out of the engine's range.
     """
     from benchmark.catalogue import SEARCH_SPACES
     from benchmark.catalogue.tuning import check_budget, is_tuned_id, tuned_id, tuned_spec
@@ -43,9 +45,10 @@ def with_tuned_twins(
             tuned_spec(spec, budget_minutes)  # a space its estimator refuses fails here
             out.append(f"{meta}:{tuned_id(base)}" if meta else tuned_id(base))
     if len(out) == len(ids):
-        raise ConfigurationError(
-            "--tune: no classifier of this run declares a search space (those that do: "
-            f"{', '.join(SEARCH_SPACES)})"
+        raise FieldError(
+            "tune",
+            "no classifier of this run declares a search space (those that do: "
+            f"{', '.join(SEARCH_SPACES)})",
         )
     return list(dict.fromkeys(out))
 
@@ -91,14 +94,17 @@ def add_stack(ids: Sequence[str], top_n: int, *, multitarget: bool) -> list[str]
 
     Raises
     ------
-    ConfigurationError
-        A multi-target run, or ``top_n`` out of range.
+    FieldError
+        For ``stack``: a multi-target run, or more members than the run has classifiers.
     """
     from benchmark.catalogue.stacking import check_top_n, stack_id
 
     if multitarget:
-        raise ConfigurationError(
-            "--stack stacks multi-class classifiers: pick one target with --target NAME"
+        raise FieldError("stack", "stacks multi-class classifiers: pick one `target`")
+    if top_n > len(ids):
+        raise FieldError(
+            "stack",
+            f"needs at least {top_n} classifiers in the run to choose from; the run has {len(ids)}",
         )
-    check_top_n(top_n, len(ids))
+    check_top_n(top_n, len(ids))  # the engine's own bounds, which the request's keep
     return [*ids, stack_id(top_n)]

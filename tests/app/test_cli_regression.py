@@ -93,8 +93,9 @@ def test_classification_leaderboards_name_their_folds_and_refuse_regression_metr
         (("-c", "ridge", "--position", "x,mic"), "'mic' in `position` is not a target"),
         (("-c", "ridge", "--metric", "euclidean_error"), "'euclidean_error' needs coordinates"),
         (("--independent",), "a regression benchmarks its targets together"),
-        (("-c", "rf", "--tune"), "--tune and --stack work on classification runs"),
-        (("-c", "rf,ridge", "--stack", "2"), "--tune and --stack work on classification runs"),
+        (("-c", "rf", "--tune"), "--tune: works on classification runs"),
+        (("-c", "rf,ridge", "--stack", "2"), "--stack: works on classification runs"),
+        (("--weka", "J48"), "--weka: works on classification runs"),
     ],
 )
 def test_what_does_not_fit_a_regression_is_refused_in_one_line(

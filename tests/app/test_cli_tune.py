@@ -84,11 +84,12 @@ def test_a_stack_records_the_members_each_fold_chose(
 @pytest.mark.parametrize(
     ("extra", "words"),
     [
-        (["--tune", "--budget", "0"], "`budget` must be more than 0"),
-        (["--tune", "--budget", "2000"], "at most 1440"),
-        (["--budget", "1"], "give --tune as well"),
-        (["--stack", "0"], "`stack` must be between 1 and 20"),
-        (["--stack", "3"], "needs at least 3 classifiers"),
+        (["--tune", "--budget", "0"], "--budget: Input should be greater than 0"),
+        (["--tune", "--budget", "2000"], "--budget: Input should be less than or equal to 1440"),
+        (["--budget", "1"], "--budget: is only meaningful with --tune"),
+        (["--stack", "0"], "--stack: Input should be greater than or equal to 1"),
+        (["--stack", "21"], "--stack: Input should be less than or equal to 20"),
+        (["--stack", "3"], "--stack: needs at least 3 classifiers"),
     ],
 )
 def test_budgets_and_stacks_out_of_range_exit_2_in_one_line(
@@ -105,9 +106,13 @@ def test_a_stack_on_several_targets_and_a_tune_without_space_exit_2(
     capsys: pytest.CaptureFixture[str], db: str
 ) -> None:
     stack = run_cli(capsys, db, "bench", "touch", "-c", "cr:logistic,cr:nb", "--stack", "1")
-    assert stack.code == 2 and "--target" in stack.err
+    assert (
+        stack.code == 2
+        and "--stack: stacks multi-class classifiers: pick one --target" in stack.err
+    )
     tune = run_cli(capsys, db, "bench", "touch", "--target", "gesture", "-c", "nb", "--tune")
-    assert tune.code == 2 and "no classifier of this run declares a search space" in tune.err
+    assert tune.code == 2
+    assert "--tune: no classifier of this run declares a search space" in tune.err
 
 
 def test_a_space_parameter_the_estimator_lacks_exits_2(

@@ -6,75 +6,19 @@ from typing import Annotated, Literal
 
 from fastapi import APIRouter, Query, status
 from fastapi.responses import PlainTextResponse
-from pydantic import Field
 
 from app.api.deps import ServiceDep, StoreDep
-from app.schemas.base import Schema
-from app.schemas.runs import LeaderboardSchema, RunCreated, RunList, RunSchema
-from app.services.runs import RunOptions, create_run, leaderboard_schema
+from app.schemas.runs import BenchRequest, LeaderboardSchema, RunCreated, RunList, RunSchema
+from app.services.runs import create_run, run_leaderboard
 from app.store.runs import get_run, list_runs, request_cancel, requeue_run
 
 router = APIRouter(prefix="/api/runs", tags=["runs"])
 
 
-class RunRequest(Schema):
-    """What to cross-validate: a data set, its target(s), classifiers or a suite, protocol."""
-
-    dataset: str | int = Field(description="Data set name or id.")
-    target: str | None = Field(
-        default=None, description="One target for the multi-class catalogue."
-    )
-    classifiers: list[str] | None = Field(default=None, min_length=1, max_length=500)
-    weka: list[str] | None = Field(
-        default=None,
-        max_length=50,
-        description='WEKA command lines, e.g. "weka.classifiers.trees.J48 -C 0.1 -M 5".',
-    )
-    suite: Literal["fast", "default", "all"] | None = None
-    position: list[str] | None = Field(
-        default=None,
-        min_length=2,
-        max_length=3,
-        description="Numeric targets that are a position's coordinates (mean Euclidean error).",
-    )
-    folds: int = Field(default=10, ge=2, le=100)
-    repeats: int = Field(default=1, ge=1, le=100)
-    seed: int = Field(default=0, ge=0, le=2**31 - 1)
-    timeout: float | None = Field(default=600.0, gt=0, le=7 * 24 * 3600)
-    max_memory_mb: float | None = Field(default=None, gt=0)
-    tune: bool = Field(
-        default=False, description="Add tuned twins (ID+tuned), searched inside each fold."
-    )
-    budget: float | None = Field(
-        default=None, description="With tune: minutes per tuned twin and outer fold."
-    )
-    stack: int | None = Field(
-        default=None, description="Add stack-topN over the run's N best by inner CV."
-    )
-
-
 @router.post("", status_code=status.HTTP_202_ACCEPTED, response_model=RunCreated)
-def start_run(body: RunRequest, service: ServiceDep) -> RunCreated:
+def start_run(body: BenchRequest, service: ServiceDep) -> RunCreated:
     """Check the request, queue the run and answer at once; a worker process carries it out."""
-    run = create_run(
-        service.store,
-        str(body.dataset),
-        body.classifiers,
-        suite=body.suite,
-        targets=[body.target] if body.target else None,
-        options=RunOptions(
-            folds=body.folds,
-            repeats=body.repeats,
-            seed=body.seed,
-            timeout=body.timeout,
-            max_memory_mb=body.max_memory_mb,
-        ),
-        weka=body.weka or (),
-        position=body.position or (),
-        tune=body.tune,
-        budget=body.budget,
-        stack=body.stack,
-    )
+    run = create_run(service.store, body)
     service.dispatcher.wake()
     return RunCreated(id=run.id, status=run.status)
 
@@ -126,9 +70,10 @@ def leaderboard(
 ) -> LeaderboardSchema | PlainTextResponse:
     """The run's classifiers ranked by ``metric`` with WEKA's marks against ``baseline``
     (JSON: the same rows as ``touchbench leaderboard --json``)."""
-    run, board, report = leaderboard_schema(store, run_id, metric=metric, baseline=baseline)
+    ranked = run_leaderboard(store, run_id, metric=metric, baseline=baseline)
+    run, board = ranked.run, ranked.board
     if format == "json":
-        return report
+        return ranked.report()
     from app.reports.leaderboard import leaderboard_csv, leaderboard_markdown, metric_columns
 
     columns = metric_columns(run, board)

@@ -14,12 +14,11 @@ from app.errors import NotFoundError
 from app.reports.run_tables import run_tables
 from app.schemas.runs import FINAL_STATUSES
 from app.services.datasets import list_datasets
-from app.services.runs import leaderboard_schema
+from app.services.runs import NoResultsError, run_leaderboard
 from app.store.runs import RunInfo, get_run, list_runs
 from app.web.deps import StoreDep
 from app.web.rendering import draw, render
 from app.web.routes.pages import Ref
-from benchmark.errors import ConfigurationError
 
 # The plots and the statistics (matplotlib, scipy) load with the first fragment that needs
 # them, so that the service starts at once.
@@ -75,20 +74,15 @@ def leaderboard(
 ) -> HTMLResponse:
     """The run's classifiers ranked by ``metric`` with WEKA's marks against ``baseline``."""
     try:
-        run, board, report = leaderboard_schema(
-            store, run_id, metric=metric or None, baseline=baseline or None
-        )
-    except ConfigurationError:
-        run = get_run(store, run_id)
-        if run.n_results:
-            raise  # an unknown metric or baseline
-        return render("fragments/leaderboard.html.j2", run=run, board=None)
+        ranked = run_leaderboard(store, run_id, metric=metric or None, baseline=baseline or None)
+    except NoResultsError as missing:
+        return render("fragments/leaderboard.html.j2", run=missing.run, board=None)
     return render(
         "fragments/leaderboard.html.j2",
-        run=run,
-        board=board,
-        table=_table(run, board, chosen_baseline=baseline or None),
-        tables=run_tables(report),
+        run=ranked.run,
+        board=ranked.board,
+        table=_table(ranked.run, ranked.board, chosen_baseline=baseline or None),
+        tables=run_tables(ranked.report()),
     )
 
 

@@ -198,7 +198,11 @@ def test_a_tuned_and_stacked_run_over_http_is_the_clis(
     assert {c["classifier"] for c in board["choices"]} == {"logistic+tuned", "stack-top2"}
     cli_board = run_cli(capsys, server.database_url, "leaderboard", str(run["id"]), "--json")
     assert board == cli_board.json()
-    for bad, message in (({"budget": 0.01, "tune": False}, "--tune"), ({"stack": 0}, "stack")):
+    for bad, where, message in (
+        ({"budget": 0.01, "tune": False}, "body.budget", "is only meaningful with `tune`"),
+        ({"stack": 0}, "body.stack", "greater than or equal to 1"),
+    ):
         refused = api.post("/api/runs", json={**request, **bad})
-        assert refused.status_code in (400, 422), refused.text
-        assert message in str(refused.json()["error"]), refused.text
+        assert refused.status_code == 422, refused.text
+        error = refused.json()["error"]
+        assert error["where"] == where and message in error["message"], refused.text

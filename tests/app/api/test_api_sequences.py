@@ -24,8 +24,9 @@ def test_sequence_classifiers_on_flat_data_are_refused_with_400(
     model = api.post(
         "/api/models", json={"dataset": "touch", "classifier": "multirocket", "target": "gesture"}
     )
+    assert run.status_code == 422 and run.json()["error"]["where"] == "body.classifiers", run.text
+    assert model.status_code == 400, model.text
     for response, classifier in ((run, "minirocket"), (model, "multirocket")):
-        assert response.status_code == 400, response.text
         message = response.json()["error"]["message"]
         assert message.startswith(f"classifier '{classifier}' needs a sequence data set")
     assert api.get("/api/runs").json()["runs"] == []

@@ -17,8 +17,9 @@ import pytest
 
 from app.jobs import dispatcher as dispatching
 from app.jobs.dispatcher import Dispatcher, dispatch_address
+from app.schemas.runs import BenchRequest
 from app.services.datasets import import_file
-from app.services.runs import RunOptions, create_run
+from app.services.runs import create_run
 from app.settings import Settings
 from app.store.database import Store
 from app.store.runs import get_run
@@ -84,14 +85,14 @@ def test_the_leader_hears_a_wake_from_another_process_and_is_replaced_when_it_st
         time.sleep(0.01)
     second.start()
     try:
-        options = RunOptions(folds=2)
-        run = create_run(sqlite_store, "touch", ["nb"], targets=["gesture"], options=options)
+        request = BenchRequest(dataset="touch", classifiers=["nb"], target="gesture", folds=2)
+        run = create_run(sqlite_store, request)
         second.wake()
         _wait_done(sqlite_store, run.id)
         assert not second.leading
 
         first.stop()
-        later = create_run(sqlite_store, "touch", ["nb"], targets=["gesture"], options=options)
+        later = create_run(sqlite_store, request)
         second.wake()
         _wait_done(sqlite_store, later.id)
         assert second.leading
@@ -143,8 +144,8 @@ def test_an_address_held_by_another_user_does_not_stop_dispatching(
     try:
         assert squatter.stdout is not None and squatter.stdout.readline().strip() == "bound"
         dispatcher.start()
-        options = RunOptions(folds=2)
-        run = create_run(sqlite_store, "touch", ["nb"], targets=["gesture"], options=options)
+        request = BenchRequest(dataset="touch", classifiers=["nb"], target="gesture", folds=2)
+        run = create_run(sqlite_store, request)
         dispatcher.wake()
         _wait_done(sqlite_store, run.id)
         assert not dispatcher.leading  # the squatter still holds the address

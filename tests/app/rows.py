@@ -1,0 +1,15 @@
+"""Reading a store's tables directly, as a test checks what a refusal left behind."""
+
+from __future__ import annotations
+
+from sqlalchemy import create_engine, text
+
+
+def count_rows(url: str, table: str) -> int:
+    """Rows of ``table`` in the store at ``url`` (SQLite or PostgreSQL)."""
+    engine = create_engine(url.replace("postgresql://", "postgresql+psycopg://", 1))
+    try:
+        with engine.connect() as connection:
+            return int(connection.execute(text(f"SELECT count(*) FROM {table}")).scalar_one())
+    finally:
+        engine.dispose()
