@@ -168,8 +168,16 @@ async def require_api_key(
         service.settings,
         x_api_key,
         needed_role(request.method, template),
-        action=f"{request.method} {request.url.path}",
+        action=action_of(request),
     )
+
+
+def action_of(request: Request) -> str:
+    """``METHOD path`` for the log, with the path as sent (still percent-encoded, so that a
+    name holding a line break cannot forge a line of the log)."""
+    raw = request.scope.get("raw_path")
+    path = raw.decode("latin-1") if isinstance(raw, bytes) else request.url.path
+    return f"{request.method} {path}"
 
 
 #: Routes a ``predict`` key may call besides every GET: predictions and uploads (the live

@@ -25,7 +25,13 @@ from pydantic import BaseModel, ValidationError
 from starlette.requests import Request
 from starlette.responses import Response
 
-from app.api.deps import check_api_key, get_service, needed_role, require_api_key
+from app.api.deps import (
+    action_of,
+    check_api_key,
+    get_service,
+    needed_role,
+    require_api_key,
+)
 
 #: The dependencies a direct route knows how to provide.
 _SUPPORTED = {get_service, require_api_key}
@@ -63,7 +69,7 @@ class DirectRoute(APIRoute):
                 service.settings,
                 request.headers.get("x-api-key"),
                 needed_role(request.method, template),
-                action=f"{request.method} {request.url.path}",
+                action=action_of(request),
             )
             arguments: dict[str, Any] = {name: request.path_params[name] for name in plan.path}
             arguments[plan.body] = await _body(request, plan.model)

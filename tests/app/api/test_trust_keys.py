@@ -218,11 +218,14 @@ def test_without_keys_changes_are_logged_as_keyless(
 ) -> None:
     server = make_sqlite_server(arguments=("--log-level", "info"))
     assert server.client.delete("/api/datasets/none").status_code == 404
+    forged = "/api/datasets/x%0AINFO%3A%20%20%20%20%20DELETE%20everything%20by%20key%20lab"
+    assert server.client.delete(forged).status_code == 404
     server.stop()
     assert server.log is not None
-    assert (
-        "DELETE /api/datasets/none by key (none: the service has no key)" in server.log.read_text()
-    )
+    log = server.log.read_text()
+    assert "DELETE /api/datasets/none by key (none: the service has no key)" in log
+    assert f"DELETE {forged} by key (none" in log  # as sent: no line of its own
+    assert "\nINFO:     DELETE everything by key lab" not in log
 
 
 def test_every_route_a_predict_key_may_change_exists_and_lets_it_in(tmp_path: Path) -> None:
