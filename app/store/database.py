@@ -79,8 +79,8 @@ class Store:
             shown = ", ".join(tables[:5]) + (f", ... ({len(tables)})" if len(tables) > 5 else "")
             raise AppError(
                 f"{self.engine.url.render_as_string()} holds another application's tables "
-                f"({shown}) and no touchbench store; touchbench will not write into it: give "
-                "--db a new file or an empty database"
+                f"({shown}) and no touchbench store; touchbench will not write into it: choose "
+                "a new file or an empty database for the store"
             )
 
     def revision(self) -> str | None:
@@ -198,7 +198,7 @@ def _check_sqlite_file(path: Path, url: str) -> None:
         shown = ", ".join(sorted(tables)[:5])
         raise AppError(
             f"{path} is another application's SQLite database (tables: {shown}); touchbench "
-            "will not write into it: give --db a new file"
+            "will not write into it: choose a new file for the store"
         )
 
 
