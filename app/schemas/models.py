@@ -98,12 +98,13 @@ class TrainRequest(Request):
         """A data set and a classifier, or a run (whose data set, targets and seed are its
         own): what is missing or would be ignored is refused, naming the field."""
         if self.run is not None:
-            for other in ("dataset", "classifier", "target", "seed"):
-                if other in self.model_fields_set:
+            given = {"dataset": self.dataset, "classifier": self.classifier, "target": self.target}
+            for other, value in {**given, "seed": self.seed or None}.items():
+                if value is not None:
                     raise FieldError(
                         other,
-                        "is not taken with `run`: a run's best classifier is trained "
-                        "on the run's own data set, targets and seed",
+                        "is not taken with `run`: a run's best classifier is trained on the "
+                        "run's own data set, targets and seed",
                     )
             return self
         if self.dataset is None:

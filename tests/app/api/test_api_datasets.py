@@ -118,7 +118,8 @@ def test_a_recording_session_upload_becomes_a_data_set(server: Server, tmp_path:
         files=[("recordings", ("x.wav", b"x"))],
         data={"extractor": "nope"},
     )
-    assert unknown.status_code == 400 and "unknown extractor 'nope'" in unknown.text
+    assert unknown.status_code == 422 and "unknown extractor 'nope'" in unknown.text
+    assert unknown.json()["error"]["where"] == "body.extractor"
 
 
 def test_uploads_over_the_limit_are_refused_while_streaming(
