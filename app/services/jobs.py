@@ -8,6 +8,7 @@ and calls :func:`execute_job` or :func:`app.services.runs.execute_run`.
 
 from __future__ import annotations
 
+import os
 import shutil
 import socket
 from typing import Any
@@ -109,18 +110,27 @@ def execute_job(store: Store, job_id: int) -> JobSchema | None:
     try:
         result = _carry_out(store, job_request(job))
     except USER_ERRORS as error:
-        finish_job(store, job.id, "failed", error=str(error))
+        finish_job(store, job.id, "failed", error=_client_words(str(error), folder))
     except KeyboardInterrupt:
         finish_job(store, job.id, "interrupted", error="interrupted")
         raise
     except Exception as error:
-        finish_job(store, job.id, "failed", error=f"unexpected {type(error).__name__}: {error}")
+        message = f"unexpected {type(error).__name__}: {error}"
+        finish_job(store, job.id, "failed", error=_client_words(message, folder))
     else:
         finish_job(store, job.id, "done", result=result)
     finally:
         if folder:
             shutil.rmtree(folder, ignore_errors=True)
     return get_job(store, job.id)
+
+
+def _client_words(message: str, folder: str | None) -> str:
+    """``message`` with the upload folder left out of its paths: the client knows its files
+    by their names, and the service's folders are not its business."""
+    if not folder:
+        return message
+    return message.replace(folder.rstrip(os.sep) + os.sep, "").replace(folder, "the upload")
 
 
 def _carry_out(store: Store, request: Request) -> dict[str, Any]:
