@@ -35,6 +35,12 @@ class JobSchema(Schema):
     started_at: datetime | None = None
     finished_at: datetime | None = None
 
+    def for_client(self) -> JobSchema:
+        """The job as the API shows it: without the service's own folder of an upload (the
+        client knows its files by their names)."""
+        params = {key: value for key, value in self.params.items() if key != "folder"}
+        return self.model_copy(update={"params": params})
+
 
 class JobList(Schema):
     jobs: list[JobSchema]

@@ -74,7 +74,11 @@ def job_request(job: JobSchema) -> Request:
     try:
         return JOB_REQUESTS[job.kind].model_validate(params)
     except ValidationError as error:
-        raise AppError(f"job {job.id} does not hold a valid {job.kind} request: {error}") from None
+        problem = error.errors(include_url=False)[0]
+        where = ".".join(str(part) for part in problem["loc"]) or "request"
+        raise AppError(
+            f"job {job.id} does not hold a valid {job.kind} request ({where}: {problem['msg']})"
+        ) from None
 
 
 def requeue_run(store: Store, run_id: int | str) -> RunInfo:

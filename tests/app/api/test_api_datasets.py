@@ -101,6 +101,9 @@ def test_a_recording_session_upload_becomes_a_data_set(server: Server, tmp_path:
     job = server.wait_for(f"/api/jobs/{response.json()['job']}", finished)
     assert job["status"] == "done", job
     assert job["result"]["name"] == "robot-session" and job["result"]["n_instances"] >= 10
+    assert job["params"]["recordings"] == [p.name for p in recordings]
+    assert (job["params"]["labels"], job["params"]["extractor"]) == ("labels.csv", "uc3m-audio")
+    assert str(server.work_dir) not in response.text + str(server.client.get("/api/jobs").json())
     described = server.client.get("/api/datasets/robot-session").json()
     assert described["targets"] == ["gesture", "place"]
     assert not list((server.work_dir / "uploads").glob("*/*")), "the upload folder is left"
