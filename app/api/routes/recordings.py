@@ -11,8 +11,7 @@ from fastapi import APIRouter, File, Form, UploadFile, status
 
 from app.api.deps import ServiceDep
 from app.api.uploads import form_request, save_upload
-from app.errors import FieldError
-from app.schemas.extraction import MAX_RECORDINGS, ExtractRequest
+from app.schemas.extraction import DEFAULT_EXTRACTOR, ExtractRequest
 from app.schemas.jobs import JobCreated
 from app.services.jobs import submit_extraction
 
@@ -30,7 +29,7 @@ def upload_session(
         UploadFile | None,
         File(description="Labels CSV: file,start,end,TARGET... or file,TARGET..."),
     ] = None,
-    extractor: Annotated[str | None, Form(description="Default: uc3m-audio.")] = None,
+    extractor: Annotated[str | None, Form(description=f"Default: {DEFAULT_EXTRACTOR}.")] = None,
     events: Annotated[str | None, Form()] = None,
     name: Annotated[str | None, Form()] = None,
     samplerate: Annotated[float | None, Form()] = None,
@@ -39,13 +38,10 @@ def upload_session(
 ) -> JobCreated:
     """Save the session and queue its extraction (answer: the job's id, status 202).
 
-    Everything that can be refused without reading the recordings (the extractor, event
-    detection, the data set's name) is refused before anything is saved or queued.
+    Everything that can be refused without reading the recordings is refused before the job
+    exists: the extractor, event detection and bounds before anything is saved, the data
+    set's name before the job is queued (the saved files are then removed).
     """
-    if len(recordings) > MAX_RECORDINGS:
-        raise FieldError(
-            "recordings", f"at most {MAX_RECORDINGS} recordings per upload, got {len(recordings)}"
-        )
     fields = {
         "extractor": extractor,
         "events": events,
@@ -54,7 +50,8 @@ def upload_session(
         "segment": segment,
         "topic": topic,
     }
-    # Checked before a byte is saved, with the files' names as placeholders.
+    # Checked before a byte is saved (the files' names stand for them), so that a refused
+    # request leaves nothing on the disk.
     form_request(
         ExtractRequest,
         recordings=[r.filename or "recording" for r in recordings],
