@@ -113,8 +113,8 @@ def import_file(
     """
     path, name, targets = request.file, request.name, request.targets
     shown = request.source_name or path.name
-    if name is not None:
-        stored.check_dataset_name(store, name)
+    if name is not None:  # a name taken by the same content answers "already stored"
+        stored.valid_dataset_name(name)
     chosen = request.format or guess_format(Path(shown))
     notes: list[str] = []
     label = request.source_name or str(path)  # what messages call the file

@@ -29,6 +29,7 @@ from app.store.models import (
     save_model,
 )
 from app.store.naming import shorten
+from app.store.runs import RunInfo, get_run, load_results
 from benchmark.dataset import Attribute, Dataset, Schema
 from benchmark.errors import ConfigurationError, DataFormatError
 from benchmark.model import TrainedModel, dumps_model, fit_model, loads_model
@@ -85,13 +86,16 @@ def check_training(store: Store, request: TrainRequest) -> Training:
         classifier or one that cannot learn the targets (a multi-class classifier for
         several targets, or the reverse; a sequence classifier on flat features).
     """
-    from benchmark.estimators import check_classifier
+    from benchmark.estimators import check_classifier  # start-up time: the catalogue is big
 
     if request.name is not None:
         check_model_name(request.name)
         check_name_free(store, request.name)
+    targets: list[str] | None
     if request.run is not None:
-        run_id, dataset_id, classifier, targets, seed = _best_of_run(store, request.run)
+        run, classifier = _best_of_run(store, request.run)
+        run_id, dataset_id, seed = run.id, run.dataset_id, int(run.config.get("seed", 0))
+        targets = run.config.get("targets_given")
     else:
         assert request.dataset is not None and request.classifier is not None  # the request's rule
         run_id, classifier, seed = None, request.classifier, request.seed
@@ -131,30 +135,23 @@ def _check_learnable(problem: Problem, field: str) -> None:
             raise FieldError(field, f"target '{name}' has a single class: nothing to learn")
 
 
-def _best_of_run(store: Store, run_ref: int) -> tuple[int, int, str, list[str] | None, int]:
-    """A finished run's id, data set, best classifier, targets and seed.
+def _best_of_run(store: Store, run_ref: int) -> tuple[RunInfo, str]:
+    """A finished run and its best classifier.
 
     Raises
     ------
     ConflictError
         The run has no successful classifier (yet).
     """
-    from app.services.runs import run_leaderboard
-    from app.store.runs import get_run, load_results
+    from app.services.runs import run_leaderboard  # start-up time: the engine's imports
 
     run = get_run(store, run_ref)
     if not load_results(store, run.id):
         raise ConflictError(f"run {run.id} has no results yet (it is {run.status})")
     _, board = run_leaderboard(store, run.id)
-    if board.baseline is None or run.dataset_id is None:
+    if board.baseline is None:
         raise ConflictError(f"run {run.id} has no successful classifier to train")
-    return (
-        run.id,
-        run.dataset_id,
-        board.rows[0].classifier,
-        run.config.get("targets_given"),
-        int(run.config.get("seed", 0)),
-    )
+    return run, board.rows[0].classifier
 
 
 def load_model(store: Store, ref: str | int) -> tuple[ModelInfo, TrainedModel]:

@@ -271,20 +271,31 @@ def _insert_row(
     return row
 
 
-def check_dataset_name(store: Store, name: str) -> None:
-    """Refuse a name no new data set can take.
+def valid_dataset_name(name: str) -> str:
+    """``name`` if it can name a data set (see :func:`check_name`).
 
     Raises
     ------
     FieldError
-        For the request's ``name``: the rule it breaks (see :func:`check_name`).
+        For the request's ``name``: the rule it breaks.
+    """
+    try:
+        return check_name(name, kind="dataset")
+    except AppError as error:
+        raise FieldError("name", str(error)) from None
+
+
+def check_dataset_name(store: Store, name: str) -> None:
+    """Refuse a name no new data set can take: invalid, or another data set's.
+
+    Raises
+    ------
+    FieldError
+        For the request's ``name``: the rule it breaks.
     ConflictError
         Another data set has it.
     """
-    try:
-        check_name(name, kind="dataset")
-    except AppError as error:
-        raise FieldError("name", str(error)) from None
+    valid_dataset_name(name)
     with store.session() as session:
         _refuse_taken(session, name)
 

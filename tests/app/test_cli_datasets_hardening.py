@@ -68,6 +68,8 @@ def test_known_content_under_another_name_or_targets_is_refused_saying_how(
     again = run_cli(capsys, store_url, "import", str(path), "--json")
     assert again.code == 0 and again.json()["created"] is False
     assert again.json()["action"] == "already stored" and again.json()["id"] == first["id"]
+    named = run_cli(capsys, store_url, "import", str(path), "--name", "mini", "--json")
+    assert named.code == 0 and (named.json()["created"], named.json()["id"]) == (False, first["id"])
     renamed = run_cli(capsys, store_url, "import", str(path), "--name", "robot1")
     one_error_line(
         renamed, "already stored as dataset 1 'mini'", "renaming dataset 1 gives it that name"

@@ -11,7 +11,7 @@ from tests.app.cli_runner import run_cli
 from tests.app.synthetic import touch_arff
 
 
-def test_sequence_classifiers_on_flat_data_are_refused_with_400(
+def test_sequence_classifiers_on_flat_data_are_refused_with_4xx(
     capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path
 ) -> None:
     data = touch_arff(tmp_path / "t.arff", n=60)
@@ -24,9 +24,12 @@ def test_sequence_classifiers_on_flat_data_are_refused_with_400(
     model = api.post(
         "/api/models", json={"dataset": "touch", "classifier": "multirocket", "target": "gesture"}
     )
-    for response, classifier in ((run, "minirocket"), (model, "multirocket")):
-        assert response.status_code == 400, response.text
+    # The run is refused by the engine's check (400), the training by its request's
+    # `classifier` field (422, at body.classifier).
+    for response, classifier, status in ((run, "minirocket", 400), (model, "multirocket", 422)):
+        assert response.status_code == status, response.text
         message = response.json()["error"]["message"]
         assert message.startswith(f"classifier '{classifier}' needs a sequence data set")
+    assert model.json()["error"]["where"] == "body.classifier"
     assert api.get("/api/runs").json()["runs"] == []
     assert api.get("/api/models").json()["models"] == []
