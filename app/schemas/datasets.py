@@ -25,7 +25,7 @@ def parse_targets(text: str | None) -> int | list[str] | None:
 
 
 class ImportRequest(Request):
-    """``touchbench import`` and ``POST /api/datasets``: an ARFF or CSV file to a data set."""
+    """The CLI's ``import`` and ``POST /api/datasets``: an ARFF or CSV file to a data set."""
 
     file: Path = Field(description="The file to read.")
     name: str | None = Field(

@@ -26,7 +26,7 @@ OptionValue = str | float | int | bool | list[float] | list[list[float]]
 
 
 class ExtractRequest(Request):
-    """``touchbench extract`` and ``POST /api/datasets/recordings``: recordings and a labels
+    """The CLI's ``extract`` and ``POST /api/datasets/recordings``: recordings and a labels
     file to a stored data set.
 
     The extractor, event detection and their options are checked when the request is made

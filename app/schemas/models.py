@@ -77,11 +77,13 @@ class PredictRequest(Request):
 
 
 class TrainRequest(Request):
-    """``POST /api/models`` and ``touchbench train``: a classifier on a data set, or the best
+    """``POST /api/models`` and the CLI's ``train``: a classifier on a data set, or the best
     classifier of a finished run (``run``) on that run's data set and targets."""
 
     dataset: str | int | None = Field(default=None, description="Data set name or id.")
-    classifier: str | None = Field(default=None, max_length=200, description="Classifier id.")
+    classifier: str | None = Field(
+        default=None, min_length=1, max_length=200, description="Classifier id."
+    )
     target: str | None = Field(
         default=None, max_length=2000, description="Train for this one target only."
     )

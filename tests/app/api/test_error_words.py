@@ -34,18 +34,19 @@ def _cli_words() -> re.Pattern[str]:
 
 CLI_WORDS = _cli_words()
 
-#: Values that make a body plausible up to the field being spoiled, by field name.
+#: Values that make a body plausible up to the field being spoiled, by field name (no
+#: ``name``: a body that is accepted would take it, and hide the checks behind it after).
 PLAUSIBLE: dict[str, Any] = {
     "dataset": "touch",
     "classifier": "nb",
     "classifiers": ["nb"],
     "target": "gesture",
     "targets": ["gesture"],
-    "name": "fresh-name",
     "instances": [{"f0": 0.5, "f1": 0.1, "f2": 0.2, "f3": 0.3, "mic": "left"}],
 }
-#: Path parameters, by name: what the test's store holds.
-PATH_VALUES = {"dataset": "touch", "model_ref": "touch-nb"}
+#: Path parameters, by name: what the test's store holds (``spare`` is the data set that
+#: renames are tried on, renamed back after each that is accepted).
+PATH_VALUES = {"dataset": "spare", "model_ref": "touch-nb"}
 
 
 def _resolve(document: dict[str, Any], schema: dict[str, Any]) -> dict[str, Any]:
@@ -76,13 +77,14 @@ def _bad_values(kinds: set[str]) -> list[Any]:
     """Wrong types, numbers out of range, unknown names, for a property of ``kinds``."""
     values: list[Any] = [{"nested": "object"}]
     if "string" in kinds:
-        values += [123, "", "nope-unknown", "x" * 5000, "12", "touch", "touch-nb"]
+        values += [123, "", "nope-unknown", "x" * 5000, "12", "touch", "touch-nb", "minirocket"]
     if kinds & {"integer", "number"}:
         values += ["abc", -1, 0, 1.5, 2**40, 1e308, -1e308]
     if "boolean" in kinds:
         values += ["maybe", 2]
     if "array" in kinds:
-        values += ["not a list", [], [123], ["nope-unknown"], [{"nope": 1}], [[1, 2]]]
+        values += ["not a list", [], [123], ["nope-unknown"], ["minirocket"], [{"nope": 1}]]
+        values += [[[1, 2]]]
     if "object" in kinds:
         values += ["not an object", {"nope-unknown": 1}, {"": None}]
     return values
@@ -152,9 +154,11 @@ def _operations(document: dict[str, Any]) -> Iterator[tuple[str, str, str, dict[
 def _prepare(server: Server, tmp_path: Path) -> bytes:
     """A data set ``touch`` and a model ``touch-nb``, so that names resolve and bodies reach
     the rules behind the look-ups."""
-    path = touch_arff(tmp_path / "touch.arff", n=60)
-    with path.open("rb") as handle:
-        assert server.client.post("/api/datasets", files={"file": (path.name, handle)}).is_success
+    for name, seed in (("spare", 1), ("touch", 0)):
+        path = touch_arff(tmp_path / f"{name}.arff", n=60, seed=seed)
+        with path.open("rb") as handle:
+            sent = server.client.post("/api/datasets", files={"file": (path.name, handle)})
+            assert sent.status_code == 201, sent.text
     trained = server.client.post(
         "/api/models",
         json={"dataset": "touch", "classifier": "nb", "target": "gesture", "name": "touch-nb"},
@@ -209,6 +213,10 @@ def test_no_error_names_a_cli_flag_or_command(server: Server, tmp_path: Path) ->
         for request in requests:
             response = server.client.request(method.upper(), url, **request)
             sent += 1
+            if path.endswith("/rename") and response.is_success:
+                back = {"name": PATH_VALUES["dataset"]}
+                renamed = response.json()["name"]
+                assert server.client.post(f"/api/datasets/{renamed}/rename", json=back).is_success
             problem = _problem(response)
             if problem is not None:
                 shown = request.get("content") or request.get("data")
