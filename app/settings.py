@@ -9,7 +9,7 @@ from pathlib import Path
 from pydantic import Field, SecretStr
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
-DEFAULT_DATABASE_URL = "sqlite:///touchbench.db"
+from app.environment import DEFAULT_DATABASE_URL, ENV_PREFIX
 
 
 class Settings(BaseSettings):
@@ -41,7 +41,7 @@ class Settings(BaseSettings):
         Loaded models kept in memory per service process for predictions.
     """
 
-    model_config = SettingsConfigDict(env_prefix="TOUCHBENCH_", extra="ignore")
+    model_config = SettingsConfigDict(env_prefix=ENV_PREFIX, extra="ignore")
 
     database_url: str = DEFAULT_DATABASE_URL
     api_key: SecretStr | None = None

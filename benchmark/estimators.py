@@ -116,8 +116,8 @@ def check_classifier(
     if problem.kind == "multitarget":
         raise ConfigurationError(
             f"'{classifier_id}' is a multi-class classifier and the data set has "
-            f"{len(problem.target_names)} targets ({names}): use --target NAME for one "
-            f"target, or a multi-target configuration such as bcc:{classifier_id}"
+            f"{len(problem.target_names)} targets ({names}): choose one of them as `target`, "
+            f"or a multi-target configuration such as bcc:{classifier_id}"
         )
     return spec
 

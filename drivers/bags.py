@@ -104,7 +104,7 @@ class RosbagSource(Source):
             if len(topics) > 1:
                 raise DriverError(
                     f"{self.name}: several audio topics ({', '.join(topics)}); choose one "
-                    "with --topic"
+                    "as `topic`"
                 )
             topic = topics[0]
         chosen = [c for c in connections if c.topic == topic]

@@ -64,10 +64,13 @@ def read_recording(path: str | Path, *, samplerate: float | None = None) -> Reco
     else:
         samples, rate = _read_audio(path, samplerate)
     if rate is None:
-        raise DriverError(
-            f"{path}: no sample rate: give samplerate= (--samplerate) for a file without one"
-        )
+        raise no_sample_rate(path)
     return _finish(samples, rate, path)
+
+
+def no_sample_rate(path: str | Path) -> DriverError:
+    """The error for a file that does not say its sample rate when none was given."""
+    return DriverError(f"{path}: no sample rate: give `samplerate` for a file without one")
 
 
 def check_rate(rate: float, path: Path, what: str) -> float:

@@ -18,7 +18,7 @@ import numpy as np
 import soundfile
 
 from drivers.errors import DriverError
-from drivers.files import check_rate, open_npy, read_recording
+from drivers.files import check_rate, no_sample_rate, open_npy, read_recording
 from drivers.source import Block, RecordingSource, Source, check_finite, paced
 
 CSV_SUFFIXES = frozenset({".csv", ".tsv", ".txt"})
@@ -73,7 +73,7 @@ class FileReplaySource(Source):
         self._audio: soundfile.SoundFile | None = None
         self._array: np.ndarray | None = None
         if topic is not None and not is_bag(self.path):
-            raise DriverError(f"{path}: --topic applies to ROS bags only")
+            raise DriverError(f"{path}: `topic` applies to ROS bags only")
         if is_bag(self.path):
             from drivers.bags import RosbagSource
 
@@ -100,9 +100,7 @@ class FileReplaySource(Source):
                     "was given"
                 )
         if rate is None:
-            raise DriverError(
-                f"{path}: no sample rate: give samplerate= (--samplerate) for a file without one"
-            )
+            raise no_sample_rate(path)
         self.samplerate = rate
 
     @property

@@ -90,7 +90,7 @@ def find_device(device: str | int) -> Device:
             found = sd.query_devices(key, "input")
     except ValueError:
         raise DriverError(
-            f"no capture device '{device}' (see `touchbench devices` for those PortAudio sees)"
+            f"no capture device '{device}' (the device listing shows those PortAudio sees)"
         ) from None
     return next(d for d in list_devices() if d.index == int(found["index"]))
 

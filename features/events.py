@@ -357,7 +357,7 @@ EVENT_KINDS: dict[str, EventKind] = {
         ),
         EventKind(
             name="none",
-            description="each recording (or each --segment seconds) is one instance",
+            description="each recording (or each `segment` seconds of it) is one instance",
             options=(),
             detect=detect_none,
         ),

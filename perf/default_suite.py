@@ -79,7 +79,7 @@ def run_suite(problem: Problem, ids: list[str], n_folds: int, jobs: int, top: in
     for note in notes:
         print(f"  note: {note}")
     start = time.perf_counter()
-    results = run_tasks(problem, ids, folds, jobs=jobs)
+    results = run_tasks(problem, ids, folds, jobs=jobs, timeout=600.0)
     elapsed = time.perf_counter() - start
     board = build_leaderboard(results)
     fit = {

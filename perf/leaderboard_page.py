@@ -35,7 +35,7 @@ sys.path.insert(0, str(ROOT))
 
 from fastapi.testclient import TestClient  # noqa: E402
 
-from app.api.main import create_app  # noqa: E402
+from app.main import create_app  # noqa: E402
 from app.schemas.datasets import ImportRequest  # noqa: E402
 from app.services.datasets import import_file  # noqa: E402
 from app.settings import Settings  # noqa: E402

@@ -1,70 +1,22 @@
-"""The touchbench service: wiring only (settings, store, dispatcher, routers, errors).
+"""The JSON API's part of the service: its routers, error answers and upload limit.
 
-``uvicorn --factory app.api.main:create_app`` or ``touchbench serve``.
+The application is made by :func:`app.main.create_app`, which wires this and the web page.
 """
 
 from __future__ import annotations
 
-import threading
-from collections.abc import AsyncIterator
-from contextlib import asynccontextmanager
-from importlib import metadata
-
 from fastapi import Depends, FastAPI
 
 from app.api import errors
-from app.api.deps import ModelCache, Service, require_api_key
+from app.api.deps import require_api_key
 from app.api.routes import datasets, health, jobs, live, models, recordings, runs
 from app.api.uploads import BodyLimit
-from app.jobs.dispatcher import Dispatcher
-from app.settings import Settings, get_settings
-from app.store.database import Store
-from app.store.jobs import mark_lost_jobs
-from app.store.runs import finish_run, mark_lost_runs
-from app.web.site import install as install_web_page
+from app.settings import Settings
 
 
-def _warm_up() -> None:
-    """Import the machine-learning stack in the background, so that start-up is quick and
-    the first prediction does not pay for the imports."""
-    import app.services.models  # noqa: F401
-    import benchmark.model  # noqa: F401
-
-
-def create_app(settings: Settings | None = None) -> FastAPI:
-    """The FastAPI application for ``settings`` (default: from the environment)."""
-    settings = settings or get_settings()
-
-    @asynccontextmanager
-    async def lifespan(app: FastAPI) -> AsyncIterator[None]:
-        store = Store(settings.database_url)
-        lost = mark_lost_runs(store)
-        mark_lost_jobs(store)
-        if settings.resume_on_start:
-            for run_id in lost:
-                finish_run(store, run_id, "queued")
-        settings.work_dir.mkdir(parents=True, exist_ok=True)
-        dispatcher = Dispatcher(store, settings)
-        app.state.service = Service(settings, store, dispatcher, ModelCache(settings.model_cache))
-        dispatcher.start()
-        threading.Thread(target=_warm_up, daemon=True, name="warm-up").start()
-        try:
-            yield
-        finally:
-            dispatcher.stop()
-            app.state.service.models.close()
-            store.dispose()
-
-    app = FastAPI(
-        title="touchbench",
-        version=metadata.version("touchbench"),
-        summary=(
-            "Benchmark classifiers for robot touch sensing: data sets, recording-session "
-            "uploads, cross-validation runs with WEKA's statistics, models and live "
-            "predictions."
-        ),
-        lifespan=lifespan,
-    )
+def install(app: FastAPI, settings: Settings) -> None:
+    """Add the API's routes (behind the API key but for health and the live WebSocket, which
+    checks it itself), its error handlers and the upload limit to ``app``."""
     errors.install(app)
     app.add_middleware(BodyLimit, limit=settings.max_upload_bytes)
     protected = [Depends(require_api_key)]
@@ -79,5 +31,3 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         jobs.router,
     ):
         app.include_router(router, dependencies=protected, responses=errors.ERROR_RESPONSES)
-    install_web_page(app, dependencies=protected)
-    return app

@@ -18,7 +18,7 @@ if TYPE_CHECKING:
     from benchmark.evaluation.leaderboard import Leaderboard
 
 # scikit-learn, the engine and Dask are imported by the commands that use them, so that
-# `touchbench datasets` and `--help` start at once.
+# this module's other commands (runs, leaderboard, cancel) start without them.
 
 JsonOption = Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")]
 FORMATS = ("table", "json", "csv", "markdown", "arff")
@@ -336,6 +336,7 @@ def bench_command(
     every finished fold: `touchbench bench --resume RUN` carries out the rest.
     """
     from app.cli.progress import TaskProgress
+    from app.errors import ConflictError
     from app.services.runs import (
         RunCancelled,
         RunOptions,
@@ -343,6 +344,7 @@ def bench_command(
         execute_run,
         independent_runs,
     )
+    from app.store.run_states import RunBusy
 
     store = get_state(ctx).store
     jobs = _check_jobs(jobs, oversubscribe)
@@ -407,8 +409,11 @@ def bench_command(
             run = execute_run(
                 store, run_id, jobs=jobs, scheduler=scheduler, callbacks=progress.callbacks()
             )
-    except KeyboardInterrupt:
-        raise ExitWith(_kept_message(store, run_id, "interrupted"), EXIT_INTERRUPTED) from None
+    except RunBusy as busy:
+        raise ConflictError(f"{busy} (`touchbench cancel {busy.run_id}` stops it)") from None
+    except KeyboardInterrupt as interrupt:  # Ctrl-C or SIGTERM (app.cli.signals)
+        code = getattr(interrupt, "exit_code", EXIT_INTERRUPTED)
+        raise ExitWith(_kept_message(store, run_id, "interrupted"), code) from None
     except RunCancelled as cancelled:
         raise ExitWith(_kept_message(store, cancelled.run.id, "cancelled"), EXIT_FAILED) from None
     _print_run_report(store, run.id, metric, baseline, as_json)
@@ -436,7 +441,7 @@ def cancel_command(
     if run.status == "cancelled":
         info(f"run {run.id} cancelled ({run.n_results}/{run.n_tasks} tasks kept)")
     else:
-        info(f"asked {run.owner} to stop run {run.id}; it ends within a few seconds")
+        info(f"run {run.id} is cancelling: {run.owner} stops it within about half a second")
 
 
 def _check_jobs(jobs: int, oversubscribe: bool) -> int:

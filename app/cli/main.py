@@ -13,23 +13,134 @@ from typing import Annotated
 
 import typer
 
-from app.cli import bench as bench_commands
-from app.cli import capture as capture_commands
-from app.cli import datasets as datasets_commands
-from app.cli import demo as demo_commands
-from app.cli import extract as extract_commands
 from app.cli import help as help_pages
-from app.cli import models as models_commands
-from app.cli import reports as reports_commands
-from app.cli import serve as serve_commands
-from app.cli.output import EXIT_FAILED, EXIT_INTERRUPTED, ExitWith
-from app.cli.requests import describe, reset
+from app.cli.exits import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_USAGE, ExitWith
+from app.cli.lazy import LazyGroup, Subcommand
+from app.cli.signals import interrupts
 from app.cli.state import CliState
-from app.errors import USER_ERRORS, FieldError
-from app.settings import get_settings
+from app.environment import database_url
 
-EXIT_USAGE = 2
 EXIT_UNEXPECTED = EXIT_FAILED
+
+#: Every sub-command, in the order ``touchbench --help`` lists them: its name, the module whose
+#: ``register`` adds it, and its one-line help (its help's first paragraph, which
+#: tests/app/test_cli_startup.py holds equal).  A module is imported when one of its commands
+#: is chosen, so that each command pays only for what it uses.
+COMMANDS = (
+    Subcommand(
+        "import",
+        "app.cli.datasets",
+        "Import an ARFF or CSV file as a data set, named after the file.",
+    ),
+    Subcommand("datasets", "app.cli.datasets", "List the data sets in the store."),
+    Subcommand(
+        "show",
+        "app.cli.datasets",
+        "Show a data set's schema, class distribution per target and missing values.",
+    ),
+    Subcommand(
+        "export",
+        "app.cli.datasets",
+        "Write a data set back as ARFF (the relation keeps MEKA's -C header for its targets).",
+    ),
+    Subcommand("rename", "app.cli.datasets", "Give a data set another name."),
+    Subcommand(
+        "delete",
+        "app.cli.datasets",
+        "Delete a data set with its instances, runs and results (not while a run uses it).",
+    ),
+    Subcommand(
+        "classifiers",
+        "app.cli.bench",
+        "List the classifier catalogue (id, WEKA name, family, capabilities).",
+    ),
+    Subcommand(
+        "bench",
+        "app.cli.bench",
+        "Cross-validate classifiers on a data set; every finished fold is stored at once.",
+    ),
+    Subcommand("runs", "app.cli.bench", "List benchmark runs with their status and progress."),
+    Subcommand(
+        "leaderboard",
+        "app.cli.bench",
+        "Show a run's leaderboard with WEKA's significance marks (v better, * worse).",
+    ),
+    Subcommand(
+        "cancel",
+        "app.cli.bench",
+        "Cancel a run: a queued run at once, a running one as soon as its process hears of it.",
+    ),
+    Subcommand(
+        "train",
+        "app.cli.models",
+        "Fit a classifier on every instance of a data set and store the model.",
+    ),
+    Subcommand("models", "app.cli.models", "List trained models (artifacts are not read)."),
+    Subcommand(
+        "predict",
+        "app.cli.models",
+        "Predict every instance of a file; attributes are matched to the model's by name.",
+    ),
+    Subcommand("delete-model", "app.cli.models", "Delete a trained model."),
+    Subcommand(
+        "extract",
+        "app.cli.extract",
+        "Detect touch events in recordings, extract features, and store them as a data set.",
+    ),
+    Subcommand(
+        "demo",
+        "app.cli.demo",
+        "Simulate touch sessions, extract features, benchmark, train and predict.",
+    ),
+    Subcommand(
+        "serve",
+        "app.cli.serve",
+        "Serve the REST API (data sets, recording uploads, runs, leaderboards, models, "
+        "predictions) at http://HOST:PORT/api, its documentation at /docs.",
+    ),
+    Subcommand(
+        "compare",
+        "app.cli.reports",
+        "Compare the classifiers that all the runs share, one score per data set (the run's "
+        "mean): average ranks, Friedman's test (chi-square and Iman-Davenport F), the Nemenyi"
+        " critical difference, Holm's test against the best, and the groups not significantly"
+        " different (Demšar 2006). With one run, its folds are the blocks (descriptive only).",
+    ),
+    Subcommand(
+        "plot", "app.cli.reports", "Draw one plot of a run as SVG (text kept as text) or PNG."
+    ),
+    Subcommand(
+        "report",
+        "app.cli.reports",
+        "Write one self-contained HTML file (inline SVG, no network) with each run's "
+        "leaderboard and marks, plots, configuration and library versions, and the comparison"
+        " across runs: ready to attach to a paper's supplementary material.",
+    ),
+    Subcommand(
+        "devices",
+        "app.cli.capture",
+        "List the capture devices PortAudio sees (index, name, input channels, default rate).",
+    ),
+    Subcommand(
+        "record",
+        "app.cli.capture",
+        "Record a labelled take into a session folder: OUT/take-NNN.wav plus a row of "
+        "OUT/labels.csv (file,TARGET...), the input of `touchbench extract`.",
+    ),
+    Subcommand("simulate", "app.cli.capture", "Write simulated recordings and their labels CSV."),
+    Subcommand(
+        "live",
+        "app.cli.capture",
+        "Predict every touch of a live stream with a model: its own event detection and "
+        "extractor run on the stream, and each touch is printed as soon as it ends.",
+    ),
+)
+
+
+class TouchbenchGroup(LazyGroup):
+    """The ``touchbench`` group: :data:`COMMANDS`, each module imported when chosen."""
+
+    subcommands = COMMANDS
 
 
 help_pages.install()
@@ -42,6 +153,7 @@ app = typer.Typer(
         "of multi-class and multi-target classifiers, read leaderboards with WEKA's "
         "corrected t-test, and train models for live prediction."
     ),
+    cls=TouchbenchGroup,
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
@@ -83,63 +195,80 @@ def root(
         ),
     ] = False,
 ) -> None:
-    ctx.obj = CliState(database_url=db or get_settings().database_url)
+    ctx.obj = CliState(database_url=db or database_url())
 
 
-datasets_commands.register(app)
-bench_commands.register(app)
-models_commands.register(app)
-extract_commands.register(app)
-demo_commands.register(app)
-serve_commands.register(app)
-reports_commands.register(app)
-capture_commands.register(app)
-
-# What importing the CLI made (some 100 000 objects that live as long as the process) is
-# moved out of the cyclic collector's reach: every full collection would walk it again, and
-# one more runs at exit, together a few tenths of a second of an import's CPU time.
+# What importing the CLI made (objects that live as long as the process) is moved out of the
+# cyclic collector's reach: every full collection would walk it again, and one more runs at
+# exit.  Most such objects come with the chosen command's module (some 60 000 for `datasets`,
+# with SQLAlchemy and the store), which app.cli.lazy freezes the same way once imported.
 gc.freeze()
 
 
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; returns (and, as a console script, exits with) the status."""
     command = typer.main.get_command(app)
-    reset()
+    _forget_options()
     try:
-        returned = command.main(args=argv, prog_name="touchbench", standalone_mode=False)
+        with interrupts():
+            returned = command.main(args=argv, prog_name="touchbench", standalone_mode=False)
     except typer.Exit as done:
         return _exit(done.exit_code)
     except ExitWith as outcome:
         print(f"touchbench: {outcome}", file=sys.stderr)
         return outcome.exit_code
-    except typer.Abort:
+    except typer.Abort as abort:  # click's wrapping of a KeyboardInterrupt
         print("touchbench: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        return getattr(abort.__cause__, "exit_code", EXIT_INTERRUPTED)
     except typer.TyperException as error:  # typer's (vendored click's) usage errors
         context = getattr(error, "ctx", None)
         hint = f" (see '{context.command_path} --help')" if context is not None else ""
         message = error.format_message() if hasattr(error, "format_message") else str(error)
         print(f"touchbench: error: {message}{hint}", file=sys.stderr)
         return _exit(EXIT_USAGE)
-    except USER_ERRORS as error:
-        message = describe(error) if isinstance(error, FieldError) else str(error)
-        print(f"touchbench: error: {message}", file=sys.stderr)
-        return _exit(EXIT_USAGE)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as interrupt:
         print("touchbench: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
-    except Exception as error:  # anything else is a bug: say so in one line, trace on request
-        if os.environ.get("TOUCHBENCH_DEBUG"):
-            traceback.print_exc()
-        print(
-            f"touchbench: unexpected error: {type(error).__name__}: {error} "
-            "(set TOUCHBENCH_DEBUG=1 for the traceback)",
-            file=sys.stderr,
-        )
-        return _exit(EXIT_UNEXPECTED)
+        return getattr(interrupt, "exit_code", EXIT_INTERRUPTED)
+    except Exception as error:
+        return _failed(error)
     if returned == EXIT_INTERRUPTED:  # typer turned a Ctrl-C into this status, silently
         print("touchbench: interrupted", file=sys.stderr)
     return returned if isinstance(returned, int) else 0
+
+
+def _failed(error: Exception) -> int:
+    """One line on stderr for a command that raised ``error``, and the exit status.
+
+    Bad input (:data:`app.errors.USER_ERRORS`) exits 2; anything else is a bug: said so in
+    one line, with the traceback on request.
+    """
+    # loaded when a command fails: start-up time (app.errors imports the drivers and NumPy)
+    from app.cli.requests import describe
+    from app.errors import USER_ERRORS, FieldError
+
+    if isinstance(error, USER_ERRORS):
+        message = describe(error) if isinstance(error, FieldError) else str(error)
+        print(f"touchbench: error: {message}", file=sys.stderr)
+        return EXIT_USAGE
+    if os.environ.get("TOUCHBENCH_DEBUG"):
+        traceback.print_exc()
+    print(
+        f"touchbench: unexpected error: {type(error).__name__}: {error} "
+        "(set TOUCHBENCH_DEBUG=1 for the traceback)",
+        file=sys.stderr,
+    )
+    return EXIT_UNEXPECTED
+
+
+def _forget_options() -> None:
+    """Forget the options of the command run before in this process (tests run many).
+
+    Only a command that built a request (:mod:`app.cli.requests`) can have left them, so a
+    process that has not imported that module has nothing to forget.
+    """
+    requests = sys.modules.get("app.cli.requests")
+    if requests is not None:
+        requests.reset()
 
 
 def _exit(code: int | None) -> int:

@@ -13,30 +13,11 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
+# Defined where app.cli.main finds them without rich's tables; commands take them from here.
+from app.cli.exits import EXIT_FAILED as EXIT_FAILED
+from app.cli.exits import EXIT_INTERRUPTED as EXIT_INTERRUPTED
+from app.cli.exits import ExitWith as ExitWith
 from app.schemas.base import finite
-
-#: Exit status of a command whose work failed (a run whose every task failed, a cancelled
-#: run) or that met an unexpected error.
-EXIT_FAILED = 1
-#: Exit status after Ctrl-C (128 + SIGINT), as shells expect.
-EXIT_INTERRUPTED = 130
-
-
-class ExitWith(Exception):  # noqa: N818 (an outcome that ends the command, not a bug)
-    """End the command with one line on stderr and ``exit_code``.
-
-    Parameters
-    ----------
-    message : str
-        What happened and what to do next, e.g. how to resume an interrupted run.
-    exit_code : int
-        :data:`EXIT_INTERRUPTED` after Ctrl-C, :data:`EXIT_FAILED` when the work failed.
-    """
-
-    def __init__(self, message: str, exit_code: int) -> None:
-        super().__init__(message)
-        self.exit_code = exit_code
-
 
 #: Pipes and files get a wide page: nobody wants a leaderboard wrapped at 80 columns.
 console = Console(highlight=False, soft_wrap=False, width=None if sys.stdout.isatty() else 160)

@@ -107,9 +107,9 @@ def compare_command(
     if plot is not None:
         save_figure(cd_figure(comparison), plot)
     if as_json:
-        from app.schemas.compare import ComparisonOut
+        from app.services.compare import comparison_schema
 
-        print_json(ComparisonOut.of(comparison).to_json())
+        print_json(comparison_schema(comparison).to_json())
     else:
         _print_comparison(comparison)
     if plot is not None:

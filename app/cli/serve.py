@@ -65,7 +65,7 @@ def serve_command(
     state.store  # noqa: B018 (open and migrate the store once, before the workers start)
     pin_native_threads()
     uvicorn.run(
-        "app.api.main:create_app",
+        "app.main:create_app",
         factory=True,
         host=host,
         port=port,

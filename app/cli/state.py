@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import typer
 
-from app.store.database import Store
+if TYPE_CHECKING:
+    from app.store.database import Store
 
 
 @dataclass
@@ -17,6 +19,9 @@ class CliState:
     @property
     def store(self) -> Store:
         if self._store is None:
+            # loaded when the command runs: start-up time (SQLAlchemy and the store's tables)
+            from app.store.database import Store
+
             self._store = Store(self.database_url)
         return self._store
 

@@ -1,4 +1,8 @@
-"""A worker process for one queued run or job: ``python -m app.jobs.process --db URL run 5``.
+"""A worker process for one queued run or job: ``python -m app.jobs.process run 5``.
+
+The store's URL comes from ``TOUCHBENCH_DATABASE_URL``, as the dispatcher passes it: a
+command line is readable by any user on the host, and the URL may hold a password.  A
+person running the module by hand may give ``--db URL`` instead.
 
 It claims the item (another process claiming it first is not an error: it exits quietly),
 carries it out, records how it ended, and exits.  It ends itself, mid-run included, once
@@ -14,6 +18,8 @@ import sys
 import threading
 import time
 
+from app.environment import DATABASE_URL_VARIABLE
+
 #: Seconds between checks that the parent service is alive.
 PARENT_CHECK_INTERVAL = 1.0
 
@@ -26,20 +32,31 @@ def _exit_with_parent(parent: int) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m app.jobs.process")
-    parser.add_argument("--db", required=True)
+    parser.add_argument(
+        "--db", metavar="URL", help=f"The store (default: ${DATABASE_URL_VARIABLE})."
+    )
     parser.add_argument("--jobs", type=int, default=1)
     parser.add_argument("--scheduler", default=None)
     parser.add_argument("kind", choices=["run", "job"])
     parser.add_argument("id", type=int)
     args = parser.parse_args(argv)
+    url = args.db or os.environ.get(DATABASE_URL_VARIABLE)
+    if not url:
+        parser.error(f"no store: set {DATABASE_URL_VARIABLE} or pass --db")
     threading.Thread(target=_exit_with_parent, args=(os.getppid(),), daemon=True).start()
 
+    # loaded once the arguments are read and the parent is watched: start-up time (``--help``
+    # and a bad argument need none of it; a service that dies meanwhile ends this process)
     from app.errors import AppError
     from app.services.jobs import execute_job
     from app.services.runs import RunCancelled, execute_run
     from app.store.database import Store
 
-    store = Store(args.db)
+    try:
+        store = Store(url)
+    except AppError as error:  # the message shows the URL without its password
+        print(f"{args.kind} {args.id}: {error}", file=sys.stderr)
+        return 1
     try:
         if args.kind == "job":
             execute_job(store, args.id)

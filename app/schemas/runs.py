@@ -10,14 +10,16 @@ from pydantic import Field
 
 from app.schemas.base import Schema
 
-#: Where a run is in its life: ``queued`` (created, waiting for a worker), ``running``,
+#: Where a run is in its life (the rules: :mod:`app.store.run_states`): ``queued`` (created,
+#: waiting for a worker), ``running``, ``cancelling`` (its process was asked to stop),
 #: ``done`` (every task has a result), ``failed`` (every task failed, or the run could not
 #: be carried out), ``cancelled`` (on request), ``interrupted`` (its process stopped: Ctrl-C,
 #: kill -9, a crash; ``--resume`` finishes it).
-RunStatus = Literal["queued", "running", "done", "failed", "cancelled", "interrupted"]
+RunStatus = Literal["queued", "running", "cancelling", "done", "failed", "cancelled", "interrupted"]
 RUN_STATUSES: tuple[RunStatus, ...] = (
     "queued",
     "running",
+    "cancelling",
     "done",
     "failed",
     "cancelled",

@@ -16,6 +16,19 @@ from typing import Literal
 
 import numpy as np
 
+from app.schemas.base import finite
+from app.schemas.compare import (
+    BayesianOut,
+    ClassifierRank,
+    ComparisonOut,
+    FriedmanOut,
+    HolmOut,
+    HolmRow,
+    MissingCellOut,
+    MissingOut,
+    NemenyiOut,
+    PairOut,
+)
 from app.store.database import Store
 from app.store.runs import RunInfo, get_run, load_results
 from benchmark.errors import ConfigurationError
@@ -326,3 +339,86 @@ def _pair(
                 means[usable, 0], means[usable, 1], rope=rope, lower_is_better=lower
             )
     return PairComparison(a, b, per_run, across)
+
+
+def comparison_schema(comparison: Comparison) -> ComparisonOut:
+    """The JSON of a comparison (``touchbench compare --json``)."""
+    ranks = comparison.ranks
+    table = comparison.table
+    names = list(ranks.classifiers)
+    completed = comparison.completed
+    return ComparisonOut(
+        runs=[scores.run.id for scores in comparison.runs],
+        metric=comparison.metric,
+        lower_is_better=comparison.lower_is_better,
+        alpha=ranks.alpha,
+        blocks_are=comparison.blocks_are,
+        blocks=list(ranks.blocks),
+        classifiers=[
+            ClassifierRank(
+                classifier=name,
+                average_rank=float(rank),
+                mean_score=finite(float(mean)),
+                scores={
+                    block: finite(float(value))
+                    for block, value in zip(table.blocks, table.column(name), strict=True)
+                },
+            )
+            for name, rank, mean in zip(names, ranks.average_ranks, ranks.mean_scores, strict=True)
+        ],
+        friedman=FriedmanOut(
+            chi_square=ranks.friedman.statistic,
+            p_value=ranks.friedman.p_value,
+            iman_davenport_f=finite(ranks.friedman.iman_davenport),
+            iman_davenport_p_value=ranks.friedman.iman_davenport_p_value,
+            df=ranks.friedman.df,
+            df_denominator=ranks.friedman.df_denominator,
+            tie_corrected=ranks.friedman.tie_corrected,
+        ),
+        nemenyi=NemenyiOut(
+            q_alpha=ranks.q_alpha,
+            critical_difference=ranks.critical_difference,
+            groups=[list(group) for group in ranks.groups],
+            p_values={
+                a: {b: float(ranks.nemenyi_p_values[i, j]) for j, b in enumerate(names)}
+                for i, a in enumerate(names)
+            },
+        ),
+        holm=HolmOut(
+            control=ranks.control,
+            comparisons=[
+                HolmRow(
+                    classifier=h.classifier,
+                    z=h.z,
+                    p_value=h.p_value,
+                    adjusted_p_value=h.adjusted_p_value,
+                    significant=h.significant,
+                )
+                for h in ranks.holm
+            ],
+        ),
+        missing=MissingOut(
+            policy=completed.policy,
+            cells=[
+                MissingCellOut(block=m.block, classifier=m.classifier) for m in completed.missing
+            ],
+            dropped_classifiers=completed.dropped_classifiers,
+            dropped_blocks=completed.dropped_blocks,
+        ),
+        not_shared=comparison.not_shared,
+        bayesian=pair_schema(comparison.pair) if comparison.pair else None,
+        notes=comparison.notes,
+    )
+
+
+def pair_schema(pair: PairComparison) -> PairOut:
+    """The JSON of a Bayesian comparison of two classifiers."""
+    return PairOut(
+        first=pair.a,
+        second=pair.b,
+        per_run=[
+            BayesianOut.of(result, block=scores.label, run_id=scores.run.id)
+            for scores, result in pair.per_run
+        ],
+        across_runs=BayesianOut.of(pair.across) if pair.across else None,
+    )

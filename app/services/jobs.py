@@ -15,17 +15,13 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from app.errors import USER_ERRORS, AppError, ConflictError
+from app.errors import USER_ERRORS, AppError
 from app.schemas.base import Request
 from app.schemas.extraction import ExtractRequest
 from app.schemas.jobs import JOB_REQUESTS, JobKind, JobSchema
 from app.schemas.models import TrainRequest
 from app.store.database import Store
 from app.store.jobs import claim_job, create_job, finish_job, get_job
-from app.store.runs import RunInfo, finish_run, get_run
-
-#: Statuses from which a run can be put back in the queue.
-REQUEUEABLE = frozenset({"queued", "interrupted", "cancelled", "failed"})
 
 
 def submit_extraction(store: Store, request: ExtractRequest) -> JobSchema:
@@ -79,25 +75,6 @@ def job_request(job: JobSchema) -> Request:
         raise AppError(
             f"job {job.id} does not hold a valid {job.kind} request ({where}: {problem['msg']})"
         ) from None
-
-
-def requeue_run(store: Store, run_id: int | str) -> RunInfo:
-    """Put an interrupted, cancelled or failed run back in the queue (to be resumed).
-
-    Raises
-    ------
-    ConflictError
-        The run is running or done.
-    """
-    run = get_run(store, run_id)
-    if run.status == "running" and run.is_alive():
-        raise ConflictError(f"run {run.id} is running; nothing to resume")
-    if run.status == "done":
-        raise ConflictError(f"run {run.id} is done; nothing to resume")
-    if run.status not in REQUEUEABLE and run.status != "running":
-        raise AppError(f"run {run.id} is {run.status}; it cannot be resumed")
-    finish_run(store, run.id, "queued")
-    return get_run(store, run.id)
 
 
 def execute_job(store: Store, job_id: int) -> JobSchema | None:

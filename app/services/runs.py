@@ -10,6 +10,7 @@ processes it is alive (and hears a cancel request), and writes the final status.
 from __future__ import annotations
 
 import threading
+import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -30,6 +31,7 @@ from app.store.database import Store
 from app.store.datasets import find_dataset, load_dataset, load_schema
 from app.store.ownership import process_owner
 from app.store.runs import (
+    CANCEL_POLL,
     HEARTBEAT_INTERVAL,
     RunInfo,
     claim_run,
@@ -39,6 +41,7 @@ from app.store.runs import (
     heartbeat,
     load_results,
     record_result,
+    should_stop,
 )
 from app.store.runs import (
     create_run as store_run,
@@ -694,7 +697,13 @@ def independent_runs(
 
 
 class _Heartbeat:
-    """A thread that keeps a run's heartbeat and sets ``stop`` on a cancel request."""
+    """A thread that keeps a run's heartbeat and sets ``stop`` when the run should stop.
+
+    It looks for a cancel request every :data:`~app.store.runs.CANCEL_POLL` seconds (one
+    read of the run's row) and writes the heartbeat every
+    :data:`~app.store.runs.HEARTBEAT_INTERVAL` seconds, so that a cancel is heard within a
+    fraction of a second while the store takes a write only every few seconds.
+    """
 
     def __init__(self, store: Store, run_id: int, owner: str, stop: threading.Event) -> None:
         self._store = store
@@ -713,12 +722,18 @@ class _Heartbeat:
             self._thread.join(timeout=HEARTBEAT_INTERVAL * 2)
 
     def _beat(self) -> None:
-        while not self._done.wait(HEARTBEAT_INTERVAL):
+        next_beat = time.monotonic() + HEARTBEAT_INTERVAL
+        while not self._done.wait(CANCEL_POLL):
             try:
-                if heartbeat(self._store, self._run_id, self._owner):
-                    self._stop.set()
-            except Exception:  # a busy store: try again at the next beat
+                if time.monotonic() >= next_beat:
+                    next_beat = time.monotonic() + HEARTBEAT_INTERVAL
+                    told = heartbeat(self._store, self._run_id, self._owner)
+                else:
+                    told = should_stop(self._store, self._run_id, self._owner)
+            except Exception:  # a busy store: try again at the next look
                 continue
+            if told:
+                self._stop.set()
 
 
 def _outcome(results: Sequence[TaskResult]) -> tuple[RunStatus, str | None]:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import re
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -66,8 +67,7 @@ class Store:
                 command.upgrade(config, "head")
         except (OperationalError, DatabaseError) as error:
             raise AppError(
-                f"cannot open the store at {self.engine.url.render_as_string()}: "
-                f"{_first_line(error.orig)}"
+                f"cannot open the store at {display_url(self.url)}: {first_line(error.orig)}"
             ) from None
 
     def _refuse_foreign_database(self) -> None:
@@ -78,9 +78,9 @@ class Store:
         if tables:
             shown = ", ".join(tables[:5]) + (f", ... ({len(tables)})" if len(tables) > 5 else "")
             raise AppError(
-                f"{self.engine.url.render_as_string()} holds another application's tables "
-                f"({shown}) and no touchbench store; touchbench will not write into it: choose "
-                "a new file or an empty database for the store"
+                f"{display_url(self.url)} holds another application's tables ({shown}) and "
+                "no touchbench store; touchbench will not write into it: choose a new file "
+                "or an empty database"
             )
 
     def revision(self) -> str | None:
@@ -153,11 +153,31 @@ def _normalise(url: str) -> str:
     return url
 
 
+def display_url(url: str) -> str:
+    """``url`` as a message or a log line may show it: with its password hidden (``***``).
+
+    Every URL of a store that touchbench prints goes through here.  Everything between
+    ``user:`` and the last ``@`` is hidden too, in a URL that does not parse as in one that
+    does: a password with an unescaped ``@`` in it would otherwise show its end as the host.
+    """
+    try:
+        shown = make_url(url).render_as_string(hide_password=True)
+    except (ArgumentError, ValueError):
+        shown = url
+    return _USER_PASSWORD.sub(r"\1***@", shown, count=1)
+
+
+#: ``scheme://user:`` and what follows it up to the last ``@``: where a password may be.
+_USER_PASSWORD = re.compile(r"(://[^:/@]*:).*@")
+
+
 def _create_engine(url: str) -> Engine:
     try:
         parsed = make_url(url)
-    except ArgumentError:
-        raise AppError(f"not a database URL: '{url}' (e.g. sqlite:///touchbench.db)") from None
+    except (ArgumentError, ValueError):  # ValueError: a port that is not a number
+        raise AppError(
+            f"not a database URL: '{display_url(url)}' (e.g. sqlite:///touchbench.db)"
+        ) from None
     options: dict[str, Any] = {}
     if parsed.get_backend_name() == "sqlite":
         database = parsed.database or ""
@@ -165,9 +185,9 @@ def _create_engine(url: str) -> Engine:
             _check_sqlite_file(Path(database), url)
         options["connect_args"] = {"timeout": 30}
     try:
-        engine = create_engine(url, **options)
+        engine = create_engine(parsed, **options)
     except (ArgumentError, ImportError) as error:
-        raise AppError(f"cannot use the database URL '{url}': {error}") from None
+        raise AppError(f"cannot use the database URL '{display_url(url)}': {error}") from None
     if parsed.get_backend_name() == "sqlite":
         event.listen(engine, "connect", _sqlite_pragmas)
     return engine
@@ -176,11 +196,13 @@ def _create_engine(url: str) -> Engine:
 def _check_sqlite_file(path: Path, url: str) -> None:
     """Refuse a path that cannot hold a SQLite store before SQLite touches it."""
     if not path.parent.is_dir():
-        raise AppError(f"cannot open the store at {url}: folder {path.parent} does not exist")
+        raise AppError(
+            f"cannot open the store at {display_url(url)}: folder {path.parent} does not exist"
+        )
     if not path.exists():
         return
     if not path.is_file():
-        raise AppError(f"cannot open the store at {url}: {path} is not a regular file")
+        raise AppError(f"cannot open the store at {display_url(url)}: {path} is not a regular file")
     if path.stat().st_size == 0:
         return
     import sqlite3
@@ -193,12 +215,12 @@ def _check_sqlite_file(path: Path, url: str) -> None:
             tables = {name for (name,) in peek.execute("SELECT name FROM sqlite_master")}
     except sqlite3.DatabaseError as error:
         reason = "is not a SQLite database" if "not a database" in str(error) else str(error)
-        raise AppError(f"cannot open the store at {url}: {path} {reason}") from None
+        raise AppError(f"cannot open the store at {display_url(url)}: {path} {reason}") from None
     if tables and "alembic_version" not in tables:
         shown = ", ".join(sorted(tables)[:5])
         raise AppError(
             f"{path} is another application's SQLite database (tables: {shown}); touchbench "
-            "will not write into it: choose a new file for the store"
+            "will not write into it: choose a new file"
         )
 
 
@@ -214,5 +236,7 @@ def _sqlite_pragmas(dbapi_connection: Any, _record: Any) -> None:
     cursor.close()
 
 
-def _first_line(error: object) -> str:
+def first_line(error: object) -> str:
+    """The first line of ``error``'s message (its type's name when it has none): driver and
+    SQLAlchemy errors add the statement, hints and a link on lines of their own."""
     return str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__

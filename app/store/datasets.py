@@ -619,7 +619,7 @@ def _live_run(session: Session, dataset_id: int) -> tuple[int, str] | None:
     runs = session.execute(
         select(RunRow.id, RunRow.status, RunRow.owner, RunRow.heartbeat_at)
         .where(RunRow.dataset_id == dataset_id)
-        .where(RunRow.status.in_(("queued", "running")))
+        .where(RunRow.status.in_(("queued", "running", "cancelling")))
         .order_by(RunRow.id)
     ).all()
     for run_id, status, owner, heartbeat in runs:

@@ -41,13 +41,14 @@ def owner_alive(owner: str | None, heartbeat_at: datetime | None) -> bool:
     return datetime.now(UTC) - aware(heartbeat_at) < timedelta(seconds=STALE_AFTER)
 
 
-def mark_lost(session: Session, table: Any, **values: Any) -> list[int]:
-    """Set ``values`` on the rows of ``table`` left ``running`` by a dead owner; their ids.
+def mark_lost(session: Session, table: Any, *, of: str = "running", **values: Any) -> list[int]:
+    """Set ``values`` on the rows of ``table`` left in status ``of`` by a dead owner; their
+    ids.
 
     ``table`` is a mapped class with ``id``, ``status``, ``owner`` and ``heartbeat_at``.
     """
     running = session.execute(
-        select(table.id, table.owner, table.heartbeat_at).where(table.status == "running")
+        select(table.id, table.owner, table.heartbeat_at).where(table.status == of)
     ).all()
     lost = [item for item, owner, beat in running if not owner_alive(owner, beat)]
     if lost:

@@ -11,7 +11,7 @@ already recorded, so a resumed run never duplicates rows.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from datetime import datetime
 from typing import Any
 
@@ -20,11 +20,12 @@ from sqlalchemy.dialects.postgresql import insert as postgresql_insert
 from sqlalchemy.dialects.sqlite import insert as sqlite_insert
 from sqlalchemy.orm import Session
 
-from app.errors import AppError, NotFoundError
+from app.errors import ConflictError, NotFoundError
 from app.schemas.runs import FINAL_STATUSES, RunSchema, RunStatus
 from app.store.database import Store
 from app.store.naming import is_row_id
 from app.store.ownership import aware, mark_lost, owner_alive, process_owner
+from app.store.run_states import ACTIVE, LOST_AS, cancel_outcome, check_claim, check_resume
 from app.store.tables import DatasetRow, FoldResultRow, RunRow, utcnow
 from benchmark.results import TaskKey, TaskResult
 
@@ -34,6 +35,9 @@ PER_TARGET = "per_target"
 PARAMS = "params"
 #: Seconds between heartbeats of the process executing a run.
 HEARTBEAT_INTERVAL = 5.0
+#: Seconds between the executing process's looks for a cancel request: one read of the run's
+#: row by its primary key, cheap enough on either store to take a few times a second.
+CANCEL_POLL = 0.2
 
 
 @dataclass(frozen=True)
@@ -73,8 +77,18 @@ class RunInfo:
         return stratified + ("group " if self.config.get("grouped") else "") + "k-fold"
 
     def is_alive(self) -> bool:
-        """Whether a live process is executing the run."""
-        return self.status == "running" and owner_alive(self.owner, self.heartbeat_at)
+        """Whether a live process is executing the run (``running`` or ``cancelling``)."""
+        return self.status in ACTIVE and self.owner_alive()
+
+    def owner_alive(self) -> bool:
+        """Whether the process named as the run's owner still runs."""
+        return owner_alive(self.owner, self.heartbeat_at)
+
+    def seconds_since_heartbeat(self) -> float:
+        """Seconds since the owner's last heartbeat (0 without one)."""
+        if self.heartbeat_at is None:
+            return 0.0
+        return (utcnow() - aware(self.heartbeat_at)).total_seconds()
 
     def schema(self) -> RunSchema:
         return RunSchema(
@@ -140,28 +154,20 @@ def list_runs(store: Store, *, status: str | None = None) -> list[RunInfo]:
 def claim_run(store: Store, run_id: int, *, owner: str | None = None) -> RunInfo:
     """Make this process the one executing ``run_id``: status ``running``, owner, heartbeat.
 
-    A run that another live process executes is refused; a ``running`` run whose process
-    died (kill -9, a crash, a lost machine) is taken over.
+    A run that another live process executes, or that is being cancelled, is refused
+    (:func:`app.store.run_states.check_claim`); an active run whose process died (kill -9, a
+    crash, a lost machine) is taken over.
 
     Raises
     ------
-    AppError
-        Another process is executing the run.
+    ConflictError
+        Another process is executing the run, or just took it.
     """
     owner = owner or process_owner()
     now = utcnow()
+    check_claim(get_run(store, run_id), owner)
     with store.session() as session:
         row = _row(session, run_id)
-        if (
-            row.status == "running"
-            and row.owner != owner
-            and owner_alive(row.owner, row.heartbeat_at)
-        ):
-            seconds = (now - aware(row.heartbeat_at)).total_seconds() if row.heartbeat_at else 0
-            raise AppError(
-                f"run {row.id} is being executed by {row.owner} (heard from {seconds:.0f} s "
-                f"ago); wait for it to end or cancel it with `touchbench cancel {row.id}`"
-            )
         same_owner = RunRow.owner.is_(None) if row.owner is None else RunRow.owner == row.owner
         claimed = session.execute(
             update(RunRow)
@@ -178,26 +184,37 @@ def claim_run(store: Store, run_id: int, *, owner: str | None = None) -> RunInfo
             .execution_options(synchronize_session=False)
         ).rowcount  # type: ignore[attr-defined]  # an UPDATE gives a CursorResult
         if not claimed:
-            raise AppError(f"run {row.id} was just taken up by another process; try again")
+            raise ConflictError(f"run {row.id} was just taken up by another process; try again")
     return get_run(store, run_id)
 
 
 def heartbeat(store: Store, run_id: int, owner: str) -> bool:
-    """Say that ``owner`` still executes the run; returns whether a cancel was requested
-    (or the run was taken away from this owner)."""
+    """Say that ``owner`` still executes the run; returns whether it should stop (see
+    :func:`should_stop`)."""
     with store.session() as session:
         session.execute(
             update(RunRow)
-            .where(RunRow.id == run_id, RunRow.owner == owner, RunRow.status == "running")
+            .where(RunRow.id == run_id, RunRow.owner == owner, RunRow.status.in_(ACTIVE))
             .values(heartbeat_at=utcnow())
         )
-        row = session.execute(
-            select(RunRow.cancel_requested, RunRow.owner, RunRow.status).where(RunRow.id == run_id)
-        ).one_or_none()
+        return _should_stop(session, run_id, owner)
+
+
+def should_stop(store: Store, run_id: int, owner: str) -> bool:
+    """Whether the process ``owner`` executing the run should stop: a cancel was requested,
+    or the run was taken away from it (deleted, claimed by another process)."""
+    with store.session() as session:
+        return _should_stop(session, run_id, owner)
+
+
+def _should_stop(session: Session, run_id: int, owner: str) -> bool:
+    row = session.execute(
+        select(RunRow.cancel_requested, RunRow.owner, RunRow.status).where(RunRow.id == run_id)
+    ).one_or_none()
     if row is None:
         return True
     cancel, current_owner, status = row
-    return bool(cancel) or current_owner != owner or status != "running"
+    return bool(cancel) or current_owner != owner or status not in ACTIVE
 
 
 def finish_run(store: Store, run_id: int, status: RunStatus, *, error: str | None = None) -> None:
@@ -217,28 +234,57 @@ def finish_run(store: Store, run_id: int, status: RunStatus, *, error: str | Non
 
 
 def request_cancel(store: Store, run_id: int | str) -> RunInfo:
-    """Cancel a run: at once if nobody executes it, else by asking its process to stop.
+    """Cancel a run: at once if nobody executes it, else by asking its process to stop
+    (status ``cancelling`` until it has; see :mod:`app.store.run_states`).
 
     Raises
     ------
-    AppError
+    ConflictError
         The run is already over.
     """
     run = get_run(store, run_id)
-    if run.status in ("done", "failed", "cancelled"):
-        raise AppError(f"run {run.id} is already {run.status}; nothing to cancel")
-    if run.is_alive():
+    outcome = cancel_outcome(run)
+    if outcome == "cancelling":
         with store.session() as session:
-            session.execute(update(RunRow).where(RunRow.id == run.id).values(cancel_requested=True))
-    else:
+            asked = session.execute(
+                update(RunRow)
+                .where(RunRow.id == run.id, RunRow.status == run.status)
+                .values(status="cancelling", cancel_requested=True)
+                .execution_options(synchronize_session=False)
+            ).rowcount  # type: ignore[attr-defined]  # an UPDATE gives a CursorResult
+        if asked:  # what this request did, whatever the run's process does next
+            return replace(run, status="cancelling", cancel_requested=True)
+        return request_cancel(store, run.id)  # the run changed meanwhile: judge it again
+    if outcome == "cancelled":
         finish_run(store, run.id, "cancelled")
     return get_run(store, run.id)
 
 
+def requeue_run(store: Store, run_id: int | str) -> RunInfo:
+    """Put an interrupted, cancelled or failed run back in the queue, to be resumed (only
+    its tasks without a result are carried out).
+
+    Raises
+    ------
+    ConflictError
+        The run is queued, executing, being cancelled or done.
+    """
+    check_resume(get_run(store, run_id))
+    finish_run(store, int(str(run_id)), "queued")
+    return get_run(store, run_id)
+
+
 def mark_lost_runs(store: Store) -> list[int]:
-    """Runs left ``running`` by a process that died become ``interrupted``; their ids."""
+    """Runs left active by a process that died become ``interrupted`` (or ``cancelled``,
+    when they were being cancelled); their ids."""
+    lost: list[int] = []
     with store.session() as session:
-        return mark_lost(session, RunRow, status="interrupted", owner=None, heartbeat_at=None)
+        for status, becomes in LOST_AS.items():
+            values = {"finished_at": utcnow()} if becomes in FINAL_STATUSES else {}
+            lost += mark_lost(
+                session, RunRow, of=status, status=becomes, owner=None, heartbeat_at=None, **values
+            )
+    return sorted(lost)
 
 
 def record_result(store: Store, run_id: int, result: TaskResult) -> None:

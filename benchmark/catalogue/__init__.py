@@ -20,6 +20,7 @@ from sklearn.pipeline import Pipeline
 
 from benchmark.catalogue.entries import SPECS as _ENTRIES
 from benchmark.catalogue.pipeline import check_sequence_input, pipeline_for_spec
+from benchmark.catalogue.plugins import plugin_specs
 from benchmark.catalogue.spaces import SEARCH_SPACES
 from benchmark.catalogue.spec import ClassifierSpec
 from benchmark.catalogue.tuning import TUNED_SUFFIX, is_tuned_id, tuned_spec
@@ -39,10 +40,11 @@ __all__ = [
     "suite",
 ]
 
-SPECS: tuple[ClassifierSpec, ...] = tuple(
+_OWN = tuple(
     replace(spec, search_space=SEARCH_SPACES[spec.id]) if spec.id in SEARCH_SPACES else spec
     for spec in _ENTRIES
 )
+SPECS: tuple[ClassifierSpec, ...] = _OWN + plugin_specs(spec.id for spec in _OWN)
 CATALOGUE: Mapping[str, ClassifierSpec] = MappingProxyType({spec.id: spec for spec in SPECS})
 SUITES: tuple[str, ...] = ("fast", "default", "all")
 
@@ -68,7 +70,7 @@ def get_spec(classifier_id: str) -> ClassifierSpec:
 def unknown_classifier_message(classifier_id: str, known: Mapping[str, object]) -> str:
     """``unknown classifier 'rff'; did you mean 'rf'?`` (or a pointer to the listing)."""
     close = difflib.get_close_matches(classifier_id.lower(), list(known), n=1, cutoff=0.5)
-    hint = f"did you mean '{close[0]}'?" if close else "see `touchbench classifiers`"
+    hint = f"did you mean '{close[0]}'?" if close else "see the classifier listing"
     return f"unknown classifier '{classifier_id}'; {hint}"
 
 

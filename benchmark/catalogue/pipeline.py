@@ -128,8 +128,8 @@ def check_sequence_input(spec: ClassifierSpec, sequence: SequenceLayout | None) 
     if sequence is None:
         raise ConfigurationError(
             f"classifier '{spec.id}' needs a sequence data set (attributes named "
-            "CHANNEL[T], as `touchbench extract -e sequence` or `-e mfcc -O frames=N` make "
-            "them); this data set has flat features"
+            "CHANNEL[T], as the extractor `sequence`, or `mfcc` with its option frames=N, "
+            "makes them); this data set has flat features"
         )
     if sequence.length < spec.min_sequence:
         raise ConfigurationError(

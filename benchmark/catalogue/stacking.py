@@ -65,13 +65,13 @@ def stacked_spec(members: Sequence[ClassifierSpec], top_n: int) -> ClassifierSpe
 
 
 def check_top_n(top_n: int, n_members: int) -> None:
-    """Refuse a ``--stack TOP_N`` outside 1..min(members, :data:`MAX_TOP_N`)."""
+    """Refuse a stack of the ``top_n`` best outside 1..min(members, :data:`MAX_TOP_N`)."""
     if not 1 <= top_n <= MAX_TOP_N:
-        raise ConfigurationError(f"--stack must be between 1 and {MAX_TOP_N}, got {top_n}")
+        raise ConfigurationError(f"`stack` must be between 1 and {MAX_TOP_N}, got {top_n}")
     if top_n > n_members:
         raise ConfigurationError(
-            f"--stack {top_n} needs at least {top_n} classifiers in the run to choose from, "
-            f"the run has {n_members}"
+            f"a stack of the top {top_n} needs at least {top_n} classifiers in the run to "
+            f"choose from, the run has {n_members}"
         )
 
 

@@ -76,7 +76,7 @@ def check_budget(budget_minutes: float | None) -> None:
         return
     if not 0 < budget_minutes <= MAX_BUDGET_MINUTES:
         raise ConfigurationError(
-            f"--budget must be more than 0 and at most {MAX_BUDGET_MINUTES:g} minutes, "
+            f"`budget` must be more than 0 and at most {MAX_BUDGET_MINUTES:g} minutes, "
             f"got {budget_minutes:g}"
         )
 
@@ -120,7 +120,7 @@ def tuned_spec(spec: ClassifierSpec, budget_minutes: float | None = None) -> Cla
     if not spec.search_space:
         raise ConfigurationError(
             f"classifier '{spec.id}' declares no search space, so it has no tuned twin "
-            "(`touchbench classifiers --json` lists the spaces)"
+            "(the classifier listing gives each entry's search space)"
         )
     check_search_space(spec)
     check_budget(budget_minutes)

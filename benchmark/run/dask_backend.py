@@ -13,16 +13,29 @@ from __future__ import annotations
 import contextlib
 import re
 import threading
-import time
 import uuid
 from collections import deque
-from collections.abc import Callable, Sequence
-from typing import Any
+from collections.abc import Sequence
+from dataclasses import dataclass
+from queue import Empty, SimpleQueue
+from typing import TYPE_CHECKING, Any
 
 from benchmark.errors import BenchmarkError, ConfigurationError
 from benchmark.results import TaskKey, TaskResult
+from benchmark.run.backend import (
+    STOP_POLL,
+    ResultCallback,
+    RunStopped,
+    StartCallback,
+    StopCheck,
+    timed_out,
+    worker_could_not_start,
+)
 from benchmark.run.task import failed_result
 from benchmark.run.worker import Worker, WorkerDiedError
+
+if TYPE_CHECKING:
+    from distributed import Future
 
 #: Seconds to wait for the scheduler to answer.
 CONNECT_TIMEOUT = "10s"
@@ -71,77 +84,89 @@ def connect(address: str) -> Any:
         ) from None
 
 
-def run_on_dask(
-    scheduler: str,
-    context: bytes,
-    tasks: Sequence[TaskKey],
-    *,
-    timeout: float | None,
-    on_start: Callable[[TaskKey], None],
-    on_result: Callable[[TaskResult], None],
-    max_memory: int | None = None,
-    stop: Callable[[], bool] | None = None,
-) -> None:
-    """Run ``tasks`` on the cluster at ``scheduler``, reporting each result as it arrives.
+@dataclass(frozen=True)
+class DaskBackend:
+    """The workers of the Dask distributed cluster at ``scheduler``.
 
-    Raises
-    ------
-    ConfigurationError
-        The scheduler cannot be reached.
-    RunStopped
-        ``stop`` returned true (the tasks in flight are cancelled).
+    Parameters
+    ----------
+    scheduler : str
+        The scheduler's address (``tcp://host:port``); it is connected to by :meth:`run`.
+    context : bytes
+        The run's pickled :class:`~benchmark.run.task.TaskContext`, scattered to every
+        Dask worker once.
+    timeout : float or None
+        Seconds one task may take before its worker process is killed; ``None`` for no limit.
+    max_memory : int or None
+        Bytes one task may allocate beyond its worker process's copy of the data.
     """
-    from distributed import Future, as_completed
 
-    from benchmark.run.engine import STOP_POLL, RunStopped
+    scheduler: str
+    context: bytes
+    timeout: float | None
+    max_memory: int | None
 
-    client = connect(scheduler)
-    token = uuid.uuid4().hex
-    try:
-        [data] = client.scatter([context], broadcast=True, hash=False)
-        slots = max(1, sum(client.nthreads().values()))
-        queue = deque(tasks)
-        keys: dict[Future, TaskKey] = {}
+    def run(
+        self,
+        tasks: Sequence[TaskKey],
+        on_start: StartCallback,
+        deliver: ResultCallback,
+        stop: StopCheck,
+    ) -> None:
+        """Run ``tasks`` (see :meth:`benchmark.run.backend.Backend.run`).
 
-        def submit() -> Future:
-            key = queue.popleft()
-            on_start(key)
-            future = client.submit(
-                run_remote_task,
-                data,
-                token,
-                key,
-                timeout,
-                max_memory,
-                pure=False,
-                key=f"touchbench-{token}-{key}",
-            )
-            keys[future] = key
-            return future
-
-        running = as_completed([submit() for _ in range(min(slots, len(queue)))], loop=client.loop)
-        while not running.is_empty():
-            if stop is not None and stop():
-                client.cancel(list(keys))
-                raise RunStopped
-            if not running.has_ready():
-                time.sleep(STOP_POLL / 5 if stop is not None else 0.01)
-                continue
-            for future in running.next_batch(block=False):
-                key = keys.pop(future)
+        Raises
+        ------
+        ConfigurationError
+            The scheduler cannot be reached.
+        RunStopped
+            ``stop`` returned true (the tasks in flight are cancelled, their worker
+            processes killed).
+        """
+        client = connect(self.scheduler)
+        token = uuid.uuid4().hex
+        try:
+            [data] = client.scatter([self.context], broadcast=True, hash=False)
+            slots = max(1, sum(client.nthreads().values()))
+            queue = deque(tasks)
+            in_flight: dict[Future, TaskKey] = {}
+            # Dask calls the callbacks in its own thread; this thread waits on the queue.
+            finished: SimpleQueue[Future] = SimpleQueue()
+            while queue or in_flight:
+                if stop():
+                    client.cancel(list(in_flight))
+                    raise RunStopped
+                while queue and len(in_flight) < slots:
+                    key = queue.popleft()
+                    on_start(key)
+                    future = client.submit(
+                        run_remote_task,
+                        data,
+                        token,
+                        key,
+                        self.timeout,
+                        self.max_memory,
+                        pure=False,
+                        key=f"touchbench-{token}-{key}",
+                    )
+                    in_flight[future] = key
+                    future.add_done_callback(finished.put)
+                try:
+                    future = finished.get(timeout=STOP_POLL)
+                except Empty:
+                    continue
+                key = in_flight.pop(future)
                 try:
                     result = future.result()
                 except BenchmarkError:
                     raise
                 except Exception as exc:
                     result = failed_result(key, "error", f"Dask: {exc}", None)
-                on_result(result)
-                if queue:
-                    running.add(submit())
-    finally:
-        with contextlib.suppress(Exception):
-            client.run(release_remote_workers, token)
-        client.close()
+                deliver(result)
+        finally:
+            with contextlib.suppress(Exception):
+                client.run(release_remote_workers, token)
+            client.close()
 
 
 def run_remote_task(
@@ -165,14 +190,12 @@ def run_remote_task(
                 raise BenchmarkError(payload)
     except WorkerDiedError as died:
         _forget(slot)
-        raise RuntimeError(f"a worker process could not start: {died}") from None
+        raise worker_could_not_start(died) from None
     worker.submit(key, timeout)
-    if not worker.connection.poll(timeout):
+    if timeout is not None and not worker.connection.poll(timeout):
         worker.kill()
         _forget(slot)
-        return failed_result(
-            key, "timeout", f"timed out after {timeout:g} s (worker process killed)", None
-        )
+        return timed_out(key, timeout)
     try:
         kind, payload = worker.receive()
     except WorkerDiedError as died:

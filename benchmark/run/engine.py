@@ -1,16 +1,10 @@
 """The cross-validation engine: every classifier on every fold, in parallel, with time limits.
 
-Tasks (one classifier on one fold) run in worker processes (:mod:`benchmark.run.worker`) that
-each receive the run's data once.  Locally, ``jobs`` workers take tasks from one queue;
-with ``scheduler="tcp://host:port"`` the tasks go to a Dask distributed cluster, where each
-Dask worker thread keeps such a worker process (:mod:`benchmark.run.dask_backend`).
-
-Why our own pool rather than joblib's: a task that overruns its time limit must be
-stopped, native code included, without losing the other workers or their data, and a
-worker that crashes (segfault, out-of-memory kill) must cost one task, not the run.
-joblib can neither cancel one running task nor survive a killed worker without
-restarting its whole pool; here the parent kills that one process group and starts a
-replacement.
+The engine checks the classifier ids, lists the tasks (one classifier on one fold), pickles
+what every task needs once, and hands the tasks to a backend
+(:class:`~benchmark.run.backend.Backend`): ``jobs`` local worker processes
+(:mod:`benchmark.run.local_backend`), or with ``scheduler="tcp://host:port"`` a Dask
+distributed cluster (:mod:`benchmark.run.dask_backend`).
 
 Every finished task is reported at once through ``on_result`` (in the calling process),
 so that the caller can store it; ``skip`` resumes a run without repeating what is done.
@@ -18,21 +12,21 @@ so that the caller can store it; ``skip`` resumes a run without repeating what i
 
 from __future__ import annotations
 
+import math
 import os
 import pickle
-import time
-from collections import deque
 from collections.abc import Callable, Collection, Mapping, Sequence
-from multiprocessing.connection import wait
 
 from benchmark.catalogue import ClassifierSpec
-from benchmark.errors import BenchmarkError, ConfigurationError
+from benchmark.errors import ConfigurationError
 from benchmark.estimators import check_classifier
 from benchmark.problem import Problem
 from benchmark.results import TaskKey, TaskResult
+from benchmark.run.backend import Backend, RunStopped, StartCallback, StopCheck
+from benchmark.run.dask_backend import DaskBackend
 from benchmark.run.folds import Fold
-from benchmark.run.task import TaskContext, failed_result
-from benchmark.run.worker import Worker, WorkerDiedError
+from benchmark.run.local_backend import LocalBackend
+from benchmark.run.task import TaskContext
 
 __all__ = [
     "Problem",
@@ -44,16 +38,9 @@ __all__ = [
     "run_tasks",
 ]
 
-ResultCallback = Callable[[TaskResult], None]
-StartCallback = Callable[[TaskKey], None]
-StopCheck = Callable[[], bool]
-
-#: Seconds between checks of ``stop`` while tasks run.
-STOP_POLL = 0.5
-
-
-class RunStopped(Exception):  # noqa: N818 (a signal, not an error)
-    """``stop`` asked the engine to end the run early; finished tasks were reported."""
+#: Bytes of ``max_memory`` at most: the kernel's limits are signed 64-bit numbers, and a
+#: worker adds what it already uses.
+MAX_MEMORY = 2**62
 
 
 def run_tasks(
@@ -63,11 +50,11 @@ def run_tasks(
     *,
     jobs: int = 1,
     scheduler: str | None = None,
-    timeout: float | None = 600.0,
+    timeout: float | None,
     random_state: int = 0,
     skip: Collection[TaskKey] = (),
     on_start: StartCallback | None = None,
-    on_result: ResultCallback | None = None,
+    on_result: Callable[[TaskResult], None] | None = None,
     extra_specs: Mapping[str, ClassifierSpec] | None = None,
     max_memory: int | None = None,
     stop: StopCheck | None = None,
@@ -90,6 +77,7 @@ def run_tasks(
         Address of a Dask distributed scheduler (``tcp://host:port``) to run on instead.
     timeout : float or None
         Seconds one task may take before its worker is killed; ``None`` for no limit.
+        Required: the caller's request owns its default.
     random_state : int
         Seed of every classifier.
     skip : collection of TaskKey
@@ -105,8 +93,9 @@ def run_tasks(
         Bytes of memory one task may allocate beyond its worker's copy of the data; a task
         that needs more fails with an ``error`` result saying so.
     stop : callable, optional
-        Checked about twice a second; when it returns true, running tasks are killed and
-        :class:`RunStopped` is raised (the results reported so far stand).
+        Cheap (such as ``threading.Event().is_set``); checked about ten times a second
+        while tasks run.  When it returns true, running tasks are killed, no task starts
+        any more and :class:`RunStopped` is raised (the results reported so far stand).
 
     Returns
     -------
@@ -123,11 +112,8 @@ def run_tasks(
     RunStopped
         ``stop`` returned true.
     """
+    check_limits(jobs=jobs, timeout=timeout, max_memory=max_memory)
     specs, tasks = plan_tasks(problem, classifiers, folds, skip=skip, extra_specs=extra_specs)
-    if timeout is not None and not timeout > 0:
-        raise ConfigurationError(f"timeout must be a positive number of seconds, got {timeout}")
-    if max_memory is not None and max_memory <= 0:
-        raise ConfigurationError(f"max_memory must be a positive number of bytes, got {max_memory}")
     if not tasks:
         return []
     context = pickle.dumps(
@@ -148,24 +134,35 @@ def run_tasks(
         if on_result is not None:
             on_result(result)
 
-    started = on_start or _ignore
+    backend: Backend
     if scheduler:
-        from benchmark.run.dask_backend import run_on_dask
-
-        run_on_dask(
-            scheduler,
-            context,
-            tasks,
-            timeout=timeout,
-            on_start=started,
-            on_result=deliver,
-            max_memory=max_memory,
-            stop=stop,
-        )
+        backend = DaskBackend(scheduler, context, timeout=timeout, max_memory=max_memory)
     else:
-        pool = _LocalPool(context, _worker_count(jobs, len(tasks)), max_memory)
-        pool.run(tasks, timeout, started, deliver, stop)
+        workers = available_cores() if jobs == -1 else jobs
+        backend = LocalBackend(context, workers=workers, timeout=timeout, max_memory=max_memory)
+    backend.run(tasks, on_start or _ignore, deliver, stop or _never)
     return [results[key] for key in tasks if key in results]
+
+
+def check_limits(*, jobs: int, timeout: float | None, max_memory: int | None) -> None:
+    """Refuse limits no run can have, naming the parameter.
+
+    Raises
+    ------
+    ConfigurationError
+        ``jobs`` below 1 (other than -1), ``timeout`` not a positive finite number of
+        seconds, ``max_memory`` not a positive number of bytes up to :data:`MAX_MEMORY`.
+    """
+    if jobs != -1 and jobs < 1:
+        raise ConfigurationError(f"jobs must be a positive number of processes or -1, got {jobs}")
+    if timeout is not None and not (timeout > 0 and math.isfinite(timeout)):
+        raise ConfigurationError(
+            f"timeout must be a positive, finite number of seconds or None, got {timeout}"
+        )
+    if max_memory is not None and not 0 < max_memory <= MAX_MEMORY:
+        raise ConfigurationError(
+            f"max_memory must be a positive number of bytes up to 2**62, got {max_memory}"
+        )
 
 
 def plan_tasks(
@@ -215,105 +212,12 @@ def available_cores() -> int:
         return os.cpu_count() or 1
 
 
-def _worker_count(jobs: int, n_tasks: int) -> int:
-    if jobs == -1:
-        jobs = available_cores()
-    if jobs < 1:
-        raise ConfigurationError(f"jobs must be a positive number of processes or -1, got {jobs}")
-    return min(jobs, n_tasks)
-
-
-class _LocalPool:
-    """``n_workers`` local worker processes, one task each at a time.
-
-    A worker that dies or overruns its task's time limit is replaced while tasks remain.
-    """
-
-    def __init__(self, context: bytes, n_workers: int, max_memory: int | None) -> None:
-        self.context = context
-        self.n_workers = n_workers
-        self.max_memory = max_memory
-
-    def _spawn(self) -> Worker:
-        return Worker(self.context, max_memory=self.max_memory)
-
-    def run(
-        self,
-        tasks: Sequence[TaskKey],
-        timeout: float | None,
-        on_start: StartCallback,
-        deliver: ResultCallback,
-        stop: StopCheck | None,
-    ) -> None:
-        queue = deque(tasks)
-        pool = [self._spawn() for _ in range(self.n_workers)]
-        try:
-            while queue or any(w.task is not None for w in pool):
-                if stop is not None and stop():
-                    raise RunStopped
-                for worker in pool:
-                    if worker.ready and worker.task is None and queue:
-                        key = queue.popleft()
-                        on_start(key)
-                        worker.submit(key, timeout)
-                wait_for = _time_left(pool)
-                if stop is not None:
-                    wait_for = STOP_POLL if wait_for is None else min(wait_for, STOP_POLL)
-                arrived = wait([w.connection for w in pool], timeout=wait_for)
-                survivors = []
-                for worker in pool:
-                    alive = worker.connection not in arrived or _take_message(worker, deliver)
-                    task = worker.task
-                    if alive and task is not None and _past_deadline(worker):
-                        worker.kill()
-                        deliver(failed_result(task, "timeout", _timeout_message(timeout), None))
-                        alive = False
-                    if alive:
-                        survivors.append(worker)
-                        continue
-                    worker.close()
-                    if queue:
-                        survivors.append(self._spawn())
-                pool = survivors
-        finally:
-            for worker in pool:
-                worker.close()
-
-
-def _take_message(worker: Worker, deliver: ResultCallback) -> bool:
-    """Handle one message of ``worker``; ``False`` if the worker has died."""
-    try:
-        kind, payload = worker.receive()
-    except WorkerDiedError as died:
-        if worker.task is None and not worker.ready:
-            raise RuntimeError(f"a worker process could not start: {died}") from None
-        if worker.task is not None:
-            deliver(failed_result(worker.task, "error", str(died), None))
-        return False
-    if kind == "result":
-        deliver(payload)
-    elif kind == "broken":
-        raise BenchmarkError(payload)
-    return True
-
-
-def _past_deadline(worker: Worker) -> bool:
-    return worker.deadline is not None and time.monotonic() >= worker.deadline
-
-
-def _time_left(workers: Sequence[Worker]) -> float | None:
-    deadlines = [w.deadline for w in workers if w.task is not None and w.deadline is not None]
-    if not deadlines:
-        return None
-    return max(0.0, min(deadlines) - time.monotonic())
-
-
-def _timeout_message(timeout: float | None) -> str:
-    return f"timed out after {timeout:g} s (worker process killed)"
-
-
 def _ignore(key: TaskKey) -> None:
     return None
+
+
+def _never() -> bool:
+    return False
 
 
 def _looks_out_of_memory(error: str | None) -> bool:

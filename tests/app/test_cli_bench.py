@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import os
 import signal
 import subprocess
@@ -19,6 +20,7 @@ from app.store.datasets import add_dataset, dataset_digest
 from benchmark.io.arff import loads_arff
 from tests.app.cli_runner import run_cli
 from tests.app.synthetic import touch_arff
+from tests.gate import Gate
 
 METRIC_KEYS = {
     "accuracy",
@@ -207,48 +209,40 @@ def test_a_killed_run_resumes_without_repeating_or_duplicating(
     capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
 ) -> None:
     imported(capsys, store_url, touch_arff(tmp_path / "touch.arff", n=300))
-    command = [
-        sys.executable,
-        "-m",
-        "app.cli.main",
-        "--db",
-        store_url,
-        "bench",
-        "touch",
-        "--target",
-        "gesture",
-        "--classifiers",
-        "zeror,mlp,rf,nb",
-        "--folds",
-        "10",
-        "--json",
-    ]
-    child = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    gate = Gate(tmp_path / "gate")  # its fits wait for the test: killed after exactly 13 tasks
+    environment = {**os.environ, **gate.environment()}
+    bench = [sys.executable, "-m", "app.cli.main", "--db", store_url, "bench"]
+    command = [*bench, "touch", "--target", "gesture", "-c", "zeror,gate,nb", "--folds", "10"]
+    child = subprocess.Popen(
+        command, env=environment, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE
+    )
+    gate.let_through(3)
     deadline = time.monotonic() + 120
-    while _count(store_url, "SELECT count(*) FROM fold_results") < 3:
+    while _count(store_url, "SELECT count(*) FROM fold_results") < 13:
         assert child.poll() is None, child.stderr.read().decode() if child.stderr else ""
         assert time.monotonic() < deadline, "the run recorded nothing in two minutes"
         time.sleep(0.05)
+    gate.wait_started(4)
     os.kill(child.pid, signal.SIGKILL)
     child.wait()
-    done_before = _count(store_url, "SELECT count(*) FROM fold_results")
-    assert 3 <= done_before < 40
+    assert _count(store_url, "SELECT count(*) FROM fold_results") == 13
     first_ids = _count(store_url, "SELECT max(id) FROM fold_results")
 
-    resumed = run_cli(capsys, store_url, "bench", "--resume", "1", "--json")
-    assert resumed.code == 0, resumed.err
-    assert _count(store_url, "SELECT count(*) FROM fold_results") == 40
+    gate.open()
+    resumed = subprocess.run(
+        [*bench, "--resume", "1", "--json"], env=environment, capture_output=True, timeout=600
+    )
+    assert resumed.returncode == 0, resumed.stderr.decode()
+    assert _count(store_url, "SELECT count(*) FROM fold_results") == 30
     distinct = _count(
         store_url,
         "SELECT count(*) FROM (SELECT DISTINCT classifier, repeat, fold FROM fold_results) t",
     )
-    assert distinct == 40
+    assert distinct == 30
     # rows written before the kill are kept, not rewritten
-    assert _count(store_url, f"SELECT count(*) FROM fold_results WHERE id <= {first_ids}") == (
-        done_before
-    )
-    board = resumed.json()["leaderboard"]
-    assert {row["classifier"] for row in board} == {"zeror", "mlp", "rf", "nb"}
+    assert _count(store_url, f"SELECT count(*) FROM fold_results WHERE id <= {first_ids}") == 13
+    board = json.loads(resumed.stdout)["leaderboard"]
+    assert {row["classifier"] for row in board} == {"zeror", "gate", "nb"}
     assert all(row["n_ok"] == 10 for row in board)
 
 

@@ -21,6 +21,7 @@ from app.store.database import Store
 from app.store.models import list_models
 from tests.app.cli_runner import run_cli
 from tests.app.synthetic import touch_arff
+from tests.gate import Gate
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -43,9 +44,24 @@ def _import(capsys: pytest.CaptureFixture[str], url: str, path: Path, name: str)
     assert result.code == 0, result.err
 
 
-def _bench_process(url: str, *args: str) -> subprocess.Popen[bytes]:
+def _bench_process(
+    url: str, gate: Gate, *args: str, ignore_sigint: bool = False
+) -> subprocess.Popen[bytes]:
+    """``touchbench bench`` in a subprocess that knows the ``gate`` entry; with
+    ``ignore_sigint`` it starts as a background job of a script does, SIGINT ignored."""
     command = [sys.executable, "-m", "app.cli.main", "--db", url, "bench", *args]
-    return subprocess.Popen(command, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+
+    def ignore() -> None:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    return subprocess.Popen(
+        command,
+        cwd=ROOT,
+        env={**os.environ, **gate.environment()},
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        preexec_fn=ignore if ignore_sigint else None,
+    )
 
 
 def _wait_for_results(url: str, child: subprocess.Popen[bytes], at_least: int) -> None:
@@ -56,28 +72,53 @@ def _wait_for_results(url: str, child: subprocess.Popen[bytes], at_least: int) -
         time.sleep(0.05)
 
 
-SLOW = ["--target", "gesture", "--classifiers", "zeror,mlp,rf,nb", "--folds", "10"]
+#: 10 tasks of the gate entry: each fit waits until the test lets it through.
+GATED = ["--target", "gesture", "--classifiers", "gate", "--folds", "10"]
 
 
-def test_ctrl_c_exits_130_keeps_the_folds_and_resume_finishes(
-    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+@pytest.mark.parametrize(
+    ("sig", "ignore_sigint", "code"),
+    [
+        (signal.SIGINT, False, 130),
+        (signal.SIGINT, True, 130),  # a script's `touchbench bench ... &`: SIGINT ignored
+        (signal.SIGTERM, False, 143),
+    ],
+    ids=["ctrl-c", "ctrl-c-in-background", "sigterm"],
+)
+def test_an_interrupt_keeps_the_folds_and_resume_finishes(
+    capsys: pytest.CaptureFixture[str],
+    store_url: str,
+    tmp_path: Path,
+    sig: signal.Signals,
+    ignore_sigint: bool,
+    code: int,
 ) -> None:
     _import(capsys, store_url, touch_arff(tmp_path / "t.arff", n=300), "touch")
-    child = _bench_process(store_url, "touch", *SLOW)
+    gate = Gate(tmp_path / "gate")
+    child = _bench_process(store_url, gate, "touch", *GATED, ignore_sigint=ignore_sigint)
+    gate.let_through(3)
     _wait_for_results(store_url, child, 3)
-    child.send_signal(signal.SIGINT)
+    gate.wait_started(4)  # the fourth task waits at the gate: the signal comes mid-task
+    child.send_signal(sig)
     _, err = child.communicate(timeout=60)
     message = err.decode()
-    assert child.returncode == 130, message
+    assert child.returncode == code, message
     assert "run 1 interrupted" in message and "touchbench bench --resume 1" in message
     assert "Traceback" not in message
     assert _scalar(store_url, "SELECT status FROM runs WHERE id = 1") == "interrupted"
-    kept = _scalar(store_url, "SELECT count(*) FROM fold_results")
-    assert f"{kept} of 40 tasks are stored" in message
-    resumed = run_cli(capsys, store_url, "bench", "--resume", "1", "--json")
-    assert resumed.code == 0, resumed.err
-    assert resumed.json()["status"] == "done"
-    assert _scalar(store_url, "SELECT count(*) FROM fold_results") == 40
+    assert _scalar(store_url, "SELECT count(*) FROM fold_results") == 3
+    assert "3 of 10 tasks are stored" in message
+    gate.open()
+    resumed = subprocess.run(
+        [sys.executable, "-m", "app.cli.main", "--db", store_url, "bench", "--resume", "1"],
+        cwd=ROOT,
+        env={**os.environ, **gate.environment()},
+        capture_output=True,
+        timeout=300,
+    )
+    assert resumed.returncode == 0, resumed.stderr.decode()
+    assert _scalar(store_url, "SELECT status FROM runs WHERE id = 1") == "done"
+    assert _scalar(store_url, "SELECT count(*) FROM fold_results") == 10
 
 
 def test_a_run_whose_every_task_fails_is_failed_and_says_why(
@@ -119,9 +160,12 @@ def test_a_running_run_is_not_resumed_twice_and_can_be_cancelled(
     capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
 ) -> None:
     _import(capsys, store_url, touch_arff(tmp_path / "t.arff", n=300), "touch")
-    child = _bench_process(store_url, "touch", *SLOW, "--repeats", "3")
+    gate = Gate(tmp_path / "gate")
+    child = _bench_process(store_url, gate, "touch", *GATED)
     try:
+        gate.let_through(2)
         _wait_for_results(store_url, child, 2)
+        gate.wait_started(3)
         second = run_cli(capsys, store_url, "bench", "--resume", "1")
         assert second.code == 2
         assert "run 1 is being executed by" in second.err and "touchbench cancel 1" in second.err
@@ -132,7 +176,7 @@ def test_a_running_run_is_not_resumed_twice_and_can_be_cancelled(
         if child.poll() is None:
             child.kill()
     assert child.returncode == 1, err.decode()
-    assert "run 1 cancelled" in err.decode()
+    assert "run 1 cancelled: 2 of 10 tasks are stored" in err.decode()
     assert _scalar(store_url, "SELECT status FROM runs WHERE id = 1") == "cancelled"
     again = run_cli(capsys, store_url, "cancel", "1")
     assert again.code == 2 and "already cancelled" in again.err

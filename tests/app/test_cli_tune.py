@@ -84,10 +84,10 @@ def test_a_stack_records_the_members_each_fold_chose(
 @pytest.mark.parametrize(
     ("extra", "words"),
     [
-        (["--tune", "--budget", "0"], "--budget must be more than 0"),
+        (["--tune", "--budget", "0"], "`budget` must be more than 0"),
         (["--tune", "--budget", "2000"], "at most 1440"),
         (["--budget", "1"], "give --tune as well"),
-        (["--stack", "0"], "--stack must be between 1 and 20"),
+        (["--stack", "0"], "`stack` must be between 1 and 20"),
         (["--stack", "3"], "needs at least 3 classifiers"),
     ],
 )

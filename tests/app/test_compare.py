@@ -9,8 +9,7 @@ from pathlib import Path
 import pytest
 
 from app.errors import NotFoundError
-from app.schemas.compare import ComparisonOut
-from app.services.compare import compare_runs
+from app.services.compare import compare_runs, comparison_schema
 from app.store.database import Store
 from app.store.datasets import add_dataset, dataset_digest
 from app.store.runs import create_run, finish_run, record_result
@@ -93,7 +92,7 @@ def test_demsar_example_from_stored_runs(store: Store, tmp_path: Path) -> None:
     assert dropped_block.ranks.n_blocks == 13
     assert dropped_block.completed.dropped_blocks == ["d3 (gesture)"]
 
-    data = ComparisonOut.of(worst).to_json()
+    data = comparison_schema(worst).to_json()
     svm = next(c for c in data["classifiers"] if c["classifier"] == "svm")
     assert svm["mean_score"] is None  # an infinite stand-in is no score
     assert svm["scores"]["d3 (gesture)"] is None and svm["scores"]["d0 (gesture)"] == 0.5

@@ -11,7 +11,7 @@ from typing import Any
 import pytest
 from fastapi.testclient import TestClient
 
-from app.api.main import create_app
+from app.main import create_app
 from app.settings import Settings
 from tests.app.cli_runner import run_cli
 from tests.app.synthetic import position_arff, touch_arff

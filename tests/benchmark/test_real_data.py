@@ -28,7 +28,7 @@ def test_random_forest_beats_zeror_on_mini_gestures(shared_datasets: Path) -> No
     )
     folds, notes = make_folds(problem.Y, n_folds=3, seed=1)
     assert notes == []
-    results = run_tasks(problem, ["rf", "zeror"], folds, jobs=2)
+    results = run_tasks(problem, ["rf", "zeror"], folds, jobs=2, timeout=600)
     assert [r.status for r in results] == ["ok"] * 6
     board = build_leaderboard(results)
     assert [row.classifier for row in board.rows] == ["rf", "zeror"]

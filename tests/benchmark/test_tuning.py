@@ -116,11 +116,11 @@ def test_entries_without_space_and_budgets_out_of_range_are_refused() -> None:
     with pytest.raises(ConfigurationError, match="no search space"):
         get_spec("nb+tuned")
     for budget in (0.0, -1.0, 5000.0, math.nan):
-        with pytest.raises(ConfigurationError, match="--budget"):
+        with pytest.raises(ConfigurationError, match="`budget` must be more than 0"):
             tuned_spec(get_spec("logistic"), budget)
-    with pytest.raises(ConfigurationError, match="--stack"):
+    with pytest.raises(ConfigurationError, match="a stack of the top 2 needs at least 2"):
         stacked_spec([get_spec("nb")], 2)
-    with pytest.raises(ConfigurationError, match="--stack"):
+    with pytest.raises(ConfigurationError, match="`stack` must be between 1 and"):
         stacked_spec([get_spec("nb")], 0)
 
 

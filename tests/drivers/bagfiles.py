@@ -39,10 +39,11 @@ def write_audio_bag(
     audio_delay: float = 0.25,
     extra_topic: bool = True,
     with_definitions: bool = True,
+    twin_topic: str | None = None,
 ) -> Path:
     """A bag at ``path`` (.bag: ROS 1; .mcap or .db3: a ROS 2 bag folder of that storage)
-    holding ``samples`` on ``topic``; the first message, on ``/status``, comes
-    ``audio_delay`` seconds before the audio."""
+    holding ``samples`` on ``topic`` (and on ``twin_topic`` too, if given); the first
+    message, on ``/status``, comes ``audio_delay`` seconds before the audio."""
     store = audio_typestore()
     types = store.types
     ros1 = path.suffix == ".bag"
@@ -62,6 +63,9 @@ def write_audio_bag(
         writer = Writer(path.with_suffix(""), version=9, storage_plugin=plugin)
     with writer as bag:  # type: ignore[attr-defined]
         audio = None if topic is None else bag.add_connection(topic, data_type, typestore=store)
+        twin = None
+        if twin_topic is not None:
+            twin = bag.add_connection(twin_topic, data_type, typestore=store)
         if extra_topic:
             status = bag.add_connection("/status", "std_msgs/msg/String", typestore=store)
             bag.write(
@@ -95,6 +99,8 @@ def write_audio_bag(
                 )
                 payload = types[data_type](header=header, audio=payload)
             bag.write(audio, stamp, serialize(payload, data_type))
+            if twin is not None:
+                bag.write(twin, stamp, serialize(payload, data_type))
     if ros1:
         return path
     folder = path.with_suffix("")

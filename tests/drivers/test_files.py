@@ -43,7 +43,7 @@ def test_csv_with_a_time_column_gives_the_rate(tmp_path: Path) -> None:
 def test_csv_without_time_needs_a_samplerate(tmp_path: Path) -> None:
     path = tmp_path / "plain.csv"
     path.write_text("1,2\n3,4\n5,6\n")
-    with pytest.raises(DriverError, match="no sample rate: give samplerate="):
+    with pytest.raises(DriverError, match="no sample rate: give `samplerate` for a file"):
         read_recording(path)
     recording = read_recording(path, samplerate=100)
     assert np.array_equal(recording.samples, [[1, 3, 5], [2, 4, 6]])

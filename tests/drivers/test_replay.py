@@ -12,6 +12,7 @@ import soundfile
 from drivers.errors import DriverError
 from drivers.files import read_recording
 from drivers.replay import FileReplaySource
+from tests.drivers.bagfiles import write_audio_bag
 
 
 def _joined(source: FileReplaySource) -> np.ndarray:
@@ -95,8 +96,23 @@ def test_rates_and_topics_that_do_not_apply(tmp_path: Path) -> None:
     soundfile.write(path, np.zeros((100, 1)), 8000)
     with pytest.raises(DriverError, match="sampled at 8000 Hz, but samplerate=16000"):
         FileReplaySource(path, samplerate=16000)
-    with pytest.raises(DriverError, match="--topic applies to ROS bags only"):
+    with pytest.raises(DriverError, match="`topic` applies to ROS bags only"):
         FileReplaySource(path, topic="/audio")
     np.save(tmp_path / "b.npy", np.zeros(10))
     with pytest.raises(DriverError, match="no sample rate"):
         FileReplaySource(tmp_path / "b.npy")
+
+
+def test_a_bag_with_several_audio_topics_asks_for_one(tmp_path: Path) -> None:
+    samples = np.zeros((1, 2048))
+    bag = write_audio_bag(tmp_path / "two.mcap", samples, 8000, twin_topic="/audio/twin")
+    with pytest.raises(DriverError) as error:
+        FileReplaySource(bag)
+    assert str(error.value).endswith(
+        "several audio topics (/audio/audio, /audio/twin); choose one as `topic`"
+    )
+    chosen = FileReplaySource(bag, topic="/audio/twin")
+    try:
+        assert (chosen.samplerate, chosen.n_channels) == (8000, 1)
+    finally:
+        chosen.close()

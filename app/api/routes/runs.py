@@ -11,9 +11,8 @@ from pydantic import Field
 from app.api.deps import ServiceDep, StoreDep
 from app.schemas.base import Schema
 from app.schemas.runs import LeaderboardSchema, RunCreated, RunList, RunSchema
-from app.services.jobs import requeue_run
 from app.services.runs import RunOptions, create_run, leaderboard_schema
-from app.store.runs import get_run, list_runs, request_cancel
+from app.store.runs import get_run, list_runs, request_cancel, requeue_run
 
 router = APIRouter(prefix="/api/runs", tags=["runs"])
 
@@ -93,7 +92,8 @@ def run(run_id: int, store: StoreDep) -> RunSchema:
 
 @router.post("/{run_id}/cancel", response_model=RunSchema)
 def cancel(run_id: int, store: StoreDep) -> RunSchema:
-    """Cancel a queued run at once, a running one within seconds; finished folds stay."""
+    """Cancel a queued run at once; a running one becomes ``cancelling`` and stops within
+    about half a second. Finished folds stay."""
     return request_cancel(store, run_id).schema()
 
 

@@ -9,9 +9,9 @@ from typing import Annotated
 from fastapi import APIRouter, Query
 from fastapi.responses import HTMLResponse
 
-from app.api.deps import StoreDep
 from app.errors import AppError
 from app.store.runs import list_runs
+from app.web.deps import StoreDep
 from app.web.rendering import draw, render
 from benchmark.errors import BenchmarkError
 

@@ -5,10 +5,10 @@ from __future__ import annotations
 from fastapi import APIRouter
 from fastapi.responses import HTMLResponse
 
-from app.api.deps import StoreDep
 from app.schemas.runs import FINAL_STATUSES
 from app.store.jobs import list_jobs
 from app.store.models import get_model, list_models
+from app.web.deps import StoreDep
 from app.web.rendering import render
 from app.web.routes.pages import Ref
 from benchmark.dataset import Schema

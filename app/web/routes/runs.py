@@ -10,13 +10,13 @@ from typing import TYPE_CHECKING, Annotated, Any
 from fastapi import APIRouter, Query
 from fastapi.responses import HTMLResponse
 
-from app.api.deps import StoreDep
 from app.errors import NotFoundError
 from app.reports.run_tables import run_tables
 from app.schemas.runs import FINAL_STATUSES
 from app.services.datasets import list_datasets
 from app.services.runs import leaderboard_schema
 from app.store.runs import RunInfo, get_run, list_runs
+from app.web.deps import StoreDep
 from app.web.rendering import draw, render
 from app.web.routes.pages import Ref
 from benchmark.errors import ConfigurationError

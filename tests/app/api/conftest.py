@@ -17,6 +17,8 @@ from typing import Any
 import httpx
 import pytest
 
+from tests.gate import Gate
+
 ROOT = Path(__file__).resolve().parents[3]
 
 
@@ -37,6 +39,7 @@ class Server:
     process: subprocess.Popen[bytes] | None = None
     log: Path | None = None
     arguments: tuple[str, ...] = ()
+    gate: Gate | None = None
     client: httpx.Client = field(init=False)
 
     def start(self, *, timeout: float = 120.0) -> None:
@@ -116,9 +119,10 @@ def _servers(database_url: str, tmp_path: Path) -> Iterator[Callable[..., Server
     servers: list[Server] = []
 
     def build(*, arguments: tuple[str, ...] = (), **settings: str) -> Server:
+        gate = Gate(tmp_path / "gate")  # the `gate` entry waits for the test (tests/gate.py)
         environment = {
             **os.environ,
-            "PYTHONPATH": str(ROOT),
+            **gate.environment(),
             "TOUCHBENCH_WORK_DIR": str(tmp_path / "work"),
             "TOUCHBENCH_JOB_WORKERS": "2",
             **{f"TOUCHBENCH_{key.upper()}": value for key, value in settings.items()},
@@ -131,6 +135,7 @@ def _servers(database_url: str, tmp_path: Path) -> Iterator[Callable[..., Server
             environment=environment,
             log=tmp_path / f"service-{len(servers)}.log",
             arguments=arguments,
+            gate=gate,
         )
         servers.append(server)
         server.start()

@@ -140,28 +140,33 @@ def test_cancel_and_resume_over_http(
     capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path
 ) -> None:
     _import(capsys, server.database_url, touch_arff(tmp_path / "t.arff", n=300), "touch")
-    api = server.client
+    api, gate = server.client, server.gate
+    assert gate is not None
     run_id = api.post(
         "/api/runs",
         json={
             "dataset": "touch",
             "target": "gesture",
-            "classifiers": ["mlp", "rf", "nb"],
+            "classifiers": ["gate"],
             "folds": 10,
             "repeats": 2,
         },
     ).json()["id"]
+    gate.let_through(1)
     server.wait_for(f"/api/runs/{run_id}", lambda body: body["tasks_done"] >= 1)
+    gate.wait_started(2)  # the second task waits at the gate while the cancel comes
     cancelled = api.post(f"/api/runs/{run_id}/cancel")
-    assert cancelled.status_code == 200
+    assert (cancelled.status_code, cancelled.json()["status"]) == (200, "cancelling")
     run = server.wait_for(f"/api/runs/{run_id}", finished)
-    assert run["status"] == "cancelled" and run["tasks_done"] < 60
+    assert (run["status"], run["tasks_done"]) == ("cancelled", 1)
     resumed = api.post(f"/api/runs/{run_id}/resume")
     assert resumed.status_code == 202 and resumed.json()["status"] == "queued"
+    gate.open()
     run = server.wait_for(f"/api/runs/{run_id}", finished, timeout=600)
-    assert (run["status"], run["tasks_done"]) == ("done", 60)
-    again = api.post(f"/api/runs/{run_id}/resume")
-    assert again.status_code == 409 and again.json()["error"]["type"] == "ConflictError"
+    assert (run["status"], run["tasks_done"]) == ("done", 20)
+    for refused in ("resume", "cancel"):
+        again = api.post(f"/api/runs/{run_id}/{refused}")
+        assert again.status_code == 409 and again.json()["error"]["type"] == "ConflictError"
 
 
 def test_a_tuned_and_stacked_run_over_http_is_the_clis(

@@ -17,8 +17,8 @@ from pydantic import SecretStr
 
 from app.api.deps import ServiceDep, StoreDep, require_api_key
 from app.api.direct import DirectRoute
-from app.api.main import create_app
 from app.api.routes.models import predict_instances
+from app.main import create_app
 from app.schemas.datasets import ImportRequest
 from app.schemas.models import PredictionReport, PredictRequest, TrainRequest
 from app.services.datasets import import_file

@@ -13,7 +13,7 @@ import pytest
 from fastapi.testclient import TestClient
 
 from app.api.deps import INLINE_SECONDS, ModelCache, request_size
-from app.api.main import create_app
+from app.main import create_app
 from app.schemas.datasets import ImportRequest
 from app.schemas.models import TrainRequest
 from app.services.datasets import import_file

@@ -1,0 +1,70 @@
+"""The touchbench service: wiring only (settings, store, dispatcher, the JSON API, the web
+page).
+
+``uvicorn --factory app.main:create_app`` or ``touchbench serve``.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import AsyncIterator
+from contextlib import asynccontextmanager
+from importlib import metadata
+
+from fastapi import Depends, FastAPI
+
+from app.api import main as api
+from app.api.deps import ModelCache, Service, require_api_key
+from app.jobs.dispatcher import Dispatcher
+from app.settings import Settings, get_settings
+from app.store.database import Store
+from app.store.jobs import mark_lost_jobs
+from app.store.runs import finish_run, get_run, mark_lost_runs
+from app.web.site import install as install_web_page
+
+
+def _warm_up() -> None:
+    """Import the machine-learning stack in the background, so that start-up is quick and
+    the first prediction does not pay for the imports."""
+    import app.services.models  # noqa: F401
+    import benchmark.model  # noqa: F401
+
+
+def create_app(settings: Settings | None = None) -> FastAPI:
+    """The FastAPI application for ``settings`` (default: from the environment)."""
+    settings = settings or get_settings()
+
+    @asynccontextmanager
+    async def lifespan(app: FastAPI) -> AsyncIterator[None]:
+        store = Store(settings.database_url)
+        lost = mark_lost_runs(store)
+        mark_lost_jobs(store)
+        if settings.resume_on_start:  # runs their process left; not those being cancelled
+            for run_id in lost:
+                if get_run(store, run_id).status == "interrupted":
+                    finish_run(store, run_id, "queued")
+        settings.work_dir.mkdir(parents=True, exist_ok=True)
+        dispatcher = Dispatcher(store, settings)
+        app.state.service = Service(settings, store, dispatcher, ModelCache(settings.model_cache))
+        dispatcher.start()
+        threading.Thread(target=_warm_up, daemon=True, name="warm-up").start()
+        try:
+            yield
+        finally:
+            dispatcher.stop()
+            app.state.service.models.close()
+            store.dispose()
+
+    app = FastAPI(
+        title="touchbench",
+        version=metadata.version("touchbench"),
+        summary=(
+            "Benchmark classifiers for robot touch sensing: data sets, recording-session "
+            "uploads, cross-validation runs with WEKA's statistics, models and live "
+            "predictions."
+        ),
+        lifespan=lifespan,
+    )
+    api.install(app, settings)
+    install_web_page(app, dependencies=[Depends(require_api_key)])
+    return app

@@ -1,0 +1,104 @@
+"""The life of a run: which status may become which, and what a request that does not fit
+the run's state is told (a :class:`~app.errors.ConflictError`, HTTP 409, exit 2).
+
+::
+
+    queued ──claim──► running ──► done | failed
+      │                 │  └─(process lost, Ctrl-C, SIGTERM)──► interrupted
+      │                 └─cancel──► cancelling ──(the process stops)──► cancelled
+      └─cancel──► cancelled
+    interrupted | cancelled | failed ──resume──► queued
+
+A run is *active* while a process executes it (``running``, ``cancelling``); a cancel of an
+active run asks its process to stop (status ``cancelling`` until it has), a cancel of any
+other unfinished run takes effect at once.  Every rule about these changes lives here; the
+store's functions (:mod:`app.store.runs`) apply them.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from app.errors import ConflictError
+
+if TYPE_CHECKING:
+    from app.store.runs import RunInfo
+
+#: A process executes the run.
+ACTIVE: frozenset[str] = frozenset({"running", "cancelling"})
+#: Over: nothing runs and nothing will unless it is resumed.
+FINISHED: frozenset[str] = frozenset({"done", "failed", "cancelled", "interrupted"})
+#: What a resume puts back in the queue.
+RESUMABLE: frozenset[str] = frozenset({"interrupted", "cancelled", "failed"})
+#: What a process whose owner died leaves: a running run is interrupted, a run being
+#: cancelled is cancelled (its process stopped, as asked).
+LOST_AS: dict[str, str] = {"running": "interrupted", "cancelling": "cancelled"}
+
+
+class RunBusy(ConflictError):  # noqa: N818 (a state, like ConflictError's other cases)
+    """Another live process executes the run."""
+
+    def __init__(self, run: RunInfo) -> None:
+        super().__init__(
+            f"run {run.id} is being executed by {run.owner} (heard from "
+            f"{run.seconds_since_heartbeat():.0f} s ago); wait for it to end or cancel it"
+        )
+        self.run_id = run.id
+
+
+def is_active(run: RunInfo) -> bool:
+    """Whether a live process executes the run."""
+    return run.status in ACTIVE and run.owner_alive()
+
+
+def check_claim(run: RunInfo, owner: str) -> None:
+    """Refuse to let ``owner`` execute a run that another live process executes or that is
+    being cancelled.
+
+    Raises
+    ------
+    RunBusy
+        Another live process executes it.
+    ConflictError
+        It is being cancelled.
+    """
+    if run.status == "cancelling" and run.owner_alive():
+        raise ConflictError(f"run {run.id} is being cancelled; resume it once it is cancelled")
+    if run.status == "running" and run.owner != owner and run.owner_alive():
+        raise RunBusy(run)
+
+
+def cancel_outcome(run: RunInfo) -> str:
+    """What a cancel does to the run: ``cancelling`` (its process is asked to stop),
+    ``cancelled`` (at once), or ``unchanged`` (a cancel already asked).
+
+    Raises
+    ------
+    ConflictError
+        The run is done, failed or already cancelled.
+    """
+    if run.status in ("done", "failed", "cancelled"):
+        raise ConflictError(f"run {run.id} is already {run.status}; nothing to cancel")
+    if run.status == "cancelling" and run.owner_alive():
+        return "unchanged"
+    return "cancelling" if is_active(run) else "cancelled"
+
+
+def check_resume(run: RunInfo) -> None:
+    """Refuse to queue again a run that is queued, executing, being cancelled or done.
+
+    Raises
+    ------
+    ConflictError
+    """
+    if run.status == "cancelling" and run.owner_alive():
+        raise ConflictError(
+            f"run {run.id} is being cancelled; resume it once it is cancelled (its process "
+            "stops within a second)"
+        )
+    if run.status == "running" and run.owner_alive():
+        raise ConflictError(f"run {run.id} is running; nothing to resume")
+    if run.status == "done":
+        raise ConflictError(f"run {run.id} is done; nothing to resume")
+    if run.status == "queued":
+        raise ConflictError(f"run {run.id} is queued already; it starts when a worker is free")

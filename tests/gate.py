@@ -1,0 +1,132 @@
+"""A classifier whose fit waits for the test: interrupt tests that do not race the machine.
+
+A test that cancels or interrupts a run "after the first task" cannot rely on the run
+lasting long enough: a fast machine finishes it first, a slow one not at all.  The ``gate``
+entry's fit waits until the test lets it through, so a test decides exactly how many tasks
+finish before it acts, on any machine.
+
+It reaches every process of touchbench (the CLI, a service, its job and worker processes)
+as a plugin (:mod:`benchmark.catalogue.plugins`): :meth:`Gate.environment` gives the
+variables a subprocess needs.  Each fit takes one *pass* (a file the test writes; renaming
+it is atomic, so two workers never take the same one) or goes through at once when the gate
+is open, and leaves a ``started-*`` file as it begins, so the test can see tasks waiting.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+import uuid
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from sklearn.base import BaseEstimator, ClassifierMixin
+
+from benchmark.catalogue.spec import ClassifierSpec
+
+#: The folder of the gate's files, given to every process through the environment.
+GATE_VARIABLE = "TOUCHBENCH_TEST_GATE"
+#: Longest a fit waits for a pass before it fails (a test that forgot its gate).
+LONGEST_WAIT = 600.0
+ROOT = Path(__file__).resolve().parents[1]
+
+
+class GateClassifier(ClassifierMixin, BaseEstimator):
+    """Majority class, once the test lets the fit through (see :class:`Gate`)."""
+
+    def __init__(self, random_state: int | None = None) -> None:
+        self.random_state = random_state
+
+    def fit(self, X: Any, y: Any) -> GateClassifier:
+        Gate(Path(os.environ[GATE_VARIABLE])).wait()
+        labels, counts = np.unique(np.asarray(y), return_counts=True)
+        self.classes_ = labels
+        self.majority_ = labels[int(np.argmax(counts))]
+        self.prior_ = counts / counts.sum()
+        return self
+
+    def predict(self, X: Any) -> np.ndarray:
+        return np.full(len(X), self.majority_)
+
+    def predict_proba(self, X: Any) -> np.ndarray:
+        return np.tile(self.prior_, (len(X), 1))
+
+
+CLASSIFIERS = (
+    ClassifierSpec(
+        id="gate",
+        weka_command=None,
+        family="test",
+        description="Test only: majority class once the test lets each fit through",
+        factory=GateClassifier,
+        params={},
+        probabilities=True,
+        needs_scaling=False,
+        handles_missing=True,
+        handles_nominal=False,
+        cost="fast",
+        suites=frozenset(),
+    ),
+)
+
+
+class Gate:
+    """The test's side of the gate: a folder of pass files.
+
+    Parameters
+    ----------
+    folder : Path
+        Created if absent; one per test (``tmp_path``).
+    """
+
+    def __init__(self, folder: Path) -> None:
+        self.folder = folder
+        folder.mkdir(parents=True, exist_ok=True)
+
+    def environment(self) -> dict[str, str]:
+        """Variables for a subprocess that should know the ``gate`` entry."""
+        path = os.environ.get("PYTHONPATH", "")
+        return {
+            GATE_VARIABLE: str(self.folder),
+            "TOUCHBENCH_PLUGINS": "tests.gate",
+            "PYTHONPATH": os.pathsep.join(p for p in (str(ROOT), path) if p),
+        }
+
+    def let_through(self, n: int = 1) -> None:
+        """Let ``n`` more fits through."""
+        for _ in range(n):
+            (self.folder / f"pass-{uuid.uuid4().hex}").touch()
+
+    def open(self) -> None:
+        """Let every fit through from now on."""
+        (self.folder / "open").touch()
+
+    def started(self) -> int:
+        """How many fits have begun (waiting or through)."""
+        return sum(1 for _ in self.folder.glob("started-*"))
+
+    def wait_started(self, n: int, timeout: float = 120.0) -> None:
+        """Wait until ``n`` fits have begun."""
+        deadline = time.monotonic() + timeout
+        while self.started() < n:
+            if time.monotonic() > deadline:
+                raise AssertionError(f"{self.started()} fits began, not {n}, in {timeout:g} s")
+            time.sleep(0.02)
+
+    def wait(self) -> None:
+        """A fit's side: take a pass, or go through an open gate."""
+        me = uuid.uuid4().hex
+        (self.folder / f"started-{me}").touch()
+        deadline = time.monotonic() + LONGEST_WAIT
+        while time.monotonic() < deadline:
+            if (self.folder / "open").exists():
+                return
+            for ticket in sorted(self.folder.glob("pass-*")):
+                try:
+                    ticket.rename(self.folder / f"used-{me}")
+                except FileNotFoundError:  # another fit took it first
+                    continue
+                return
+            time.sleep(0.02)
+        raise TimeoutError(f"no pass in {self.folder} after {LONGEST_WAIT:g} s")
