@@ -89,7 +89,11 @@ def execute_job(store: Store, job_id: int) -> JobSchema | None:
         return None
     folder = job.params.get("folder") if job.kind == "extract" else None
     try:
-        result = _carry_out(store, job_request(job))
+        try:
+            result = _carry_out(store, job_request(job))
+        finally:  # before the job ends, so that whoever sees it ended finds no upload left
+            if folder:
+                shutil.rmtree(folder, ignore_errors=True)
     except USER_ERRORS as error:
         finish_job(store, job.id, "failed", error=_client_words(str(error), folder))
     except KeyboardInterrupt:
@@ -100,9 +104,6 @@ def execute_job(store: Store, job_id: int) -> JobSchema | None:
         finish_job(store, job.id, "failed", error=_client_words(message, folder))
     else:
         finish_job(store, job.id, "done", result=result)
-    finally:
-        if folder:
-            shutil.rmtree(folder, ignore_errors=True)
     return get_job(store, job.id)
 
 
