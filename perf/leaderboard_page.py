@@ -36,6 +36,7 @@ sys.path.insert(0, str(ROOT))
 from fastapi.testclient import TestClient  # noqa: E402
 
 from app.main import create_app  # noqa: E402
+from app.schemas.datasets import ImportRequest  # noqa: E402
 from app.services.datasets import import_file  # noqa: E402
 from app.settings import Settings  # noqa: E402
 from app.store.database import Store  # noqa: E402
@@ -62,7 +63,7 @@ COSTS = ("fit_time", "predict_time", "fit_cpu_time", "predict_cpu_time", "log_lo
 def build_run(store: Store, folder: Path, n_classifiers: int, n_folds: int) -> int:
     """A data set and a finished run of ``n_classifiers`` x ``n_folds`` recorded results."""
     data = touch_arff(folder / "touch.arff", n=300, with_place=False)
-    dataset = import_file(store, data, name="perf", targets=None, file_format=None)
+    dataset = import_file(store, ImportRequest(file=data, name="perf"))
     ids = list(CATALOGUE)[:n_classifiers]
     if len(ids) < n_classifiers:
         raise SystemExit(f"the catalogue has {len(ids)} configurations, fewer than asked")

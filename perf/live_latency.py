@@ -68,6 +68,8 @@ def percentiles(values: list[float]) -> str:
 
 
 def main() -> None:
+    from app.schemas.extraction import ExtractRequest
+    from app.schemas.models import TrainRequest
     from app.services.extraction import extract_and_store
     from app.services.live import open_live
     from app.services.models import load_model, train
@@ -92,8 +94,8 @@ def main() -> None:
             recordings.append(wav)
             rows += [(wav.name, *touch) for touch in touches]
         labels = write_labels(here / "labels.csv", rows)
-        extract_and_store(store, recordings, labels=labels, extractor="uc3m-audio", name="touch")
-        train(store, "touch", "rf", targets=["gesture"])
+        extract_and_store(store, ExtractRequest(recordings=recordings, labels=labels, name="touch"))
+        train(store, TrainRequest(dataset="touch", classifier="rf", target="gesture"))
         _, model = load_model(store, "touch-rf")
 
         rows = []

@@ -296,6 +296,8 @@ def main() -> None:
     )
     args = parser.parse_args()
 
+    from app.schemas.datasets import ImportRequest
+    from app.schemas.models import TrainRequest
     from app.services.datasets import import_file
     from app.services.models import align_features, load_model, train
     from app.store.database import Store
@@ -305,9 +307,14 @@ def main() -> None:
     db = f"sqlite:///{folder / 'perf.db'}"
     store = Store(db)
     source = data_file(folder)
-    imported = import_file(store, source, name="mini")
+    imported = import_file(store, ImportRequest(file=source, name="mini"))
     for classifier in ("logistic", "rf"):
-        train(store, "mini", classifier, targets=["gesture"], name=f"mini-{classifier}")
+        train(
+            store,
+            TrainRequest(
+                dataset="mini", classifier=classifier, target="gesture", name=f"mini-{classifier}"
+            ),
+        )
     data = read_arff(source)
     process, url = start_service(db, folder, args.workers)
     rows = []

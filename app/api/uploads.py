@@ -1,18 +1,23 @@
-"""Uploads: a body-size limit enforced while the body streams in, and uploaded files saved
-under safe names."""
+"""Uploads: a body-size limit enforced while the body streams in, uploaded files saved under
+safe names, and requests built from a form's fields."""
 
 from __future__ import annotations
 
 import re
 import shutil
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 from fastapi import UploadFile
+from fastapi.exceptions import RequestValidationError
+from pydantic import ValidationError
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from app.api.errors import UploadTooLarge, error_body
 from app.errors import AppError
+from app.schemas.base import Request
+
+RequestType = TypeVar("RequestType", bound=Request)
 
 #: Bytes copied at a time from an upload to its file.
 CHUNK = 1 << 20
@@ -75,6 +80,25 @@ def save_upload(upload: UploadFile, folder: Path, fallback: str) -> Path:
     with target.open("wb") as out:
         shutil.copyfileobj(upload.file, out, CHUNK)
     return target
+
+
+def form_request(kind: type[RequestType], **fields: Any) -> RequestType:
+    """The request ``kind`` made of a form's fields (``None``: the request's default).
+
+    Raises
+    ------
+    RequestValidationError
+        A field the request refuses, located as ``body.FIELD`` as FastAPI locates a JSON
+        body's (a rule of the request raises its :class:`~app.errors.FieldError`, which the
+        service answers the same way).
+    """
+    try:
+        return kind(**{name: value for name, value in fields.items() if value is not None})
+    except ValidationError as error:
+        problems = error.errors(include_url=False, include_input=False, include_context=False)
+        raise RequestValidationError(
+            [{**problem, "loc": ("body", *problem["loc"])} for problem in problems]
+        ) from None
 
 
 def _content_length(scope: Scope) -> int | None:

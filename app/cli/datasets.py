@@ -77,18 +77,20 @@ def import_command(
 
     Nothing is stored from a file with an error, and known content is never stored twice.
     """
-    if file_format is not None and file_format not in ("arff", "csv"):
-        raise typer.BadParameter(f"'{file_format}' is not arff or csv", param_hint="--format")
+    from app.cli.requests import build_request
+    from app.schemas.datasets import ImportRequest
+
+    request = build_request(
+        ImportRequest,
+        {"file": "FILE", "format": "--format"},
+        file=file,
+        name=name,
+        targets=targets,
+        format=file_format,
+    )
     store = get_state(ctx).store
     with _import_progress(enabled=not as_json and sys.stderr.isatty()) as progress:
-        result = service.import_file(
-            store,
-            file,
-            name=name,
-            targets=service.parse_targets(targets),
-            file_format=file_format,  # type: ignore[arg-type]  # checked above
-            progress=progress,
-        )
+        result = service.import_file(store, request, progress=progress)
     if as_json:
         print_json(result.to_json())
         return

@@ -31,13 +31,13 @@ def extract_command(
         ),
     ] = None,
     extractor: Annotated[
-        str,
+        str | None,
         typer.Option(
             "--extractor",
             "-e",
-            help="uc3m-audio, band-peaks, mfcc, taxel-dft, window or sequence.",
+            help="uc3m-audio (the default), band-peaks, mfcc, taxel-dft, window or sequence.",
         ),
-    ] = "uc3m-audio",
+    ] = None,
     events: Annotated[
         str | None,
         typer.Option("--events", help="snr, dbscan or none (default: the extractor's own)."),
@@ -68,9 +68,7 @@ def extract_command(
     ] = None,
     max_event: Annotated[
         float | None,
-        typer.Option(
-            "--max-event", min=0.001, metavar="S", help="Longest event in seconds (default 60)."
-        ),
+        typer.Option("--max-event", metavar="S", help="Longest event in seconds (default 60)."),
     ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")] = False,
 ) -> None:
@@ -79,23 +77,26 @@ def extract_command(
     Recordings are read block by block (memory follows the longest event, not the
     recording); ROS bags (.bag, .mcap, .db3) are read for their audio_common audio.
     """
+    from app.cli.requests import build_request
+    from app.schemas.extraction import ExtractRequest
     from app.services.extraction import extract_and_store
 
+    request = build_request(
+        ExtractRequest,
+        {"recordings": "RECORDING...", "options": "--option"},
+        recordings=recordings,
+        labels=labels,
+        extractor=extractor,
+        events=events,
+        name=name,
+        samplerate=samplerate,
+        segment=segment,
+        options=key_values(option or [], "--option"),
+        topic=topic,
+        max_event=max_event,
+    )
     with _Reading() as reading:
-        summary = extract_and_store(
-            get_state(ctx).store,
-            recordings,
-            labels=labels,
-            extractor=extractor,
-            events=events,
-            name=name,
-            samplerate=samplerate,
-            segment=segment,
-            options=key_values(option or [], "--option"),
-            topic=topic,
-            max_event=max_event,
-            on_progress=reading.update,
-        )
+        summary = extract_and_store(get_state(ctx).store, request, on_progress=reading.update)
     if as_json:
         print_json(summary.to_json())
         return

@@ -43,20 +43,27 @@ def train_command(
         str | None,
         typer.Option("--name", metavar="NAME", help="Model name (default: DATASET-CLASSIFIER)."),
     ] = None,
-    seed: Annotated[int, typer.Option("--seed", metavar="S", help="Seed of the classifier.")] = 0,
+    seed: Annotated[
+        int | None,
+        typer.Option("--seed", metavar="S", help="Seed of the classifier.", show_default="0"),
+    ] = None,
     as_json: JsonOption = False,
 ) -> None:
     """Fit a classifier on every instance of a data set and store the model."""
+    from app.cli.requests import build_request
+    from app.schemas.models import TrainRequest
     from app.services.models import train
 
-    model = train(
-        get_state(ctx).store,
-        dataset,
-        classifier,
-        targets=[target] if target else None,
+    request = build_request(
+        TrainRequest,
+        {"dataset": "DATASET", "classifier": "--classifier"},
+        dataset=dataset,
+        classifier=classifier,
+        target=target,
         name=name,
         seed=seed,
     )
+    model = train(get_state(ctx).store, request)
     if as_json:
         print_json(model.to_json())
         return

@@ -27,11 +27,12 @@ _options: dict[str, str] = {}
 
 
 def build_request(
-    kind: type[RequestType], options: Mapping[str, str] | None = None, **values: Any
+    kind: type[RequestType], options: Mapping[str, str] | None = None, /, **values: Any
 ) -> RequestType:
     """The request ``kind`` made of ``values``; ``options`` names the option of each field.
 
-    Values that are ``None`` are left out, so that the request's own defaults apply to
+    ``kind`` and ``options`` are positional only, so that a request may have a field called
+    ``options``.  Values that are ``None`` are left out, so that the request's own defaults apply to
     options the user did not give.  A field without an entry in ``options`` is shown as
     ``--`` and its name with dashes (``max_memory_mb`` as ``--max-memory-mb``); a field an
     argument sets is named in ``options`` by the argument's metavar (``DATASET``).

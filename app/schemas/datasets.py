@@ -1,11 +1,57 @@
-"""Response models of data sets: listings, imports, descriptions, renames."""
+"""Data sets: the import request, and listings, imports, descriptions, renames."""
 
 from __future__ import annotations
 
 from datetime import datetime
-from typing import Literal
+from pathlib import Path
+from typing import Any, Literal
 
-from app.schemas.base import Schema
+from pydantic import Field, field_validator
+
+from app.schemas.base import Request, Schema
+
+FileFormat = Literal["arff", "csv"]
+
+
+def parse_targets(text: str | None) -> int | list[str] | None:
+    """``"2"`` -> 2 (first two), ``"-2"`` -> -2 (last two), ``"a,b"`` -> names."""
+    if text is None or not text.strip():
+        return None
+    stripped = text.strip()
+    digits = stripped.removeprefix("-")
+    if digits.isascii() and digits.isdigit():  # not "²", which int() refuses
+        return int(stripped)
+    return [name.strip() for name in stripped.split(",") if name.strip()]
+
+
+class ImportRequest(Request):
+    """The CLI's ``import`` and ``POST /api/datasets``: an ARFF or CSV file to a data set."""
+
+    file: Path = Field(description="The file to read.")
+    name: str | None = Field(
+        default=None, max_length=200, description="Name in the store (default: the file's stem)."
+    )
+    targets: int | list[str] | None = Field(
+        default=None,
+        description="N first attributes, -N last ones, or names (default: MEKA's -C header, "
+        "else the last attribute).",
+    )
+    format: FileFormat | None = Field(
+        default=None, description="File format (default: by the file's ending)."
+    )
+    source_name: str | None = Field(
+        default=None,
+        max_length=255,
+        description="The name the user knows the file by (an upload's file name): it names "
+        "the data set, is kept as its source and is what messages call the file.",
+    )
+
+    @field_validator("targets", mode="before")
+    @classmethod
+    def _targets_text(cls, value: Any) -> Any:
+        """Targets written as text (``"2"``, ``"-2"``, ``"a,b"``), as an option or a form
+        field gives them."""
+        return parse_targets(value) if isinstance(value, str) else value
 
 
 class DatasetSummary(Schema):

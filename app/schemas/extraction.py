@@ -1,8 +1,123 @@
-"""What an extraction answers: the stored data set and what happened to the events."""
+"""Extraction from recordings: its request, and what it answers (the stored data set and
+what happened to the events)."""
 
 from __future__ import annotations
 
-from app.schemas.base import Schema
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from pydantic import Field, model_validator
+
+from app.errors import FieldError
+from app.schemas.base import Request, Schema
+
+if TYPE_CHECKING:
+    from features.recipe import Recipe
+
+#: The extractor used when none is asked for.
+DEFAULT_EXTRACTOR = "uc3m-audio"
+#: Recordings one extraction may read.
+MAX_RECORDINGS = 1000
+#: A day, in seconds: the longest segment or event one may ask for.
+MAX_SECONDS = 86400.0
+
+#: A value of an extractor's or event detector's option (text as the CLI gives it).
+OptionValue = str | float | int | bool | list[float] | list[list[float]]
+
+
+class ExtractRequest(Request):
+    """The CLI's ``extract`` and ``POST /api/datasets/recordings``: recordings and a labels
+    file to a stored data set.
+
+    The extractor, event detection and their options are checked when the request is made
+    (:meth:`recipe`), so that nothing is read, queued or stored for a request that cannot
+    succeed.  ``folder``, when set, is the folder on the service's host that holds an
+    upload; ``recordings`` and ``labels`` are then the uploaded files' names in it.
+    """
+
+    recordings: list[Path] = Field(
+        min_length=1, max_length=MAX_RECORDINGS, description="Recordings to read."
+    )
+    labels: Path | None = Field(
+        default=None, description="Labels CSV: file,start,end,TARGET... or file,TARGET..."
+    )
+    extractor: str = Field(default=DEFAULT_EXTRACTOR, max_length=40)
+    events: str | None = Field(
+        default=None, max_length=20, description="snr, dbscan or none (default: the extractor's)."
+    )
+    options: dict[str, OptionValue] = Field(
+        default_factory=dict,
+        max_length=100,
+        description="Options of the extractor and of the event detector, in one mapping.",
+    )
+    name: str | None = Field(default=None, max_length=200, description="Data set name.")
+    samplerate: float | None = Field(
+        default=None, gt=0, le=1e9, description="Sample rate (Hz) of files that carry none."
+    )
+    segment: float | None = Field(
+        default=None, gt=0, le=MAX_SECONDS, description="Segment seconds for events 'none'."
+    )
+    topic: str | None = Field(default=None, max_length=200, description="Audio topic of bags.")
+    max_event: float | None = Field(
+        default=None, ge=0.001, le=MAX_SECONDS, description="Longest event in seconds."
+    )
+    folder: Path | None = Field(
+        default=None, description="The service's folder holding an upload's files."
+    )
+
+    @model_validator(mode="after")
+    def _checked_recipe(self) -> ExtractRequest:
+        self.recipe()
+        return self
+
+    def recipe(self) -> Recipe:
+        """How instances are made, defaults filled in.
+
+        Raises
+        ------
+        FieldError
+            An unknown extractor or event detection, a segment length with events other
+            than ``none``, an unknown option or a bad option value.
+        """
+        # Imported here for start-up time: the extractors load scipy and scikit-learn.
+        from features.errors import FeatureError
+        from features.events import EVENT_KINDS
+        from features.extractors import EXTRACTORS
+        from features.recipe import Recipe
+
+        if self.extractor not in EXTRACTORS:
+            raise FieldError(
+                "extractor",
+                f"unknown extractor '{self.extractor}' (known: {', '.join(EXTRACTORS)})",
+            )
+        events = self.events or EXTRACTORS[self.extractor].default_events
+        if events not in EVENT_KINDS:
+            raise FieldError(
+                "events", f"unknown event detection '{events}' (known: {', '.join(EVENT_KINDS)})"
+            )
+        if self.segment is not None and events != "none":
+            raise FieldError("segment", f"only applies to `events` 'none', not '{events}'")
+        try:
+            return Recipe.resolve(
+                self.extractor,
+                events=events,
+                segment=self.segment,
+                options=self.options,
+                max_event=self.max_event,
+            )
+        except FeatureError as error:
+            raise FieldError("options", str(error)) from None
+
+    def recording_paths(self) -> list[Path]:
+        """Where the recordings are read from (in ``folder`` for an upload)."""
+        return [self._path(recording) for recording in self.recordings]
+
+    def labels_path(self) -> Path | None:
+        """Where the labels file is read from, if there is one."""
+        return None if self.labels is None else self._path(self.labels)
+
+    def _path(self, path: Path) -> Path:
+        return path if self.folder is None else self.folder / path.name
 
 
 class ExtractionSummary(Schema):

@@ -8,9 +8,13 @@ from typing import Any, Literal
 
 from pydantic import Field
 
-from app.schemas.base import Schema
+from app.schemas.base import Request, Schema
+from app.schemas.extraction import ExtractRequest
+from app.schemas.models import TrainRequest
 
 JobKind = Literal["extract", "train"]
+#: The request each kind of job carries out (its JSON is the job's ``params``).
+JOB_REQUESTS: dict[JobKind, type[Request]] = {"extract": ExtractRequest, "train": TrainRequest}
 #: Same life as a run's: queued -> running -> done | failed (| interrupted after a crash).
 JobStatus = Literal["queued", "running", "done", "failed", "cancelled", "interrupted"]
 
@@ -19,7 +23,10 @@ class JobSchema(Schema):
     id: int
     kind: JobKind
     status: JobStatus
-    params: dict[str, Any] = Field(description="What the job was asked to do.")
+    params: dict[str, Any] = Field(
+        description="What the job was asked to do: its request (TrainRequest, ExtractRequest) "
+        "and the host whose workers may take it."
+    )
     result: dict[str, Any] | None = Field(
         default=None, description="extract: the new data set; train: the new model."
     )
@@ -27,6 +34,12 @@ class JobSchema(Schema):
     created_at: datetime
     started_at: datetime | None = None
     finished_at: datetime | None = None
+
+    def for_client(self) -> JobSchema:
+        """The job as the API shows it: without the service's own folder of an upload (the
+        client knows its files by their names)."""
+        params = {key: value for key, value in self.params.items() if key != "folder"}
+        return self.model_copy(update={"params": params})
 
 
 class JobList(Schema):

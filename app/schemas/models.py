@@ -6,9 +6,13 @@ from __future__ import annotations
 from datetime import datetime
 from typing import Any
 
-from pydantic import ConfigDict, Field
+from pydantic import ConfigDict, Field, model_validator
 
-from app.schemas.base import Schema
+from app.errors import FieldError
+from app.schemas.base import Request, Schema
+
+#: The largest id or seed (the store's integer columns are 32-bit on PostgreSQL).
+MAX_ID = 2**31 - 1
 
 
 class ModelSchema(Schema):
@@ -66,18 +70,47 @@ class PredictionReport(Schema):
     )
 
 
-class PredictRequest(Schema):
+class PredictRequest(Request):
     """``POST /api/models/{id}/predict``: instances as attribute -> value, matched by name."""
 
     instances: list[dict[str, float | int | str | None]] = Field(min_length=1, max_length=10000)
 
 
-class TrainRequest(Schema):
-    """``POST /api/models``: a classifier on a data set, or the best of a run."""
+class TrainRequest(Request):
+    """``POST /api/models`` and the CLI's ``train``: a classifier on a data set, or the best
+    classifier of a finished run (``run``) on that run's data set and targets."""
 
-    dataset: str | int | None = None
-    classifier: str | None = None
-    target: str | None = None
-    run: int | None = None
-    name: str | None = Field(default=None, max_length=200)
-    seed: int = Field(default=0, ge=0, le=2**31 - 1)
+    dataset: str | int | None = Field(default=None, description="Data set name or id.")
+    classifier: str | None = Field(
+        default=None, min_length=1, max_length=200, description="Classifier id."
+    )
+    target: str | None = Field(
+        default=None, max_length=2000, description="Train for this one target only."
+    )
+    run: int | None = Field(
+        default=None, ge=1, le=MAX_ID, description="Train the best classifier of this run."
+    )
+    name: str | None = Field(
+        default=None, max_length=200, description="Model name (default: DATASET-CLASSIFIER)."
+    )
+    seed: int = Field(default=0, ge=0, le=MAX_ID, description="Seed of the classifier.")
+
+    @model_validator(mode="after")
+    def _one_source(self) -> TrainRequest:
+        """A data set and a classifier, or a run (whose data set, targets and seed are its
+        own): what is missing or would be ignored is refused, naming the field."""
+        if self.run is not None:
+            given = {"dataset": self.dataset, "classifier": self.classifier, "target": self.target}
+            for other, value in {**given, "seed": self.seed or None}.items():
+                if value is not None:
+                    raise FieldError(
+                        other,
+                        "is not taken with `run`: a run's best classifier is trained on the "
+                        "run's own data set, targets and seed",
+                    )
+            return self
+        if self.dataset is None:
+            raise FieldError("dataset", "is required (or `run`, for a run's best classifier)")
+        if self.classifier is None:
+            raise FieldError("classifier", "is required with `dataset`")
+        return self

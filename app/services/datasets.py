@@ -22,41 +22,32 @@ import warnings
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Literal, TextIO
+from typing import Any, TextIO
 
 import numpy as np
 
-from app.errors import AppError
+from app.errors import AppError, ConflictError, FieldError
 from app.schemas.datasets import (
     AttributeDescription,
     DatasetDescription,
     DatasetSummary,
+    FileFormat,
+    ImportRequest,
     ImportResult,
     RenameResult,
 )
 from app.store import datasets as stored
 from app.store.database import Store
 from app.store.datasets import DatasetInfo, DatasetInMemory, InstanceSource
-from app.store.naming import check_name, default_name, is_decimal
+from app.store.naming import default_name
 from benchmark.dataset import Dataset, InstanceBlock, Schema
 from benchmark.errors import DataFormatError, DataWarning
 from benchmark.io.arff import ArffWriter, open_arff, read_arff
 from benchmark.io.csv import read_csv
 from benchmark.io.textfile import FileScan, check_regular_file, open_binary, scan_file
 
-FileFormat = Literal["arff", "csv"]
 #: Called with (what is being done, bytes done, bytes in all) while a file is imported.
 ImportProgress = Callable[[str, int, int], None]
-
-
-def parse_targets(text: str | None) -> int | list[str] | None:
-    """``"2"`` -> 2 (first two), ``"-2"`` -> -2 (last two), ``"a,b"`` -> names."""
-    if text is None or not text.strip():
-        return None
-    stripped = text.strip()
-    if is_decimal(stripped.removeprefix("-")):
-        return int(stripped)
-    return [name.strip() for name in stripped.split(",") if name.strip()]
 
 
 def guess_format(path: Path) -> FileFormat:
@@ -88,34 +79,20 @@ def list_datasets(store: Store) -> list[DatasetSummary]:
 
 
 def import_file(
-    store: Store,
-    path: str | os.PathLike[str],
-    *,
-    name: str | None = None,
-    targets: int | Sequence[str] | None = None,
-    file_format: FileFormat | None = None,
-    source_name: str | None = None,
-    progress: ImportProgress | None = None,
+    store: Store, request: ImportRequest, *, progress: ImportProgress | None = None
 ) -> ImportResult:
     """Import an ARFF or CSV file as a data set, streaming it into the store.
 
     Parameters
     ----------
     store : Store
-    path : str or path-like
-        A regular file.
-    name : str, optional
-        The data set's name; by default the stem of ``source_name`` or of the file
-        (made unique with a numeric suffix).
-    targets : int, sequence of str, or None
-        ``N`` first attributes, ``-N`` last ones, or names; by default MEKA's ``-C`` in
-        the relation, else the last attribute.
-    file_format : {"arff", "csv"}, optional
-        By default from the file name's ending.
-    source_name : str, optional
-        The name the user knows the file by (an upload's file name, when ``path`` is a
-        temporary copy): it names the data set, is kept as its source, and is what error
-        messages call the file.
+    request : ImportRequest
+        The file (a regular file), and optionally the data set's name (by default the stem
+        of its ``source_name`` or of the file, made unique with a numeric suffix), its
+        targets (by default MEKA's ``-C`` in the relation, else the last attribute), its
+        format (by default from the file name's ending) and the name the user knows the
+        file by (an upload's file name, when ``file`` is a temporary copy: it names the
+        data set, is kept as its source, and is what error messages call the file).
     progress : callable, optional
         Called with (what is being done, bytes done, bytes in all).
 
@@ -128,17 +105,19 @@ def import_file(
     DataFormatError
         If the file is not a regular file, not text, or not valid ARFF/CSV; if it holds
         no instances or infinite values; if it leaves no feature.  Nothing is stored.
-    AppError
-        If the name is invalid or taken, or the content is stored already and another
-        name or other targets were asked for.
+    FieldError
+        If the name is invalid.
+    ConflictError
+        If the name is taken, or the content is stored already and another name or other
+        targets were asked for.
     """
-    path = Path(path)
-    shown = source_name or path.name
-    if name is not None:
-        check_name(name, kind="dataset")
-    chosen = file_format or guess_format(Path(shown))
+    path, name, targets = request.file, request.name, request.targets
+    shown = request.source_name or path.name
+    if name is not None:  # a name taken by the same content answers "already stored"
+        stored.valid_dataset_name(name)
+    chosen = request.format or guess_format(Path(shown))
     notes: list[str] = []
-    label = source_name or str(path)  # what messages call the file
+    label = request.source_name or str(path)  # what messages call the file
     with _open_data(path, label, chosen, targets, Path(shown).stem, progress, notes) as data:
         _check_schema(data.schema, label, notes)
         existing = stored.stored_digest(store, data.scan.sha256)
@@ -221,8 +200,8 @@ def _check_schema(schema: Schema, source: str, notes: list[str]) -> None:
 def target_notes(schema: Schema) -> list[str]:
     """What a user should know about the targets: numeric ones are regression targets."""
     return [
-        f"target '{target.name}' is numeric: a regression target (bench runs regressors and "
-        "ranks by mean absolute error; --targets at import, --target in bench choose others)"
+        f"target '{target.name}' is numeric: a regression target (a run on it runs regressors "
+        "and ranks by mean absolute error; the targets of an import or of a run choose others)"
         for target in schema.targets
         if target.kind == "numeric"
     ]
@@ -332,14 +311,13 @@ def _already_stored(
 ) -> ImportResult:
     stored_as = f"{shown} is already stored as dataset {existing.id} '{existing.name}'"
     if name is not None and name != existing.name:
-        raise AppError(
-            f"{stored_as}; nothing imported (`touchbench rename {existing.id} {name}` "
-            "gives it that name)"
+        raise ConflictError(
+            f"{stored_as}; nothing imported (renaming dataset {existing.id} gives it that name)"
         )
     if targets is not None and list(schema.target_names) != existing.targets:
-        raise AppError(
+        raise ConflictError(
             f"{stored_as} with targets {', '.join(existing.targets)}; nothing imported "
-            "(`touchbench bench --target` chooses the targets of a run)"
+            "(a run chooses its own targets among the attributes)"
         )
     return _result(existing, False, [*notes, f"{stored_as}; nothing imported"])
 
@@ -457,9 +435,11 @@ def export_to_file(store: Store, ref: str | int, path: Path, *, force: bool = Fa
 
     Raises
     ------
+    FieldError
+        For ``force``: ``path`` is a file and ``force`` is not set.
     AppError
-        If ``path`` is a folder, its folder does not exist, it is a file and ``force`` is
-        not set, or it cannot be written (full disk, no permission).
+        If ``path`` is a folder, its folder does not exist, or it cannot be written (full
+        disk, no permission).
     """
     stored.find_dataset(store, ref)  # an unknown data set fails before any file is touched
     try:
@@ -477,7 +457,7 @@ def export_to_file(store: Store, ref: str | int, path: Path, *, force: bool = Fa
         except OSError as error:
             raise AppError(f"cannot write {path}: {error.strerror or error}") from None
     if mode is not None and not force:
-        raise AppError(f"{path} exists; --force replaces it")
+        raise FieldError("force", f"is needed to replace {path}, which exists")
     folder = path.parent
     if not folder.is_dir():
         raise AppError(f"cannot write {path}: the folder {folder} does not exist")

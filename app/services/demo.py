@@ -12,6 +12,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from app.schemas.models import TrainRequest
 from app.schemas.runs import BenchRequest
 from app.services.extraction import extract_dataset
 from app.services.live import TouchPrediction, open_live
@@ -86,7 +87,7 @@ def run_demo(
 
     best = board.rows[0].classifier
     say(f"4. training {best} on every instance and predicting a session it never saw")
-    model = train(store, str(dataset.id), best)
+    model = train(store, TrainRequest(dataset=dataset.id, classifier=best))
     holdout_wav, holdout_touches = write_session(
         folder, "holdout", n_touches=touches_per_session, seed=1000
     )

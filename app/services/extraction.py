@@ -35,9 +35,9 @@ from typing import Any
 
 import numpy as np
 
-from app.schemas.extraction import ExtractionSummary
+from app.schemas.extraction import ExtractionSummary, ExtractRequest
 from app.store.database import Store
-from app.store.datasets import add_dataset, dataset_digest
+from app.store.datasets import add_dataset, check_dataset_name, dataset_digest
 from benchmark.dataset import Attribute, Dataset, Schema
 from benchmark.errors import DataFormatError
 from drivers.replay import FileReplaySource
@@ -222,47 +222,60 @@ def extract_dataset(
     )
 
 
+def check_extraction(store: Store, request: ExtractRequest) -> None:
+    """Refuse what can be refused before any recording is read: the request checked its
+    extractor, event detection and options when it was made; here, the data set's name.
+
+    Raises
+    ------
+    FieldError
+        An invalid name.
+    ConflictError
+        The name is taken.
+    """
+    if request.name is not None:
+        check_dataset_name(store, request.name)
+
+
 def extract_and_store(
     store: Store,
-    recordings: Sequence[Path],
+    request: ExtractRequest,
     *,
-    labels: Path | None,
-    extractor: str,
-    events: str | None = None,
-    name: str | None = None,
-    samplerate: float | None = None,
-    segment: float | None = None,
-    options: Mapping[str, Any] | None = None,
-    topic: str | None = None,
-    max_event: float | None = None,
     on_progress: Callable[[str, float], None] | None = None,
 ) -> ExtractionSummary:
     """:func:`extract_dataset`, then store the data set with its extraction recipe in one
     transaction (nothing is stored when anything fails).
 
-    Parameters are those of :func:`extract_dataset`; ``name``, when given, must be free
-    in the store.
+    Parameters
+    ----------
+    store : Store
+    request : ExtractRequest
+        What to read and how; its ``name``, when given, must be free in the store.
+    on_progress : callable, optional
+        Called as ``on_progress(file_name, seconds_read)`` after every block.
     """
+    check_extraction(store, request)
+    recordings = request.recording_paths()
     result = extract_dataset(
         recordings,
-        labels=labels,
-        extractor=extractor,
-        events=events,
-        name=name,
-        samplerate=samplerate,
-        segment=segment,
-        options=options,
-        topic=topic,
-        max_event=max_event,
+        labels=request.labels_path(),
+        extractor=request.extractor,
+        events=request.events,
+        name=request.name,
+        samplerate=request.samplerate,
+        segment=request.segment,
+        options=request.options,
+        topic=request.topic,
+        max_event=request.max_event,
         on_progress=on_progress,
     )
     data = result.dataset
-    shown = ", ".join(Path(p).name for p in recordings[:3])
+    shown = ", ".join(path.name for path in recordings[:3])
     info, created = add_dataset(
         store,
         data,
         sha256=dataset_digest(data),
-        name=name,
+        name=request.name,
         source_name=shown + (f" (+{len(recordings) - 3})" if len(recordings) > 3 else ""),
         extraction=result.recipe,
     )

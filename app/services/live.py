@@ -98,7 +98,7 @@ class LiveSession:
             raise AppError(
                 f"model '{name}' was trained on a data set imported from a file, not extracted "
                 "from recordings, so touchbench does not know how to compute its features "
-                "live; train it on a data set made by `touchbench extract`"
+                "live; train it on a data set extracted from recordings"
             )
         recipe = Recipe.from_json(recipe_json)
         trained_rate = recipe_json.get("samplerate")

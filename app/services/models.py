@@ -17,79 +17,141 @@ from typing import Any
 
 import numpy as np
 
-from app.errors import AppError
-from app.schemas.models import PredictionReport, PredictionRow
+from app.errors import ConflictError, FieldError
+from app.schemas.models import PredictionReport, PredictionRow, TrainRequest
 from app.store.database import Store
-from app.store.datasets import find_dataset, load_dataset, load_schema
-from app.store.models import ModelInfo, load_artifact, save_model
+from app.store.datasets import find_dataset, load_dataset
+from app.store.models import (
+    ModelInfo,
+    check_model_name,
+    check_name_free,
+    load_artifact,
+    save_model,
+)
+from app.store.naming import shorten
+from app.store.runs import RunInfo, get_run, load_results
 from benchmark.dataset import Attribute, Dataset, Schema
-from benchmark.errors import DataFormatError
+from benchmark.errors import ConfigurationError, DataFormatError
 from benchmark.model import TrainedModel, dumps_model, fit_model, loads_model
-from benchmark.problem import problem_from_dataset, restrict_targets
+from benchmark.problem import Problem, problem_from_dataset, restrict_targets
 
 #: Labels quoted in one warning at most.
 MAX_QUOTED = 5
 
 
-def train(
-    store: Store,
-    dataset_ref: str,
-    classifier: str,
-    *,
-    targets: Sequence[str] | None = None,
-    name: str | None = None,
-    seed: int = 0,
-    run_id: int | None = None,
-) -> ModelInfo:
-    """Fit a classifier on every instance of a data set and store the model."""
-    info = find_dataset(store, dataset_ref)
-    data = restrict_targets(load_dataset(store, info.id), targets)
-    model = fit_model(data, classifier, random_state=seed)
+@dataclass(frozen=True)
+class Training:
+    """What a :class:`TrainRequest` comes to once checked against the store: the data set
+    (restricted to the targets), classifier, seed and run to train from."""
+
+    data: Dataset
+    dataset_id: int
+    classifier: str
+    seed: int
+    run_id: int | None
+
+
+def train(store: Store, request: TrainRequest) -> ModelInfo:
+    """Fit a classifier on every instance of a data set (or a finished run's best classifier
+    on the run's data set and targets) and store the model.
+
+    Raises as :func:`check_training` does.
+    """
+    plan = check_training(store, request)
+    model = fit_model(plan.data, plan.classifier, random_state=plan.seed)
     return save_model(
         store,
-        classifier=classifier,
+        classifier=plan.classifier,
         params=_jsonable(model.params),
-        schema=data.schema.to_json(),
-        targets=list(data.schema.target_names),
+        schema=plan.data.schema.to_json(),
+        targets=list(plan.data.schema.target_names),
         artifact=dumps_model(model),
-        dataset_id=info.id,
-        run_id=run_id,
-        name=name,
+        dataset_id=plan.dataset_id,
+        run_id=plan.run_id,
+        name=request.name,
     )
 
 
-def check_training(
-    store: Store, dataset_ref: str, classifier: str, *, targets: Sequence[str] | None = None
-) -> None:
-    """Refuse at once, from the data set's schema alone, what :func:`train` would refuse
-    after loading it: an unknown data set, target or classifier, a multi-class classifier
-    for several targets (or the reverse), a sequence classifier on flat features."""
-    from benchmark.estimators import check_classifier
+def check_training(store: Store, request: TrainRequest) -> Training:
+    """Refuse at once what training would refuse after the work, before a job is queued.
 
-    _, schema, _ = load_schema(store, dataset_ref)
-    empty = Dataset(schema, np.zeros((0, schema.n_attributes)))
-    problem, _ = problem_from_dataset(restrict_targets(empty, targets))
-    check_classifier(classifier, problem)
+    Raises
+    ------
+    NotFoundError
+        No such data set or run.
+    ConflictError
+        The model name is taken; the run has no successful classifier.
+    FieldError
+        An invalid name; an unknown target or one without any known value; an unknown
+        classifier or one that cannot learn the targets (a multi-class classifier for
+        several targets, or the reverse; a sequence classifier on flat features).
+    """
+    from benchmark.estimators import check_classifier  # start-up time: the catalogue is big
+
+    if request.name is not None:
+        check_model_name(request.name)
+        check_name_free(store, request.name)
+    targets: list[str] | None
+    if request.run is not None:
+        run, classifier = _best_of_run(store, request.run)
+        run_id, dataset_id, seed = run.id, run.dataset_id, int(run.config.get("seed", 0))
+        targets = run.config.get("targets_given")
+    else:
+        assert request.dataset is not None and request.classifier is not None  # the request's rule
+        run_id, classifier, seed = None, request.classifier, request.seed
+        targets = [request.target] if request.target else None
+        dataset_id = find_dataset(store, str(request.dataset)).id
+    data = load_dataset(store, dataset_id)
+    if request.target is not None and request.target not in {
+        attribute.name for attribute in data.schema.attributes
+    }:
+        raise FieldError(
+            "target",
+            f"the data set has no attribute '{shorten(request.target)}' (targets: "
+            f"{', '.join(data.schema.target_names) or 'none'})",
+        )
+    data = restrict_targets(data, targets)
+    problem, _ = problem_from_dataset(data)
+    _check_learnable(problem, "target" if targets else "dataset")
+    try:
+        check_classifier(classifier, problem)
+    except ConfigurationError as error:
+        raise FieldError("run" if request.run is not None else "classifier", str(error)) from None
+    return Training(data, dataset_id, classifier, seed, run_id)
 
 
-def train_best(store: Store, run_id: int | str, *, name: str | None = None) -> ModelInfo:
-    """Train the best classifier of a finished run on its whole data set and targets."""
-    from app.services.runs import run_leaderboard
+def _check_learnable(problem: Problem, field: str) -> None:
+    """Refuse targets without a known value, or with a single class, for ``field``."""
+    names = ", ".join(f"'{name}'" for name in problem.target_names)
+    if problem.n_instances == 0:
+        every = "every target" if problem.n_targets > 1 else "the target"
+        raise FieldError(
+            field, f"no instance has a known value of {every} ({names}): nothing to train on"
+        )
+    if problem.kind == "regression":
+        return
+    for name, column in zip(problem.target_names, problem.Y.T, strict=True):
+        if np.unique(column).size < 2:
+            raise FieldError(field, f"target '{name}' has a single class: nothing to learn")
 
-    ranked = run_leaderboard(store, run_id)
-    run, board = ranked.run, ranked.board
+
+def _best_of_run(store: Store, run_ref: int) -> tuple[RunInfo, str]:
+    """A finished run and its best classifier.
+
+    Raises
+    ------
+    ConflictError
+        The run has no successful classifier (yet).
+    """
+    from app.services.runs import run_leaderboard  # start-up time: the engine's imports
+
+    run = get_run(store, run_ref)
+    if not load_results(store, run.id):
+        raise ConflictError(f"run {run.id} has no results yet (it is {run.status})")
+    board = run_leaderboard(store, run.id).board
     if board.baseline is None:
-        raise AppError(f"run {run.id} has no successful classifier to train")
-    best = board.rows[0].classifier
-    return train(
-        store,
-        str(run.dataset_id),
-        best,
-        targets=run.config.get("targets_given"),
-        name=name,
-        seed=int(run.config.get("seed", 0)),
-        run_id=run.id,
-    )
+        raise ConflictError(f"run {run.id} has no successful classifier to train")
+    return run, board.rows[0].classifier
 
 
 def load_model(store: Store, ref: str | int) -> tuple[ModelInfo, TrainedModel]:

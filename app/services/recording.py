@@ -107,8 +107,8 @@ def _check_header(labels_path: Path, targets: list[str]) -> list[str]:
         if found != header:
             raise AppError(
                 f"{labels_path} labels takes with {','.join(found[1:]) or 'no target'}; "
-                f"give the same --label targets (got {','.join(targets) or 'none'}) or "
-                "record into another folder"
+                f"record with the same label targets (got {','.join(targets) or 'none'}) or "
+                "into another folder"
             )
     return header
 

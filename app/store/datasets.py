@@ -23,7 +23,7 @@ from sqlalchemy import delete, insert, select, update
 from sqlalchemy.exc import IntegrityError, OperationalError
 from sqlalchemy.orm import Session
 
-from app.errors import AppError
+from app.errors import AppError, ConflictError, FieldError
 from app.store.database import Store
 from app.store.naming import check_name, default_name, find_row, free_name, shorten
 from app.store.ownership import owner_alive
@@ -231,7 +231,7 @@ def add_dataset_stream(
                 return DatasetInfo.of(row), True
         except _NameTakenError as taken:
             if name is not None:
-                raise AppError(_taken_message(store, taken.name)) from None
+                raise ConflictError(_taken_message(store, taken.name)) from None
             # Another process took the default name meanwhile: choose again.
         except OperationalError as error:
             raise _busy_or_raise(error) from None
@@ -271,10 +271,39 @@ def _insert_row(
     return row
 
 
+def valid_dataset_name(name: str) -> str:
+    """``name`` if it can name a data set (see :func:`check_name`).
+
+    Raises
+    ------
+    FieldError
+        For the request's ``name``: the rule it breaks.
+    """
+    try:
+        return check_name(name, kind="dataset")
+    except AppError as error:
+        raise FieldError("name", str(error)) from None
+
+
+def check_dataset_name(store: Store, name: str) -> None:
+    """Refuse a name no new data set can take: invalid, or another data set's.
+
+    Raises
+    ------
+    FieldError
+        For the request's ``name``: the rule it breaks.
+    ConflictError
+        Another data set has it.
+    """
+    valid_dataset_name(name)
+    with store.session() as session:
+        _refuse_taken(session, name)
+
+
 def _refuse_taken(session: Session, name: str) -> None:
     clash = session.scalars(select(DatasetRow).where(DatasetRow.name == name)).first()
     if clash is not None:
-        raise AppError(
+        raise ConflictError(
             f"a dataset named '{shorten(name)}' already exists (id {clash.id}); choose another name"
         )
 
@@ -557,7 +586,7 @@ def rename_dataset(store: Store, ref: str | int, new_name: str) -> tuple[Dataset
                     raise _NameTakenError(new_name) from None
             return DatasetInfo.of(row), old
     except _NameTakenError as taken:
-        raise AppError(_taken_message(store, taken.name)) from None
+        raise ConflictError(_taken_message(store, taken.name)) from None
 
 
 def delete_dataset(store: Store, ref: str | int) -> DatasetInfo:
@@ -565,7 +594,7 @@ def delete_dataset(store: Store, ref: str | int) -> DatasetInfo:
 
     Raises
     ------
-    AppError
+    ConflictError
         If a run on it is queued, or running in a process that is alive: the run must be
         cancelled first.
     """
@@ -575,9 +604,9 @@ def delete_dataset(store: Store, ref: str | int) -> DatasetInfo:
         live = _live_run(session, row.id)
         if live is not None:
             run_id, status = live
-            raise AppError(
+            raise ConflictError(
                 f"dataset '{shorten(info.name)}' is in use by run {run_id} ({status}); "
-                f"cancel it first (`touchbench cancel {run_id}`) or wait for it to end"
+                f"cancel run {run_id} first or wait for it to end"
             )
         session.execute(delete(InstanceRow).where(InstanceRow.dataset_id == row.id))
         session.execute(delete(InstanceBlockRow).where(InstanceBlockRow.dataset_id == row.id))

@@ -19,10 +19,10 @@ from sqlalchemy import bindparam, delete, select, update
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session
 
-from app.errors import AppError
+from app.errors import AppError, ConflictError, FieldError
 from app.schemas.models import ModelSchema
 from app.store.database import Store
-from app.store.naming import find_row, free_name, is_decimal, is_row_id, may_be_name
+from app.store.naming import find_row, free_name, is_decimal, is_row_id, may_be_name, shorten
 from app.store.tables import DatasetRow, ModelArtifactRow, ModelRow
 
 #: The only artifact format that is loaded (see :mod:`benchmark.artifacts`).
@@ -101,8 +101,8 @@ def save_model(
             if name is None:
                 base = f"{dataset.name if dataset else 'model'}-{classifier}"
                 name = free_name(session, ModelRow, base)
-            elif session.scalars(select(ModelRow.id).where(ModelRow.name == name)).first():
-                raise AppError(f"a model named '{name}' already exists; choose another --name")
+            else:
+                _refuse_taken(session, name)
             row = ModelRow(
                 name=name,
                 dataset_id=dataset_id,
@@ -121,19 +121,46 @@ def save_model(
             session.add(ModelArtifactRow(model_id=row.id, artifact=artifact))
             return _info(session, row)
     except IntegrityError:  # another process took the name between our check and insert
-        raise AppError(f"a model named '{name}' already exists; choose another --name") from None
+        raise ConflictError(_taken(str(name))) from None
 
 
 def check_model_name(name: str) -> None:
-    """Refuse names that cannot be told from ids or do not print."""
+    """Refuse names that cannot be told from ids or do not print.
+
+    Raises
+    ------
+    FieldError
+        For the request's ``name``, saying which rule the name breaks.
+    """
     if not name.strip():
-        raise AppError("a model name cannot be empty")
+        raise FieldError("name", "a model name cannot be empty")
     if is_decimal(name):
-        raise AppError(f"a model name cannot be a number ('{name}' would read as an id)")
+        raise FieldError("name", f"a model name cannot be a number ('{name}' would read as an id)")
     if len(name) > 200:
-        raise AppError(f"a model name has at most 200 characters, got {len(name)}")
+        raise FieldError("name", f"a model name has at most 200 characters, got {len(name)}")
     if any(not character.isprintable() for character in name):
-        raise AppError("a model name cannot contain control characters")
+        raise FieldError("name", "a model name cannot contain control characters")
+
+
+def check_name_free(store: Store, name: str) -> None:
+    """Refuse a model name another model has.
+
+    Raises
+    ------
+    ConflictError
+        The name is taken.
+    """
+    with store.session() as session:
+        _refuse_taken(session, name)
+
+
+def _refuse_taken(session: Session, name: str) -> None:
+    if session.scalars(select(ModelRow.id).where(ModelRow.name == name)).first() is not None:
+        raise ConflictError(_taken(name))
+
+
+def _taken(name: str) -> str:
+    return f"a model named '{shorten(name)}' already exists; choose another name"
 
 
 def list_models(store: Store) -> list[ModelInfo]:
@@ -193,7 +220,7 @@ def load_artifact(store: Store, ref: str | int) -> tuple[ModelInfo, bytes]:
         if row.format != SAFE_FORMAT:
             raise AppError(
                 f"model '{row.name}' is stored as a {row.format}, a format that can run code "
-                f"when loaded; train it again (`touchbench train ... --name {row.name}-2`)"
+                "when loaded; train it again under another name"
             )
         artifact = session.get_one(ModelArtifactRow, row.id).artifact
         return info, bytes(artifact)
@@ -214,14 +241,12 @@ def rename_model(store: Store, ref: str | int, new_name: str) -> ModelInfo:
             row = _row(session, ref)
             session.execute(update(ModelRow).where(ModelRow.id == row.id).values(name=new_name))
     except IntegrityError:
-        raise AppError(f"a model named '{new_name}' already exists") from None
+        raise ConflictError(_taken(new_name)) from None
     return get_model(store, new_name)
 
 
 def _row(session: Session, ref: str | int) -> ModelRow:
-    return find_row(
-        session, ModelRow, ref, kind="model", hint="none yet; `touchbench train` makes one"
-    )
+    return find_row(session, ModelRow, ref, kind="model", hint="none yet; training makes one")
 
 
 def _dataset_names(session: Session, rows: Sequence[ModelRow]) -> dict[int, str]:

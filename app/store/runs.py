@@ -386,7 +386,7 @@ def _row(session: Session, run_id: int | str) -> RunRow:
         last = session.scalar(select(func.max(RunRow.id)))
         known = f"runs are 1..{last}" if last else "the store has no runs yet"
         shown = text if len(text) <= 40 else text[:39] + "…"
-        raise NotFoundError(f"no run '{shown}' ({known}; `touchbench runs` lists them)")
+        raise NotFoundError(f"no run '{shown}' ({known})")
     return row
 
 

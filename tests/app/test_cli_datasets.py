@@ -181,6 +181,10 @@ def test_a_missing_file_and_bad_usage_exit_2(
     assert missing.code == 2 and "nope.arff" in missing.err and "no such file" in missing.err
     usage = run_cli(capsys, store_url, "import", "x.arff", "--format", "xlsx")
     assert usage.code == 2 and len(usage.err.strip().splitlines()) == 1
+    assert usage.err.startswith("touchbench: error: --format: Input should be 'arff' or 'csv'")
+    named = run_cli(capsys, store_url, "import", "x.arff", "--name", "12")
+    assert named.code == 2
+    assert named.err.startswith("touchbench: error: --name: a dataset name cannot be a number")
     unknown = run_cli(capsys, store_url, "frobnicate")
     assert unknown.code == 2 and "frobnicate" in unknown.err
 

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pytest
 
+from app.schemas.datasets import ImportRequest
 from app.services import datasets as dataset_service
 from app.store import datasets as store_datasets
 from app.store.database import Store
@@ -67,10 +68,16 @@ def test_known_content_under_another_name_or_targets_is_refused_saying_how(
     again = run_cli(capsys, store_url, "import", str(path), "--json")
     assert again.code == 0 and again.json()["created"] is False
     assert again.json()["action"] == "already stored" and again.json()["id"] == first["id"]
+    named = run_cli(capsys, store_url, "import", str(path), "--name", "mini", "--json")
+    assert named.code == 0 and (named.json()["created"], named.json()["id"]) == (False, first["id"])
     renamed = run_cli(capsys, store_url, "import", str(path), "--name", "robot1")
-    one_error_line(renamed, "already stored as dataset", "'mini'", "touchbench rename")
+    one_error_line(
+        renamed, "already stored as dataset 1 'mini'", "renaming dataset 1 gives it that name"
+    )
     retargeted = run_cli(capsys, store_url, "import", str(path), "--targets", "-1")
-    one_error_line(retargeted, "already stored", "targets gesture, place")
+    one_error_line(
+        retargeted, "already stored", "targets gesture, place", "a run chooses its own targets"
+    )
     assert stored_names(capsys, store_url) == ["mini"]
 
 
@@ -269,7 +276,7 @@ def test_delete_is_refused_while_a_live_run_uses_the_dataset(
     run_id = _add_run(store_url, status, heartbeat, owner)
     result = run_cli(capsys, store_url, "delete", "mini")
     if refused:
-        one_error_line(result, f"in use by run {run_id}", f"touchbench cancel {run_id}")
+        one_error_line(result, f"in use by run {run_id}", f"cancel run {run_id} first")
         assert stored_names(capsys, store_url) == ["mini"]
     else:
         assert result.code == 0, result.err
@@ -375,14 +382,16 @@ def test_an_upload_is_named_and_reported_by_its_own_file_name(
 ) -> None:
     store = Store(store_url)
     temporary = write(tmp_path, "upload-1a2b3c.tmp", TOUCH_ARFF)
-    result = dataset_service.import_file(store, temporary, source_name="robot arm.arff")
+    result = dataset_service.import_file(
+        store, ImportRequest(file=temporary, source_name="robot arm.arff")
+    )
     assert (result.name, result.created) == ("robot_arm", True)
     assert dataset_service.list_datasets(store)[0].source == "robot arm.arff"
     broken = write(tmp_path, "upload-4d5e6f.tmp", TOUCH_ARFF.replace("0.75", "oops"))
     with pytest.raises(DataFormatError) as caught:
-        dataset_service.import_file(store, broken, source_name="bad.arff")
+        dataset_service.import_file(store, ImportRequest(file=broken, source_name="bad.arff"))
     assert str(caught.value).startswith("bad.arff:12: attribute 'energy'")
     csv = write(tmp_path, "upload-7a8b9c.tmp", "a,b\n1,x\n2,y,3\n")
     with pytest.raises(DataFormatError, match=r"^bad\.csv:3: "):
-        dataset_service.import_file(store, csv, source_name="bad.csv")
+        dataset_service.import_file(store, ImportRequest(file=csv, source_name="bad.csv"))
     store.dispose()

@@ -71,3 +71,23 @@ def test_extract_bad_input_exits_2_and_stores_nothing(
         assert len(result.err.strip().splitlines()) == 1, result.err
         assert expected in result.err
     assert run_cli(capsys, store_url, "datasets", "--json").json() == {"datasets": []}
+
+
+def test_the_request_is_refused_before_any_recording_is_read(
+    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+) -> None:
+    absent = str(tmp_path / "absent.wav")  # never opened: the request is refused first
+    cases = [
+        (["--events", "nope"], "--events: unknown event detection 'nope' (known: "),
+        (["-e", "nope"], "--extractor: unknown extractor 'nope' (known: uc3m-audio, "),
+        (["--segment", "2"], "--segment: only applies to --events 'none', not 'snr'"),
+        (["-O", "bands=1"], "--option: unknown option 'bands' for extractor 'uc3m-audio'"),
+        (["--max-event", "1e300"], "--max-event: Input should be less than or equal to 86400"),
+        (["--name", "12"], "--name: a dataset name cannot be a number"),
+    ]
+    for args, expected in cases:
+        result = run_cli(capsys, store_url, "extract", absent, *args)
+        assert result.code == 2, (args, result.err)
+        assert result.err.strip().splitlines() == [result.err.strip()], result.err
+        assert result.err.startswith(f"touchbench: error: {expected}"), result.err
+    assert run_cli(capsys, store_url, "datasets", "--json").json() == {"datasets": []}

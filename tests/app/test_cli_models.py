@@ -105,3 +105,41 @@ def test_a_tampered_artifact_is_refused_before_loading(
     result = run_cli(capsys, store_url, "predict", "touch-nb", str(trained))
     assert result.code == 2
     assert "sha256" in result.err
+
+
+def test_training_is_refused_naming_the_option(
+    capsys: pytest.CaptureFixture[str], store_url: str, trained: Path, tmp_path: Path
+) -> None:
+    half = tmp_path / "half.arff"
+    rows = "".join(f"{'tap' if i % 2 else 'slap'},?,{i % 2 + 0.1 * i}\n" for i in range(20))
+    half.write_text(
+        "@relation 'half: -C 2'\n@attribute gesture {tap, slap}\n@attribute place {head, arm}\n"
+        "@attribute f0 numeric\n@data\n" + rows,
+        encoding="utf-8",
+    )
+    assert run_cli(capsys, store_url, "import", str(half)).code == 0
+    cases = [
+        (
+            ["touch", "-c", "nb", "--name", "touch-nb"],
+            "a model named 'touch-nb' already exists; choose another name",
+        ),
+        (
+            ["half", "-c", "nb", "--target", "place"],
+            "--target: no instance has a known value of the target ('place'): nothing to train on",
+        ),
+        (
+            ["half", "-c", "cc:nb"],
+            "DATASET: no instance has a known value of every target ('gesture', 'place'): "
+            "nothing to train on",
+        ),
+        (["touch", "-c", "nb", "--target", "nope"], "--target: the data set has no attribute"),
+        (["touch", "-c", "nb", "--seed", "-1"], "--seed: Input should be greater than or equal"),
+        (["touch", "-c", "nope"], "--classifier: unknown classifier 'nope'"),
+    ]
+    for args, expected in cases:
+        result = run_cli(capsys, store_url, "train", *args)
+        assert result.code == 2, (args, result.err)
+        assert result.err.strip().splitlines() == [result.err.strip()], result.err
+        assert result.err.startswith(f"touchbench: error: {expected}"), result.err
+    listing = run_cli(capsys, store_url, "models", "--json").json()["models"]
+    assert [model["name"] for model in listing] == ["touch-nb"]

@@ -10,6 +10,8 @@ import pytest
 import soundfile
 
 from app.errors import AppError
+from app.schemas.extraction import ExtractRequest
+from app.schemas.models import TrainRequest
 from app.services.extraction import extract_and_store, extract_dataset
 from app.services.live import LiveSession, open_live
 from app.services.models import load_model, predict, train
@@ -28,8 +30,8 @@ def trained(tmp_path: Path, store: Store) -> tuple[str, Path]:
         recordings.append(wav)
         rows += [(wav.name, *touch) for touch in touches]
     labels = write_labels(tmp_path / "labels.csv", rows)
-    extract_and_store(store, recordings, labels=labels, extractor="uc3m-audio", name="touch")
-    model = train(store, "touch", "cc:rf", targets=["gesture", "place"])
+    extract_and_store(store, ExtractRequest(recordings=recordings, labels=labels, name="touch"))
+    model = train(store, TrainRequest(dataset="touch", classifier="cc:rf"))
     unseen, _ = write_session(tmp_path, "unseen", n_touches=6, seed=99)
     return model.name, unseen
 
@@ -102,8 +104,8 @@ def test_live_bad_input_is_one_line(
     try:
         wav, touches = write_session(tmp_path, "s", n_touches=6, seed=4)
         labels = write_labels(tmp_path / "l.csv", [(wav.name, *t) for t in touches])
-        extract_and_store(store, [wav], labels=labels, extractor="uc3m-audio", name="touch")
-        train(store, "touch", "j48", targets=["gesture"])
+        extract_and_store(store, ExtractRequest(recordings=[wav], labels=labels, name="touch"))
+        train(store, TrainRequest(dataset="touch", classifier="j48", target="gesture"))
     finally:
         store.dispose()
     mono = tmp_path / "mono.wav"
@@ -129,8 +131,8 @@ def test_the_block_length_changes_when_touches_are_told_not_what_they_are(
 ) -> None:
     wav, touches = write_session(tmp_path, "s", n_touches=6, seed=4)
     labels = write_labels(tmp_path / "l.csv", [(wav.name, *t) for t in touches])
-    extract_and_store(store, [wav], labels=labels, extractor="uc3m-audio", name="touch")
-    train(store, "touch", "j48", targets=["gesture"])
+    extract_and_store(store, ExtractRequest(recordings=[wav], labels=labels, name="touch"))
+    train(store, TrainRequest(dataset="touch", classifier="j48", target="gesture"))
     seen = []
     for block in ("256", "512", "4096"):
         result = run_cli(

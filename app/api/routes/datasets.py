@@ -6,18 +6,19 @@ import contextlib
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated
 
 from fastapi import APIRouter, File, Form, Response, UploadFile, status
 from fastapi.responses import StreamingResponse
 
 from app.api.deps import ServiceDep, StoreDep
-from app.api.uploads import save_upload
+from app.api.uploads import form_request, save_upload
 from app.schemas.base import Schema
 from app.schemas.datasets import (
     DatasetDescription,
     DatasetList,
     DatasetSummary,
+    ImportRequest,
     ImportResult,
     RenameResult,
 )
@@ -27,7 +28,6 @@ from app.services.datasets import (
     export_dataset,
     import_file,
     list_datasets,
-    parse_targets,
     rename_dataset,
 )
 from app.store.database import Store
@@ -49,7 +49,7 @@ def upload(
     service: ServiceDep,
     response: Response,
     file: Annotated[UploadFile, File(description="An ARFF or CSV file.")],
-    name: Annotated[str | None, Form(max_length=200)] = None,
+    name: Annotated[str | None, Form()] = None,
     targets: Annotated[
         str | None,
         Form(
@@ -58,21 +58,17 @@ def upload(
             "(default: MEKA's -C header, else the last attribute).",
         ),
     ] = None,
-    format: Annotated[Literal["arff", "csv"] | None, Form()] = None,
+    format: Annotated[str | None, Form(description="arff or csv (default: by the ending).")] = None,
 ) -> ImportResult:
-    """Import an uploaded file as a data set (what ``touchbench import --json`` prints);
-    nothing is stored if the file has an error."""
+    """Import an uploaded file as a data set (what the CLI's import prints as JSON); nothing
+    is stored if the file has an error."""
     service.settings.work_dir.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=service.settings.work_dir) as folder:
+        fields = {"name": name, "targets": targets, "format": format}
+        form_request(ImportRequest, file=Path(folder) / "upload", **fields)  # before saving
         path = save_upload(file, Path(folder), "upload.arff")
-        result = import_file(
-            service.store,
-            path,
-            name=name,
-            targets=parse_targets(targets),
-            file_format=format,
-            source_name=path.name,
-        )
+        request = form_request(ImportRequest, file=path, source_name=path.name, **fields)
+        result = import_file(service.store, request)
     if not result.created:
         response.status_code = status.HTTP_200_OK
     return result

@@ -13,10 +13,10 @@ router = APIRouter(prefix="/api/jobs", tags=["jobs"])
 
 @router.get("", response_model=JobList)
 def jobs(store: StoreDep) -> JobList:
-    return JobList(jobs=list_jobs(store))
+    return JobList(jobs=[job.for_client() for job in list_jobs(store)])
 
 
 @router.get("/{job_id}", response_model=JobSchema)
 def job(job_id: int, store: StoreDep) -> JobSchema:
     """A job's status and, once done, its result (the new data set or model)."""
-    return get_job(store, job_id)
+    return get_job(store, job_id).for_client()

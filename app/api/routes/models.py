@@ -14,7 +14,6 @@ from fastapi import APIRouter, File, Response, UploadFile, status
 from app.api.deps import Service, ServiceDep, StoreDep, request_size
 from app.api.direct import DirectRoute
 from app.api.uploads import save_upload
-from app.errors import AppError
 from app.schemas.jobs import JobCreated
 from app.schemas.models import (
     ModelList,
@@ -35,32 +34,10 @@ predictions = APIRouter(prefix="/api/models", tags=["models"], route_class=Direc
 @router.post("", status_code=status.HTTP_202_ACCEPTED, response_model=JobCreated)
 def train(body: TrainRequest, service: ServiceDep) -> JobCreated:
     """Train a classifier on a data set (``dataset`` + ``classifier``), or a run's best
-    classifier (``run``), as a job; the job's result names the model."""
-    if body.run is None and (body.dataset is None or body.classifier is None):
-        raise AppError("give 'dataset' and 'classifier', or 'run' (its best classifier)")
-    if body.run is not None and body.classifier is not None:
-        raise AppError("give 'run' or 'classifier', not both")
-    if body.run is not None:
-        from app.store.runs import get_run
-
-        get_run(service.store, body.run)  # 404 now rather than a failed job later
-        params = {"run": body.run, "name": body.name}
-    else:
-        from app.services.models import check_training
-
-        assert body.classifier is not None
-        check_training(
-            service.store,
-            str(body.dataset),
-            body.classifier,
-            targets=[body.target] if body.target else None,
-        )
-        params = body.model_dump(exclude={"run"})
-    if body.name is not None:
-        from app.store.models import check_model_name
-
-        check_model_name(body.name)
-    job = submit_training(service.store, params)
+    classifier (``run``), as a job; the job's result names the model.  What training would
+    refuse (a name taken, a run without results, a target without known values) is refused
+    before the job exists."""
+    job = submit_training(service.store, body)
     service.dispatcher.wake()
     return JobCreated(job=job.id, status=job.status, kind=job.kind)
 

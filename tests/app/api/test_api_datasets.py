@@ -101,6 +101,9 @@ def test_a_recording_session_upload_becomes_a_data_set(server: Server, tmp_path:
     job = server.wait_for(f"/api/jobs/{response.json()['job']}", finished)
     assert job["status"] == "done", job
     assert job["result"]["name"] == "robot-session" and job["result"]["n_instances"] >= 10
+    assert job["params"]["recordings"] == [p.name for p in recordings]
+    assert (job["params"]["labels"], job["params"]["extractor"]) == ("labels.csv", "uc3m-audio")
+    assert str(server.work_dir) not in response.text + str(server.client.get("/api/jobs").json())
     described = server.client.get("/api/datasets/robot-session").json()
     assert described["targets"] == ["gesture", "place"]
     assert not list((server.work_dir / "uploads").glob("*/*")), "the upload folder is left"
@@ -112,13 +115,15 @@ def test_a_recording_session_upload_becomes_a_data_set(server: Server, tmp_path:
     )
     assert refused.status_code == 202
     failed = server.wait_for(f"/api/jobs/{refused.json()['job']}", finished)
-    assert failed["status"] == "failed" and "x.wav" in failed["error"]
+    assert failed["status"] == "failed" and failed["error"].startswith("x.wav: ")
+    assert str(server.work_dir) not in failed["error"], "a server path in the job's error"
     unknown = server.client.post(
         "/api/datasets/recordings",
         files=[("recordings", ("x.wav", b"x"))],
         data={"extractor": "nope"},
     )
-    assert unknown.status_code == 400 and "unknown extractor 'nope'" in unknown.text
+    assert unknown.status_code == 422 and "unknown extractor 'nope'" in unknown.text
+    assert unknown.json()["error"]["where"] == "body.extractor"
 
 
 def test_uploads_over_the_limit_are_refused_while_streaming(

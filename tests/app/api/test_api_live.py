@@ -14,6 +14,8 @@ import soundfile
 from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect
 
+from app.schemas.extraction import ExtractRequest
+from app.schemas.models import TrainRequest
 from app.services.extraction import extract_and_store
 from app.services.models import train
 from app.services.simulation import write_labels, write_session
@@ -33,8 +35,8 @@ def live_model(tmp_path: Path, store_url: str) -> tuple[str, Path]:
             recordings.append(wav)
             rows += [(wav.name, *touch) for touch in touches]
         labels = write_labels(tmp_path / "labels.csv", rows)
-        extract_and_store(store, recordings, labels=labels, extractor="uc3m-audio", name="touch")
-        model = train(store, "touch", "cc:j48", targets=["gesture", "place"])
+        extract_and_store(store, ExtractRequest(recordings=recordings, labels=labels, name="touch"))
+        model = train(store, TrainRequest(dataset="touch", classifier="cc:j48"))
     finally:
         store.dispose()
     unseen, _ = write_session(tmp_path, "unseen", n_touches=5, seed=99)

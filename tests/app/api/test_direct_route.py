@@ -19,7 +19,8 @@ from app.api.deps import ServiceDep, StoreDep, require_api_key
 from app.api.direct import DirectRoute
 from app.api.routes.models import predict_instances
 from app.main import create_app
-from app.schemas.models import PredictionReport, PredictRequest
+from app.schemas.datasets import ImportRequest
+from app.schemas.models import PredictionReport, PredictRequest, TrainRequest
 from app.services.datasets import import_file
 from app.services.models import train
 from app.settings import Settings
@@ -37,8 +38,8 @@ def client(tmp_path: Path) -> Iterator[TestClient]:
     time as a plain FastAPI route."""
     url = f"sqlite:///{tmp_path / 'touchbench.db'}"
     store = Store(url)
-    import_file(store, touch_arff(tmp_path / "touch.arff"), name="touch")
-    train(store, "touch", "bcc:nb", name="touch-nb")
+    import_file(store, ImportRequest(file=touch_arff(tmp_path / "touch.arff"), name="touch"))
+    train(store, TrainRequest(dataset="touch", classifier="bcc:nb", name="touch-nb"))
     store.dispose()
     settings = Settings(database_url=url, work_dir=tmp_path / "work", api_key=SecretStr(KEY))
     app = create_app(settings)

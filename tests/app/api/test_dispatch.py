@@ -17,6 +17,7 @@ import pytest
 
 from app.jobs import dispatcher as dispatching
 from app.jobs.dispatcher import Dispatcher, dispatch_address
+from app.schemas.datasets import ImportRequest
 from app.schemas.runs import BenchRequest
 from app.services.datasets import import_file
 from app.services.runs import create_run
@@ -58,7 +59,7 @@ def test_two_service_processes_run_one_job_at_a_time_each_once(
 @pytest.fixture
 def sqlite_store(tmp_path: Path) -> Iterator[Store]:
     store = Store(f"sqlite:///{tmp_path / 'touchbench.db'}")
-    import_file(store, touch_arff(tmp_path / "t.arff", n=60), name="touch")
+    import_file(store, ImportRequest(file=touch_arff(tmp_path / "t.arff", n=60), name="touch"))
     yield store
     store.dispose()
 

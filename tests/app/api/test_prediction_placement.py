@@ -14,6 +14,8 @@ from fastapi.testclient import TestClient
 
 from app.api.deps import INLINE_SECONDS, ModelCache, request_size
 from app.main import create_app
+from app.schemas.datasets import ImportRequest
+from app.schemas.models import TrainRequest
 from app.services.datasets import import_file
 from app.services.models import predict_records, train
 from app.settings import Settings
@@ -68,8 +70,11 @@ def test_a_quick_model_waits_its_turn_in_the_thread_when_another_prediction_is_u
 @pytest.fixture
 def client(tmp_path: Path, store_url: str) -> Iterator[TestClient]:
     store = Store(store_url)
-    import_file(store, touch_arff(tmp_path / "touch.arff", with_place=False), name="touch")
-    train(store, "touch", "nb", targets=["gesture"], name="quick")
+    import_file(
+        store,
+        ImportRequest(file=touch_arff(tmp_path / "touch.arff", with_place=False), name="touch"),
+    )
+    train(store, TrainRequest(dataset="touch", classifier="nb", target="gesture", name="quick"))
     store.dispose()
     settings = Settings(database_url=store_url, work_dir=tmp_path / "work")
     with TestClient(create_app(settings), base_url="http://localhost") as test_client:

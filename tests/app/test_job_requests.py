@@ -1,0 +1,53 @@
+"""A job carries its typed request: stored as the request's JSON, rebuilt and carried out by
+``execute_job``; params that are not a request of the job's kind fail the job, saying so.
+On SQLite and PostgreSQL."""
+
+from __future__ import annotations
+
+import socket
+from pathlib import Path
+
+import pytest
+
+from app.errors import ConflictError
+from app.schemas.datasets import ImportRequest
+from app.schemas.models import TrainRequest
+from app.services.datasets import import_file
+from app.services.jobs import execute_job, job_request, submit_training
+from app.store.database import Store
+from app.store.jobs import create_job, list_jobs
+from app.store.models import list_models
+from tests.app.synthetic import touch_arff
+
+
+@pytest.fixture
+def store(store_url: str, tmp_path: Path) -> Store:
+    store = Store(store_url)
+    import_file(store, ImportRequest(file=touch_arff(tmp_path / "touch.arff", n=60)))
+    return store
+
+
+def test_a_training_job_holds_its_request_and_carries_it_out(store: Store) -> None:
+    request = TrainRequest(dataset="touch", classifier="nb", target="gesture", name="quick")
+    job = submit_training(store, request)
+    assert job.params == {**request.model_dump(mode="json"), "host": socket.gethostname()}
+    assert job_request(job) == request
+    done = execute_job(store, job.id)
+    assert done is not None and done.status == "done", done
+    assert done.result is not None and done.result["name"] == "quick"
+    assert [(m.name, m.targets) for m in list_models(store)] == [("quick", ["gesture"])]
+
+    with pytest.raises(ConflictError, match="a model named 'quick' already exists"):
+        submit_training(store, request)
+    assert len(list_jobs(store)) == 1
+
+
+def test_params_that_are_not_a_request_fail_the_job(store: Store) -> None:
+    job = create_job(store, "train", {"dataset": "touch", "classifier": "nb", "folds": 3})
+    failed = execute_job(store, job.id)
+    assert failed is not None and failed.status == "failed"
+    assert failed.error is not None
+    assert failed.error == (
+        f"job {job.id} does not hold a valid train request (folds: Extra inputs are not permitted)"
+    )
+    assert list_models(store) == []
