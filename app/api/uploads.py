@@ -3,6 +3,7 @@ safe names, and requests built from a form's fields."""
 
 from __future__ import annotations
 
+import json
 import re
 import shutil
 from pathlib import Path
@@ -112,7 +113,6 @@ def _content_length(scope: Scope) -> int | None:
 
 
 async def _refuse(send: Send, limit: int) -> None:
-    import json
 
     body: Any = json.dumps(error_body("UploadTooLarge", str(UploadTooLarge(limit)), "body"))
     await send(

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+# Imports inside functions: start-up time. This module holds several commands and the
+# one chosen loads only what it uses (the CLI imports the module when a command of it
+# is chosen).
 import sys
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Annotated, Any

@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+import json
+
+# Imports inside functions: start-up time. This module holds several commands and the
+# one chosen loads only what it uses (the CLI imports the module when a command of it
+# is chosen).
 import sys
 from enum import StrEnum
 from pathlib import Path
@@ -257,8 +262,6 @@ def live_command(
 
 def _show(touch: dict, as_json: bool) -> None:
     if as_json:
-        import json
-
         sys.stdout.write(json.dumps(touch) + "\n")
         sys.stdout.flush()
         return

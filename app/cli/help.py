@@ -12,6 +12,8 @@ patched only when a help page is drawn, as typer itself imports it.
 
 from __future__ import annotations
 
+# Imports inside functions: start-up time: typer's internals load only when a help page
+# is drawn.
 import inspect
 from typing import Any
 

@@ -163,7 +163,7 @@ app = typer.Typer(
 
 def _print_version(value: bool) -> None:
     if value:
-        from importlib import metadata
+        from importlib import metadata  # start-up time: only --version reads it
 
         print(f"touchbench {metadata.version('touchbench')}")
         raise typer.Exit()

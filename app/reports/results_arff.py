@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import TextIO
 
+from app.services.tuning import run_specs
 from app.store.database import Store
 from app.store.runs import RunInfo, load_results
 from benchmark.catalogue import CATALOGUE
@@ -20,8 +21,6 @@ def write_results_arff(store: Store, run: RunInfo, stream: TextIO) -> None:
             f"run {run.id} is {what}; WEKA's results format holds multi-class runs "
             "(the csv and json formats hold every kind)"
         )
-    from app.services.tuning import run_specs
-
     results = load_results(store, run.id)
     name = f"{run.dataset_name}: {', '.join(run.targets)}"
     specs = {**CATALOGUE, **run_specs(run.config, run.classifiers)}

@@ -3,6 +3,8 @@ what happened to the events)."""
 
 from __future__ import annotations
 
+# Imports inside functions: start-up time: the feature stack (numpy, scipy) loads when an
+# extraction request is checked, not when a command that never extracts starts.
 from pathlib import Path
 from typing import TYPE_CHECKING
 

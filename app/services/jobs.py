@@ -8,6 +8,8 @@ and calls :func:`execute_job` or :func:`app.services.runs.execute_run`.
 
 from __future__ import annotations
 
+# Imports inside functions: start-up time: a job of one kind loads only its own service
+# (extraction loads the feature stack, training scikit-learn).
 import os
 import shutil
 import socket

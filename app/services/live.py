@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from app.errors import AppError
+from app.services.models import load_model
 from app.store.database import Store
 from app.store.models import ModelInfo
 from benchmark.model import TrainedModel
@@ -205,8 +206,6 @@ class LiveSession:
 def load_live_model(store: Store, ref: str | int) -> tuple[ModelInfo, TrainedModel]:
     """A stored model (name or id) with its artifact checked; ``info.extraction`` is the
     recipe of the data set it was trained on (None for an imported one)."""
-    from app.services.models import load_model
-
     return load_model(store, ref)
 
 

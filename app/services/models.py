@@ -19,6 +19,7 @@ import numpy as np
 
 from app.errors import ConflictError, FieldError
 from app.schemas.models import PredictionReport, PredictionRow, TrainRequest
+from app.services.datasets import read_data_file
 from app.store.database import Store
 from app.store.datasets import find_dataset, load_dataset
 from app.store.models import (
@@ -285,8 +286,6 @@ def _predict_values(
 
 def predict_file(store: Store, model_ref: str | int, path: Path) -> PredictionReport:
     """Predict every instance of an ARFF or CSV file (attributes matched by name)."""
-    from app.services.datasets import read_data_file
-
     info, model = load_model(store, model_ref)
     data = read_data_file(path)
     return predict(model, data, source=path.name).report(info)

@@ -9,6 +9,9 @@ processes it is alive (and hears a cancel request), and writes the final status.
 
 from __future__ import annotations
 
+# Imports inside functions: start-up time. The listing commands, the API's routes and the
+# job process import this module; the catalogue, the engine and the statistics load
+# scikit-learn and scipy, which only the functions that need them import.
 import threading
 import time
 from collections.abc import Callable, Mapping, Sequence

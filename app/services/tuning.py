@@ -4,6 +4,8 @@ and the specs the engine needs to build them again from the run's stored config.
 
 from __future__ import annotations
 
+# Imports inside functions: start-up time: the catalogue loads scikit-learn, which only
+# a run with tuned twins or a stack needs.
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 

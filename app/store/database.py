@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import re
+import sqlite3
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -54,7 +55,7 @@ class Store:
                 return
             if revision is None:
                 self._refuse_foreign_database()
-            from alembic import command
+            from alembic import command  # start-up time: alembic loads only to migrate
             from alembic.config import Config
 
             config = Config()
@@ -72,8 +73,6 @@ class Store:
 
     def _refuse_foreign_database(self) -> None:
         """An unversioned database that holds tables belongs to someone else: never write."""
-        from sqlalchemy import inspect
-
         tables = sorted(inspect(self.engine).get_table_names())
         if tables:
             shown = ", ".join(tables[:5]) + (f", ... ({len(tables)})" if len(tables) > 5 else "")
@@ -205,7 +204,6 @@ def _check_sqlite_file(path: Path, url: str) -> None:
         raise AppError(f"cannot open the store at {display_url(url)}: {path} is not a regular file")
     if path.stat().st_size == 0:
         return
-    import sqlite3
 
     # Through SQLite itself, read-only: opening and closing the file any other way would
     # drop the POSIX locks this process's own connections hold on it (SQLite shares them

@@ -9,6 +9,8 @@ strict: nothing inline, nothing from another origin.
 
 from __future__ import annotations
 
+# Imports inside functions: start-up time: the report templates and matplotlib load when a
+# page first needs them.
 import base64
 from collections.abc import Callable
 from dataclasses import dataclass

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import contextlib
+import queue
 import tempfile
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Annotated
@@ -123,8 +125,6 @@ class _Abandoned(Exception):  # noqa: N818 (the client went away)
 def _arff_lines(store: Store, dataset: str) -> Iterator[bytes]:
     """The export in chunks of about 64 kB, written by a thread through a bounded queue, so
     that memory stays flat whatever the size and a client that goes away stops the export."""
-    import queue
-    import threading
 
     chunks: queue.Queue[bytes | None] = queue.Queue(maxsize=8)
     abandoned = threading.Event()

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+# Imports inside functions: start-up time: scikit-learn (behind the model service) loads
+# in the service's warm-up thread, not before it answers its first request.
 import functools
 import tempfile
 import time

@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import io
+
+# Imports inside functions: start-up time: the leaderboard's text formats and the results
+# ARFF writer load when a format other than JSON is first asked for.
 from typing import Annotated, Literal
 
 from fastapi import APIRouter, Query, status
@@ -82,8 +86,6 @@ def leaderboard(
     elif format == "markdown":
         text = leaderboard_markdown(run, board, columns)
     else:
-        import io
-
         from app.reports.results_arff import write_results_arff
 
         buffer = io.StringIO()

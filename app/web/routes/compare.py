@@ -3,6 +3,8 @@ Friedman's and Holm's tests, Nemenyi's groups and the critical-difference diagra
 
 from __future__ import annotations
 
+# Imports inside functions: start-up time: matplotlib and the statistics load when a
+# comparison is first drawn, not when the service starts.
 from functools import partial
 from typing import Annotated
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+# Imports inside functions: start-up time: matplotlib loads when a class distribution is
+# first drawn.
 from functools import partial
 
 from fastapi import APIRouter

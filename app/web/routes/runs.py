@@ -4,6 +4,8 @@ the form that starts a run."""
 
 from __future__ import annotations
 
+# Imports inside functions: start-up time: matplotlib, the catalogue and the reports load
+# when a fragment that draws or lists them is first asked for, not when the service starts.
 from functools import partial
 from typing import TYPE_CHECKING, Annotated, Any
 
