@@ -33,13 +33,18 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 class GateClassifier(ClassifierMixin, BaseEstimator):
-    """Majority class, once the test lets the fit through (see :class:`Gate`)."""
+    """Majority class, once the test lets the fit through (see :class:`Gate`).
 
-    def __init__(self, random_state: int | None = None) -> None:
+    ``stubborn`` fits ignore Ctrl-C while they wait, as a fit inside native code does
+    (libsvm, a BLAS call): only killing the process stops them.
+    """
+
+    def __init__(self, random_state: int | None = None, stubborn: bool = False) -> None:
         self.random_state = random_state
+        self.stubborn = stubborn
 
     def fit(self, X: Any, y: Any) -> GateClassifier:
-        Gate(Path(os.environ[GATE_VARIABLE])).wait()
+        Gate(Path(os.environ[GATE_VARIABLE])).wait(ignore_interrupts=self.stubborn)
         labels, counts = np.unique(np.asarray(y), return_counts=True)
         self.classes_ = labels
         self.majority_ = labels[int(np.argmax(counts))]
@@ -53,21 +58,22 @@ class GateClassifier(ClassifierMixin, BaseEstimator):
         return np.tile(self.prior_, (len(X), 1))
 
 
-CLASSIFIERS = (
+CLASSIFIERS = tuple(
     ClassifierSpec(
-        id="gate",
+        id=spec_id,
         weka_command=None,
         family="test",
         description="Test only: majority class once the test lets each fit through",
         factory=GateClassifier,
-        params={},
+        params=params,
         probabilities=True,
         needs_scaling=False,
         handles_missing=True,
         handles_nominal=False,
         cost="fast",
         suites=frozenset(),
-    ),
+    )
+    for spec_id, params in (("gate", {}), ("gate-stubborn", {"stubborn": True}))
 )
 
 
@@ -114,19 +120,30 @@ class Gate:
                 raise AssertionError(f"{self.started()} fits began, not {n}, in {timeout:g} s")
             time.sleep(0.02)
 
-    def wait(self) -> None:
-        """A fit's side: take a pass, or go through an open gate."""
+    def wait(self, *, ignore_interrupts: bool = False) -> None:
+        """A fit's side: take a pass, or go through an open gate; with ``ignore_interrupts``
+        a KeyboardInterrupt does not end the wait."""
         me = uuid.uuid4().hex
         (self.folder / f"started-{me}").touch()
         deadline = time.monotonic() + LONGEST_WAIT
         while time.monotonic() < deadline:
-            if (self.folder / "open").exists():
-                return
-            for ticket in sorted(self.folder.glob("pass-*")):
-                try:
-                    ticket.rename(self.folder / f"used-{me}")
-                except FileNotFoundError:  # another fit took it first
-                    continue
-                return
-            time.sleep(0.02)
+            try:
+                if self._take_pass(me):
+                    return
+                time.sleep(0.02)
+            except KeyboardInterrupt:
+                if not ignore_interrupts:
+                    raise
         raise TimeoutError(f"no pass in {self.folder} after {LONGEST_WAIT:g} s")
+
+    def _take_pass(self, me: str) -> bool:
+        """Whether this fit may go: the gate is open, or it took a pass."""
+        if (self.folder / "open").exists():
+            return True
+        for ticket in sorted(self.folder.glob("pass-*")):
+            try:
+                ticket.rename(self.folder / f"used-{me}")
+            except FileNotFoundError:  # another fit took it first
+                continue
+            return True
+        return False

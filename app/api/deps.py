@@ -117,6 +117,8 @@ class ModelCache:
             if cached is not None:
                 self._models.move_to_end(key)
                 return cached
+        # loaded with the first model: start-up time (scikit-learn loads in the service's
+        # warm-up thread, not before it answers its first request)
         from app.services.models import load_model
 
         info, model = load_model(store, key[0])

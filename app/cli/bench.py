@@ -374,7 +374,7 @@ def bench_command(
     from app.cli.requests import build_request
     from app.errors import ConflictError
     from app.services.runs import RunCancelled, create_run, execute_run, independent_runs
-    from app.store.run_states import RunBusy
+    from app.store.states import RunBusy
 
     store = get_state(ctx).store
     values = {

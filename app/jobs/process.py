@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sys
 import threading
 import time
@@ -44,6 +45,11 @@ def main(argv: list[str] | None = None) -> int:
     if not url:
         parser.error(f"no store: set {DATABASE_URL_VARIABLE} or pass --db")
     threading.Thread(target=_exit_with_parent, args=(os.getppid(),), daemon=True).start()
+    # A cancel interrupts the work as Ctrl-C does (app.services.jobs), and so does the
+    # service stopping it with SIGTERM: the item is recorded cancelled or interrupted, not
+    # left running.  Set whatever the service's own disposition was (it may ignore SIGINT).
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, signal.default_int_handler)
 
     # loaded once the arguments are read and the parent is watched: start-up time (``--help``
     # and a bad argument need none of it; a service that dies meanwhile ends this process)

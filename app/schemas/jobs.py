@@ -15,8 +15,9 @@ from app.schemas.models import TrainRequest
 JobKind = Literal["extract", "train"]
 #: The request each kind of job carries out (its JSON is the job's ``params``).
 JOB_REQUESTS: dict[JobKind, type[Request]] = {"extract": ExtractRequest, "train": TrainRequest}
-#: Same life as a run's: queued -> running -> done | failed (| interrupted after a crash).
-JobStatus = Literal["queued", "running", "done", "failed", "cancelled", "interrupted"]
+#: Same life as a run's (app/store/states.py), without resume: queued -> running -> done |
+#: failed | cancelling -> cancelled (| interrupted after a crash).
+JobStatus = Literal["queued", "running", "cancelling", "done", "failed", "cancelled", "interrupted"]
 
 
 class JobSchema(Schema):

@@ -11,7 +11,7 @@ from pydantic import Field, field_validator, model_validator
 from app.errors import FieldError
 from app.schemas.base import Request, Schema
 
-#: Where a run is in its life (the rules: :mod:`app.store.run_states`): ``queued`` (created,
+#: Where a run is in its life (the rules: :mod:`app.store.states`): ``queued`` (created,
 #: waiting for a worker), ``running``, ``cancelling`` (its process was asked to stop),
 #: ``done`` (every task has a result), ``failed`` (every task failed, or the run could not
 #: be carried out), ``cancelled`` (on request), ``interrupted`` (its process stopped: Ctrl-C,

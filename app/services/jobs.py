@@ -10,9 +10,11 @@ from __future__ import annotations
 
 # Imports inside functions: start-up time: a job of one kind loads only its own service
 # (extraction loads the feature stack, training scikit-learn).
+import _thread
 import os
 import shutil
 import socket
+import threading
 from typing import Any
 
 from pydantic import ValidationError
@@ -23,7 +25,12 @@ from app.schemas.extraction import ExtractRequest
 from app.schemas.jobs import JOB_REQUESTS, JobKind, JobSchema
 from app.schemas.models import TrainRequest
 from app.store.database import Store
-from app.store.jobs import claim_job, create_job, finish_job, get_job
+from app.store.jobs import claim_job, create_job, finish_job, get_job, job_heartbeat
+from app.store.ownership import process_owner
+
+#: Seconds a job's work has, once asked to stop, to end by itself (the interrupt reaches
+#: Python code at once, native code only when it returns) before its process ends it.
+STOP_GRACE = 5.0
 
 
 def submit_extraction(store: Store, request: ExtractRequest) -> JobSchema:
@@ -84,29 +91,83 @@ def execute_job(store: Store, job_id: int) -> JobSchema | None:
 
     Bad input (a recording that cannot be read, an unknown classifier) ends the job
     ``failed`` with the same one-line message the CLI prints; the job's upload folder is
-    removed either way.
+    removed either way.  A cancel, heard through the job's heartbeat, interrupts the work
+    (see :class:`_Stopper`) and ends the job ``cancelled``.  Meant for the main thread of a
+    job process (:mod:`app.jobs.process`).
     """
     job = get_job(store, job_id)
-    if not claim_job(store, job.id):
+    owner = process_owner()
+    if not claim_job(store, job.id, owner=owner):
         return None
     folder = job.params.get("folder") if job.kind == "extract" else None
+    stopper = _Stopper(store, job.id, folder)
+    beat = job_heartbeat(store, job.id, owner, stopper.stop)
+    beat.start()
     try:
         try:
             result = _carry_out(store, job_request(job))
         finally:  # before the job ends, so that whoever sees it ended finds no upload left
             if folder:
                 shutil.rmtree(folder, ignore_errors=True)
-    except USER_ERRORS as error:
-        finish_job(store, job.id, "failed", error=_client_words(str(error), folder))
     except KeyboardInterrupt:
-        finish_job(store, job.id, "interrupted", error="interrupted")
-        raise
+        if not stopper.asked:
+            stopper.finish("interrupted", error="interrupted")
+            raise
+        stopper.finish("cancelled")
+    except USER_ERRORS as error:
+        stopper.finish("failed", error=_client_words(str(error), folder))
     except Exception as error:
         message = f"unexpected {type(error).__name__}: {error}"
-        finish_job(store, job.id, "failed", error=_client_words(message, folder))
+        stopper.finish("failed", error=_client_words(message, folder))
     else:
-        finish_job(store, job.id, "done", result=result)
+        stopper.finish("done", result=result)
+    finally:
+        beat.stop()
     return get_job(store, job.id)
+
+
+class _Stopper:
+    """Ends a job once, whoever comes first: its own work, or a cancel.
+
+    A cancel interrupts the main thread (a KeyboardInterrupt where the work is), which ends
+    the job ``cancelled``; work in native code (a fit inside libsvm) hears the interrupt
+    only when it returns, so after :data:`STOP_GRACE` seconds the process records the
+    cancel itself, removes the upload and exits.
+    """
+
+    def __init__(self, store: Store, job_id: int, folder: str | None) -> None:
+        self._store = store
+        self._job_id = job_id
+        self._folder = folder
+        self._lock = threading.Lock()
+        self._finished = False
+        self.asked = False
+
+    def stop(self) -> None:
+        """The heartbeat heard a cancel (called in its thread)."""
+        self.asked = True
+        _thread.interrupt_main()
+        timer = threading.Timer(STOP_GRACE, self._end_process)
+        timer.daemon = True
+        timer.start()
+
+    def finish(self, status: str, **values: Any) -> None:
+        """Record how the job ended, unless that is done already."""
+        with self._lock:
+            if self._finished:
+                return
+            self._finished = True
+            finish_job(self._store, self._job_id, status, **values)
+
+    def _end_process(self) -> None:
+        with self._lock:
+            if self._finished:
+                return
+            self._finished = True
+            finish_job(self._store, self._job_id, "cancelled")
+            if self._folder:
+                shutil.rmtree(self._folder, ignore_errors=True)
+        os._exit(1)
 
 
 def _client_words(message: str, folder: str | None) -> str:

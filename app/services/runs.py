@@ -13,7 +13,6 @@ from __future__ import annotations
 # job process import this module; the catalogue, the engine and the statistics load
 # scikit-learn and scipy, which only the functions that need them import.
 import threading
-import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -35,17 +34,14 @@ from app.store.database import Store
 from app.store.datasets import load_dataset, load_schema
 from app.store.ownership import process_owner
 from app.store.runs import (
-    CANCEL_POLL,
-    HEARTBEAT_INTERVAL,
     RunInfo,
     claim_run,
     finish_run,
     finished_keys,
     get_run,
-    heartbeat,
     load_results,
     record_result,
-    should_stop,
+    run_heartbeat,
 )
 from app.store.runs import (
     create_run as store_run,
@@ -426,7 +422,7 @@ def execute_run(
     owner = process_owner()
     run = claim_run(store, run.id, owner=owner)
     stop = threading.Event()
-    beat = _Heartbeat(store, run.id, owner, stop)
+    beat = run_heartbeat(store, run.id, owner, stop.set)
     try:
         options = RunOptions.from_config(run.config)
         prepared = prepare_problem(
@@ -744,46 +740,6 @@ def independent_runs(
             value *= board.rows[0].metrics[name][0]
         product[name] = value
     return IndependentResult(runs, product)
-
-
-class _Heartbeat:
-    """A thread that keeps a run's heartbeat and sets ``stop`` when the run should stop.
-
-    It looks for a cancel request every :data:`~app.store.runs.CANCEL_POLL` seconds (one
-    read of the run's row) and writes the heartbeat every
-    :data:`~app.store.runs.HEARTBEAT_INTERVAL` seconds, so that a cancel is heard within a
-    fraction of a second while the store takes a write only every few seconds.
-    """
-
-    def __init__(self, store: Store, run_id: int, owner: str, stop: threading.Event) -> None:
-        self._store = store
-        self._run_id = run_id
-        self._owner = owner
-        self._stop = stop
-        self._done = threading.Event()
-        self._thread = threading.Thread(target=self._beat, daemon=True, name="run-heartbeat")
-
-    def start(self) -> None:
-        self._thread.start()
-
-    def stop(self) -> None:
-        self._done.set()
-        if self._thread.is_alive():
-            self._thread.join(timeout=HEARTBEAT_INTERVAL * 2)
-
-    def _beat(self) -> None:
-        next_beat = time.monotonic() + HEARTBEAT_INTERVAL
-        while not self._done.wait(CANCEL_POLL):
-            try:
-                if time.monotonic() >= next_beat:
-                    next_beat = time.monotonic() + HEARTBEAT_INTERVAL
-                    told = heartbeat(self._store, self._run_id, self._owner)
-                else:
-                    told = should_stop(self._store, self._run_id, self._owner)
-            except Exception:  # a busy store: try again at the next look
-                continue
-            if told:
-                self._stop.set()
 
 
 def _outcome(results: Sequence[TaskResult]) -> tuple[RunStatus, str | None]:

@@ -4,16 +4,40 @@ service processes on one store) never carry out the same job twice."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass
+from datetime import datetime
 from typing import Any
 
 from sqlalchemy import select, update
 
 from app.errors import NotFoundError
 from app.schemas.jobs import JobSchema
+from app.store import queue
 from app.store.database import Store
 from app.store.naming import is_row_id
-from app.store.ownership import mark_lost, process_owner
+from app.store.ownership import mark_lost, owner_alive, process_owner
 from app.store.tables import JobRow, utcnow
+
+#: What a job whose process died is left as: a running job is interrupted, a job being
+#: cancelled is cancelled (its process stopped, as asked).
+_LOST = {
+    "running": ("interrupted", "the worker process stopped before the job ended"),
+    "cancelling": ("cancelled", None),
+}
+
+
+@dataclass(frozen=True)
+class _JobState:
+    """What the state rules (:mod:`app.store.states`) read of a job."""
+
+    id: int
+    status: str
+    owner: str | None
+    heartbeat_at: datetime | None
+
+    def owner_alive(self) -> bool:
+        return owner_alive(self.owner, self.heartbeat_at)
 
 
 def create_job(store: Store, kind: str, params: dict[str, Any]) -> JobSchema:
@@ -48,7 +72,11 @@ def claim_job(store: Store, job_id: int, *, owner: str | None = None) -> bool:
             update(JobRow)
             .where(JobRow.id == job_id, JobRow.status == "queued")
             .values(
-                status="running", owner=owner or process_owner(), started_at=now, heartbeat_at=now
+                status="running",
+                owner=owner or process_owner(),
+                started_at=now,
+                heartbeat_at=now,
+                cancel_requested=False,
             )
             .execution_options(synchronize_session=False)
         ).rowcount  # type: ignore[attr-defined]  # an UPDATE gives a CursorResult
@@ -67,21 +95,64 @@ def finish_job(
         session.execute(
             update(JobRow)
             .where(JobRow.id == job_id)
-            .values(status=status, result=result, error=error, finished_at=utcnow())
+            .values(
+                status=status,
+                result=result,
+                error=error,
+                finished_at=utcnow(),
+                owner=None,
+                heartbeat_at=None,
+            )
             .execution_options(synchronize_session=False)
         )
 
 
-def mark_lost_jobs(store: Store) -> list[int]:
-    """Jobs left ``running`` by a process that died become ``interrupted``; their ids."""
+def request_job_cancel(store: Store, job_id: int | str) -> JobSchema:
+    """Cancel a job: at once while it is queued, else by asking its process to stop (status
+    ``cancelling`` until it has).
+
+    Raises
+    ------
+    ConflictError
+        The job is over (done, failed, cancelled or interrupted).
+    """
     with store.session() as session:
-        return mark_lost(
-            session,
-            JobRow,
-            status="interrupted",
-            error="the worker process stopped before the job ended",
-            finished_at=utcnow(),
-        )
+        row = _row(session, job_id)
+        state = _JobState(row.id, row.status, row.owner, row.heartbeat_at)
+    outcome = queue.request_cancel(store, JobRow, state, "job")
+    if outcome == "changed":  # the job changed meanwhile: judge it again
+        return request_job_cancel(store, state.id)
+    job = get_job(store, state.id)
+    if outcome == "cancelling":  # what this request did, whatever the job's process does next
+        return job.model_copy(update={"status": "cancelling"})
+    return job
+
+
+def job_heartbeat(
+    store: Store, job_id: int, owner: str, on_stop: Callable[[], None]
+) -> queue.Heartbeat:
+    """The thread that keeps the job's heartbeat for ``owner`` and calls ``on_stop`` once
+    when the job should stop (a cancel)."""
+    return queue.Heartbeat(store, JobRow, job_id, owner, on_stop)
+
+
+def mark_lost_jobs(store: Store) -> list[int]:
+    """Jobs left active by a process that died become ``interrupted`` (``cancelled`` when
+    they were being cancelled); their ids."""
+    lost: list[int] = []
+    with store.session() as session:
+        for status, (becomes, error) in _LOST.items():
+            lost += mark_lost(
+                session,
+                JobRow,
+                of=status,
+                status=becomes,
+                error=error,
+                finished_at=utcnow(),
+                owner=None,
+                heartbeat_at=None,
+            )
+    return sorted(lost)
 
 
 def _row(session: Any, job_id: int | str) -> JobRow:

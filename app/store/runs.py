@@ -10,7 +10,7 @@ already recorded, so a resumed run never duplicates rows.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from datetime import datetime
 from typing import Any
@@ -22,10 +22,11 @@ from sqlalchemy.orm import Session
 
 from app.errors import ConflictError, NotFoundError
 from app.schemas.runs import FINAL_STATUSES, RunSchema, RunStatus
+from app.store import queue
 from app.store.database import Store
 from app.store.naming import is_row_id
 from app.store.ownership import aware, mark_lost, owner_alive, process_owner
-from app.store.run_states import ACTIVE, LOST_AS, cancel_outcome, check_claim, check_resume
+from app.store.states import ACTIVE, LOST_AS, check_claim, check_resume
 from app.store.tables import DatasetRow, FoldResultRow, RunRow, utcnow
 from benchmark.results import TaskKey, TaskResult
 
@@ -33,11 +34,6 @@ from benchmark.results import TaskKey, TaskResult
 PER_TARGET = "per_target"
 #: Key of a result's chosen parameters inside its stored metrics (absent before tuning).
 PARAMS = "params"
-#: Seconds between heartbeats of the process executing a run.
-HEARTBEAT_INTERVAL = 5.0
-#: Seconds between the executing process's looks for a cancel request: one read of the run's
-#: row by its primary key, cheap enough on either store to take a few times a second.
-CANCEL_POLL = 0.2
 
 
 @dataclass(frozen=True)
@@ -155,7 +151,7 @@ def claim_run(store: Store, run_id: int, *, owner: str | None = None) -> RunInfo
     """Make this process the one executing ``run_id``: status ``running``, owner, heartbeat.
 
     A run that another live process executes, or that is being cancelled, is refused
-    (:func:`app.store.run_states.check_claim`); an active run whose process died (kill -9, a
+    (:func:`app.store.states.check_claim`); an active run whose process died (kill -9, a
     crash, a lost machine) is taken over.
 
     Raises
@@ -189,32 +185,22 @@ def claim_run(store: Store, run_id: int, *, owner: str | None = None) -> RunInfo
 
 
 def heartbeat(store: Store, run_id: int, owner: str) -> bool:
-    """Say that ``owner`` still executes the run; returns whether it should stop (see
-    :func:`should_stop`)."""
-    with store.session() as session:
-        session.execute(
-            update(RunRow)
-            .where(RunRow.id == run_id, RunRow.owner == owner, RunRow.status.in_(ACTIVE))
-            .values(heartbeat_at=utcnow())
-        )
-        return _should_stop(session, run_id, owner)
+    """Say that ``owner`` still executes the run; returns whether it should stop."""
+    return queue.beat(store, RunRow, run_id, owner)
+
+
+def run_heartbeat(
+    store: Store, run_id: int, owner: str, on_stop: Callable[[], None]
+) -> queue.Heartbeat:
+    """The thread that keeps the run's heartbeat for ``owner`` and calls ``on_stop`` once
+    when the run should stop (a cancel, the run taken away)."""
+    return queue.Heartbeat(store, RunRow, run_id, owner, on_stop)
 
 
 def should_stop(store: Store, run_id: int, owner: str) -> bool:
     """Whether the process ``owner`` executing the run should stop: a cancel was requested,
     or the run was taken away from it (deleted, claimed by another process)."""
-    with store.session() as session:
-        return _should_stop(session, run_id, owner)
-
-
-def _should_stop(session: Session, run_id: int, owner: str) -> bool:
-    row = session.execute(
-        select(RunRow.cancel_requested, RunRow.owner, RunRow.status).where(RunRow.id == run_id)
-    ).one_or_none()
-    if row is None:
-        return True
-    cancel, current_owner, status = row
-    return bool(cancel) or current_owner != owner or status not in ACTIVE
+    return queue.should_stop(store, RunRow, run_id, owner)
 
 
 def finish_run(store: Store, run_id: int, status: RunStatus, *, error: str | None = None) -> None:
@@ -235,7 +221,7 @@ def finish_run(store: Store, run_id: int, status: RunStatus, *, error: str | Non
 
 def request_cancel(store: Store, run_id: int | str) -> RunInfo:
     """Cancel a run: at once if nobody executes it, else by asking its process to stop
-    (status ``cancelling`` until it has; see :mod:`app.store.run_states`).
+    (status ``cancelling`` until it has; see :mod:`app.store.states`).
 
     Raises
     ------
@@ -243,20 +229,11 @@ def request_cancel(store: Store, run_id: int | str) -> RunInfo:
         The run is already over.
     """
     run = get_run(store, run_id)
-    outcome = cancel_outcome(run)
-    if outcome == "cancelling":
-        with store.session() as session:
-            asked = session.execute(
-                update(RunRow)
-                .where(RunRow.id == run.id, RunRow.status == run.status)
-                .values(status="cancelling", cancel_requested=True)
-                .execution_options(synchronize_session=False)
-            ).rowcount  # type: ignore[attr-defined]  # an UPDATE gives a CursorResult
-        if asked:  # what this request did, whatever the run's process does next
-            return replace(run, status="cancelling", cancel_requested=True)
-        return request_cancel(store, run.id)  # the run changed meanwhile: judge it again
-    if outcome == "cancelled":
-        finish_run(store, run.id, "cancelled")
+    outcome = queue.request_cancel(store, RunRow, run, "run")
+    if outcome == "changed":  # the run changed meanwhile: judge it again
+        return request_cancel(store, run.id)
+    if outcome == "cancelling":  # what this request did, whatever the run's process does next
+        return replace(run, status="cancelling", cancel_requested=True)
     return get_run(store, run.id)
 
 

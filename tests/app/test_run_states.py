@@ -1,4 +1,4 @@
-"""The life of a run (app/store/run_states.py) on SQLite and PostgreSQL: cancelling, resume
+"""The life of a run (app/store/states.py) on SQLite and PostgreSQL: cancelling, resume
 after a cancel, claims by a second process, and what a lost process leaves."""
 
 from __future__ import annotations
@@ -12,7 +12,6 @@ from app.errors import ConflictError
 from app.store.database import Store
 from app.store.datasets import add_dataset
 from app.store.ownership import process_owner
-from app.store.run_states import RunBusy
 from app.store.runs import (
     claim_run,
     create_run,
@@ -24,6 +23,7 @@ from app.store.runs import (
     requeue_run,
     should_stop,
 )
+from app.store.states import RunBusy
 from tests.app.test_store import small_dataset
 
 

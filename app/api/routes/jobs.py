@@ -6,7 +6,7 @@ from fastapi import APIRouter
 
 from app.api.deps import StoreDep
 from app.schemas.jobs import JobList, JobSchema
-from app.store.jobs import get_job, list_jobs
+from app.store.jobs import get_job, list_jobs, request_job_cancel
 
 router = APIRouter(prefix="/api/jobs", tags=["jobs"])
 
@@ -20,3 +20,10 @@ def jobs(store: StoreDep) -> JobList:
 def job(job_id: int, store: StoreDep) -> JobSchema:
     """A job's status and, once done, its result (the new data set or model)."""
     return get_job(store, job_id).for_client()
+
+
+@router.post("/{job_id}/cancel", response_model=JobSchema)
+def cancel(job_id: int, store: StoreDep) -> JobSchema:
+    """Cancel a queued job at once; a running one becomes ``cancelling`` and stops within
+    about half a second (work in native code within a few seconds)."""
+    return request_job_cancel(store, job_id).for_client()

@@ -50,7 +50,7 @@ async def live(websocket: WebSocket, model_ref: str) -> None:
         _check_key(service, websocket, header)
         samplerate, channels, sample_format = _stream_format(header)
         info, model = await run_in_threadpool(service.models.get, service.store, model_ref)
-        from app.services.live import LiveSession
+        from app.services.live import LiveSession  # start-up time: the feature stack
 
         try:
             session = LiveSession(info, model, samplerate=samplerate, n_channels=channels)

@@ -1,5 +1,7 @@
-"""The life of a run: which status may become which, and what a request that does not fit
-the run's state is told (a :class:`~app.errors.ConflictError`, HTTP 409, exit 2).
+"""The life of a run or a job: which status may become which, and what a request that does
+not fit the item's state is told (a :class:`~app.errors.ConflictError`, HTTP 409, exit 2).
+
+A run:
 
 ::
 
@@ -9,15 +11,19 @@ the run's state is told (a :class:`~app.errors.ConflictError`, HTTP 409, exit 2)
       └─cancel──► cancelled
     interrupted | cancelled | failed ──resume──► queued
 
-A run is *active* while a process executes it (``running``, ``cancelling``); a cancel of an
-active run asks its process to stop (status ``cancelling`` until it has), a cancel of any
-other unfinished run takes effect at once.  Every rule about these changes lives here; the
-store's functions (:mod:`app.store.runs`) apply them.
+A job (an extraction, a training) lives the same life but is never resumed: a job whose
+process was lost is ``interrupted`` for good, and is submitted again instead.
+
+An item is *active* while a process executes it (``running``, ``cancelling``); a cancel of
+an active item asks its process to stop (status ``cancelling`` until it has), a cancel of
+any other unfinished item takes effect at once.  Every rule about these changes lives here;
+the store's functions (:mod:`app.store.runs`, :mod:`app.store.jobs`, the protocol both
+follow in :mod:`app.store.queue`) apply them.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 from app.errors import ConflictError
 
@@ -46,9 +52,18 @@ class RunBusy(ConflictError):  # noqa: N818 (a state, like ConflictError's other
         self.run_id = run.id
 
 
-def is_active(run: RunInfo) -> bool:
-    """Whether a live process executes the run."""
-    return run.status in ACTIVE and run.owner_alive()
+class Item(Protocol):
+    """What the rules read of a run or a job."""
+
+    id: int
+    status: str
+
+    def owner_alive(self) -> bool: ...
+
+
+def is_active(item: Item) -> bool:
+    """Whether a live process executes the item."""
+    return item.status in ACTIVE and item.owner_alive()
 
 
 def check_claim(run: RunInfo, owner: str) -> None:
@@ -68,20 +83,21 @@ def check_claim(run: RunInfo, owner: str) -> None:
         raise RunBusy(run)
 
 
-def cancel_outcome(run: RunInfo) -> str:
-    """What a cancel does to the run: ``cancelling`` (its process is asked to stop),
-    ``cancelled`` (at once), or ``unchanged`` (a cancel already asked).
+def cancel_outcome(item: Item, kind: str = "run") -> str:
+    """What a cancel does to a run or a job (``kind``): ``cancelling`` (its process is asked
+    to stop), ``cancelled`` (at once), or ``unchanged`` (a cancel already asked).
 
     Raises
     ------
     ConflictError
-        The run is done, failed or already cancelled.
+        The item is done, failed or already cancelled; a job that was interrupted.
     """
-    if run.status in ("done", "failed", "cancelled"):
-        raise ConflictError(f"run {run.id} is already {run.status}; nothing to cancel")
-    if run.status == "cancelling" and run.owner_alive():
+    over = ("done", "failed", "cancelled") + (("interrupted",) if kind == "job" else ())
+    if item.status in over:
+        raise ConflictError(f"{kind} {item.id} is already {item.status}; nothing to cancel")
+    if item.status == "cancelling" and item.owner_alive():
         return "unchanged"
-    return "cancelling" if is_active(run) else "cancelled"
+    return "cancelling" if is_active(item) else "cancelled"
 
 
 def check_resume(run: RunInfo) -> None:
