@@ -4,7 +4,6 @@ from __future__ import annotations
 
 # Imports inside functions: start-up time: uvicorn, the settings and threadpoolctl load
 # when the service starts, not when another command of the CLI runs.
-
 import copy
 import ipaddress
 import os
