@@ -17,14 +17,11 @@ from app.store import queue
 from app.store.database import Store
 from app.store.naming import is_row_id
 from app.store.ownership import mark_lost, owner_alive, process_owner
+from app.store.states import LOST_AS
 from app.store.tables import JobRow, utcnow
 
-#: What a job whose process died is left as: a running job is interrupted, a job being
-#: cancelled is cancelled (its process stopped, as asked).
-_LOST = {
-    "running": ("interrupted", "the worker process stopped before the job ended"),
-    "cancelling": ("cancelled", None),
-}
+#: The error a job left by a dead process is recorded with.
+_LOST_ERROR = "the worker process stopped before the job ended"
 
 
 @dataclass(frozen=True)
@@ -141,7 +138,10 @@ def mark_lost_jobs(store: Store) -> list[int]:
     they were being cancelled); their ids."""
     lost: list[int] = []
     with store.session() as session:
-        for status, (becomes, error) in _LOST.items():
+        for status, becomes in LOST_AS.items():
+            error = (
+                "the worker process stopped before the job ended" if status == "running" else None
+            )
             lost += mark_lost(
                 session,
                 JobRow,

@@ -20,6 +20,7 @@ from collections.abc import Callable
 from typing import Any
 
 from sqlalchemy import select, update
+from sqlalchemy.orm import Session
 
 from app.store.database import Store
 from app.store.states import ACTIVE, cancel_outcome
@@ -40,16 +41,20 @@ def beat(store: Store, table: Any, item_id: int, owner: str) -> bool:
             .where(table.id == item_id, table.owner == owner, table.status.in_(ACTIVE))
             .values(heartbeat_at=utcnow())
         )
-    return should_stop(store, table, item_id, owner)
+        return _should_stop(session, table, item_id, owner)
 
 
 def should_stop(store: Store, table: Any, item_id: int, owner: str) -> bool:
     """Whether the process ``owner`` executing the item should stop: a cancel was requested,
     or the item was taken away from it (deleted, claimed by another process)."""
     with store.session() as session:
-        row = session.execute(
-            select(table.cancel_requested, table.owner, table.status).where(table.id == item_id)
-        ).one_or_none()
+        return _should_stop(session, table, item_id, owner)
+
+
+def _should_stop(session: Session, table: Any, item_id: int, owner: str) -> bool:
+    row = session.execute(
+        select(table.cancel_requested, table.owner, table.status).where(table.id == item_id)
+    ).one_or_none()
     if row is None:
         return True
     cancel, current_owner, status = row

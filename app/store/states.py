@@ -32,12 +32,8 @@ if TYPE_CHECKING:
 
 #: A process executes the run.
 ACTIVE: frozenset[str] = frozenset({"running", "cancelling"})
-#: Over: nothing runs and nothing will unless it is resumed.
-FINISHED: frozenset[str] = frozenset({"done", "failed", "cancelled", "interrupted"})
-#: What a resume puts back in the queue.
-RESUMABLE: frozenset[str] = frozenset({"interrupted", "cancelled", "failed"})
-#: What a process whose owner died leaves: a running run is interrupted, a run being
-#: cancelled is cancelled (its process stopped, as asked).
+#: What a process whose owner died leaves, of a run or a job: a running one is interrupted,
+#: one being cancelled is cancelled (its process stopped, as asked).
 LOST_AS: dict[str, str] = {"running": "interrupted", "cancelling": "cancelled"}
 
 
