@@ -2,9 +2,9 @@
 
 * Audio: any channel count and sample format, scaled to full scale (-1 to 1) as
   soundfile does; the sample rate comes from the file.
-* CSV: one column per channel, with a header row (or none, when the first row is all
-  numbers).  A column named ``time`` or ``t`` (any case) holds seconds and gives the
-  sample rate (its steps must be even to 1 %); otherwise ``samplerate`` is required.
+* CSV: one column per channel, perhaps a time column (:mod:`drivers.csv_series`: named
+  channels, stamps in seconds or nanoseconds, uneven stamps resampled); without a time
+  column ``samplerate`` is required.
 * ``.npy``: shape (n_channels, n_samples), or (n_samples,) for one channel;
   ``samplerate`` is required.
 
@@ -14,21 +14,27 @@ and column for CSV).
 
 from __future__ import annotations
 
-import csv
 import math
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 import soundfile
 
+from drivers.csv_series import read_csv_series
 from drivers.errors import DriverError
 from drivers.recording import Recording
 
-TIME_COLUMNS = frozenset({"time", "t"})
 _CSV_SUFFIXES = frozenset({".csv", ".tsv", ".txt"})
 
 
-def read_recording(path: str | Path, *, samplerate: float | None = None) -> Recording:
+def read_recording(
+    path: str | Path,
+    *,
+    samplerate: float | None = None,
+    time_column: str | None = None,
+    channels: Sequence[str] | None = None,
+) -> Recording:
     """Read one recording, choosing the reader by the file's suffix.
 
     Parameters
@@ -37,7 +43,12 @@ def read_recording(path: str | Path, *, samplerate: float | None = None) -> Reco
         A ``.wav``/``.flac``/other soundfile format, ``.csv``/``.tsv``/``.txt``, or ``.npy``.
     samplerate : float, optional
         Samples per second, for CSV files without a time column and ``.npy`` files; for
-        audio files and timed CSV files it must agree with the file if given.
+        audio files it must agree with the file if given; for timed CSV files, the even
+        grid their stamps are resampled onto if they differ.
+    time_column : str, optional
+        A CSV file's time column, when it has none of the usual names.
+    channels : sequence of str, optional
+        The CSV columns to keep (names, or 1-based numbers); all by default.
 
     Returns
     -------
@@ -57,15 +68,28 @@ def read_recording(path: str | Path, *, samplerate: float | None = None) -> Reco
     if samplerate is not None:
         samplerate = check_rate(samplerate, path, "the given samplerate")
     suffix = path.suffix.lower()
+    if (time_column is not None or channels) and suffix not in _CSV_SUFFIXES:
+        raise DriverError(f"{path}: `time_column` and `channels` apply to CSV files only")
+    names: tuple[str, ...] | None = None
+    notes: tuple[str, ...] = ()
     if suffix == ".npy":
         samples, rate = np.asarray(open_npy(path), dtype=np.float64), samplerate
     elif suffix in _CSV_SUFFIXES:
-        samples, rate = _read_csv(path, samplerate)
+        series = read_csv_series(
+            path, samplerate=samplerate, time_column=time_column, channels=channels
+        )
+        samples, rate, names, notes = (
+            series.samples,
+            series.samplerate,
+            series.channels,
+            series.notes,
+        )
     else:
         samples, rate = _read_audio(path, samplerate)
     if rate is None:
         raise no_sample_rate(path)
-    return _finish(samples, rate, path)
+    recording = _finish(samples, rate, path)
+    return Recording(recording.samples, rate, recording.path, names, notes)
 
 
 def no_sample_rate(path: str | Path) -> DriverError:
@@ -124,74 +148,3 @@ def open_npy(path: Path) -> np.ndarray:
             f"{path}: must be 1-D (samples) or 2-D (channels, samples), got shape {data.shape}"
         )
     return data
-
-
-def _read_csv(path: Path, samplerate: float | None) -> tuple[np.ndarray, float | None]:
-    try:
-        with path.open(newline="", encoding="utf-8") as handle:
-            dialect = csv.excel_tab if path.suffix.lower() == ".tsv" else csv.excel
-            rows = [(number, row) for number, row in enumerate(csv.reader(handle, dialect), 1)]
-    except (OSError, UnicodeDecodeError) as error:
-        raise DriverError(f"{path}: cannot read as text: {error}") from None
-    rows = [(number, row) for number, row in rows if any(cell.strip() for cell in row)]
-    if not rows:
-        raise DriverError(f"{path}: the recording has no samples")
-    header: list[str] | None = [cell.strip() for cell in rows[0][1]]
-    if header is not None and all(_is_number(cell) for cell in header):
-        header = None
-    else:
-        rows = rows[1:]
-    width = len(header) if header is not None else len(rows[0][1]) if rows else 0
-    names = header if header is not None else [f"column {i + 1}" for i in range(width)]
-    values = np.empty((len(rows), width))
-    for row_index, (number, row) in enumerate(rows):
-        if len(row) != width:
-            raise DriverError(f"{path}:{number}: has {len(row)} fields, expected {width}")
-        for column, cell in enumerate(row):
-            if not cell.strip():
-                raise DriverError(
-                    f"{path}:{number}: column '{names[column]}' is empty (a missing sample)"
-                )
-            try:
-                values[row_index, column] = float(cell)
-            except ValueError:
-                raise DriverError(
-                    f"{path}:{number}: column '{names[column]}': {cell.strip()!r} is not a number"
-                ) from None
-    time_column = next(
-        (i for i, name in enumerate(names) if name.lower() in TIME_COLUMNS and header), None
-    )
-    if time_column is None:
-        return values.T, samplerate
-    rate = _rate_from_times(values[:, time_column], path, names[time_column])
-    if samplerate is not None and abs(rate - samplerate) > 0.01 * samplerate:
-        raise DriverError(
-            f"{path}: column '{names[time_column]}' gives {rate:g} Hz, "
-            f"but samplerate={samplerate:g} was given"
-        )
-    channels = np.delete(values, time_column, axis=1).T
-    if channels.shape[0] == 0:
-        raise DriverError(f"{path}: has a time column but no signal column")
-    return channels, rate
-
-
-def _rate_from_times(times: np.ndarray, path: Path, name: str) -> float:
-    if times.size < 2:
-        raise DriverError(f"{path}: column '{name}' needs at least two times to give a rate")
-    if not np.isfinite(times).all():
-        raise DriverError(f"{path}: column '{name}' has an empty or non-finite time")
-    steps = np.diff(times)
-    step = float(np.median(steps))
-    if step <= 0 or np.abs(steps - step).max() > 0.01 * step:
-        raise DriverError(
-            f"{path}: column '{name}' must rise in even steps (a uniformly sampled recording)"
-        )
-    return 1.0 / step
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True

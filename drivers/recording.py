@@ -19,11 +19,17 @@ class Recording:
         Samples per second per channel.
     path : str
         Where it came from (a file path, or a description for generated data).
+    channels : tuple of str, optional
+        The channels' names when the file has them (a CSV header), one per channel.
+    notes : tuple of str
+        What was done to the samples on reading (resampled stamps...), one line each.
     """
 
     samples: np.ndarray
     samplerate: float
     path: str
+    channels: tuple[str, ...] | None = None
+    notes: tuple[str, ...] = ()
 
     @property
     def n_channels(self) -> int:

@@ -11,7 +11,7 @@ for a sound card.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -47,6 +47,9 @@ class FileReplaySource(Source):
         Deliver blocks no faster than real time.
     topic : str, optional
         The audio topic of a ROS bag.
+    time_column, channels : optional
+        A CSV file's time column and the columns to keep
+        (:func:`drivers.files.read_recording`).
     """
 
     def __init__(
@@ -57,6 +60,8 @@ class FileReplaySource(Source):
         block_length: int = DEFAULT_BLOCK,
         realtime: bool = False,
         topic: str | None = None,
+        time_column: str | None = None,
+        channels: Sequence[str] | None = None,
     ) -> None:
         self.path = Path(path)
         self.name = str(path)
@@ -72,6 +77,8 @@ class FileReplaySource(Source):
         self._start = 0.0
         self._audio: soundfile.SoundFile | None = None
         self._array: np.ndarray | None = None
+        if (time_column is not None or channels) and self.path.suffix.lower() not in CSV_SUFFIXES:
+            raise DriverError(f"{path}: `time_column` and `channels` apply to CSV files only")
         if topic is not None and not is_bag(self.path):
             raise DriverError(f"{path}: `topic` applies to ROS bags only")
         if is_bag(self.path):
@@ -84,8 +91,11 @@ class FileReplaySource(Source):
         elif self.path.is_dir():
             raise DriverError(f"{path}: is a folder, not a recording (nor a ROS 2 bag)")
         elif self.path.suffix.lower() in CSV_SUFFIXES:
-            recording = read_recording(self.path, samplerate=samplerate)
-            self._inner = RecordingSource(recording, block_length=block_length)
+            recording = read_recording(
+                self.path, samplerate=samplerate, time_column=time_column, channels=channels
+            )
+            inner = RecordingSource(recording, block_length=block_length)
+            self._inner, self.channel_names, self.notes = inner, inner.channel_names, inner.notes
             rate, self.n_channels = recording.samplerate, recording.n_channels
         elif self.path.suffix.lower() == ".npy":
             self._array = open_npy(self.path)

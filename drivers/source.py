@@ -61,12 +61,18 @@ class Source(ABC):
     overflows : int
         Blocks a live source had to drop because the consumer fell behind (always 0 for
         files).
+    channel_names : tuple of str or None
+        The channels' names when the source has them (a CSV header), else None.
+    notes : tuple of str
+        What was done to the samples on reading (resampled stamps...), one line each.
     """
 
     name: str
     samplerate: float
     n_channels: int
     overflows: int = 0
+    channel_names: tuple[str, ...] | None = None
+    notes: tuple[str, ...] = ()
 
     @abstractmethod
     def blocks(self) -> Iterator[Block]:
@@ -121,6 +127,8 @@ class RecordingSource(Source):
         self.name = recording.path
         self.samplerate = recording.samplerate
         self.n_channels = recording.n_channels
+        self.channel_names = recording.channels
+        self.notes = recording.notes
 
     def blocks(self) -> Iterator[Block]:
         samples = self.recording.samples

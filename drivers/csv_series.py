@@ -1,0 +1,273 @@
+"""CSV time series: one row per sample, one column per channel, perhaps a time column.
+
+* A header row names the channels (``pac1``, ``ele3``...), which are kept; a file whose
+  first row is all numbers has none (channels are then numbered).
+* A time column is found by its name (:data:`TIME_COLUMNS`, any case) or given
+  (``time_column``); it is never a channel.  Its stamps are seconds, or nanoseconds
+  when they are that large (:func:`stamps_in_seconds`).  Stamps even to 1 % give the
+  sample rate; uneven ones (real drivers jitter) are resampled onto an even grid at the
+  given sample rate, else at their median rate (:func:`drivers.resample.resample_even`),
+  and a note says how uneven they were.
+* A delimiter at the end of every row (a trailing comma) is accepted.
+* ``channels`` picks columns by name (or 1-based number among the channels).
+
+Every problem is a :class:`~drivers.errors.DriverError` naming the file, and the line
+and column where there is one.
+"""
+
+from __future__ import annotations
+
+import csv
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from drivers.errors import DriverError
+from drivers.resample import resample_even
+
+#: Names of a time column, lower case: the common ones and those ROS tools write
+#: (``rostopic echo -p`` writes ``%time`` and ``field.header.stamp``, in nanoseconds).
+TIME_COLUMNS = frozenset(
+    {
+        "time",
+        "t",
+        "timestamp",
+        "timestamps",
+        "time_stamp",
+        "stamp",
+        "header.stamp",
+        "field.header.stamp",
+        "%time",
+        "ros_time",
+        "rostime",
+        "time_s",
+        "time_ns",
+        "timestamp_ns",
+        "t_ns",
+    }
+)
+#: Stamps larger than this (in absolute value), or steps longer than :data:`NS_STEP`, are
+#: nanoseconds: 1e11 s is more than 3000 years, 1e3 s between two samples is no series.
+NS_MAGNITUDE = 1e11
+NS_STEP = 1e3
+#: Steps within this fraction of the median step count as even.
+EVEN = 0.01
+
+
+@dataclass(frozen=True)
+class CsvSeries:
+    """What :func:`read_csv_series` read.
+
+    Parameters
+    ----------
+    samples : ndarray of shape (n_channels, n_samples), float64
+    samplerate : float or None
+        From the time column, or the given one; None when neither says it.
+    channels : tuple of str or None
+        The channels' names from the header, None without a header.
+    notes : tuple of str
+        What was done on reading (resampling, the time column's unit).
+    """
+
+    samples: np.ndarray
+    samplerate: float | None
+    channels: tuple[str, ...] | None
+    notes: tuple[str, ...]
+
+
+def read_csv_series(
+    path: Path,
+    *,
+    samplerate: float | None = None,
+    time_column: str | None = None,
+    channels: Sequence[str] | None = None,
+) -> CsvSeries:
+    """Read a CSV time series (see the module docstring).
+
+    Parameters
+    ----------
+    path : Path
+        A ``.csv`` (comma), ``.tsv`` (tab) or ``.txt`` (comma) file.
+    samplerate : float, optional
+        Hz: the rate of a file without a time column, or the grid uneven stamps are
+        resampled onto.
+    time_column : str, optional
+        The time column's name, when it has none of the usual ones.
+    channels : sequence of str, optional
+        The columns to keep as channels, by name or 1-based number; all by default.
+    """
+    header, rows = _parse(path)
+    names = header if header is not None else [f"column {i + 1}" for i in range(len(rows[0][1]))]
+    values = _numbers(path, names, rows)
+    time = _time_column(path, header, time_column)
+    signal = [i for i in range(len(names)) if i != time]
+    if not signal:
+        raise DriverError(f"{path}: has a time column but no signal column")
+    picked = signal if not channels else _pick(path, names, signal, channels, header is not None)
+    kept_names = tuple(names[i] for i in picked) if header is not None else None
+    samples = values[:, picked]
+    if time is None:
+        return CsvSeries(np.ascontiguousarray(samples.T), samplerate, kept_names, ())
+    lines = [number for number, _ in rows]
+    times, unit = stamps_in_seconds(values[:, time])
+    rate, samples, notes = _on_even_grid(path, names[time], times, lines, samples, samplerate)
+    if unit != "s":
+        notes.insert(0, f"column '{names[time]}' holds nanoseconds")
+    return CsvSeries(np.ascontiguousarray(samples.T), rate, kept_names, tuple(notes))
+
+
+def stamps_in_seconds(stamps: np.ndarray) -> tuple[np.ndarray, str]:
+    """Stamps of shape (n,) as seconds from the first one, and their unit (``s``, ``ns``).
+
+    Nanoseconds are told from seconds by magnitude: stamps beyond :data:`NS_MAGNITUDE`
+    or a median step beyond :data:`NS_STEP` (ROS stamps since 1970 in nanoseconds are
+    about 1.7e18; in seconds about 1.7e9).
+    """
+    stamps = np.asarray(stamps, dtype=np.float64)
+    relative = stamps - stamps[0]
+    step = float(np.median(np.diff(stamps))) if stamps.size > 1 else 0.0
+    if np.abs(stamps).max() > NS_MAGNITUDE or step > NS_STEP:
+        return relative * 1e-9, "ns"
+    return relative, "s"
+
+
+def _parse(path: Path) -> tuple[list[str] | None, list[tuple[int, list[str]]]]:
+    """The header (None if the first row is numbers) and the numbered rows, with a
+    trailing empty field (a delimiter at the end of the row) removed."""
+    try:
+        with path.open(newline="", encoding="utf-8-sig") as handle:
+            dialect = csv.excel_tab if path.suffix.lower() == ".tsv" else csv.excel
+            rows = [
+                (number, row)
+                for number, row in enumerate(csv.reader(handle, dialect), 1)
+                if any(cell.strip() for cell in row)
+            ]
+    except (OSError, UnicodeDecodeError) as error:
+        raise DriverError(f"{path}: cannot read as text: {error}") from None
+    if not rows:
+        raise DriverError(f"{path}: the recording has no samples")
+    header: list[str] | None = [cell.strip() for cell in rows[0][1]]
+    assert header is not None
+    if all(_is_number(cell) for cell in header if cell):
+        header = None
+    else:
+        rows = rows[1:]
+        if header and not header[-1]:
+            header = header[:-1]
+    if not rows:
+        raise DriverError(f"{path}: the recording has no samples")
+    width = len(header) if header is not None else len(_trimmed(rows[0][1]))
+    return header, [(number, _trimmed(row, width)) for number, row in rows]
+
+
+def _trimmed(row: list[str], width: int | None = None) -> list[str]:
+    """``row`` without a last empty field where that field is one too many."""
+    if row and not row[-1].strip() and (width is None or len(row) == width + 1):
+        return row[:-1]
+    return row
+
+
+def _numbers(path: Path, names: list[str], rows: list[tuple[int, list[str]]]) -> np.ndarray:
+    """Every cell as a float, shape (n_rows, n_columns); errors name the line and column."""
+    width = len(names)
+    values = np.empty((len(rows), width))
+    for row_index, (number, row) in enumerate(rows):
+        if len(row) != width:
+            raise DriverError(f"{path}:{number}: has {len(row)} fields, expected {width}")
+        try:
+            values[row_index] = [float(cell) for cell in row]
+        except ValueError:
+            # Rare: only then look for the cell, to say which one.
+            for column, cell in enumerate(row):
+                if not cell.strip():
+                    raise DriverError(
+                        f"{path}:{number}: column '{names[column]}' is empty (a missing sample)"
+                    ) from None
+                if not _is_number(cell):
+                    raise DriverError(
+                        f"{path}:{number}: column '{names[column]}': {cell.strip()!r} is not "
+                        "a number"
+                    ) from None
+            raise
+    return values
+
+
+def _time_column(path: Path, header: list[str] | None, given: str | None) -> int | None:
+    """The index of the time column: the given name, else the first usual name."""
+    lowered = [name.lower() for name in header or []]
+    if given is not None:
+        if given.lower() not in lowered:
+            raise DriverError(
+                f"{path}: has no column '{given}' to read times from "
+                f"(columns: {_few(header or [])})"
+            )
+        return lowered.index(given.lower())
+    return next((i for i, name in enumerate(lowered) if name in TIME_COLUMNS), None)
+
+
+def _pick(
+    path: Path, names: list[str], signal: list[int], wanted: Sequence[str], named: bool
+) -> list[int]:
+    """The columns of ``wanted`` (names, or 1-based numbers among the channels)."""
+    lowered = {names[i].lower(): i for i in signal} if named else {}
+    picked = []
+    for item in wanted:
+        key = item.strip()
+        if key.lower() in lowered:
+            picked.append(lowered[key.lower()])
+        elif key.isdigit() and 1 <= int(key) <= len(signal):
+            picked.append(signal[int(key) - 1])
+        else:
+            raise DriverError(
+                f"{path}: has no channel '{key}' (channels: "
+                f"{_few([names[i] for i in signal]) if named else f'1 to {len(signal)}'})"
+            )
+    if len(set(picked)) != len(picked):
+        raise DriverError(f"{path}: a channel is asked for twice")
+    return picked
+
+
+def _on_even_grid(
+    path: Path,
+    name: str,
+    times: np.ndarray,
+    lines: list[int],
+    samples: np.ndarray,
+    samplerate: float | None,
+) -> tuple[float, np.ndarray, list[str]]:
+    """The rate and the samples of shape (n, n_channels) on an even grid, and notes."""
+    if times.size < 2:
+        raise DriverError(f"{path}: column '{name}' needs at least two times to give a rate")
+    steps = np.diff(times)
+    if not (steps > 0).all():
+        index = int(np.flatnonzero(steps <= 0)[0]) + 1
+        raise DriverError(
+            f"{path}:{lines[index]}: column '{name}': the time does not rise over the line before"
+        )
+    median = float(np.median(steps))
+    even = float(np.abs(steps - median).max()) <= EVEN * median
+    if even and (samplerate is None or abs(1.0 / median - samplerate) <= EVEN * samplerate):
+        return 1.0 / median, samples, []
+    rate = samplerate if samplerate is not None else 1.0 / median
+    resampled, jitter = resample_even(times, samples, rate)
+    note = (
+        f"column '{name}': {jitter.describe()}; {times.size} samples resampled to "
+        f"{resampled.shape[0]} at {rate:.6g} Hz (linear interpolation)"
+    )
+    return rate, resampled, [note]
+
+
+def _few(names: Sequence[str], shown: int = 8) -> str:
+    """At most ``shown`` names, then how many more."""
+    text = ", ".join(names[:shown])
+    return text + (f" and {len(names) - shown} more" if len(names) > shown else "")
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
