@@ -5,9 +5,9 @@
 * A time column is found by its name (:data:`TIME_COLUMNS`, any case) or given
   (``time_column``); it is never a channel.  Its stamps are seconds, or nanoseconds
   when they are that large (:func:`stamps_in_seconds`).  Stamps even to 1 % give the
-  sample rate; uneven ones (real drivers jitter) are resampled onto an even grid at the
-  given sample rate, else at their median rate (:func:`drivers.resample.resample_even`),
-  and a note says how uneven they were.
+  sample rate (the given one, if they agree with it to 1 %); uneven ones (real drivers
+  jitter) are resampled onto an even grid at the given sample rate, else at their median
+  rate (:func:`drivers.resample.resample_even`), and a note says how uneven they were.
 * A delimiter at the end of every row (a trailing comma) is accepted.
 * ``channels`` picks columns by name (or 1-based number among the channels).
 
@@ -248,8 +248,10 @@ def _on_even_grid(
         )
     median = float(np.median(steps))
     even = float(np.abs(steps - median).max()) <= EVEN * median
-    if even and (samplerate is None or abs(1.0 / median - samplerate) <= EVEN * samplerate):
+    if even and samplerate is None:
         return 1.0 / median, samples, []
+    if even and samplerate is not None and abs(1.0 / median - samplerate) <= EVEN * samplerate:
+        return samplerate, samples, []
     rate = samplerate if samplerate is not None else 1.0 / median
     resampled, jitter = resample_even(times, samples, rate)
     note = (

@@ -100,12 +100,16 @@ class FeatureStream:
         return self._extract(final=False)
 
     def finish(self) -> Instances:
-        """The end of the stream: the instances of the events still open."""
+        """The end of the stream: the instances of the events still open (none, with a
+        warning, for a stream shorter than one analysis window)."""
         window = self.extractor.min_samples(self.samplerate)
         if self.position < window:
-            raise FeatureError(
-                f"lasts {self.position} samples, shorter than one "
-                f"'{self.extractor.name}' window of {window}"
+            return Instances.empty(
+                len(self.feature_names),
+                [
+                    f"lasts {self.position} samples, shorter than one "
+                    f"'{self.extractor.name}' window of {window}; it was left out"
+                ],
             )
         if self._own_track:
             assert self.track is not None

@@ -10,8 +10,9 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 
-from app.cli.output import info, print_json, table
+from app.cli.output import info, print_json, table, warn
 from app.cli.state import get_state
 from app.errors import AppError
 
@@ -49,7 +50,31 @@ def extract_command(
     samplerate: Annotated[
         float | None,
         typer.Option(
-            "--samplerate", help="Sample rate (Hz) of CSV/.npy files without a time column."
+            "--samplerate",
+            help=(
+                "Sample rate (Hz) of CSV/.npy files without a time column; for CSV files "
+                "with uneven stamps, the even grid they are resampled onto (default: their "
+                "median rate)."
+            ),
+        ),
+    ] = None,
+    time_column: Annotated[
+        str | None,
+        typer.Option(
+            "--time-column",
+            metavar="NAME",
+            help=(
+                "The time column of CSV files (seconds or nanoseconds), when it is not named "
+                "time, t, timestamp, stamp, header.stamp, %time, ..."
+            ),
+        ),
+    ] = None,
+    channels: Annotated[
+        str | None,
+        typer.Option(
+            "--channels",
+            metavar="A,B,...",
+            help="The CSV columns to read as channels, by name or 1-based number (all).",
         ),
     ] = None,
     segment: Annotated[
@@ -66,7 +91,10 @@ def extract_command(
             "--option",
             "-O",
             metavar="KEY=VALUE",
-            help="KEY=VALUE option of the extractor or the event detector, e.g. threshold=12.",
+            help=(
+                "KEY=VALUE option of the extractor or the event detector, e.g. threshold=12; "
+                "`touchbench extractors` lists them with their defaults."
+            ),
         ),
     ] = None,
     max_event: Annotated[
@@ -79,6 +107,8 @@ def extract_command(
 
     Recordings are read block by block (memory follows the longest event, not the
     recording); ROS bags (.bag, .mcap, .db3) are read for their audio_common audio.
+    `touchbench extractors` lists every extractor's options (-O KEY=VALUE) with their
+    type, default and meaning.
     """
     from app.cli.requests import build_request
     from app.schemas.extraction import ExtractRequest
@@ -97,14 +127,18 @@ def extract_command(
         options=key_values(option or [], "--option"),
         topic=topic,
         max_event=max_event,
+        time_column=time_column,
+        channels=None if channels is None else [c for c in channels.split(",") if c.strip()],
     )
     with _Reading() as reading:
         summary = extract_and_store(get_state(ctx).store, request, on_progress=reading.update)
     if as_json:
         print_json(summary.to_json())
         return
+    for note in summary.notes:
+        info(f"note: {escape(note)}")
     for warning in summary.warnings:
-        info(f"[yellow]warning:[/yellow] {warning}")
+        warn(warning)
     if not summary.created:
         info(f"the same features are already stored as dataset {summary.id}")
     table(

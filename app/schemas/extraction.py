@@ -60,6 +60,18 @@ class ExtractRequest(Request):
         default=None, gt=0, le=MAX_SECONDS, description="Segment seconds for events 'none'."
     )
     topic: str | None = Field(default=None, max_length=200, description="Audio topic of bags.")
+    time_column: str | None = Field(
+        default=None,
+        min_length=1,
+        max_length=200,
+        description="The time column of CSV recordings, when it has none of the usual names.",
+    )
+    channels: list[str] | None = Field(
+        default=None,
+        min_length=1,
+        max_length=1000,
+        description="The CSV columns to read as channels (names or 1-based numbers).",
+    )
     max_event: float | None = Field(
         default=None, ge=0.001, le=MAX_SECONDS, description="Longest event in seconds."
     )
@@ -128,6 +140,8 @@ class ExtractionSummary(Schema):
     ``events_found`` instances were made from the detected events, ``events_labelled``
     were kept, ``events_dropped`` fell outside every labelled interval; ``created`` is
     false when the same features were stored already (then ``id`` is that data set).
+    ``warnings`` say what was left out, ``notes`` what was done on the way (resampled
+    stamps, defaults computed from the sample rate, label rows of other recordings).
     """
 
     id: int
@@ -139,4 +153,5 @@ class ExtractionSummary(Schema):
     events_labelled: int
     events_dropped: int
     warnings: list[str]
+    notes: list[str] = Field(default_factory=list)
     created: bool

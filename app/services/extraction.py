@@ -20,7 +20,8 @@ seconds from its first message).  An instance takes
 the targets of the interval of its file it overlaps most (the earlier one on a tie);
 one that overlaps none is dropped and counted.  Without ``start``/``end``, every
 instance of a file takes that file's targets.  An empty cell or ``?`` is a missing
-target value.
+target value.  Rows of recordings not given are left out, with one note counting them
+(a session's labels used for some of its takes); their values stay declared.
 """
 
 from __future__ import annotations
@@ -40,7 +41,7 @@ from app.store.database import Store
 from app.store.datasets import add_dataset, check_dataset_name, dataset_digest
 from benchmark.dataset import Attribute, Dataset, Schema
 from benchmark.errors import DataFormatError
-from drivers.replay import FileReplaySource
+from drivers.replay import CSV_SUFFIXES, FileReplaySource
 from features.errors import FeatureError
 from features.extractors import Instances
 from features.recipe import Recipe
@@ -68,7 +69,10 @@ class ExtractionResult:
         What was left out and why, one line each.
     recipe : dict
         How the instances were made (:meth:`features.recipe.Recipe.to_json`) with the
-        recordings' ``samplerate`` and ``n_channels``: what a live model repeats.
+        recordings' ``samplerate``, ``n_channels`` and ``channels`` (their names, or
+        None): what a live model repeats.
+    notes : list of str
+        What was done on the way (resampled stamps, label rows of other recordings).
     """
 
     dataset: Dataset
@@ -77,6 +81,7 @@ class ExtractionResult:
     n_dropped: int
     warnings: list[str] = field(default_factory=list)
     recipe: dict[str, Any] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
 
 
 @dataclass(frozen=True)
@@ -111,6 +116,8 @@ def extract_dataset(
     options: Mapping[str, Any] | None = None,
     topic: str | None = None,
     max_event: float | None = None,
+    time_column: str | None = None,
+    channels: Sequence[str] | None = None,
     on_progress: Callable[[str, float], None] | None = None,
 ) -> ExtractionResult:
     """Turn recordings into a labelled data set, each recording read block by block.
@@ -129,7 +136,9 @@ def extract_dataset(
     name : str, optional
         Data set name (default: the labels file's stem, else the first recording's).
     samplerate : float, optional
-        Sample rate for recordings that do not carry one (CSV without time, ``.npy``).
+        Sample rate for recordings that do not carry one (CSV without time, ``.npy``), and
+        the grid of CSV recordings with uneven stamps (default: the first recording's
+        rate, else the median rate of its stamps).
     segment : float, optional
         Segment seconds for events ``none`` (default: the extractor's, else whole files).
     options : mapping, optional
@@ -138,6 +147,8 @@ def extract_dataset(
         The audio topic of ROS bags.
     max_event : float, optional
         Longest event in seconds (default 60); longer ones are cut, with a warning.
+    time_column, channels : optional
+        The time column of CSV recordings and the columns to read as channels.
     on_progress : callable, optional
         Called as ``on_progress(file_name, seconds_read)`` after every block.
 
@@ -153,8 +164,11 @@ def extract_dataset(
     paths = [Path(path) for path in recordings]
     by_name = _unique_names(paths)
     table = read_labels(labels) if labels is not None else None
+    notes: list[str] = []
     if table is not None:
-        _check_label_files(table, by_name)
+        other = _other_recordings(table, by_name)
+        if other:
+            notes.append(other)
     dataset_name = name or (labels.stem if labels is not None else paths[0].stem)
 
     features: list[np.ndarray] = []
@@ -162,11 +176,21 @@ def extract_dataset(
     meta: list[dict[str, Any]] = []
     warnings: list[str] = []
     shape: tuple[float, int] | None = None
-    for path in paths:
-        with FileReplaySource(path, samplerate=samplerate, topic=topic) as source:
+    names: tuple[str, ...] | None = None
+    for index, path in enumerate(paths):
+        # Jittered stamps give each file a slightly different median rate: without a rate
+        # given, later CSV files are read onto the first one's grid, so that they agree.
+        rate_given = samplerate
+        if rate_given is None and shape is not None and path.suffix.lower() in CSV_SUFFIXES:
+            rate_given = shape[0]
+        with FileReplaySource(
+            path, samplerate=rate_given, topic=topic, time_column=time_column, channels=channels
+        ) as source:
             shape = _same_shape(shape, (source.samplerate, source.n_channels), path)
+            names = _same_names(names, source.channel_names, path, first=index == 0)
             instances = _extract_one(recipe, source, path, on_progress)
             origin, rate = source.start_time, source.samplerate
+        notes += [f"{path.name}: {text}" for text in source.notes]
         warnings += [f"{path.name}: {text}" for text in instances.warnings]
         features.append(instances.values)
         for (first, last), details in zip(instances.spans, instances.meta, strict=True):
@@ -175,13 +199,14 @@ def extract_dataset(
             meta.append({"source": path.name, "start": start, "end": end, **details})
 
     assert shape is not None
-    feature_names = recipe.make_extractor().feature_names(shape[1])
+    feature_names = recipe.make_extractor().feature_names(shape[1], names)
     matrix = np.concatenate(features) if features else np.zeros((0, len(feature_names)))
     n_events = matrix.shape[0]
     if table is None:
         if n_events == 0:
             raise FeatureError(
                 f"no event was found in {len(paths)} recording(s) with events '{recipe.events}'"
+                + (f" ({warnings[0]}{_more(warnings)})" if warnings else "")
             )
         keep = np.ones(n_events, dtype=bool)
         target_attributes: list[Attribute] = []
@@ -218,7 +243,13 @@ def extract_dataset(
         n_labelled=int(rows.size),
         n_dropped=n_events - int(rows.size),
         warnings=warnings,
-        recipe={**recipe.to_json(), "samplerate": shape[0], "n_channels": shape[1]},
+        recipe={
+            **recipe.to_json(),
+            "samplerate": shape[0],
+            "n_channels": shape[1],
+            "channels": None if names is None else list(names),
+        },
+        notes=notes,
     )
 
 
@@ -267,6 +298,8 @@ def extract_and_store(
         options=request.options,
         topic=request.topic,
         max_event=request.max_event,
+        time_column=request.time_column,
+        channels=request.channels,
         on_progress=on_progress,
     )
     data = result.dataset
@@ -289,6 +322,7 @@ def extract_and_store(
         events_labelled=result.n_labelled,
         events_dropped=result.n_dropped,
         warnings=result.warnings,
+        notes=result.notes,
         created=created,
     )
 
@@ -340,6 +374,29 @@ def _same_shape(
             f"{expected[0]:g} Hz; one data set needs one sample rate"
         )
     return found
+
+
+def _same_names(
+    expected: tuple[str, ...] | None, found: tuple[str, ...] | None, path: Path, *, first: bool
+) -> tuple[str, ...] | None:
+    """One list of channel names for every recording (the features are named after it)."""
+    if not first and found != expected:
+        raise FeatureError(
+            f"{path}: has channels {_few(found or ('unnamed',))} but the recordings before it "
+            f"{_few(expected or ('unnamed',))}; one data set needs the same channels"
+        )
+    return found
+
+
+def _more(lines: Sequence[str]) -> str:
+    """`` and N more`` for the lines after the first ("" for one)."""
+    return f" and {len(lines) - 1} more" if len(lines) > 1 else ""
+
+
+def _few(names: Sequence[str], shown: int = 3) -> str:
+    """At most ``shown`` names, then how many more: messages stay one short line."""
+    text = ", ".join(str(name) for name in names[:shown])
+    return text + (f" and {len(names) - shown} more" if len(names) > shown else "")
 
 
 def read_labels(path: Path) -> LabelTable:
@@ -460,16 +517,31 @@ def _check_overlaps(file_name: str, entries: list[LabelRow], intervals: bool, so
             )
 
 
-def _check_label_files(table: LabelTable, recordings: Mapping[str, Path]) -> None:
-    for file_name, entries in table.rows.items():
-        if file_name not in recordings:
-            raise DataFormatError(
-                f"names recording '{file_name}', which is not among the recordings given "
-                f"({', '.join(sorted(recordings))})",
-                source=table.source,
-                line=entries[0].line,
-                attribute="file",
-            )
+def _other_recordings(table: LabelTable, recordings: Mapping[str, Path]) -> str:
+    """A note counting the rows of recordings not given ("" if there are none): a
+    session's labels used for a subset of its takes.  Those rows label nothing, but their
+    target values stay declared, so that the data sets of a session's subsets agree.
+
+    Raises
+    ------
+    DataFormatError
+        When no row names a recording given: the labels are for other recordings.
+    """
+    other = sorted(name for name in table.rows if name not in recordings)
+    if not other:
+        return ""
+    count = sum(len(table.rows[name]) for name in other)
+    if len(other) == len(table.rows):
+        raise DataFormatError(
+            f"names none of the {len(recordings)} recording(s) given "
+            f"({_few(sorted(recordings))}); it names {_few(other)}",
+            source=table.source,
+            attribute="file",
+        )
+    return (
+        f"{Path(table.source).name}: {count} row(s) of {len(other)} recording(s) not given "
+        f"were left out ({_few(other)})"
+    )
 
 
 def _label(
@@ -504,9 +576,11 @@ def _label(
             if value is not None:
                 codes[i, j] = attributes[j].values.index(value)
     keep = np.array([row is not None for row in chosen], dtype=bool)
-    warnings = [
-        f"{file_name}: no labels for this recording; its instances were dropped"
-        for file_name in recordings
-        if file_name not in table.rows
-    ]
+    unlabelled = [file_name for file_name in recordings if file_name not in table.rows]
+    warnings = []
+    if unlabelled:
+        warnings.append(
+            f"{len(unlabelled)} recording(s) have no labels; their instances were dropped "
+            f"({_few(unlabelled)})"
+        )
     return keep, attributes, codes, warnings

@@ -17,6 +17,7 @@ For each instance (by default each second of the recording):
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import ClassVar
 
 import numpy as np
@@ -70,7 +71,7 @@ class BandPeaks(Extractor):
         narrowest = min(high - low for low, high in self.bands)
         return max(3, math.ceil(samplerate / narrowest))
 
-    def feature_names(self, n_channels: int) -> list[str]:
+    def feature_names(self, n_channels: int, channels: Sequence[str] | None = None) -> list[str]:
         names = ["theta"]
         for low, high in self.bands:
             names += [f"peakFrequency_{low:g}_{high:g}", f"peakProminence_{low:g}_{high:g}"]

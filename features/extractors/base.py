@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Sequence as CollectionSequence
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
@@ -133,8 +134,11 @@ class Extractor(ABC):
         """Samples in one analysis window: the shortest recording or event it can use."""
 
     @abstractmethod
-    def feature_names(self, n_channels: int) -> list[str]:
-        """Attribute names of the features, in order, for ``n_channels`` channels."""
+    def feature_names(
+        self, n_channels: int, channels: CollectionSequence[str] | None = None
+    ) -> list[str]:
+        """Attribute names of the features, in order, for ``n_channels`` channels (named
+        ``channels`` when the recording names them: ``t0_pac1``, ``pac1[0]``)."""
 
     @abstractmethod
     def extract(self, y: np.ndarray, *, samplerate: float, detection: Detection) -> Instances:
@@ -191,9 +195,23 @@ class Extractor(ABC):
         )
 
 
-def channel_suffixed(names: list[str], n_channels: int) -> list[str]:
-    """``name_1 ... name_k`` for channel 1, then channel 2, ... (1-based, the UC3M style)."""
-    return [f"{name}_{channel}" for channel in range(1, n_channels + 1) for name in names]
+def channel_suffixed(
+    names: list[str], n_channels: int, channels: CollectionSequence[str] | None = None
+) -> list[str]:
+    """``name_1 ... name_k`` for channel 1, then channel 2, ... (1-based, the UC3M style),
+    or ``name_pac1 ...`` with the channels' own names."""
+    return [f"{name}_{label}" for label in channel_labels(n_channels, channels) for name in names]
+
+
+def channel_labels(
+    n_channels: int, channels: CollectionSequence[str] | None = None, *, prefix: str = ""
+) -> list[str]:
+    """The channels' names, or ``PREFIX1 ... PREFIXn`` without them."""
+    if channels:
+        if len(channels) != n_channels:
+            raise FeatureError(f"{len(channels)} channel names given for {n_channels} channels")
+        return list(channels)
+    return [f"{prefix}{channel}" for channel in range(1, n_channels + 1)]
 
 
 def sequence_names(channels: list[str], length: int) -> list[str]:

@@ -18,12 +18,19 @@ sequence channel ``mfccq_c``), the layout ``benchmark.sequence`` reads back.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any, ClassVar
 
 import numpy as np
 
 from features.events import Detection
-from features.extractors.base import Extractor, Instances, channel_suffixed, sequence_names
+from features.extractors.base import (
+    Extractor,
+    Instances,
+    channel_labels,
+    channel_suffixed,
+    sequence_names,
+)
 from features.framing import frame, power_spectrogram
 from features.mel import mel_filter_bank, mel_spectrogram, mfcc
 from features.options import Option, positive_float, positive_int
@@ -56,18 +63,18 @@ class Mfcc(Extractor):
     def min_samples(self, samplerate: float) -> int:
         return self.frame_length(samplerate)
 
-    def feature_names(self, n_channels: int) -> list[str]:
+    def feature_names(self, n_channels: int, channels: Sequence[str] | None = None) -> list[str]:
         count = self.params["n_mfcc"]
         if self.params["frames"] is not None:
             tracks = [
-                f"mfcc{q}_{channel}"
-                for channel in range(1, n_channels + 1)
+                f"mfcc{q}_{label}"
+                for label in channel_labels(n_channels, channels)
                 for q in range(1, count + 1)
             ]
             return sequence_names(tracks, self.params["frames"])
         names = [f"mfcc{q}_mean" for q in range(1, count + 1)]
         names += [f"mfcc{q}_std" for q in range(1, count + 1)]
-        return channel_suffixed(names, n_channels)
+        return channel_suffixed(names, n_channels, channels)
 
     def extract(self, y: np.ndarray, *, samplerate: float, detection: Detection) -> Instances:
         n_channels = y.shape[0]

@@ -16,12 +16,13 @@ samples before the onset is subtracted from its window, as ``window`` does.
 
 from __future__ import annotations
 
+from collections.abc import Sequence as CollectionSequence
 from typing import ClassVar
 
 import numpy as np
 
 from features.events import Detection, Event
-from features.extractors.base import Instances, sequence_names
+from features.extractors.base import Instances, channel_labels, sequence_names
 from features.extractors.window import Window, baselines
 from features.options import Option, flag, non_negative_int, positive_int
 from features.resample import to_length
@@ -53,9 +54,11 @@ class Sequence(Window):
             return super().read_span(event, samplerate)
         return event.onset - self.params["baseline"], event.offset
 
-    def feature_names(self, n_channels: int) -> list[str]:
-        channels = [f"ch{channel}" for channel in range(1, n_channels + 1)]
-        return sequence_names(channels, self.params["length"])
+    def feature_names(
+        self, n_channels: int, channels: CollectionSequence[str] | None = None
+    ) -> list[str]:
+        labels = channel_labels(n_channels, channels, prefix="ch")
+        return sequence_names(labels, self.params["length"])
 
     def extract(self, y: np.ndarray, *, samplerate: float, detection: Detection) -> Instances:
         if not self.resampled:

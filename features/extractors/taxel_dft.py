@@ -10,6 +10,7 @@ then channel 2, ....
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import ClassVar
 
 import numpy as np
@@ -50,8 +51,8 @@ class TaxelDft(Extractor):
     def min_samples(self, samplerate: float) -> int:
         return int(self.params["window"])
 
-    def feature_names(self, n_channels: int) -> list[str]:
-        return channel_suffixed([f"dft{k}" for k in self.bins], n_channels)
+    def feature_names(self, n_channels: int, channels: Sequence[str] | None = None) -> list[str]:
+        return channel_suffixed([f"dft{k}" for k in self.bins], n_channels, channels)
 
     def extract(self, y: np.ndarray, *, samplerate: float, detection: Detection) -> Instances:
         window, step = self.params["window"], self.params["step"]

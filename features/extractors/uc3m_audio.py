@@ -42,6 +42,7 @@ all zeros, with a warning.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import ClassVar
 
 import numpy as np
@@ -82,9 +83,9 @@ CHANNEL_FEATURES: tuple[str, ...] = (
 )
 
 
-def uc3m_feature_names(n_channels: int) -> list[str]:
+def uc3m_feature_names(n_channels: int, channels: Sequence[str] | None = None) -> list[str]:
     """The UC3M attribute names for ``n_channels`` microphones (33 per channel)."""
-    return channel_suffixed(list(CHANNEL_FEATURES), n_channels)
+    return channel_suffixed(list(CHANNEL_FEATURES), n_channels, channels)
 
 
 class Uc3mAudio(Extractor):
@@ -113,8 +114,8 @@ class Uc3mAudio(Extractor):
     def lookback(self, samplerate: float) -> int:
         return 2 * WINDOW_LENGTH
 
-    def feature_names(self, n_channels: int) -> list[str]:
-        return uc3m_feature_names(n_channels)
+    def feature_names(self, n_channels: int, channels: Sequence[str] | None = None) -> list[str]:
+        return uc3m_feature_names(n_channels, channels)
 
     def extract(self, y: np.ndarray, *, samplerate: float, detection: Detection) -> Instances:
         track = detection.snr

@@ -10,6 +10,7 @@ warning.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import ClassVar
 
 import numpy as np
@@ -40,8 +41,9 @@ class Window(Extractor):
     def lookback(self, samplerate: float) -> int:
         return int(self.params["baseline"])
 
-    def feature_names(self, n_channels: int) -> list[str]:
-        return channel_suffixed([f"t{i}" for i in range(self.params["length"])], n_channels)
+    def feature_names(self, n_channels: int, channels: Sequence[str] | None = None) -> list[str]:
+        names = [f"t{i}" for i in range(self.params["length"])]
+        return channel_suffixed(names, n_channels, channels)
 
     def extract(self, y: np.ndarray, *, samplerate: float, detection: Detection) -> Instances:
         length, baseline = self.params["length"], self.params["baseline"]

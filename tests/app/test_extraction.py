@@ -95,7 +95,9 @@ def test_recording_without_labels_is_dropped_with_a_warning(
     labels = _labels(tmp_path, "file,robot\ns1.wav,mini\n")
     result = extract_dataset(two_sessions, labels=labels, extractor="uc3m-audio")
     assert (result.n_labelled, result.n_dropped) == (3, 2)
-    assert any("s2.wav: no labels" in warning for warning in result.warnings)
+    assert "1 recording(s) have no labels; their instances were dropped (s2.wav)" in (
+        result.warnings
+    )
 
 
 def test_without_labels_every_event_is_kept_without_targets(two_sessions: list[Path]) -> None:
@@ -161,12 +163,28 @@ def test_options_reach_the_detector_and_the_extractor(two_sessions: list[Path]) 
         extract_dataset(two_sessions, labels=None, extractor="uc3m-audio", options={"bands": 1})
 
 
-def test_labels_naming_a_missing_recording(tmp_path: Path, two_sessions: list[Path]) -> None:
-    labels = _labels(tmp_path, "file,gesture\ns1.wav,tap\ns3.wav,tap\n")
+def test_labels_of_recordings_not_given_are_left_out_with_one_note(
+    tmp_path: Path, two_sessions: list[Path]
+) -> None:
+    # A session's labels used on some of its takes: the others are held out.
+    rows = [f"take-{i:03d}.wav,slap" for i in range(100)]
+    labels = _labels(tmp_path, "file,gesture\ns1.wav,tap\n" + "\n".join(rows) + "\n")
+    result = extract_dataset(two_sessions[:1], labels=labels, extractor="uc3m-audio")
+    assert result.notes == [
+        "labels.csv: 100 row(s) of 100 recording(s) not given were left out "
+        "(take-000.wav, take-001.wav, take-002.wav and 97 more)"
+    ]
+    assert result.n_labelled == 3 and result.warnings == []
+    # The values of the held-out takes stay declared: a held-out set's data set agrees.
+    assert result.dataset.schema.attributes[0].values == ("tap", "slap")
+
+
+def test_labels_naming_none_of_the_recordings(tmp_path: Path, two_sessions: list[Path]) -> None:
+    labels = _labels(tmp_path, "file,gesture\n" + "".join(f"x{i}.wav,tap\n" for i in range(9)))
     with pytest.raises(
         DataFormatError,
-        match=r"labels.csv:3: attribute 'file': names recording "
-        r"'s3.wav', which is not among",
+        match=r"labels.csv: attribute 'file': names none of the 2 recording\(s\) given "
+        r"\(s1.wav, s2.wav\); it names x0.wav, x1.wav, x2.wav and 6 more$",
     ):
         extract_dataset(two_sessions, labels=labels, extractor="uc3m-audio")
 
@@ -208,13 +226,20 @@ def test_missing_labels_file(tmp_path: Path, two_sessions: list[Path]) -> None:
         extract_dataset(two_sessions, labels=tmp_path / "nope.csv", extractor="uc3m-audio")
 
 
-def test_a_recording_shorter_than_one_window(tmp_path: Path) -> None:
+def test_a_recording_shorter_than_one_window_is_left_out_with_a_warning(
+    tmp_path: Path, two_sessions: list[Path]
+) -> None:
     path = tmp_path / "blip.wav"
     soundfile.write(path, np.zeros((100, 3)), SAMPLERATE)
+    result = extract_dataset([*two_sessions, path], labels=None, extractor="uc3m-audio")
+    assert result.n_events == 5
+    assert result.warnings == [
+        "blip.wav: lasts 100 samples, shorter than one 'uc3m-audio' window of 256; it was left out"
+    ]
     with pytest.raises(
         FeatureError,
-        match=r"blip.wav: lasts 100 samples, shorter than one "
-        r"'uc3m-audio' window of 256",
+        match=r"no event was found in 1 recording\(s\) with events 'snr' \(blip.wav: lasts "
+        r"100 samples, shorter than one 'uc3m-audio' window of 256; it was left out\)$",
     ):
         extract_dataset([path], labels=None, extractor="uc3m-audio")
 
@@ -314,7 +339,7 @@ def test_window_extractor_on_a_timed_csv_with_dbscan_events(tmp_path: Path) -> N
     result = extract_dataset([path], labels=labels, extractor="window")
     dataset = result.dataset
     assert (result.n_events, result.n_labelled) == (2, 2)
-    assert dataset.schema.feature_names[:2] == ("t0_1", "t1_1")
+    assert dataset.schema.feature_names[:2] == ("t0_pdc", "t1_pdc")  # the header names the channels
     assert dataset.values.shape == (2, 1 + 50)
     # One sample after a unit step, minus the baseline before it: about 1.
     assert np.allclose(dataset.X[:, 0], 1.0, atol=0.05)
@@ -368,6 +393,7 @@ def test_extraction_streams_the_instances_of_whole_array_extraction(
         "max_event": 60.0,
         "samplerate": 44100.0,
         "n_channels": 3,
+        "channels": None,
     }
 
 
