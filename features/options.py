@@ -19,12 +19,36 @@ Parser = Callable[[Any], Any]
 
 @dataclass(frozen=True)
 class Option:
-    """One option: its name, default value, parser and a one-line description."""
+    """One option: its name, default value, parser and a one-line description.
+
+    Parameters
+    ----------
+    name : str
+        The key (``-O name=value``).
+    default : Any
+        The value when none is given; ``None`` for "not set" (then ``default_text`` says
+        what that means, and ``at_rate``, if set, computes it from the sample rate).
+    parse : callable
+        Text or a Python value to the option's value; ``ValueError`` for a bad one.
+    help : str
+        What the option means, one line.
+    at_rate : callable, optional
+        The default at a sample rate (Hz), for defaults that depend on it.
+    default_text : str, optional
+        The default in words, when it is computed (from the sample rate, the events...).
+    """
 
     name: str
     default: Any
     parse: Parser
     help: str
+    at_rate: Callable[[float], Any] | None = None
+    default_text: str | None = None
+
+    @property
+    def kind(self) -> str:
+        """The value's type in words (``integer >= 1``, ``boolean``...)."""
+        return KINDS.get(self.parse, getattr(self.parse, "__name__", "value"))
 
 
 def positive_float(value: Any) -> float:
@@ -98,6 +122,18 @@ def frequency_bands(value: Any) -> tuple[tuple[float, float], ...]:
     return tuple(bands)
 
 
+#: The type of each parser in words, for listings.
+KINDS: dict[Callable[[Any], Any], str] = {
+    positive_float: "number > 0",
+    non_negative_float: "number >= 0",
+    fraction: "number in (0, 1]",
+    positive_int: "integer >= 1",
+    non_negative_int: "integer >= 0",
+    flag: "boolean",
+    frequency_bands: "bands LOW-HIGH,... (Hz)",
+}
+
+
 def _float(value: Any) -> float:
     if isinstance(value, bool):
         raise ValueError("must be a number")
@@ -129,7 +165,7 @@ def resolve_options(
         )
     resolved = {}
     for spec in specs:
-        if spec.name not in given:
+        if given.get(spec.name) is None:
             resolved[spec.name] = spec.default
             continue
         try:

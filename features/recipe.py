@@ -7,7 +7,7 @@ on it, so that live features are computed exactly as the training features were.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 from features.errors import FeatureError
@@ -95,8 +95,41 @@ class Recipe:
     def make_extractor(self) -> Extractor:
         return make_extractor(self.extractor, _given(self.extractor_options))
 
+    def needs_longest(self) -> bool:
+        """Whether :meth:`at_rate` needs the longest recording's length (a sequence of
+        whole recordings)."""
+        return EXTRACTORS[self.extractor].needs_longest(
+            self.extractor_options, events=self.events, segment=self.segment
+        )
+
+    def at_rate(self, samplerate: float, *, longest: int | None = None) -> tuple[Recipe, list[str]]:
+        """This recipe with the options that depend on the recordings filled in (defaults
+        computed from the sample rate, a sequence's length from the longest recording),
+        and a note for each; itself when nothing depends on them.
+
+        Raises
+        ------
+        FeatureError
+            A filled-in value the extractor refuses.
+        """
+        filled, notes = EXTRACTORS[self.extractor].fill_defaults(
+            self.extractor_options,
+            samplerate=samplerate,
+            events=self.events,
+            segment=self.segment,
+            longest=longest,
+        )
+        if filled == self.extractor_options:
+            return self, notes
+        options = dict(make_extractor(self.extractor, _given(filled)).params)
+        return replace(self, extractor_options=options), notes
+
     def open(self, *, samplerate: float, n_channels: int) -> FeatureStream:
-        """A :class:`FeatureStream` for a stream of ``n_channels`` at ``samplerate`` Hz."""
+        """A :class:`FeatureStream` for a stream of ``n_channels`` at ``samplerate`` Hz
+        (with the defaults that depend on the rate filled in)."""
+        recipe, _ = self.at_rate(samplerate)
+        if recipe is not self:
+            return recipe.open(samplerate=samplerate, n_channels=n_channels)
         events = open_event_stream(
             self.events,
             n_channels,

@@ -177,17 +177,27 @@ def extract_dataset(
     warnings: list[str] = []
     shape: tuple[float, int] | None = None
     names: tuple[str, ...] | None = None
-    for index, path in enumerate(paths):
+
+    def open_source(path: Path, first_rate: float | None) -> FileReplaySource:
         # Jittered stamps give each file a slightly different median rate: without a rate
         # given, later CSV files are read onto the first one's grid, so that they agree.
         rate_given = samplerate
-        if rate_given is None and shape is not None and path.suffix.lower() in CSV_SUFFIXES:
-            rate_given = shape[0]
-        with FileReplaySource(
+        if rate_given is None and path.suffix.lower() in CSV_SUFFIXES:
+            rate_given = first_rate
+        return FileReplaySource(
             path, samplerate=rate_given, topic=topic, time_column=time_column, channels=channels
-        ) as source:
+        )
+
+    for index, path in enumerate(paths):
+        with open_source(path, None if shape is None else shape[0]) as source:
             shape = _same_shape(shape, (source.samplerate, source.n_channels), path)
             names = _same_names(names, source.channel_names, path, first=index == 0)
+            if index == 0:
+                longest = None
+                if recipe.needs_longest():
+                    longest = _longest(paths, lambda p: open_source(p, source.samplerate))
+                recipe, filled = _at_rate(recipe, source.samplerate, longest, path)
+                notes += filled
             instances = _extract_one(recipe, source, path, on_progress)
             origin, rate = source.start_time, source.samplerate
         notes += [f"{path.name}: {text}" for text in source.notes]
@@ -200,8 +210,7 @@ def extract_dataset(
 
     assert shape is not None
     feature_names = recipe.make_extractor().feature_names(shape[1], names)
-    matrix = np.concatenate(features) if features else np.zeros((0, len(feature_names)))
-    n_events = matrix.shape[0]
+    n_events = sum(part.shape[0] for part in features)
     if table is None:
         if n_events == 0:
             raise FeatureError(
@@ -232,7 +241,7 @@ def extract_dataset(
     rows = np.flatnonzero(keep)
     dataset = Dataset(
         schema=schema,
-        values=np.hstack([codes[rows], matrix[rows]]),
+        values=_assemble(codes[rows], features, keep),
         groups=np.array([spans[i][0] for i in rows], dtype=object),
         meta=[meta[i] for i in rows],
         name=dataset_name,
@@ -325,6 +334,48 @@ def extract_and_store(
         notes=result.notes,
         created=created,
     )
+
+
+def _longest(paths: Sequence[Path], open_source: Callable[[Path], FileReplaySource]) -> int:
+    """Samples in the longest of the recordings (each read once, block by block)."""
+    longest = 0
+    for path in paths:
+        with open_source(path) as source:
+            longest = max(longest, sum(block.samples.shape[1] for block in source.blocks()))
+    return longest
+
+
+def _at_rate(
+    recipe: Recipe, samplerate: float, longest: int | None, path: Path
+) -> tuple[Recipe, list[str]]:
+    """:meth:`Recipe.at_rate`, its errors naming the first recording."""
+    try:
+        return recipe.at_rate(samplerate, longest=longest)
+    except FeatureError as error:
+        raise FeatureError(f"{path}: {error}") from None
+
+
+def _assemble(codes: np.ndarray, parts: list[np.ndarray], keep: np.ndarray) -> np.ndarray:
+    """The data set's values: target ``codes`` of shape (n_kept, n_targets), then the kept
+    rows of the feature ``parts`` (one per recording, concatenated they are the
+    instances ``keep`` selects from).
+
+    Each part is written into the result and then released (``parts`` is emptied), so
+    that memory holds the features about once, not the parts, their concatenation and
+    the result.
+    """
+    n_features = parts[0].shape[1] if parts else 0
+    values = np.empty((codes.shape[0], codes.shape[1] + n_features))
+    values[:, : codes.shape[1]] = codes
+    start = row = 0
+    while parts:
+        part = parts.pop(0)
+        kept = keep[start : start + part.shape[0]]
+        count = int(kept.sum())
+        np.compress(kept, part, axis=0, out=values[row : row + count, codes.shape[1] :])
+        start, row = start + part.shape[0], row + count
+        del part
+    return values
 
 
 def _extract_one(

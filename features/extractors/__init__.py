@@ -25,8 +25,11 @@ EXTRACTORS: dict[str, type[Extractor]] = {
 }
 
 
-def make_extractor(name: str, options: Mapping[str, Any] | None = None) -> Extractor:
-    """The extractor called ``name`` with ``options``.
+def make_extractor(
+    name: str, options: Mapping[str, Any] | None = None, *, samplerate: float | None = None
+) -> Extractor:
+    """The extractor called ``name`` with ``options``; with ``samplerate``, the defaults
+    that depend on the sample rate are filled in (for the extractor's own event kind).
 
     Raises
     ------
@@ -35,7 +38,14 @@ def make_extractor(name: str, options: Mapping[str, Any] | None = None) -> Extra
     """
     if name not in EXTRACTORS:
         raise FeatureError(f"unknown extractor '{name}' (known: {', '.join(EXTRACTORS)})")
-    return EXTRACTORS[name](**dict(options or {}))
+    kind = EXTRACTORS[name]
+    extractor = kind(**dict(options or {}))
+    if samplerate is None:
+        return extractor
+    filled, _ = kind.fill_defaults(
+        extractor.params, samplerate=samplerate, events=kind.default_events, segment=None
+    )
+    return kind(**{key: value for key, value in filled.items() if value is not None})
 
 
 __all__ = ["EXTRACTORS", "Extractor", "Instances", "make_extractor", "uc3m_feature_names"]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Mapping
 from collections.abc import Sequence as CollectionSequence
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
@@ -47,9 +48,14 @@ class Instances:
 
     @classmethod
     def concat(cls, parts: list[Instances], n_features: int) -> Instances:
-        """``parts`` one after the other (an empty result of ``n_features`` if none)."""
+        """``parts`` one after the other (an empty result of ``n_features`` if none; the
+        only part with instances itself, not a copy, if there is one)."""
         if not parts:
             return cls.empty(n_features)
+        full = [part for part in parts if part.values.shape[0]]
+        if len(full) == 1:
+            warnings = [text for part in parts for text in part.warnings]
+            return cls(full[0].values, full[0].spans, full[0].meta, warnings)
         return cls(
             values=np.concatenate([part.values for part in parts]),
             spans=np.concatenate([part.spans for part in parts]).astype(np.int64),
@@ -99,6 +105,50 @@ class Extractor(ABC):
 
     def __init__(self, **options: Any) -> None:
         self.params = resolve_options(type(self).options, options, owner=f"extractor '{self.name}'")
+
+    @classmethod
+    def needs_longest(
+        cls, options: Mapping[str, Any], *, events: str, segment: float | None
+    ) -> bool:
+        """Whether :meth:`fill_defaults` needs the longest recording's length (in samples)
+        for these resolved options and event kind."""
+        return False
+
+    @classmethod
+    def fill_defaults(
+        cls,
+        options: Mapping[str, Any],
+        *,
+        samplerate: float,
+        events: str,
+        segment: float | None,
+        longest: int | None = None,
+    ) -> tuple[dict[str, Any], list[str]]:
+        """The resolved ``options`` with the defaults that depend on the recordings filled in,
+        and one note for each.
+
+        Parameters
+        ----------
+        options : mapping
+            Every option, resolved (``None`` where not set).
+        samplerate : float
+            The recordings' sample rate (Hz).
+        events : str
+            The event kind.
+        segment : float or None
+            Segment seconds for events ``none``.
+        longest : int, optional
+            Samples in the longest recording, when :meth:`needs_longest` says so.
+        """
+        filled, notes = dict(options), []
+        for spec in cls.options:
+            if spec.at_rate is not None and filled.get(spec.name) is None:
+                filled[spec.name] = spec.at_rate(samplerate)
+                notes.append(
+                    f"extractor '{cls.name}': {spec.name}={filled[spec.name]} at "
+                    f"{samplerate:g} Hz ({spec.default_text})"
+                )
+        return filled, notes
 
     def check_input(self, *, samplerate: float, n_channels: int) -> None:
         """Raise :class:`FeatureError` unless this extractor can use the recording."""

@@ -45,11 +45,18 @@ class Window(Extractor):
         names = [f"t{i}" for i in range(self.params["length"])]
         return channel_suffixed(names, n_channels, channels)
 
+    def pads(self) -> bool:
+        """Whether an event too close to the end is padded with the last sample (else it
+        is left out)."""
+        return False
+
     def extract(self, y: np.ndarray, *, samplerate: float, detection: Detection) -> Instances:
         length, baseline = self.params["length"], self.params["baseline"]
         n_samples = y.shape[1]
         onsets = np.array([event.onset for event in detection.events], dtype=np.int64)
         fits = onsets + length <= n_samples
+        if self.pads():
+            fits = onsets < n_samples
         warnings = [
             f"event at {(onset + detection.origin) / samplerate:.3f} s leaves fewer than "
             f"{length} samples before the end of the recording and was left out"
@@ -59,12 +66,13 @@ class Window(Extractor):
         kept = [event for event, ok in zip(detection.events, fits, strict=True) if ok]
         if onsets.size == 0:
             return Instances.empty(len(self.feature_names(y.shape[0])), warnings)
-        after = y[:, onsets[:, np.newaxis] + np.arange(length)]
+        # Indices past the end repeat the last sample: the padding of pads().
+        after = y[:, np.minimum(onsets[:, np.newaxis] + np.arange(length), n_samples - 1)]
         reference = baselines(y, onsets, baseline)
         values = after - reference[:, :, np.newaxis]
         return Instances(
             values=np.moveaxis(values, 0, 1).reshape(onsets.size, -1),
-            spans=np.stack([onsets, onsets + length], axis=1),
+            spans=np.stack([onsets, np.minimum(onsets + length, n_samples)], axis=1),
             meta=[{"channels": list(e.channels), "n_contacts": e.n_contacts} for e in kept],
             warnings=warnings,
         )
