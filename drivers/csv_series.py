@@ -18,6 +18,7 @@ and column where there is one.
 from __future__ import annotations
 
 import csv
+import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -98,9 +99,8 @@ def read_csv_series(
     channels : sequence of str, optional
         The columns to keep as channels, by name or 1-based number; all by default.
     """
-    header, rows = _parse(path)
-    names = header if header is not None else [f"column {i + 1}" for i in range(len(rows[0][1]))]
-    values = _numbers(path, names, rows)
+    header, values, lines = _read_table(path)
+    names = header if header is not None else [f"column {i + 1}" for i in range(values.shape[1])]
     time = _time_column(path, header, time_column)
     signal = [i for i in range(len(names)) if i != time]
     if not signal:
@@ -110,7 +110,6 @@ def read_csv_series(
     samples = values[:, picked]
     if time is None:
         return CsvSeries(np.ascontiguousarray(samples.T), samplerate, kept_names, ())
-    lines = [number for number, _ in rows]
     times, unit = stamps_in_seconds(values[:, time])
     rate, samples, notes = _on_even_grid(path, names[time], times, lines, samples, samplerate)
     if unit != "s":
@@ -133,33 +132,51 @@ def stamps_in_seconds(stamps: np.ndarray) -> tuple[np.ndarray, str]:
     return relative, "s"
 
 
-def _parse(path: Path) -> tuple[list[str] | None, list[tuple[int, list[str]]]]:
-    """The header (None if the first row is numbers) and the numbered rows, with a
-    trailing empty field (a delimiter at the end of the row) removed."""
+#: Rows parsed into one block of floats at a time (text is never held for the whole file).
+ROWS_PER_BLOCK = 4096
+
+
+def _read_table(path: Path) -> tuple[list[str] | None, np.ndarray, np.ndarray]:
+    """The header (None if the first row is numbers), every cell as a float of shape
+    (n_rows, n_columns), and each row's line number, shape (n_rows,).
+
+    A trailing empty field (a delimiter at the end of the row) is removed.  Rows are
+    converted as they are read, so memory holds the numbers, not the text.
+    """
     try:
         with path.open(newline="", encoding="utf-8-sig") as handle:
             dialect = csv.excel_tab if path.suffix.lower() == ".tsv" else csv.excel
-            rows = [
+            rows = (
                 (number, row)
                 for number, row in enumerate(csv.reader(handle, dialect), 1)
                 if any(cell.strip() for cell in row)
-            ]
+            )
+            first = next(rows, None)
+            if first is None:
+                raise DriverError(f"{path}: the recording has no samples")
+            header: list[str] | None = [cell.strip() for cell in first[1]]
+            assert header is not None
+            pending: list[tuple[int, list[str]]] = []
+            if all(_is_number(cell) for cell in header if cell):
+                header, pending = None, [first]
+            elif header and not header[-1]:
+                header = header[:-1]
+            width = len(header) if header is not None else len(_trimmed(first[1]))
+            names = header or [f"column {i + 1}" for i in range(width)]
+            blocks, numbers, block = [], [], []
+            for number, row in itertools.chain(pending, rows):
+                block.append(_row_values(path, names, number, _trimmed(row, width)))
+                numbers.append(number)
+                if len(block) == ROWS_PER_BLOCK:
+                    blocks.append(np.array(block))
+                    block = []
     except (OSError, UnicodeDecodeError) as error:
         raise DriverError(f"{path}: cannot read as text: {error}") from None
-    if not rows:
+    if block:
+        blocks.append(np.array(block))
+    if not blocks:
         raise DriverError(f"{path}: the recording has no samples")
-    header: list[str] | None = [cell.strip() for cell in rows[0][1]]
-    assert header is not None
-    if all(_is_number(cell) for cell in header if cell):
-        header = None
-    else:
-        rows = rows[1:]
-        if header and not header[-1]:
-            header = header[:-1]
-    if not rows:
-        raise DriverError(f"{path}: the recording has no samples")
-    width = len(header) if header is not None else len(_trimmed(rows[0][1]))
-    return header, [(number, _trimmed(row, width)) for number, row in rows]
+    return header, np.concatenate(blocks), np.array(numbers, dtype=np.int64)
 
 
 def _trimmed(row: list[str], width: int | None = None) -> list[str]:
@@ -169,29 +186,25 @@ def _trimmed(row: list[str], width: int | None = None) -> list[str]:
     return row
 
 
-def _numbers(path: Path, names: list[str], rows: list[tuple[int, list[str]]]) -> np.ndarray:
-    """Every cell as a float, shape (n_rows, n_columns); errors name the line and column."""
-    width = len(names)
-    values = np.empty((len(rows), width))
-    for row_index, (number, row) in enumerate(rows):
-        if len(row) != width:
-            raise DriverError(f"{path}:{number}: has {len(row)} fields, expected {width}")
-        try:
-            values[row_index] = [float(cell) for cell in row]
-        except ValueError:
-            # Rare: only then look for the cell, to say which one.
-            for column, cell in enumerate(row):
-                if not cell.strip():
-                    raise DriverError(
-                        f"{path}:{number}: column '{names[column]}' is empty (a missing sample)"
-                    ) from None
-                if not _is_number(cell):
-                    raise DriverError(
-                        f"{path}:{number}: column '{names[column]}': {cell.strip()!r} is not "
-                        "a number"
-                    ) from None
-            raise
-    return values
+def _row_values(path: Path, names: list[str], number: int, row: list[str]) -> list[float]:
+    """The cells of one row as floats; errors name the line and column."""
+    if len(row) != len(names):
+        raise DriverError(f"{path}:{number}: has {len(row)} fields, expected {len(names)}")
+    try:
+        return [float(cell) for cell in row]
+    except ValueError:
+        pass
+    # Rare: only then look for the cell, to say which one.
+    for column, cell in enumerate(row):
+        if not cell.strip():
+            raise DriverError(
+                f"{path}:{number}: column '{names[column]}' is empty (a missing sample)"
+            )
+        if not _is_number(cell):
+            raise DriverError(
+                f"{path}:{number}: column '{names[column]}': {cell.strip()!r} is not a number"
+            )
+    raise AssertionError("a row that float() refuses has a cell that is not a number")
 
 
 def _time_column(path: Path, header: list[str] | None, given: str | None) -> int | None:
@@ -233,7 +246,7 @@ def _on_even_grid(
     path: Path,
     name: str,
     times: np.ndarray,
-    lines: list[int],
+    lines: np.ndarray,
     samples: np.ndarray,
     samplerate: float | None,
 ) -> tuple[float, np.ndarray, list[str]]:

@@ -82,7 +82,8 @@ def resample_even(times: np.ndarray, values: np.ndarray, rate: float) -> tuple[n
     -------
     even : ndarray of shape (m, n_channels), float64
         The samples at ``times[0] + k / rate`` for ``k = 0 ... m - 1``, the last grid
-        point at or before ``times[-1]`` (``m = floor((times[-1] - times[0]) rate) + 1``).
+        point at or before ``times[-1]`` (``m = floor((times[-1] - times[0]) rate) + 1``);
+        column-major (its ``.T`` is C-contiguous).
     jitter : Jitter
         How far ``times`` were from even.
 
@@ -109,7 +110,9 @@ def resample_even(times: np.ndarray, values: np.ndarray, rate: float) -> tuple[n
     # A small tolerance: the last stamp on the grid itself must not be lost to rounding.
     count = math.floor((times[-1] - times[0]) * rate + 1e-9) + 1
     grid = times[0] + np.arange(count) / rate
-    position = np.clip(np.searchsorted(times, grid, side="right") - 1, 0, times.size - 2)
-    weight = ((grid - times[position]) / steps[position])[:, np.newaxis]
-    even = values[position] * (1.0 - weight) + values[position + 1] * weight
-    return even, jitter_of(times)
+    # One channel at a time, into a channel-major buffer: no temporary of the whole
+    # recording, and callers that want (n_channels, m) get it without a copy (``.T``).
+    even = np.empty((values.shape[1], count))
+    for channel in range(values.shape[1]):
+        even[channel] = np.interp(grid, times, values[:, channel])
+    return even.T, jitter_of(times)

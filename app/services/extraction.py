@@ -198,15 +198,13 @@ def extract_dataset(
                     longest = _longest(paths, lambda p: open_source(p, source.samplerate))
                 recipe, filled = _at_rate(recipe, source.samplerate, longest, path)
                 notes += filled
-            instances = _extract_one(recipe, source, path, on_progress)
+            parts = _extract_one(recipe, source, path, on_progress)
             origin, rate = source.start_time, source.samplerate
         notes += [f"{path.name}: {text}" for text in source.notes]
-        warnings += [f"{path.name}: {text}" for text in instances.warnings]
-        features.append(instances.values)
-        for (first, last), details in zip(instances.spans, instances.meta, strict=True):
-            start, end = origin + first / rate, origin + last / rate
-            spans.append((path.name, start, end))
-            meta.append({"source": path.name, "start": start, "end": end, **details})
+        # Kept as the parts the stream gave, joined once into the data set itself (which
+        # frees them one by one), so that no copy of all the features is ever made.
+        while parts:
+            warnings += _collect(parts.pop(0), path.name, origin, rate, features, spans, meta)
 
     assert shape is not None
     feature_names = recipe.make_extractor().feature_names(shape[1], names)
@@ -241,7 +239,7 @@ def extract_dataset(
     rows = np.flatnonzero(keep)
     dataset = Dataset(
         schema=schema,
-        values=_assemble(codes[rows], features, keep),
+        values=_assemble(codes[rows], features, keep, len(feature_names)),
         groups=np.array([spans[i][0] for i in rows], dtype=object),
         meta=[meta[i] for i in rows],
         name=dataset_name,
@@ -336,6 +334,24 @@ def extract_and_store(
     )
 
 
+def _collect(
+    instances: Instances,
+    name: str,
+    origin: float,
+    rate: float,
+    features: list[np.ndarray],
+    spans: list[tuple[str, float, float]],
+    meta: list[dict[str, Any]],
+) -> list[str]:
+    """Add one part of a recording's instances to the lists; its warnings."""
+    features.append(instances.values)
+    for (first, last), details in zip(instances.spans, instances.meta, strict=True):
+        start, end = origin + first / rate, origin + last / rate
+        spans.append((name, start, end))
+        meta.append({"source": name, "start": start, "end": end, **details})
+    return [f"{name}: {text}" for text in instances.warnings]
+
+
 def _longest(paths: Sequence[Path], open_source: Callable[[Path], FileReplaySource]) -> int:
     """Samples in the longest of the recordings (each read once, block by block)."""
     longest = 0
@@ -355,7 +371,9 @@ def _at_rate(
         raise FeatureError(f"{path}: {error}") from None
 
 
-def _assemble(codes: np.ndarray, parts: list[np.ndarray], keep: np.ndarray) -> np.ndarray:
+def _assemble(
+    codes: np.ndarray, parts: list[np.ndarray], keep: np.ndarray, n_features: int
+) -> np.ndarray:
     """The data set's values: target ``codes`` of shape (n_kept, n_targets), then the kept
     rows of the feature ``parts`` (one per recording, concatenated they are the
     instances ``keep`` selects from).
@@ -364,7 +382,6 @@ def _assemble(codes: np.ndarray, parts: list[np.ndarray], keep: np.ndarray) -> n
     that memory holds the features about once, not the parts, their concatenation and
     the result.
     """
-    n_features = parts[0].shape[1] if parts else 0
     values = np.empty((codes.shape[0], codes.shape[1] + n_features))
     values[:, : codes.shape[1]] = codes
     start = row = 0
@@ -383,8 +400,8 @@ def _extract_one(
     source: FileReplaySource,
     path: Path,
     on_progress: Callable[[str, float], None] | None,
-) -> Instances:
-    """The instances of one recording, read block by block."""
+) -> list[Instances]:
+    """The instances of one recording, read block by block, as the stream gave them."""
     try:
         stream = recipe.open(samplerate=source.samplerate, n_channels=source.n_channels)
         parts = []
@@ -395,7 +412,7 @@ def _extract_one(
         parts.append(stream.finish())
     except FeatureError as error:
         raise FeatureError(f"{path}: {error}") from None
-    return Instances.concat(parts, len(stream.feature_names))
+    return parts
 
 
 def _unique_names(paths: Sequence[Path]) -> dict[str, Path]:

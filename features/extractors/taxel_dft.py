@@ -38,8 +38,8 @@ from features.options import Option, non_negative_int, positive_int
 
 #: Below this rate only the DC bin is dropped by default (see the module docstring).
 FULL_DROP_RATE = 400.0
-#: Windows transformed at once (about 9 MB of spectra for 44 channels).
-WINDOWS_PER_BATCH = 4096
+#: Windows transformed at once (6 MB of complex spectra for 44 channels of 64 samples).
+WINDOWS_PER_BATCH = 256
 
 
 class TaxelDft(Extractor):
