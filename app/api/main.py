@@ -9,7 +9,7 @@ from fastapi import Depends, FastAPI
 
 from app.api import errors
 from app.api.deps import require_api_key
-from app.api.routes import datasets, health, jobs, live, models, recordings, runs
+from app.api.routes import datasets, extractors, health, jobs, live, models, recordings, runs
 from app.api.uploads import BodyLimit
 from app.settings import Settings
 
@@ -29,5 +29,6 @@ def install(app: FastAPI, settings: Settings) -> None:
         models.router,
         models.predictions,
         jobs.router,
+        extractors.router,
     ):
         app.include_router(router, dependencies=protected, responses=errors.ERROR_RESPONSES)

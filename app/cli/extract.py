@@ -7,7 +7,7 @@ from __future__ import annotations
 # is chosen).
 import sys
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 from rich.markup import escape
@@ -19,6 +19,53 @@ from app.errors import AppError
 
 def register(app: typer.Typer) -> None:
     app.command("extract")(extract_command)
+    app.command("extractors")(extractors_command)
+
+
+def extractors_command(
+    samplerate: Annotated[
+        float | None,
+        typer.Option(
+            "--samplerate",
+            metavar="HZ",
+            help="Show the defaults that depend on the sample rate, computed for HZ.",
+        ),
+    ] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")] = False,
+) -> None:
+    """List the extractors and event detectors with every option (-O KEY=VALUE of extract):
+    its type, default and meaning.
+    """
+    from app.cli.requests import build_request
+    from app.schemas.extraction import ExtractorsRequest
+    from app.services.extractors import list_extractors
+
+    listing = list_extractors(build_request(ExtractorsRequest, samplerate=samplerate))
+    if as_json:
+        print_json(listing.to_json())
+        return
+    rate = listing.samplerate
+    for kind, entries in (("--extractor", listing.extractors), ("--events", listing.events)):
+        for entry in entries:
+            table(
+                f"{kind} {entry.name}: {entry.description}",
+                ["option", "type", "default", "meaning"],
+                [(o.name, o.type, _default(o, rate), o.meaning) for o in entry.options]
+                or [("(none)", "", "", "")],
+            )
+
+
+def _default(option: Any, rate: float | None) -> str:
+    """The default as the listing shows it: the value, the rule, or the value at a rate."""
+    if option.at_rate is not None:
+        return f"{option.at_rate} at {rate:g} Hz"
+    if option.default is None:
+        return option.default_text or "-"
+    if isinstance(option.default, bool):
+        return "true" if option.default else "false"
+    if isinstance(option.default, list):
+        return ",".join("-".join(f"{v:g}" for v in pair) for pair in option.default)
+    return str(option.default)
 
 
 def extract_command(

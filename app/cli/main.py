@@ -88,6 +88,12 @@ COMMANDS = (
         "Detect touch events in recordings, extract features, and store them as a data set.",
     ),
     Subcommand(
+        "extractors",
+        "app.cli.extract",
+        "List the extractors and event detectors with every option (-O KEY=VALUE of extract):"
+        " its type, default and meaning.",
+    ),
+    Subcommand(
         "demo",
         "app.cli.demo",
         "Simulate touch sessions, extract features, benchmark, train and predict.",

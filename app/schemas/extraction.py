@@ -6,7 +6,7 @@ from __future__ import annotations
 # Imports inside functions: start-up time: the feature stack (numpy, scipy) loads when an
 # extraction request is checked, not when a command that never extracts starts.
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from pydantic import Field, model_validator
 
@@ -155,3 +155,56 @@ class ExtractionSummary(Schema):
     warnings: list[str]
     notes: list[str] = Field(default_factory=list)
     created: bool
+
+
+class ExtractorsRequest(Request):
+    """The CLI's ``extractors`` and ``GET /api/extractors``: the extractors and event
+    detectors with their options; with a sample rate, the defaults that depend on it."""
+
+    samplerate: float | None = Field(
+        default=None, gt=0, le=1e9, description="Show the defaults computed for this rate (Hz)."
+    )
+
+
+class OptionInfo(Schema):
+    """One option (``-O name=value``): its type, default and meaning.
+
+    ``default`` is None when it is computed (``default_text`` says how); ``at_rate`` is
+    the computed default at the request's sample rate, when it depends on the rate.
+    """
+
+    name: str
+    type: str
+    default: Any
+    default_text: str | None
+    meaning: str
+    at_rate: Any = None
+
+
+class EventsInfo(Schema):
+    """An event detector (``--events NAME``) and its options."""
+
+    name: str
+    description: str
+    options: list[OptionInfo]
+
+
+class ExtractorInfo(Schema):
+    """An extractor (``--extractor NAME``): what it makes, what it needs, its options."""
+
+    name: str
+    description: str
+    default_events: str
+    default_segment: float | None
+    samplerates: list[float] | None
+    min_samplerate: float
+    min_channels: int
+    options: list[OptionInfo]
+
+
+class ExtractorList(Schema):
+    """Every extractor and event detector (``extractors --json``, ``GET /api/extractors``)."""
+
+    samplerate: float | None
+    extractors: list[ExtractorInfo]
+    events: list[EventsInfo]

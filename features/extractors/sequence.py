@@ -53,10 +53,7 @@ class Sequence(Window):
             None,
             positive_int,
             "steps per channel",
-            default_text=(
-                f"{DEFAULT_LENGTH}; with events none, the segment's samples, else the "
-                "longest recording's"
-            ),
+            default_text=f"{DEFAULT_LENGTH}; events none: the segment, or the longest recording",
         ),
         Option("baseline", 0, non_negative_int, "samples before the onset averaged as baseline"),
         Option("resample", False, flag, "bring the whole event to 'length' steps"),

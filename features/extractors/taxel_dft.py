@@ -60,7 +60,7 @@ class TaxelDft(Extractor):
             non_negative_int,
             "lowest DFT bins dropped (0: keep the DC bin too)",
             at_rate=lambda samplerate: default_drop(samplerate),
-            default_text="4 from 400 Hz up (the published 750-800 Hz value), else 1 (DC only)",
+            default_text="4 from 400 Hz up (as published), else 1 (DC only)",
         ),
     )
 

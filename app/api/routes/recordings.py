@@ -35,6 +35,12 @@ def upload_session(
     samplerate: Annotated[float | None, Form()] = None,
     segment: Annotated[float | None, Form()] = None,
     topic: Annotated[str | None, Form()] = None,
+    time_column: Annotated[
+        str | None, Form(description="The time column of CSV recordings, if not a usual name.")
+    ] = None,
+    channels: Annotated[
+        str | None, Form(description="CSV columns to read as channels: A,B,... (names or numbers).")
+    ] = None,
 ) -> JobCreated:
     """Save the session and queue its extraction (answer: the job's id, status 202).
 
@@ -49,6 +55,8 @@ def upload_session(
         "samplerate": samplerate,
         "segment": segment,
         "topic": topic,
+        "time_column": time_column,
+        "channels": None if channels is None else [c for c in channels.split(",") if c.strip()],
     }
     # Checked before a byte is saved (the files' names stand for them), so that a refused
     # request leaves nothing on the disk.
