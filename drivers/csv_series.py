@@ -6,8 +6,9 @@
   (``time_column``); it is never a channel.  Its stamps are seconds, or nanoseconds
   when they are that large (:func:`stamps_in_seconds`).  Stamps even to 1 % give the
   sample rate (the given one, if they agree with it to 1 %); uneven ones (real drivers
-  jitter) are resampled onto an even grid at the given sample rate, else at their median
-  rate (:func:`drivers.resample.resample_even`), and a note says how uneven they were.
+  jitter) are resampled onto an even grid at the given sample rate, else at their mean
+  rate (:class:`drivers.resample.Jitter`; :func:`drivers.resample.resample_even`), and a
+  note says how uneven they were.
 * A delimiter at the end of every row (a trailing comma) is accepted.
 * ``channels`` picks columns by name (or 1-based number among the channels).
 
@@ -26,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from drivers.errors import DriverError
-from drivers.resample import resample_even
+from drivers.resample import jitter_of, resample_even
 
 #: Names of a time column, lower case: the common ones and those ROS tools write
 #: (``rostopic echo -p`` writes ``%time`` and ``field.header.stamp``, in nanoseconds).
@@ -265,7 +266,7 @@ def _on_even_grid(
         return 1.0 / median, samples, []
     if even and samplerate is not None and abs(1.0 / median - samplerate) <= EVEN * samplerate:
         return samplerate, samples, []
-    rate = samplerate if samplerate is not None else 1.0 / median
+    rate = samplerate if samplerate is not None else jitter_of(times).rate
     resampled, jitter = resample_even(times, samples, rate)
     note = (
         f"column '{name}': {jitter.describe()}; {times.size} samples resampled to "

@@ -28,7 +28,12 @@ class Jitter:
     Parameters
     ----------
     median_rate : float
-        ``1 / median step`` in Hz: the rate the stamps suggest.
+        ``1 / median step`` in Hz.
+    rate : float
+        ``1 / mean step`` over the steps that are not gaps, in Hz: the rate the stamps
+        suggest.  Far more precise than the median under jitter (the steps' errors cancel
+        in their sum: at 100 Hz, jitter of +-3 ms moves the median rate by about 1 % over
+        600 samples, the mean rate by under 0.1 %), and not lowered by lost samples.
     std_ms : float
         Standard deviation of the steps from their median, in milliseconds.
     max_ms : float
@@ -38,6 +43,7 @@ class Jitter:
     """
 
     median_rate: float
+    rate: float
     std_ms: float
     max_ms: float
     gaps: int
@@ -45,7 +51,7 @@ class Jitter:
     def describe(self) -> str:
         """One line: the median rate, the jitter and the gaps."""
         text = (
-            f"stamps at a median {self.median_rate:.6g} Hz jitter by {self.std_ms:.3g} ms "
+            f"stamps at {self.rate:.6g} Hz jitter by {self.std_ms:.3g} ms "
             f"(standard deviation; at most {self.max_ms:.3g} ms)"
         )
         if self.gaps:
@@ -58,8 +64,10 @@ def jitter_of(times: np.ndarray) -> Jitter:
     steps = np.diff(np.asarray(times, dtype=np.float64))
     median = float(np.median(steps))
     deviation = steps - median
+    regular = steps[steps <= GAP_STEPS * median]
     return Jitter(
         median_rate=1.0 / median,
+        rate=1.0 / float(regular.mean()),
         std_ms=1000.0 * float(np.sqrt(np.mean(deviation**2))),
         max_ms=1000.0 * float(np.abs(deviation).max()),
         gaps=int(np.count_nonzero(steps > GAP_STEPS * median)),

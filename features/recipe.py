@@ -6,7 +6,7 @@ on it, so that live features are computed exactly as the training features were.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -124,12 +124,15 @@ class Recipe:
         options = dict(make_extractor(self.extractor, _given(filled)).params)
         return replace(self, extractor_options=options), notes
 
-    def open(self, *, samplerate: float, n_channels: int) -> FeatureStream:
+    def open(
+        self, *, samplerate: float, n_channels: int, channels: Sequence[str] | None = None
+    ) -> FeatureStream:
         """A :class:`FeatureStream` for a stream of ``n_channels`` at ``samplerate`` Hz
-        (with the defaults that depend on the rate filled in)."""
+        (with the defaults that depend on the rate filled in), its features named after
+        ``channels`` if given."""
         recipe, _ = self.at_rate(samplerate)
         if recipe is not self:
-            return recipe.open(samplerate=samplerate, n_channels=n_channels)
+            return recipe.open(samplerate=samplerate, n_channels=n_channels, channels=channels)
         events = open_event_stream(
             self.events,
             n_channels,
@@ -139,7 +142,11 @@ class Recipe:
             max_event=self.max_event,
         )
         return FeatureStream(
-            self.make_extractor(), events, samplerate=samplerate, n_channels=n_channels
+            self.make_extractor(),
+            events,
+            samplerate=samplerate,
+            n_channels=n_channels,
+            channels=channels,
         )
 
     def to_json(self) -> dict[str, Any]:

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -39,6 +40,8 @@ class FeatureStream:
         Hz.
     n_channels : int
         Channels of every block.
+    channels : sequence of str, optional
+        The channels' names, which name the features (``t0_pac1``), if they have names.
 
     Attributes
     ----------
@@ -49,14 +52,20 @@ class FeatureStream:
     """
 
     def __init__(
-        self, extractor: Extractor, events: EventStream, *, samplerate: float, n_channels: int
+        self,
+        extractor: Extractor,
+        events: EventStream,
+        *,
+        samplerate: float,
+        n_channels: int,
+        channels: Sequence[str] | None = None,
     ) -> None:
         extractor.check_input(samplerate=samplerate, n_channels=n_channels)
         self.extractor = extractor
         self.events = events
         self.samplerate = float(samplerate)
         self.n_channels = n_channels
-        self.feature_names = extractor.feature_names(n_channels)
+        self.feature_names = extractor.feature_names(n_channels, channels)
         self.samples = History(n_channels)
         self._pending: deque[Event] = deque()
         window = extractor.track_window

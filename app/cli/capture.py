@@ -189,7 +189,12 @@ def live_command(
     samplerate: Annotated[
         float | None,
         typer.Option(
-            "--samplerate", metavar="HZ", help="Device rate in Hz (default: the model's)."
+            "--samplerate",
+            metavar="HZ",
+            help=(
+                "Device rate in Hz (default: the model's); for a replayed CSV or .npy file, "
+                "its rate."
+            ),
         ),
     ] = None,
     block_length: Annotated[
@@ -220,7 +225,13 @@ def live_command(
     extraction = model_info.extraction
     source: Source
     if replay is not None:
-        source = FileReplaySource(replay, realtime=realtime, topic=topic, block_length=block_length)
+        source = FileReplaySource(
+            replay,
+            samplerate=samplerate,
+            realtime=realtime,
+            topic=topic,
+            block_length=block_length,
+        )
     else:
         assert device is not None
         recipe = extraction or {}

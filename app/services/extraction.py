@@ -260,6 +260,36 @@ def extract_dataset(
     )
 
 
+def extract_with_recipe(path: Path, recipe: Mapping[str, Any]) -> ExtractionResult:
+    """The instances of one recording made as a model's training instances were: its
+    stored recipe (:class:`ExtractionResult.recipe`), the same sample rate (the grid of a
+    timed CSV, the rate of one without time) and the same channels.
+
+    Raises
+    ------
+    FeatureError
+        A recipe that is not one.
+    """
+    try:
+        options = {**recipe["extractor_options"], **recipe["event_options"]}
+        extractor, events = str(recipe["extractor"]), str(recipe["events"])
+    except (KeyError, TypeError) as error:
+        raise FeatureError(f"not an extraction recipe: {error!r}") from None
+    channels = recipe.get("channels")
+    return extract_dataset(
+        [path],
+        labels=None,
+        extractor=extractor,
+        events=events,
+        samplerate=recipe.get("samplerate"),
+        segment=recipe.get("segment"),
+        options=options,
+        max_event=recipe.get("max_event"),
+        # A CSV read by name: the columns the model was trained on, in its order.
+        channels=channels if channels and path.suffix.lower() in CSV_SUFFIXES else None,
+    )
+
+
 def check_extraction(store: Store, request: ExtractRequest) -> None:
     """Refuse what can be refused before any recording is read: the request checked its
     extractor, event detection and options when it was made; here, the data set's name.

@@ -115,7 +115,13 @@ class LiveSession:
                 f"but the source runs at {samplerate:g} Hz"
             )
         try:
-            self.stream = recipe.open(samplerate=samplerate, n_channels=n_channels)
+            # The features are named after the training recordings' channels (a CSV
+            # header's), which the live source, of the same channel count, stands for.
+            self.stream = recipe.open(
+                samplerate=samplerate,
+                n_channels=n_channels,
+                channels=recipe_json.get("channels"),
+            )
         except FeatureError as error:
             raise AppError(f"model '{name}': {error}") from None
         position = {feature: i for i, feature in enumerate(self.stream.feature_names)}

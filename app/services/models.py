@@ -9,6 +9,7 @@ warning that says where.
 
 from __future__ import annotations
 
+import csv
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -285,10 +286,43 @@ def _predict_values(
 
 
 def predict_file(store: Store, model_ref: str | int, path: Path) -> PredictionReport:
-    """Predict every instance of an ARFF or CSV file (attributes matched by name)."""
+    """Predict every instance of an ARFF or CSV file (attributes matched by name), or of
+    a raw recording, when the model was trained on extracted features: the recording's
+    instances are then extracted with the model's own recipe (:func:`is_recording`).
+
+    Raises
+    ------
+    DataFormatError, DriverError, FeatureError
+        A file that is neither, or a recording its recipe cannot read.
+    """
     info, model = load_model(store, model_ref)
+    if info.extraction is not None and is_recording(path, model.schema):
+        # Imported here: only raw recordings need the extraction stack.
+        from app.services.extraction import extract_with_recipe
+
+        extracted = extract_with_recipe(path, info.extraction)
+        predictions = predict(model, extracted.dataset, source=path.name)
+        predictions.warnings[:0] = extracted.notes + extracted.warnings
+        return predictions.report(info)
     data = read_data_file(path)
     return predict(model, data, source=path.name).report(info)
+
+
+def is_recording(path: Path, schema: Schema) -> bool:
+    """Whether ``path`` is a raw recording rather than a file of instances: anything but
+    ARFF and CSV, or a CSV whose header names none of the model's features (a time
+    series of channels)."""
+    suffix = path.suffix.lower()
+    if suffix == ".arff":
+        return False
+    if suffix != ".csv":
+        return True
+    try:
+        with path.open(newline="", encoding="utf-8-sig") as handle:
+            header = {cell.strip() for cell in next(csv.reader(handle), [])}
+    except (OSError, UnicodeDecodeError):
+        return False  # the data reader says what is wrong with it
+    return not header & {attribute.name for attribute in schema.features}
 
 
 def predict_records(

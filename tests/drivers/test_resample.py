@@ -26,6 +26,8 @@ def test_a_jittered_sine_comes_back_on_the_even_grid() -> None:
     bound = (2 * np.pi * frequency * np.diff(times).max()) ** 2 / 8
     assert np.abs(even - expected).max() <= bound < 0.01
     assert jitter.median_rate == pytest.approx(rate, rel=0.05)
+    # The mean of the steps is the precise rate: the jitter of the two ends over 10 s.
+    assert jitter.rate == pytest.approx(rate, rel=1e-3)
     assert 1.0 < jitter.std_ms < 4.0 and 4.0 < jitter.max_ms <= 8.0
     assert jitter.gaps == 0
 
@@ -36,6 +38,7 @@ def test_even_stamps_are_kept_and_gaps_are_counted() -> None:
     even, jitter = resample_even(times, values, 10.0)
     assert np.allclose(even[:, 0], np.arange(7.0))
     assert jitter.gaps == 1
+    assert jitter.rate == pytest.approx(10.0)  # the gap does not lower the rate
     assert "1 gap(s)" in jitter.describe()
 
 
