@@ -406,7 +406,8 @@ def bench_command(
         from benchmark.run.dask_backend import connect
 
         connect(scheduler).close()  # fail before a run exists, not after
-    progress = TaskProgress(enabled=False if as_json else None)
+    # On stderr whatever the output: --json keeps stdout to the JSON, not the progress.
+    progress = TaskProgress()
     if request is not None and request.independent:
         with progress:
             result = independent_runs(

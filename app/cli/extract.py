@@ -218,7 +218,8 @@ def key_values(pairs: list[str], option: str, what: str = "KEY=VALUE") -> dict[s
 
 
 class _Reading:
-    """A spinner with the recording being read and its seconds so far (stderr, TTY only)."""
+    """A spinner with the recording being read and its seconds so far on stderr when it is
+    a terminal, else a plain line per recording."""
 
     def __init__(self) -> None:
         from rich.console import Console
@@ -226,13 +227,16 @@ class _Reading:
 
         self._progress = Progress(
             SpinnerColumn(),
-            TextColumn("reading {task.fields[file]}: {task.fields[seconds]:.0f} s of audio"),
+            TextColumn("reading {task.fields[file]}: {task.fields[seconds]:.0f} s"),
             TimeElapsedColumn(),
             console=Console(stderr=True),
             transient=True,
             disable=not sys.stderr.isatty(),
         )
         self._task = self._progress.add_task("read", file="", seconds=0.0)
+        # Without a terminal (a log, CI): one plain line per recording instead.
+        self._lines = not sys.stderr.isatty()
+        self._file = ""
 
     def __enter__(self) -> _Reading:
         self._progress.start()
@@ -243,3 +247,6 @@ class _Reading:
 
     def update(self, file: str, seconds: float) -> None:
         self._progress.update(self._task, file=file, seconds=seconds)
+        if self._lines and file != self._file:
+            self._file = file
+            print(f"progress: reading {file}", file=sys.stderr, flush=True)

@@ -144,9 +144,41 @@ COMMANDS = (
 
 
 class TouchbenchGroup(LazyGroup):
-    """The ``touchbench`` group: :data:`COMMANDS`, each module imported when chosen."""
+    """The ``touchbench`` group: :data:`COMMANDS`, each module imported when chosen.
+
+    ``--db URL`` is the group's, but is taken after the command's name too
+    (``touchbench datasets --db URL``), as people write it.
+    """
 
     subcommands = COMMANDS
+
+    def parse_args(self, ctx: typer.Context, args: list[str]) -> list[str]:  # type: ignore[override]
+        return super().parse_args(ctx, global_options_first(args))
+
+
+def global_options_first(args: list[str]) -> list[str]:
+    """``args`` with every ``--db URL`` (or ``--db=URL``) after the command's name moved
+    before it; nothing after ``--`` is touched."""
+    names = {command.name for command in COMMANDS}
+    position = next((i for i, arg in enumerate(args) if arg in names), None)
+    if position is None:
+        return args
+    moved, rest, i = [], list(args[: position + 1]), position + 1
+    while i < len(args):
+        arg = args[i]
+        if arg == "--":
+            rest += args[i:]
+            break
+        if arg == "--db" and i + 1 < len(args):
+            moved += args[i : i + 2]
+            i += 2
+            continue
+        if arg.startswith("--db="):
+            moved.append(arg)
+        else:
+            rest.append(arg)
+        i += 1
+    return moved + rest
 
 
 help_pages.install()

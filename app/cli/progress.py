@@ -1,6 +1,8 @@
-"""A progress bar for long runs: tasks done, the classifier at work, time left.
+"""Progress of long runs: tasks done, the classifier at work, time left.
 
-Shown on stderr when it is a terminal; silent otherwise (pipes, CI, ``--json``).
+On stderr, so that stdout stays the command's output (a table, or JSON with ``--json``,
+even when stdout is redirected): a bar when stderr is a terminal, else one plain line
+per finished task (logs, CI, ``2> run.log``).
 """
 
 from __future__ import annotations
@@ -26,8 +28,13 @@ from benchmark.results import TaskKey, TaskResult
 class TaskProgress:
     """Callbacks for :mod:`app.services.runs` that draw a bar; a context manager."""
 
-    def __init__(self, *, enabled: bool | None = None) -> None:
-        self.enabled = sys.stderr.isatty() if enabled is None else enabled
+    def __init__(self, *, enabled: bool | None = None, lines: bool | None = None) -> None:
+        terminal = sys.stderr.isatty()
+        self.enabled = terminal if enabled is None else enabled
+        #: One plain line per finished task instead of the bar.
+        self.lines = (not self.enabled) if lines is None else lines
+        self._total: int | None = None
+        self._done = 0
         self._progress = Progress(
             TextColumn("{task.description}"),
             BarColumn(),
@@ -66,6 +73,9 @@ class TaskProgress:
 
     def plan(self, total: int, done: int) -> None:
         self._progress.update(self._task, total=total, completed=done)
+        self._total, self._done = total, done
+        if self.lines:
+            self._line(f"{total} task(s), {done} done before")
 
     def start(self, key: TaskKey) -> None:
         self._progress.update(
@@ -80,6 +90,17 @@ class TaskProgress:
                 f"{result.error}"
             )
         self._progress.advance(self._task)
+        self._done += 1
+        if self.lines:
+            key = result.key
+            self._line(
+                f"{self._done}/{self._total if self._total is not None else '?'} "
+                f"{key.classifier} repeat {key.repeat + 1} fold {key.fold + 1}: {result.status}"
+            )
+
+    def _line(self, text: str) -> None:
+        """A plain progress line on stderr (no markup, no colour)."""
+        print(f"progress: {text}", file=sys.stderr, flush=True)
 
     def warn(self, message: str) -> None:
         """Something the user should look at (a failed task...)."""
