@@ -76,7 +76,7 @@ def extractor_speed(name: str, seconds: float, repeats: int) -> tuple[float, flo
         seed=0,
     )
     y = session.recording.samples
-    extractor = make_extractor(name)
+    extractor = make_extractor(name, samplerate=samplerate)
     kind = extractor.default_events
 
     def run() -> int:

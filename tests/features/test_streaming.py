@@ -121,7 +121,9 @@ def _whole(recipe: Recipe, y: np.ndarray, samplerate: float) -> Instances:
         segment=recipe.segment,
         options=recipe.event_options,
     )
-    instances = recipe.make_extractor().extract(y, samplerate=samplerate, detection=detection)
+    # The stream fills in the defaults that depend on the rate; so does the whole array.
+    extractor = recipe.at_rate(samplerate)[0].make_extractor()
+    instances = extractor.extract(y, samplerate=samplerate, detection=detection)
     instances.warnings = [*detection.warnings, *instances.warnings]
     return instances
 
