@@ -6,7 +6,7 @@ from __future__ import annotations
 # Imports inside functions: start-up time: the feature stack (numpy, scipy) loads when an
 # extraction request is checked, not when a command that never extracts starts.
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 from pydantic import Field, model_validator
 
@@ -66,7 +66,7 @@ class ExtractRequest(Request):
         max_length=200,
         description="The time column of CSV recordings, when it has none of the usual names.",
     )
-    channels: list[str] | None = Field(
+    channels: list[Annotated[str, Field(min_length=1, max_length=200)]] | None = Field(
         default=None,
         min_length=1,
         max_length=1000,

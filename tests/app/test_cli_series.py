@@ -130,6 +130,7 @@ def test_a_biotac_export_keeps_its_names_and_says_it_resampled(
         (["--channels", "ele1"], "slip.csv: has no channel 'ele1' (channels: tdc, tac)"),
         (["--time-column", "when"], "slip.csv: has no column 'when' to read times from"),
         (["--time-column", ""], "--time-column:"),
+        (["--channels", "x" * 300], "--channels: String should have at most 200 characters"),
     ],
 )
 def test_bad_series_options_exit_2_in_one_line(
