@@ -11,7 +11,15 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from app.cli.output import EXIT_FAILED, EXIT_INTERRUPTED, ExitWith, info, print_json, table
+from app.cli.output import (
+    EXIT_FAILED,
+    EXIT_INTERRUPTED,
+    ExitWith,
+    JsonOption,
+    info,
+    print_json,
+    table,
+)
 from app.cli.state import get_state
 from app.schemas.runs import BenchRequest
 
@@ -25,7 +33,6 @@ if TYPE_CHECKING:
 # scikit-learn, the engine and Dask are imported by the commands that use them, so that
 # this module's other commands (runs, leaderboard, cancel) start without them.
 
-JsonOption = Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")]
 FORMATS = ("table", "json", "csv", "markdown", "arff")
 
 

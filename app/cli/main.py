@@ -32,7 +32,7 @@ COMMANDS = (
         "app.cli.datasets",
         "Import an ARFF or CSV file as a data set, named after the file.",
     ),
-    Subcommand("datasets", "app.cli.datasets", "List the data sets in the store."),
+    Subcommand("datasets", "app.cli.listing", "List the data sets in the store."),
     Subcommand(
         "show",
         "app.cli.datasets",

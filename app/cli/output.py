@@ -7,8 +7,9 @@ import math
 import re
 import sys
 from collections.abc import Iterable, Sequence
-from typing import Any
+from typing import Annotated, Any
 
+import typer
 from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
@@ -18,6 +19,9 @@ from app.cli.exits import EXIT_FAILED as EXIT_FAILED
 from app.cli.exits import EXIT_INTERRUPTED as EXIT_INTERRUPTED
 from app.cli.exits import ExitWith as ExitWith
 from app.schemas.base import finite
+
+#: The ``--json`` flag of every listing and result command.
+JsonOption = Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")]
 
 #: Pipes and files get a wide page: nobody wants a leaderboard wrapped at 80 columns.
 console = Console(highlight=False, soft_wrap=False, width=None if sys.stdout.isatty() else 160)

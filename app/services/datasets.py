@@ -36,6 +36,7 @@ from app.schemas.datasets import (
     ImportResult,
     RenameResult,
 )
+from app.services.listing import summary
 from app.store import datasets as stored
 from app.store.database import Store
 from app.store.datasets import DatasetInfo, DatasetInMemory, InstanceSource
@@ -53,26 +54,6 @@ ImportProgress = Callable[[str, int, int], None]
 def guess_format(path: Path) -> FileFormat:
     """``csv`` for ``.csv``, ``.tsv`` and ``.txt`` files, else ``arff``."""
     return "csv" if path.suffix.lower() in {".csv", ".tsv", ".txt"} else "arff"
-
-
-def summary(info: DatasetInfo) -> DatasetSummary:
-    """The listing of a stored data set as the CLI and the API show it."""
-    return DatasetSummary(
-        id=info.id,
-        name=info.name,
-        relation=info.relation,
-        n_instances=info.n_instances,
-        n_features=info.n_features,
-        targets=info.targets,
-        source=info.source_name,
-        sha256=info.sha256,
-        created_at=info.created_at,
-    )
-
-
-def list_datasets(store: Store) -> list[DatasetSummary]:
-    """Every stored data set, oldest first."""
-    return [summary(info) for info in stored.list_datasets(store)]
 
 
 # ---------------------------------------------------------------------------------- import

@@ -29,9 +29,9 @@ from app.services.datasets import (
     describe_dataset,
     export_dataset,
     import_file,
-    list_datasets,
     rename_dataset,
 )
+from app.services.listing import list_datasets
 from app.store.database import Store
 
 router = APIRouter(prefix="/api/datasets", tags=["datasets"])

@@ -9,7 +9,8 @@ from functools import partial
 from fastapi import APIRouter
 from fastapi.responses import HTMLResponse
 
-from app.services.datasets import describe_dataset, list_datasets
+from app.services.datasets import describe_dataset
+from app.services.listing import list_datasets
 from app.store.runs import list_runs
 from app.web.deps import StoreDep
 from app.web.rendering import draw, render

@@ -15,7 +15,7 @@ from fastapi.responses import HTMLResponse
 from app.errors import NotFoundError
 from app.reports.run_tables import run_tables
 from app.schemas.runs import FINAL_STATUSES
-from app.services.datasets import list_datasets
+from app.services.listing import list_datasets
 from app.services.runs import NoResultsError, run_leaderboard
 from app.store.runs import RunInfo, get_run, list_runs
 from app.web.deps import StoreDep
