@@ -48,7 +48,7 @@ from app.store.runs import (
 )
 from benchmark.dataset import Dataset
 from benchmark.errors import ConfigurationError
-from benchmark.problem import Problem, problem_from_dataset, restrict_targets
+from benchmark.problem import Problem, position_columns, problem_from_dataset, restrict_targets
 from benchmark.results import TaskKey, TaskResult
 
 if TYPE_CHECKING:  # scipy.stats (significance) loads when a leaderboard is first built
@@ -290,8 +290,7 @@ def create_run(
     NotFoundError
         An unknown data set.
     ConfigurationError
-        Anything else that would make the run fail at once: a target with one class, a
-        position that is not numeric targets.
+        Anything else that would make the run fail at once: a target with one class.
     """
     if request.independent:
         raise FieldError(
@@ -314,6 +313,12 @@ def _plan_run(store: Store, request: BenchRequest) -> _Plan:
             schema.index(request.target)
         except ConfigurationError as error:
             raise FieldError("target", str(error)) from None
+    if position:
+        run_schema = schema if targets is None else schema.with_targets([schema.index(targets[0])])
+        try:
+            position_columns(run_schema, position)
+        except ConfigurationError as error:
+            raise FieldError("position", str(error)) from None
     prepared = prepare_problem(load_dataset(store, info.id), targets, position)
     problem = prepared.problem
     if request.metric is not None:
