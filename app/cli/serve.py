@@ -54,6 +54,7 @@ def serve_command(
     """
     import uvicorn
 
+    from app.cli.stopping import GRACE, serve
     from app.settings import get_settings
 
     state = get_state(ctx)
@@ -76,17 +77,21 @@ def serve_command(
         )
     state.store  # noqa: B018 (open and migrate the store once, before the workers start)
     pin_native_threads()
-    uvicorn.run(
-        "app.main:create_app",
-        factory=True,
-        host=host,
-        port=port,
-        workers=workers,
-        log_level=log_level,
-        log_config=_log_config(log_level),
-        proxy_headers=False,
-        server_header=False,
-    )
+    options: dict[str, Any] = {
+        "factory": True,
+        "host": host,
+        "port": port,
+        "workers": workers,
+        "log_level": log_level,
+        "log_config": _log_config(log_level),
+        "proxy_headers": False,
+        "server_header": False,
+        "timeout_graceful_shutdown": GRACE,  # a request computing does not hold a stop
+    }
+    if workers > 1:  # uvicorn's supervisor signals its worker processes
+        uvicorn.run("app.main:create_app", **options)
+        return
+    serve(uvicorn.Config("app.main:create_app", **options))
 
 
 #: Variables that set the thread count of numpy's BLAS and of OpenMP (scikit-learn, xgboost).
