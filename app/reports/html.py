@@ -18,7 +18,7 @@ from jinja2 import Environment, FileSystemLoader, StrictUndefined, select_autoes
 from markupsafe import Markup
 from matplotlib.figure import Figure
 
-from app.reports import figures
+from app.reports import bounds, figures
 from app.reports.leaderboard import leaderboard_header, leaderboard_rows, metric_columns
 from app.reports.plots import svg_text
 from app.reports.run_tables import run_tables
@@ -97,6 +97,15 @@ def template_environment(*folders: Path) -> Environment:
         lstrip_blocks=True,
     )
     environment.filters["score"] = score
+    # what a page shows of a long list: the first items and a count of the others
+    environment.filters["names"] = bounds.names
+    environment.filters["first"] = bounds.first
+    environment.filters["last"] = bounds.last
+    environment.filters["count"] = bounds.count
+    environment.filters["and_more"] = bounds.and_more
+    environment.globals["bounds"] = {
+        name: getattr(bounds, name) for name in ("NAMES", "PANELS", "CLASSES", "ATTRIBUTES", "ROWS")
+    }
     return environment
 
 
