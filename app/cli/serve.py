@@ -50,7 +50,9 @@ def serve_command(
     Settings come from TOUCHBENCH_* variables: TOUCHBENCH_API_KEY or TOUCHBENCH_API_KEYS
     (required beyond loopback), TOUCHBENCH_ALLOWED_HOSTS (required beyond loopback),
     TOUCHBENCH_ALLOWED_ORIGINS, TOUCHBENCH_JOB_WORKERS, TOUCHBENCH_RUN_JOBS,
-    TOUCHBENCH_DASK_SCHEDULER, TOUCHBENCH_MAX_UPLOAD_MB, TOUCHBENCH_RESUME_ON_START.
+    TOUCHBENCH_DASK_SCHEDULER, TOUCHBENCH_MAX_UPLOAD_MB, TOUCHBENCH_MAX_TARGETS,
+    TOUCHBENCH_MAX_ATTRIBUTES, TOUCHBENCH_RESUME_ON_START.  Ctrl-C or SIGTERM stops it within
+    a few seconds (exit 130 or 143), whatever it is computing.
     """
     import uvicorn
 
@@ -88,9 +90,6 @@ def serve_command(
         "server_header": False,
         "timeout_graceful_shutdown": GRACE,  # a request computing does not hold a stop
     }
-    if workers > 1:  # uvicorn's supervisor signals its worker processes
-        uvicorn.run("app.main:create_app", **options)
-        return
     serve(uvicorn.Config("app.main:create_app", **options))
 
 
@@ -118,10 +117,15 @@ def pin_native_threads() -> None:
 
 def _log_config(level: str) -> dict[str, Any]:
     """uvicorn's logging, and the service's own log (``touchbench.*``: which key made each
-    change of state, unexpected errors) through uvicorn's handler at ``level``."""
+    change of state, unexpected errors) through uvicorn's handler at ``level``; without
+    the traceback of a request cancelled to stop (:class:`app.cli.stopping.CancelledByStop`)."""
     from uvicorn.config import LOGGING_CONFIG
 
     config = copy.deepcopy(LOGGING_CONFIG)
+    config.setdefault("filters", {})["cancelled_by_stop"] = {
+        "()": "app.cli.stopping.CancelledByStop"
+    }
+    config["loggers"]["uvicorn.error"]["filters"] = ["cancelled_by_stop"]
     config["loggers"]["touchbench"] = {
         "handlers": ["default"],
         "level": level.upper(),

@@ -8,7 +8,9 @@ both uvicorn (by default) and asyncio (for a cancelled task whose thread goes on
 wait for it, minutes for a heavy page.  So uvicorn waits at most :data:`GRACE` seconds for
 requests in flight, and a watchdog started by the first signal ends the process
 :data:`MARGIN` seconds later if it is still there; a second signal ends it at once.
-Either way the status is 128 + the first signal's number and stderr says
+With ``--workers N`` the supervisor does the same for its service processes: it stops
+them, and kills those still there :data:`GRACE` + :data:`MARGIN` seconds after the
+signal.  Either way the status is 128 + the first signal's number and stderr says
 ``touchbench: interrupted`` once, without a traceback: a request cancelled by the stop is
 not logged as an error of the application.
 """
@@ -25,6 +27,7 @@ from types import FrameType
 
 import uvicorn
 from uvicorn.main import STARTUP_FAILURE
+from uvicorn.supervisors import Multiprocess
 
 from app.cli.exits import EXIT_INTERRUPTED
 
@@ -38,17 +41,18 @@ MARGIN = 3.0
 _ENDING = threading.Lock()
 
 
+class CancelledByStop(logging.Filter):
+    """Drop the traceback uvicorn logs for a request it cancelled to stop (on the
+    ``uvicorn.error`` logger, by ``serve``'s logging settings, in every service process):
+    that is the stop at work, not an error of the application."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        error = record.exc_info[1] if record.exc_info else None
+        return not isinstance(error, asyncio.CancelledError)
+
+
 class StoppingServer(uvicorn.Server):
     """uvicorn's server, ended by a watchdog when a graceful stop takes too long."""
-
-    def __init__(self, config: uvicorn.Config) -> None:
-        super().__init__(config)
-        logging.getLogger("uvicorn.error").addFilter(self._cancelled_by_stop)
-
-    def _cancelled_by_stop(self, record: logging.LogRecord) -> bool:
-        """Keep a record unless it is a request's cancellation by the stop."""
-        error = record.exc_info[1] if record.exc_info else None
-        return not (self.should_exit and isinstance(error, asyncio.CancelledError))
 
     def handle_exit(self, sig: int, frame: FrameType | None) -> None:
         first = not self._captured_signals
@@ -60,6 +64,37 @@ class StoppingServer(uvicorn.Server):
         watchdog.daemon = True  # never what keeps the process alive
         watchdog.name = "stop-watchdog"
         watchdog.start()
+
+
+class StoppingSupervisor(Multiprocess):
+    """uvicorn's supervisor of ``--workers N`` service processes, which remembers the first
+    signal and kills the processes a graceful stop leaves behind."""
+
+    signum: int | None = None
+
+    def handle_int(self) -> None:
+        self._stopping(signal.SIGINT)
+        super().handle_int()
+
+    def handle_term(self) -> None:
+        self._stopping(signal.SIGTERM)
+        super().handle_term()
+
+    def _stopping(self, signum: int) -> None:
+        if self.signum is not None:  # the user insists: no more waiting
+            self._kill_all()
+            end_now(self.signum)
+        self.signum = signum
+        watchdog = threading.Timer(GRACE + MARGIN, self._kill_all, args=(True,))
+        watchdog.daemon = True
+        watchdog.name = "stop-watchdog"
+        watchdog.start()
+
+    def _kill_all(self, end: bool = False) -> None:
+        for process in self.processes:
+            process.kill()
+        if end and self.signum is not None:
+            end_now(self.signum)
 
 
 def end_now(signum: int) -> None:
@@ -83,6 +118,12 @@ def serve(config: uvicorn.Config) -> None:
     SystemExit
         With uvicorn's start-up failure status when the service could not start.
     """
+    if config.workers > 1:
+        supervisor = StoppingSupervisor(config, sockets=[config.bind_socket()])
+        supervisor.run()
+        if supervisor.signum is not None:
+            end_now(supervisor.signum)
+        return
     server = StoppingServer(config)
     try:
         server.run()

@@ -66,21 +66,23 @@ def _stopped(server: Server) -> tuple[int, str]:
 
 
 @pytest.mark.parametrize(
-    ("signals", "status"),
+    ("signals", "status", "workers"),
     [
-        ((signal.SIGINT,), 130),
-        ((signal.SIGTERM,), 143),
-        ((signal.SIGINT, signal.SIGINT), 130),
+        ((signal.SIGINT,), 130, 1),
+        ((signal.SIGTERM,), 143, 1),
+        ((signal.SIGINT, signal.SIGINT), 130, 1),
+        ((signal.SIGTERM,), 143, 2),
     ],
-    ids=["ctrl-c", "sigterm", "ctrl-c-twice"],
+    ids=["ctrl-c", "sigterm", "ctrl-c-twice", "sigterm-2-workers"],
 )
 def test_a_busy_service_stops_on_a_signal(
     make_sqlite_server: Callable[..., Server],
     tmp_path: Path,
     signals: tuple[signal.Signals, ...],
     status: int,
+    workers: int,
 ) -> None:
-    server = make_sqlite_server()
+    server = make_sqlite_server(arguments=("--workers", str(workers)))
     assert server.process is not None
     uploading = _busy(server, tmp_path)
     for signum in signals:
