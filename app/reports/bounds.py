@@ -56,11 +56,6 @@ def first(items: Iterable[T], limit: int) -> Shown[T]:
     return Shown(list(listed[:limit]), max(len(listed) - limit, 0))
 
 
-def last(items: Sequence[T], limit: int) -> Shown[T]:
-    """The last ``limit`` of ``items`` (the newest of a listing in order of creation)."""
-    return Shown(list(items[max(len(items) - limit, 0) :]), max(len(items) - limit, 0))
-
-
 def first_entries(mapping: Mapping[K, V], limit: int) -> dict[K, V]:
     """The first ``limit`` entries of ``mapping``, in its order."""
     return {key: mapping[key] for key in first(mapping.keys(), limit).items}

@@ -88,7 +88,9 @@ def render_report(
 
 def template_environment(*folders: Path) -> Environment:
     """The Jinja environment of the report's templates, ``folders`` searched first (the web
-    page's): autoescaped, strict about undefined names, with the ``score`` filter."""
+    page's): autoescaped, strict about undefined names, with the ``score`` filter and those
+    of :mod:`app.reports.bounds` (``names``, ``first``, ``count``, ``and_more``; its limits
+    as ``bounds.PANELS``, ...)."""
     environment = Environment(
         loader=FileSystemLoader([*folders, TEMPLATES]),
         autoescape=select_autoescape(["html", "j2"]),
@@ -100,7 +102,6 @@ def template_environment(*folders: Path) -> Environment:
     # what a page shows of a long list: the first items and a count of the others
     environment.filters["names"] = bounds.names
     environment.filters["first"] = bounds.first
-    environment.filters["last"] = bounds.last
     environment.filters["count"] = bounds.count
     environment.filters["and_more"] = bounds.and_more
     environment.globals["bounds"] = {

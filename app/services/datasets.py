@@ -36,6 +36,7 @@ from app.schemas.datasets import (
     ImportResult,
     RenameResult,
 )
+from app.schemas.listing import Page
 from app.services.limits import check_dataset_size
 from app.store import datasets as stored
 from app.store.database import Store
@@ -71,9 +72,9 @@ def summary(info: DatasetInfo) -> DatasetSummary:
     )
 
 
-def list_datasets(store: Store) -> list[DatasetSummary]:
-    """Every stored data set, oldest first."""
-    return [summary(info) for info in stored.list_datasets(store)]
+def list_datasets(store: Store, *, page: Page | None = None) -> list[DatasetSummary]:
+    """Every stored data set (those of ``page``), oldest first."""
+    return [summary(info) for info in stored.list_datasets(store, page=page)]
 
 
 # ---------------------------------------------------------------------------------- import

@@ -24,9 +24,11 @@ from sqlalchemy.exc import IntegrityError, OperationalError
 from sqlalchemy.orm import Session
 
 from app.errors import AppError, ConflictError, FieldError
+from app.schemas.listing import Page
 from app.store.database import Store
 from app.store.naming import check_name, default_name, find_row, free_name, shorten
 from app.store.ownership import owner_alive
+from app.store.paging import count_rows, paged
 from app.store.tables import DatasetRow, InstanceBlockRow, InstanceRow, RunRow
 from benchmark.dataset import Dataset, InstanceBlock, Schema, dataset_blocks
 
@@ -415,10 +417,15 @@ def find_dataset(store: Store, ref: str | int) -> DatasetInfo:
         return DatasetInfo.of(_row(session, ref))
 
 
-def list_datasets(store: Store) -> list[DatasetInfo]:
+def list_datasets(store: Store, *, page: Page | None = None) -> list[DatasetInfo]:
+    """The data sets, oldest first (those of ``page`` only, when given)."""
     with store.session() as session:
-        rows = session.scalars(select(DatasetRow).order_by(DatasetRow.id))
+        rows = session.scalars(paged(select(DatasetRow).order_by(DatasetRow.id), page))
         return [DatasetInfo.of(row) for row in rows]
+
+
+def count_datasets(store: Store) -> int:
+    return count_rows(store, DatasetRow)
 
 
 def load_schema(store: Store, ref: str | int) -> tuple[DatasetInfo, Schema, bool]:

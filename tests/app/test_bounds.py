@@ -12,6 +12,8 @@ from app.reports.plots import (
     per_target_figure,
     svg_text,
 )
+from app.schemas.listing import Page
+from app.web.listing import newest
 from tests.app.test_plots import svg_texts
 
 
@@ -19,8 +21,16 @@ def test_first_last_and_names_count_what_they_leave_out() -> None:
     shown = bounds.first(range(25), 10)
     assert shown.items == list(range(10)) and shown.more == 15 and shown.total == 25
     assert bounds.first({"a": 1, "b": 2}, 10) == bounds.Shown(["a", "b"], 0)
-    newest = bounds.last(list(range(25)), 10)
-    assert newest.items == list(range(15, 25)) and newest.more == 15
+    pages: list[Page] = []
+
+    def listed(*, page: Page) -> list[int]:
+        pages.append(page)
+        return list(range(25))[page.offset : page.offset + page.limit]
+
+    latest = newest(25, listed, 10)
+    assert latest.items == list(range(15, 25)) and latest.more == 15
+    assert pages == [Page(offset=15, limit=10)]
+    assert newest(3, lambda *, page: [0, 1, 2][page.offset :], 10) == bounds.Shown([0, 1, 2], 0)
     assert bounds.names([f"y{i}" for i in range(20_000)], 3) == "y0, y1, y2 and 19,997 more"
     assert bounds.names(["a", "b"]) == "a, b"
     assert bounds.of_all(bounds.first(range(800), 6), "targets") == "first 6 of 800 targets"

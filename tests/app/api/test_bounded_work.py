@@ -20,6 +20,7 @@ import soundfile
 
 from app.reports import bounds
 from tests.app.api.conftest import ROOT, Server
+from tests.app.synthetic import touch_arff
 from tests.app.web.conftest import figure_texts
 
 #: Far above what a bounded service needs, far below what the issue measured (9.2 GB).
@@ -175,3 +176,24 @@ def test_prediction_bodies_are_counted_while_read(server: Server) -> None:
     # within the limits the body goes on to the model (none here)
     assert api.post("/api/models/1/predict", json={"instances": [instance]}).status_code == 404
     assert api.get("/healthz").status_code == 200
+
+
+def test_listings_answer_a_page_and_say_how_many_there_are(server: Server, tmp_path: Path) -> None:
+    api = server.client
+    for seed in range(3):
+        assert _upload(api, touch_arff(tmp_path / f"touch{seed}.arff", seed=seed)).is_success
+    everything = api.get("/api/datasets")
+    assert [d["id"] for d in everything.json()["datasets"]] == [1, 2, 3]
+    assert everything.headers["x-total-count"] == "3" and "link" not in everything.headers
+    first = api.get("/api/datasets", params={"limit": 2})
+    assert [d["id"] for d in first.json()["datasets"]] == [1, 2]
+    assert first.headers["x-total-count"] == "3"
+    assert first.headers["link"] == '</api/datasets?offset=2&limit=2>; rel="next"'
+    rest = api.get("/api/datasets?limit=2&offset=2")
+    assert [d["id"] for d in rest.json()["datasets"]] == [3] and "link" not in rest.headers
+    for listing in ("/api/runs", "/api/models", "/api/jobs"):
+        answer = api.get(listing, params={"offset": 5})
+        assert answer.status_code == 200 and answer.headers["x-total-count"] == "0", listing
+        too_many = api.get(listing, params={"limit": 1001})
+        assert too_many.status_code == 422, too_many.text
+        assert too_many.json()["error"]["where"] == "query.limit"
