@@ -10,7 +10,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from app.settings import get_settings
 from benchmark.errors import DataFormatError
 
 
@@ -31,6 +30,9 @@ class DatasetLimits:
     @classmethod
     def configured(cls) -> DatasetLimits:
         """The limits of the settings (the environment)."""
+        # start-up time: a command that lists or shows reads no settings (pydantic-settings)
+        from app.settings import get_settings
+
         settings = get_settings()
         return cls(targets=settings.max_targets, attributes=settings.max_attributes)
 
