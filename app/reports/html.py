@@ -18,7 +18,7 @@ from jinja2 import Environment, FileSystemLoader, StrictUndefined, select_autoes
 from markupsafe import Markup
 from matplotlib.figure import Figure
 
-from app.reports import figures
+from app.reports import bounds, figures
 from app.reports.leaderboard import leaderboard_header, leaderboard_rows, metric_columns
 from app.reports.plots import svg_text
 from app.reports.run_tables import run_tables
@@ -88,7 +88,9 @@ def render_report(
 
 def template_environment(*folders: Path) -> Environment:
     """The Jinja environment of the report's templates, ``folders`` searched first (the web
-    page's): autoescaped, strict about undefined names, with the ``score`` filter."""
+    page's): autoescaped, strict about undefined names, with the ``score`` filter and those
+    of :mod:`app.reports.bounds` (``names``, ``first``, ``count``, ``and_more``; its limits
+    as ``bounds.PANELS``, ...)."""
     environment = Environment(
         loader=FileSystemLoader([*folders, TEMPLATES]),
         autoescape=select_autoescape(["html", "j2"]),
@@ -97,6 +99,14 @@ def template_environment(*folders: Path) -> Environment:
         lstrip_blocks=True,
     )
     environment.filters["score"] = score
+    # what a page shows of a long list: the first items and a count of the others
+    environment.filters["names"] = bounds.names
+    environment.filters["first"] = bounds.first
+    environment.filters["count"] = bounds.count
+    environment.filters["and_more"] = bounds.and_more
+    environment.globals["bounds"] = {
+        name: getattr(bounds, name) for name in ("NAMES", "PANELS", "CLASSES", "ATTRIBUTES", "ROWS")
+    }
     return environment
 
 

@@ -36,6 +36,7 @@ from app.schemas.datasets import (
     ImportResult,
     RenameResult,
 )
+from app.services.limits import check_dataset_size
 from app.services.listing import summary
 from app.store import datasets as stored
 from app.store.database import Store
@@ -85,7 +86,8 @@ def import_file(
     ------
     DataFormatError
         If the file is not a regular file, not text, or not valid ARFF/CSV; if it holds
-        no instances or infinite values; if it leaves no feature.  Nothing is stored.
+        no instances or infinite values; if it leaves no feature, or has more targets or
+        attributes than :mod:`app.services.limits` allows.  Nothing is stored.
     FieldError
         If the name is invalid.
     ConflictError
@@ -169,6 +171,9 @@ def _open_data(
 
 
 def _check_schema(schema: Schema, source: str, notes: list[str]) -> None:
+    check_dataset_size(
+        n_targets=len(schema.target_indices), n_attributes=schema.n_attributes, source=source
+    )
     if not schema.feature_indices:
         raise DataFormatError(
             "no features: every attribute is a target "

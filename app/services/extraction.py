@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 
 from app.schemas.extraction import ExtractionSummary, ExtractRequest
+from app.services.limits import check_dataset_size
 from app.store.database import Store
 from app.store.datasets import add_dataset, check_dataset_name, dataset_digest
 from benchmark.dataset import Attribute, Dataset, Schema
@@ -194,6 +195,11 @@ def extract_dataset(
                 f"none of the {n_events} instance(s) found falls inside a labelled interval",
                 source=table.source,
             )
+    check_dataset_size(
+        n_targets=len(target_attributes),
+        n_attributes=len(target_attributes) + len(feature_names),
+        source=labels.name if labels is not None else paths[0].name,
+    )
     schema = Schema(
         relation=(
             f"{dataset_name}: -C {len(target_attributes)}" if target_attributes else dataset_name
@@ -224,7 +230,8 @@ def extract_dataset(
 
 def check_extraction(store: Store, request: ExtractRequest) -> None:
     """Refuse what can be refused before any recording is read: the request checked its
-    extractor, event detection and options when it was made; here, the data set's name.
+    extractor, event detection and options when it was made; here, the data set's name
+    and the number of targets the labels file declares.
 
     Raises
     ------
@@ -232,9 +239,16 @@ def check_extraction(store: Store, request: ExtractRequest) -> None:
         An invalid name.
     ConflictError
         The name is taken.
+    DataFormatError
+        The labels file declares more targets than :mod:`app.services.limits` allows.
     """
     if request.name is not None:
         check_dataset_name(store, request.name)
+    labels = request.labels_path()
+    if labels is not None and request.labels is not None:
+        # the header alone says how many targets: a file declaring thousands is refused
+        # before a job reads any recording
+        check_dataset_size(n_targets=count_label_targets(labels), source=str(request.labels))
 
 
 def extract_and_store(
@@ -340,6 +354,21 @@ def _same_shape(
             f"{expected[0]:g} Hz; one data set needs one sample rate"
         )
     return found
+
+
+def count_label_targets(path: Path) -> int:
+    """How many target columns the header of a labels CSV names (the file is read up to
+    its first non-empty row only; a file that cannot be read counts 0, and
+    :func:`read_labels` says what is wrong with it)."""
+    try:
+        with Path(path).open(newline="", encoding="utf-8-sig") as handle:
+            for row in csv.reader(handle):
+                if any(cell.strip() for cell in row):
+                    special = {"file", "start", "end"}
+                    return sum(1 for cell in row if cell.strip().lower() not in special)
+    except (OSError, UnicodeDecodeError, csv.Error):
+        pass
+    return 0
 
 
 def read_labels(path: Path) -> LabelTable:

@@ -13,9 +13,11 @@ from dataclasses import dataclass
 from datetime import UTC, datetime
 from typing import Any
 
-from sqlalchemy import JSON, DateTime, Integer, String, Text, column, select, table
+from sqlalchemy import JSON, DateTime, Integer, String, Text, column, func, select, table
 
+from app.schemas.listing import Page
 from app.store.database import Store
+from app.store.paging import paged
 
 DATASETS = table(
     "datasets",
@@ -64,8 +66,14 @@ class DatasetInfo:
         )
 
 
-def list_datasets(store: Store) -> list[DatasetInfo]:
-    """Every stored data set, oldest first."""
+def list_datasets(store: Store, *, page: Page | None = None) -> list[DatasetInfo]:
+    """The data sets, oldest first (those of ``page`` only, when given)."""
     with store.engine.connect() as connection:
-        rows = connection.execute(select(DATASETS).order_by(DATASETS.c.id))
+        rows = connection.execute(paged(select(DATASETS).order_by(DATASETS.c.id), page))
         return [DatasetInfo.of(row) for row in rows]
+
+
+def count_datasets(store: Store) -> int:
+    """How many data sets the store holds."""
+    with store.engine.connect() as connection:
+        return int(connection.scalar(select(func.count()).select_from(DATASETS)) or 0)

@@ -21,11 +21,13 @@ from sqlalchemy.dialects.sqlite import insert as sqlite_insert
 from sqlalchemy.orm import Session
 
 from app.errors import ConflictError, NotFoundError
+from app.schemas.listing import Page
 from app.schemas.runs import FINAL_STATUSES, RunSchema, RunStatus
 from app.store import queue
 from app.store.database import Store
 from app.store.naming import is_row_id
 from app.store.ownership import aware, mark_lost, owner_alive, process_owner
+from app.store.paging import count_rows, paged
 from app.store.states import ACTIVE, LOST_AS, check_claim, check_resume
 from app.store.tables import DatasetRow, FoldResultRow, RunRow, utcnow
 from benchmark.results import TaskKey, TaskResult
@@ -139,12 +141,27 @@ def get_run(store: Store, run_id: int | str) -> RunInfo:
         return _infos(session, [_row(session, run_id)])[0]
 
 
-def list_runs(store: Store, *, status: str | None = None) -> list[RunInfo]:
+def list_runs(
+    store: Store,
+    *,
+    status: str | None = None,
+    dataset_id: int | None = None,
+    page: Page | None = None,
+) -> list[RunInfo]:
+    """The runs, oldest first: those with ``status``, on ``dataset_id``, of ``page``."""
     with store.session() as session:
         query = select(RunRow).order_by(RunRow.id)
         if status is not None:
             query = query.where(RunRow.status == status)
-        return _infos(session, list(session.scalars(query)))
+        if dataset_id is not None:
+            query = query.where(RunRow.dataset_id == dataset_id)
+        return _infos(session, list(session.scalars(paged(query, page))))
+
+
+def count_runs(store: Store, *, dataset_id: int | None = None) -> int:
+    """How many runs there are (on ``dataset_id``)."""
+    where = () if dataset_id is None else (RunRow.dataset_id == dataset_id,)
+    return count_rows(store, RunRow, *where)
 
 
 def claim_run(store: Store, run_id: int, *, owner: str | None = None) -> RunInfo:

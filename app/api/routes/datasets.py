@@ -10,10 +10,10 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Annotated
 
-from fastapi import APIRouter, File, Form, Response, UploadFile, status
+from fastapi import APIRouter, File, Form, Request, Response, UploadFile, status
 from fastapi.responses import StreamingResponse
 
-from app.api.deps import ServiceDep, StoreDep
+from app.api.deps import PageDep, ServiceDep, StoreDep, paginate
 from app.api.uploads import form_request, save_upload
 from app.schemas.base import Schema
 from app.schemas.datasets import (
@@ -33,6 +33,7 @@ from app.services.datasets import (
 )
 from app.services.listing import list_datasets
 from app.store.database import Store
+from app.store.listing import count_datasets
 
 router = APIRouter(prefix="/api/datasets", tags=["datasets"])
 
@@ -77,8 +78,11 @@ def upload(
 
 
 @router.get("", response_model=DatasetList)
-def datasets(store: StoreDep) -> DatasetList:
-    return DatasetList(datasets=list_datasets(store))
+def datasets(store: StoreDep, page: PageDep, request: Request, response: Response) -> DatasetList:
+    """The data sets, oldest first, a page of at most 1,000 (``X-Total-Count`` says how
+    many there are, ``Link`` where the next page is)."""
+    paginate(request, response, page, count_datasets(store))
+    return DatasetList(datasets=list_datasets(store, page=page))
 
 
 @router.get("/{dataset}", response_model=DatasetDescription)

@@ -11,9 +11,9 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Annotated, Any
 
-from fastapi import APIRouter, File, Response, UploadFile, status
+from fastapi import APIRouter, File, Request, Response, UploadFile, status
 
-from app.api.deps import Service, ServiceDep, StoreDep, request_size
+from app.api.deps import PageDep, Service, ServiceDep, StoreDep, paginate, request_size
 from app.api.direct import DirectRoute
 from app.api.uploads import save_upload
 from app.schemas.jobs import JobCreated
@@ -25,7 +25,7 @@ from app.schemas.models import (
     TrainRequest,
 )
 from app.services.jobs import submit_training
-from app.store.models import delete_model, get_model, list_models
+from app.store.models import count_models, delete_model, get_model, list_models
 
 router = APIRouter(prefix="/api/models", tags=["models"])
 #: Predictions of JSON instances: documented by FastAPI, answered by a direct handler (the
@@ -45,8 +45,10 @@ def train(body: TrainRequest, service: ServiceDep) -> JobCreated:
 
 
 @router.get("", response_model=ModelList)
-def models(store: StoreDep) -> ModelList:
-    return ModelList(models=[m.to_schema() for m in list_models(store)])
+def models(store: StoreDep, page: PageDep, request: Request, response: Response) -> ModelList:
+    """The models, oldest first, a page of at most 1,000 (``X-Total-Count``, ``Link``)."""
+    paginate(request, response, page, count_models(store))
+    return ModelList(models=[m.to_schema() for m in list_models(store, page=page)])
 
 
 @router.get("/{model_ref}", response_model=ModelSchema)

@@ -8,13 +8,13 @@ import io
 # ARFF writer load when a format other than JSON is first asked for.
 from typing import Annotated, Literal
 
-from fastapi import APIRouter, Query, status
+from fastapi import APIRouter, Query, Request, Response, status
 from fastapi.responses import PlainTextResponse
 
-from app.api.deps import ServiceDep, StoreDep
+from app.api.deps import PageDep, ServiceDep, StoreDep, paginate
 from app.schemas.runs import BenchRequest, LeaderboardSchema, RunCreated, RunList, RunSchema
 from app.services.runs import create_run, run_leaderboard
-from app.store.runs import get_run, list_runs, request_cancel, requeue_run
+from app.store.runs import count_runs, get_run, list_runs, request_cancel, requeue_run
 
 router = APIRouter(prefix="/api/runs", tags=["runs"])
 
@@ -28,8 +28,10 @@ def start_run(body: BenchRequest, service: ServiceDep) -> RunCreated:
 
 
 @router.get("", response_model=RunList)
-def runs(store: StoreDep) -> RunList:
-    return RunList(runs=[run.schema() for run in list_runs(store)])
+def runs(store: StoreDep, page: PageDep, request: Request, response: Response) -> RunList:
+    """The runs, oldest first, a page of at most 1,000 (``X-Total-Count``, ``Link``)."""
+    paginate(request, response, page, count_runs(store))
+    return RunList(runs=[run.schema() for run in list_runs(store, page=page)])
 
 
 @router.get("/{run_id}", response_model=RunSchema)

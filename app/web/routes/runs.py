@@ -17,8 +17,10 @@ from app.reports.run_tables import run_tables
 from app.schemas.runs import FINAL_STATUSES
 from app.services.listing import list_datasets
 from app.services.runs import NoResultsError, run_leaderboard
-from app.store.runs import RunInfo, get_run, list_runs
+from app.store.listing import count_datasets
+from app.store.runs import RunInfo, count_runs, get_run, list_runs
 from app.web.deps import StoreDep
+from app.web.listing import newest
 from app.web.rendering import draw, render
 from app.web.routes.pages import Ref
 
@@ -37,11 +39,11 @@ Baseline = Annotated[str | None, Query(max_length=200)]
 @router.get("", response_class=HTMLResponse)
 def runs(store: StoreDep) -> HTMLResponse:
     """Every run with its progress; polled while one is queued or running."""
-    listed = list_runs(store)
+    listed = newest(count_runs(store), partial(list_runs, store))
     return render(
         "fragments/runs.html.j2",
         runs=listed,
-        active=any(run.status not in FINAL_STATUSES for run in listed),
+        active=any(run.status not in FINAL_STATUSES for run in listed.items),
     )
 
 
@@ -55,7 +57,7 @@ def run_form(
 
     return render(
         "fragments/run_form.html.j2",
-        datasets=list_datasets(store),
+        datasets=newest(count_datasets(store), partial(list_datasets, store)),
         chosen=dataset,
         suites=SUITES,
         catalogue=[(spec.id, spec.description) for spec in CATALOGUE.values()],
