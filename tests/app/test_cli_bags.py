@@ -90,7 +90,8 @@ def test_bags_touchbench_cannot_use_exit_2_and_store_nothing(
 ) -> None:
     short = session[:, :8820]
     no_audio = write_audio_bag(tmp_path / "quiet.mcap", short, RATE, topic=None)
-    mp3 = write_audio_bag(tmp_path / "mp3.bag", short, RATE, coding_format="mp3")
+    not_mp3 = write_audio_bag(tmp_path / "mp3.bag", short, RATE, coding_format="mp3")
+    flac = write_audio_bag(tmp_path / "flac.bag", short, RATE, coding_format="flac")
     no_info = write_audio_bag(tmp_path / "noinfo.db3", short, RATE, info_topic=None)
     good = write_audio_bag(tmp_path / "good.bag", session, RATE)
     truncated = tmp_path / "truncated.bag"
@@ -98,13 +99,29 @@ def test_bags_touchbench_cannot_use_exit_2_and_store_nothing(
     other = write_other_audio_bag(tmp_path / "other.mcap")
     cases = [
         ([str(no_audio)], "no audio topic"),
-        ([str(good), "--topic", "/mic"], "no topic '/mic'; audio topics: /audio/audio"),
-        ([str(good), "--topic", "/status"], "topic '/status' is std_msgs/msg/String"),
-        ([str(mp3)], "carries mp3-coded audio; touchbench reads raw PCM only"),
-        ([str(no_info)], "no AudioInfo topic"),
+        (
+            [str(good), "--topic", "/mic"],
+            "no topic '/mic'; its topics: /audio/audio (audio_common_msgs/msg/AudioData), ",
+        ),
+        (
+            [str(good), "--topic", "/status"],
+            "topic '/status' (std_msgs/msg/String) has no numeric field; its fields: data "
+            "(string)",
+        ),
+        ([str(not_mp3)], "'/audio/audio': cannot decode as MP3"),
+        ([str(flac)], "carries flac-coded audio; touchbench reads raw PCM (coding_format wave)"),
+        (
+            [str(no_info)],
+            "no AudioInfo topic and the audio of '/audio/audio' is not MP3, so its format is "
+            "unknown: give `samplerate`, `channels`, `sample_format` of the raw PCM",
+        ),
+        (
+            [str(no_info), "--samplerate", "44100", "--sample-format", "s16le"],
+            "format is unknown: give `channels` of the raw PCM",
+        ),
         ([str(truncated)], "truncated.bag: cannot read"),
         ([str(other)], "no audio topic"),
-        ([str(other), "--topic", "/audio"], "fields (float32_data, int32_data"),
+        ([str(other), "--topic", "/audio"], "at least two are needed for a sample rate"),
     ]
     for args, expected in cases:
         result = run_cli(capsys, store_url, "extract", *args)
