@@ -235,7 +235,7 @@ class RosbagSource(Source):
         self._set_pcm(found["samplerate"], found["channels"], found["sample_format"])
 
     def _without_info(self, given: dict[str, Any], first: bytes) -> None:
-        if given["sample_format"] is None and looks_like_mp3(first):
+        if looks_like_mp3(first):
             self._open_mp3(given)
             self.notes.append(
                 f"no AudioInfo topic; '{self._connection.topic}' read as MP3 "
@@ -258,7 +258,7 @@ class RosbagSource(Source):
         if given["sample_format"] is not None:
             raise DriverError(
                 f"{self.name}: '{self._connection.topic}' holds MP3 audio, not raw PCM of "
-                f"sample format {given['sample_format']}"
+                f"sample format {given['sample_format']}: leave `sample_format` out"
             )
         self._mp3 = Mp3Decoder(self._chunks, name=f"{self.name} '{self._connection.topic}'")
         found = {"samplerate": self._mp3.samplerate, "channels": self._mp3.n_channels}

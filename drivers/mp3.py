@@ -94,7 +94,8 @@ class ChunkStream:
         return data
 
     def _trim(self) -> None:
-        excess = self._position - self._window - self._buffer_start
+        # Never more than the buffer holds: after a seek forward, it may all be behind.
+        excess = min(self._position - self._window - self._buffer_start, len(self._buffer))
         if excess > 0:
             del self._buffer[:excess]
             self._buffer_start += excess
@@ -110,6 +111,18 @@ class ChunkStream:
 
     def tell(self) -> int:
         return 0 if self._at_end else self._position
+
+
+class _ForwardFile(soundfile.SoundFile):
+    """A sound file read forwards only.
+
+    soundfile seeks to where it expects to be after every read from a seekable file; in
+    variable-bitrate MP3 mpg123's seek is approximate, and that seek skipped or repeated
+    audio (errors of 0.5 full scale in our tests).  A stream is read once, front to back.
+    """
+
+    def seekable(self) -> bool:
+        return False
 
 
 class Mp3Decoder:
@@ -137,7 +150,7 @@ class Mp3Decoder:
         self.name = name
         self.stream = ChunkStream(open_chunks)
         try:
-            self._file = soundfile.SoundFile(self.stream)
+            self._file = _ForwardFile(self.stream)
         except (soundfile.LibsndfileError, RuntimeError, TypeError) as error:
             raise DriverError(f"{name}: cannot decode as MP3: {error}") from None
         if self._file.format != "MP3":
@@ -149,7 +162,7 @@ class Mp3Decoder:
     def blocks(self, length: int = 65536) -> Iterator[np.ndarray]:
         """Decoded samples, shape (n_channels, <= length) each, float64, full scale."""
         try:
-            for chunk in self._file.blocks(length, dtype="float64", always_2d=True):
+            while (chunk := self._file.read(length, dtype="float64", always_2d=True)).size:
                 yield np.ascontiguousarray(chunk.T)
         except (soundfile.LibsndfileError, RuntimeError) as error:
             raise DriverError(f"{self.name}: cannot decode the MP3 audio: {error}") from None

@@ -26,7 +26,7 @@ def extract_command(
         list[Path],
         typer.Argument(
             metavar="RECORDING...",
-            help="WAV/FLAC/MP3, CSV time series, .npy files or ROS bags (.bag, .mcap, .db3).",
+            help="WAV/FLAC, CSV time series, .npy files or ROS bags (.bag, .mcap, .db3).",
         ),
     ],
     labels: Annotated[
