@@ -310,7 +310,7 @@ class BagFieldsSource(Source):
             if values.size != self.n_channels:
                 raise DriverError(
                     f"{self.name}: message {number} on '{self._connection.topic}' has "
-                    f"{values.size} values, the first one {self.n_channels}: the fields' "
+                    f"{values.size} values, the first {self.n_channels}: the fields' "
                     "arrays must keep their length"
                 )
             times.append(float(self._times[kept]))

@@ -134,10 +134,12 @@ def jitter_note(times: np.ndarray, rate: float, *, what: str) -> str | None:
     steps = np.diff(times)
     median = float(np.median(steps))
     low, high = float(steps.min()), float(steps.max())
-    if high - low <= EVEN * median and abs(median * rate - 1.0) <= EVEN:
-        return None
+    grid = f"resampled onto an even {rate:.4g} Hz grid by linear interpolation"
+    if high - low <= EVEN * median:
+        if abs(median * rate - 1.0) <= EVEN:
+            return None
+        return f"{what} are even ({1 / median:.4g} Hz); {grid}"
     return (
         f"{what} are uneven (steps {low * 1e3:.3g} to {high * 1e3:.3g} ms, median "
-        f"{median * 1e3:.3g} ms, {1 / median:.4g} Hz); resampled onto an even {rate:.4g} Hz "
-        "grid by linear interpolation"
+        f"{median * 1e3:.3g} ms, {1 / median:.4g} Hz); {grid}"
     )
