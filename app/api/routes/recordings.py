@@ -35,6 +35,15 @@ def upload_session(
     samplerate: Annotated[float | None, Form()] = None,
     segment: Annotated[float | None, Form()] = None,
     topic: Annotated[str | None, Form()] = None,
+    fields: Annotated[
+        list[str] | None, Form(description="Numeric fields of `topic` read as channels.")
+    ] = None,
+    channels: Annotated[
+        int | None, Form(description="Channels of raw PCM in bags without AudioInfo.")
+    ] = None,
+    sample_format: Annotated[
+        str | None, Form(description="S16LE, S32LE or F32LE: raw PCM in bags without AudioInfo.")
+    ] = None,
 ) -> JobCreated:
     """Save the session and queue its extraction (answer: the job's id, status 202).
 
@@ -49,6 +58,9 @@ def upload_session(
         "samplerate": samplerate,
         "segment": segment,
         "topic": topic,
+        "fields": fields,
+        "channels": channels,
+        "sample_format": sample_format,
     }
     # Checked before a byte is saved (the files' names stand for them), so that a refused
     # request leaves nothing on the disk.
