@@ -172,6 +172,8 @@ class RosbagSource(Source):
         self.name = name
         self.notes: list[str] = []
         self._mp3: Mp3Decoder | None = None
+        self.coding = "wave"
+        self.sample_format: str | None = None
         self._stamped = audio_kind(reader, connection.msgtype) == "stamped"
         try:
             first = next(raw_messages(reader, connection, name=name), None)
@@ -222,17 +224,15 @@ class RosbagSource(Source):
                 f"{info.coding_format or '?'}-coded audio; touchbench reads raw PCM "
                 "(coding_format wave) and MP3"
             )
-        found = {
-            "samplerate": float(info.sample_rate),
-            "channels": int(info.channels),
-            "sample_format": str(info.sample_format).strip().upper(),
-        }
-        if found["channels"] < 1 or found["samplerate"] <= 0:
+        rate, count = float(info.sample_rate), int(info.channels)
+        sample_format = str(info.sample_format).strip().upper()
+        if count < 1 or rate <= 0:
             raise DriverError(
                 f"{self.name}: AudioInfo gives {info.channels} channels at {info.sample_rate} Hz"
             )
+        found = {"samplerate": rate, "channels": count, "sample_format": sample_format}
         self._agree(found, given, "its AudioInfo")
-        self._set_pcm(found["samplerate"], found["channels"], found["sample_format"])
+        self._set_pcm(rate, count, sample_format)
 
     def _without_info(self, given: dict[str, Any], first: bytes) -> None:
         if looks_like_mp3(first):

@@ -37,6 +37,18 @@ def _biotac(times: np.ndarray) -> list[dict]:
     ]
 
 
+def _biotac_bag(path: Path, messages: list[dict], received: np.ndarray) -> Path:
+    """A bag of BioTac-like ``messages`` on ``/biotac``, received at ``received``."""
+    return write_fields_bag(
+        path,
+        msgtype=BIOTAC_TYPE,
+        definition=BIOTAC_MSG,
+        messages=messages,
+        received=received,
+        topic="/biotac",
+    )
+
+
 def _read(bag: Path, **options: object) -> tuple[FileReplaySource, np.ndarray, np.ndarray]:
     """The source, its samples and each sample's time."""
     with FileReplaySource(bag, **options) as source:  # type: ignore[arg-type]
@@ -54,14 +66,7 @@ def test_a_custom_message_is_read_at_its_header_stamps_on_an_even_grid(
 ) -> None:
     stamps = _jittered(1)
     received = stamps + 0.004  # the bag receives each message 4 ms after its stamp
-    bag = write_fields_bag(
-        tmp_path / f"finger{suffix}",
-        msgtype=BIOTAC_TYPE,
-        definition=BIOTAC_MSG,
-        messages=_biotac(stamps),
-        received=received,
-        topic="/biotac",
-    )
+    bag = _biotac_bag(tmp_path / f"finger{suffix}", _biotac(stamps), received)
     source, samples, times = _read(bag, topic="/biotac", fields=["pdc", "pac"])
     inner = source._inner
     assert inner is not None
@@ -82,14 +87,7 @@ def test_a_custom_message_is_read_at_its_header_stamps_on_an_even_grid(
 
 def test_default_fields_and_a_given_rate(tmp_path: Path) -> None:
     stamps = _jittered(2)
-    bag = write_fields_bag(
-        tmp_path / "finger.bag",
-        msgtype=BIOTAC_TYPE,
-        definition=BIOTAC_MSG,
-        messages=_biotac(stamps),
-        received=stamps,
-        topic="/biotac",
-    )
+    bag = _biotac_bag(tmp_path / "finger.bag", _biotac(stamps), stamps)
     source, samples, times = _read(bag, topic="/biotac", samplerate=50)
     names = source._inner.channel_names  # type: ignore[union-attr]
     assert names[:3] == ["pdc", "tdc", "pac[0]"] and names[-1] == "electrodes[18]"
@@ -126,14 +124,7 @@ def test_even_stamps_unset_headers_and_stamps_that_go_back(tmp_path: Path) -> No
     messages = _biotac(received)
     for message in messages:
         message["stamp"] = 0  # a driver that leaves its header unset
-    bag = write_fields_bag(
-        tmp_path / "unset.bag",
-        msgtype=BIOTAC_TYPE,
-        definition=BIOTAC_MSG,
-        messages=messages,
-        received=received,
-        topic="/biotac",
-    )
+    bag = _biotac_bag(tmp_path / "unset.bag", messages, received)
     source, samples, _ = _read(bag, topic="/biotac", fields=["tdc"])
     assert source.samplerate == pytest.approx(100)
     assert samples.shape == (1, 200)
@@ -143,14 +134,7 @@ def test_even_stamps_unset_headers_and_stamps_that_go_back(tmp_path: Path) -> No
 
     stamps = 0.5 + np.arange(200) / 100
     stamps[[50, 120]] = stamps[[49, 100]]  # a repeated stamp, and one that goes back
-    bag = write_fields_bag(
-        tmp_path / "back.bag",
-        msgtype=BIOTAC_TYPE,
-        definition=BIOTAC_MSG,
-        messages=_biotac(stamps),
-        received=0.5 + np.arange(200) / 100,
-        topic="/biotac",
-    )
+    bag = _biotac_bag(tmp_path / "back.bag", _biotac(stamps), 0.5 + np.arange(200) / 100)
     source, samples, _ = _read(bag, topic="/biotac", fields=["tdc"], samplerate=100)
     assert "2 message(s) of '/biotac' whose stamp did not rise past the one before" in " ".join(
         source.notes
@@ -160,14 +144,7 @@ def test_even_stamps_unset_headers_and_stamps_that_go_back(tmp_path: Path) -> No
 
 def test_fields_touchbench_cannot_read_are_refused_in_one_line(tmp_path: Path) -> None:
     stamps = _jittered(5, 50)
-    bag = write_fields_bag(
-        tmp_path / "finger.bag",
-        msgtype=BIOTAC_TYPE,
-        definition=BIOTAC_MSG,
-        messages=_biotac(stamps),
-        received=stamps,
-        topic="/biotac",
-    )
+    bag = _biotac_bag(tmp_path / "finger.bag", _biotac(stamps), stamps)
     cases = [
         ({"topic": "/tactile"}, "no topic '/tactile'; its topics: /biotac ("),
         ({"topic": "/biotac", "fields": ["pressure"]}, "has no field 'pressure' (in 'pressure')"),

@@ -51,7 +51,7 @@ def upload_session(
     exists: the extractor, event detection and bounds before anything is saved, the data
     set's name before the job is queued (the saved files are then removed).
     """
-    fields = {
+    values = {
         "extractor": extractor,
         "events": events,
         "name": name,
@@ -67,14 +67,14 @@ def upload_session(
     form_request(
         ExtractRequest,
         recordings=[r.filename or "recording" for r in recordings],
-        **fields,
+        **values,
     )
     folder = service.settings.work_dir / "uploads" / uuid.uuid4().hex
     try:
         names = [save_upload(r, folder, f"recording-{i}").name for i, r in enumerate(recordings)]
         labels_name = save_upload(labels, folder, "labels.csv").name if labels else None
         request = form_request(
-            ExtractRequest, recordings=names, labels=labels_name, folder=folder, **fields
+            ExtractRequest, recordings=names, labels=labels_name, folder=folder, **values
         )
         job = submit_extraction(service.store, request)
     except BaseException:
