@@ -19,6 +19,7 @@ message) and one block of messages.
 from __future__ import annotations
 
 import re
+from array import array
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -214,6 +215,7 @@ class BagFieldsSource(Source):
             ]
             self.n_channels = len(self.channel_names)
             self.samplerate = float(samplerate) if samplerate else median_rate(times)
+            self.resampled = not samplerate
             self.start_time = float(times[0])
             self._times = times
             note = jitter_note(times, self.samplerate, what=f"stamps of '{connection.topic}'")
@@ -222,12 +224,16 @@ class BagFieldsSource(Source):
             self.close()
             raise
 
-    def _messages(self) -> Iterator[tuple[int, int, Any]]:
-        """``(number from 1, receive time ns, message)`` of the topic, in order."""
+    def _messages(self, *, wanted: bool = True) -> Iterator[tuple[int, int, Any]]:
+        """``(number from 1, receive time ns, message)`` of the topic, in order; the
+        message is None when not ``wanted`` (only the receive times are read then)."""
         connection = self._connection
         for number, (stamp, raw) in enumerate(
             raw_messages(self._reader, connection, name=self.name), 1
         ):
+            if not wanted and number > 1:
+                yield number, stamp, None
+                continue
             try:
                 message = self._reader.deserialize(raw, connection.msgtype)
             except Exception as error:
@@ -240,10 +246,10 @@ class BagFieldsSource(Source):
     def _stamps(self) -> tuple[np.ndarray, np.ndarray, Any]:
         """Pass one: seconds from the bag's start of the kept messages, which messages are
         kept, and the first message."""
-        received: list[int] = []
-        stamped: list[int] = []
+        # 8 bytes a message (a list of ints takes several times that).
+        received, stamped = array("q"), array("q")
         first: Any = None
-        for _, stamp, message in self._messages():
+        for _, stamp, message in self._messages(wanted=self._header):
             received.append(stamp)
             if self._header:
                 header_stamp = message.header.stamp
@@ -254,9 +260,9 @@ class BagFieldsSource(Source):
         topic = self._connection.topic
         if first is None:
             raise DriverError(f"{self.name}: topic '{topic}' has no messages")
-        stamps = np.asarray(received, dtype=np.int64)
+        stamps = np.frombuffer(received, dtype=np.int64)
         if self._header and min(stamped) > 0:
-            stamps = np.asarray(stamped, dtype=np.int64)
+            stamps = np.frombuffer(stamped, dtype=np.int64)
         elif self._header:
             self.notes.append(
                 f"'{topic}' read at the times the bag received it: its header stamps are not set"

@@ -104,7 +104,7 @@ class FileReplaySource(Source):
             self._inner, self._start = bag, float(getattr(bag, "start_time", 0.0))
             rate: float | None = bag.samplerate
             self.n_channels = bag.n_channels
-            self.notes = bag.notes
+            self.notes, self.resampled = bag.notes, bag.resampled
         elif self.path.is_dir():
             raise DriverError(f"{path}: is a folder, not a recording (nor a ROS 2 bag)")
         elif self.path.suffix.lower() in CSV_SUFFIXES:

@@ -64,6 +64,9 @@ class Source(ABC):
     notes : sequence of str
         What the user should know about how the signal was read (stamps resampled, a
         format guessed), one line each; filled when the source opens.
+    resampled : bool
+        True when the source chose ``samplerate`` itself for samples it put on an even
+        grid (the median rate of uneven stamps); given a rate, it would use that one.
     """
 
     name: str
@@ -71,6 +74,7 @@ class Source(ABC):
     n_channels: int
     overflows: int = 0
     notes: Sequence[str] = ()
+    resampled: bool = False
 
     @abstractmethod
     def blocks(self) -> Iterator[Block]:

@@ -170,10 +170,11 @@ def extract_dataset(
     meta: list[dict[str, Any]] = []
     warnings: list[str] = []
     shape: tuple[float, int] | None = None
+    grid = samplerate
     for path in paths:
         with FileReplaySource(
             path,
-            samplerate=samplerate,
+            samplerate=grid,
             topic=topic,
             fields=fields,
             channels=channels,
@@ -183,6 +184,9 @@ def extract_dataset(
             instances = _extract_one(recipe, source, path, on_progress)
             origin, rate = source.start_time, source.samplerate
             notes = list(source.notes)
+            if grid is None and source.resampled:
+                # Stamped recordings go on the first one's grid: one data set, one rate.
+                grid = source.samplerate
         warnings += [f"{path.name}: {text}" for text in [*notes, *instances.warnings]]
         features.append(instances.values)
         for (first, last), details in zip(instances.spans, instances.meta, strict=True):

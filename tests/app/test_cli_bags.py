@@ -250,8 +250,6 @@ def test_extract_reads_numeric_fields_of_tactile_topics(
         "pdc,electrodes",
         "--fields",
         "tdc",
-        "--samplerate",
-        "100",
         "-e",
         "window",
         "--events",
@@ -264,6 +262,9 @@ def test_extract_reads_numeric_fields_of_tactile_topics(
     assert summary["events_labelled"] == 2
     jitter = [w for w in summary["warnings"] if "stamps of '/biotac' are uneven" in w]
     assert [w.split(":")[0] for w in jitter] == ["press.bag", "slide.bag"]
+    # Each bag's stamps have their own median rate; the second goes on the first's grid.
+    grids = {w.split("resampled onto an even ")[1] for w in jitter}
+    assert len(grids) == 1, jitter
 
     taxels = write_fields_bag(
         tmp_path / "skin.mcap",

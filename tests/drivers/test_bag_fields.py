@@ -72,7 +72,7 @@ def test_a_custom_message_is_read_at_its_header_stamps_on_an_even_grid(
     assert inner is not None
     assert inner.channel_names == ["pdc", *(f"pac[{i}]" for i in range(22))]  # type: ignore[attr-defined]
     steps = np.diff(stamps)
-    assert source.samplerate == pytest.approx(1 / np.median(steps))
+    assert source.samplerate == pytest.approx(1 / np.median(steps)) and source.resampled
     assert source.start_time == pytest.approx(stamps[0], abs=1e-9)
     assert times[0] == pytest.approx(stamps[0], abs=1e-9)
     assert times[-1] <= stamps[-1] < times[-1] + 1 / source.samplerate
@@ -92,7 +92,7 @@ def test_default_fields_and_a_given_rate(tmp_path: Path) -> None:
     names = source._inner.channel_names  # type: ignore[union-attr]
     assert names[:3] == ["pdc", "tdc", "pac[0]"] and names[-1] == "electrodes[18]"
     assert samples.shape[0] == 1 + 1 + 22 + 19
-    assert source.samplerate == 50.0
+    assert source.samplerate == 50.0 and not source.resampled
     assert np.allclose(np.diff(times), 1 / 50)
     assert np.all(samples[1] == 7) and np.all(samples[-1] == 3)
 
