@@ -4,10 +4,12 @@ std_msgs/Float32MultiArray taxels, stamps that jitter; and the fields that must 
 from __future__ import annotations
 
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
+from drivers.bag_reader import topic_listing
 from drivers.errors import DriverError
 from drivers.replay import FileReplaySource
 from tests.drivers.bagfiles import BIOTAC_MSG, BIOTAC_TYPE, float_array, write_fields_bag
@@ -174,3 +176,13 @@ def test_fields_touchbench_cannot_read_are_refused_in_one_line(tmp_path: Path) -
     )
     with pytest.raises(DriverError, match="message 11 on '/tactile' has 12 values, the first 16"):
         _read(bag, topic="/tactile")
+
+
+def test_a_bag_of_many_topics_is_listed_in_a_few() -> None:
+    connections = [
+        SimpleNamespace(topic=f"/sensor{i}", msgtype="std_msgs/msg/Float32") for i in range(9)
+    ]
+    listing = topic_listing(connections)
+    assert listing.startswith("/sensor0 (std_msgs/msg/Float32), /sensor1 (")
+    assert listing.endswith("/sensor5 (std_msgs/msg/Float32) and 3 more")
+    assert topic_listing([]) == "none"
