@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import time
 from abc import ABC, abstractmethod
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from types import TracebackType
 from typing import Self
@@ -61,12 +61,20 @@ class Source(ABC):
     overflows : int
         Blocks a live source had to drop because the consumer fell behind (always 0 for
         files).
+    notes : sequence of str
+        What the user should know about how the signal was read (stamps resampled, a
+        format guessed), one line each; filled when the source opens.
+    resampled : bool
+        True when the source chose ``samplerate`` itself for samples it put on an even
+        grid (the median rate of uneven stamps); given a rate, it would use that one.
     """
 
     name: str
     samplerate: float
     n_channels: int
     overflows: int = 0
+    notes: Sequence[str] = ()
+    resampled: bool = False
 
     @abstractmethod
     def blocks(self) -> Iterator[Block]:

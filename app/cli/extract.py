@@ -24,7 +24,10 @@ def extract_command(
     ctx: typer.Context,
     recordings: Annotated[
         list[Path],
-        typer.Argument(metavar="RECORDING...", help="WAV/FLAC, CSV time series or .npy files."),
+        typer.Argument(
+            metavar="RECORDING...",
+            help="WAV/FLAC, CSV time series, .npy files or ROS bags (.bag, .mcap, .db3).",
+        ),
     ],
     labels: Annotated[
         Path | None,
@@ -49,7 +52,10 @@ def extract_command(
     samplerate: Annotated[
         float | None,
         typer.Option(
-            "--samplerate", help="Sample rate (Hz) of CSV/.npy files without a time column."
+            "--samplerate",
+            help="Sample rate (Hz) of CSV/.npy files without a time column and of raw PCM in "
+            "bags without AudioInfo; for --fields, the even grid's rate (default: the "
+            "stamps' median rate).",
         ),
     ] = None,
     segment: Annotated[
@@ -58,7 +64,35 @@ def extract_command(
     ] = None,
     topic: Annotated[
         str | None,
-        typer.Option("--topic", metavar="TOPIC", help="Audio topic of ROS bags (if several)."),
+        typer.Option(
+            "--topic",
+            metavar="TOPIC",
+            help="Topic of ROS bags: an audio topic (if several), or any topic to read its "
+            "numeric fields as channels.",
+        ),
+    ] = None,
+    fields: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--fields",
+            metavar="A,B,...",
+            help="Numeric fields of --topic as channels, e.g. pdc,pac,electrodes or "
+            "wrench.force (arrays give pac[0], pac[1], ...; default: its numeric fields).",
+        ),
+    ] = None,
+    channels: Annotated[
+        int | None,
+        typer.Option(
+            "--channels", metavar="N", help="Channels of raw PCM audio in bags without AudioInfo."
+        ),
+    ] = None,
+    sample_format: Annotated[
+        str | None,
+        typer.Option(
+            "--sample-format",
+            metavar="FORMAT",
+            help="S16LE, S32LE or F32LE: raw PCM audio in bags without AudioInfo.",
+        ),
     ] = None,
     option: Annotated[
         list[str] | None,
@@ -78,7 +112,8 @@ def extract_command(
     """Detect touch events in recordings, extract features, and store them as a data set.
 
     Recordings are read block by block (memory follows the longest event, not the
-    recording); ROS bags (.bag, .mcap, .db3) are read for their audio_common audio.
+    recording); ROS bags (.bag, .mcap, .db3) are read for their audio_common audio (raw PCM
+    or MP3), or for the numeric fields of a --topic, put on an even grid.
     """
     from app.cli.requests import build_request
     from app.schemas.extraction import ExtractRequest
@@ -96,6 +131,9 @@ def extract_command(
         segment=segment,
         options=key_values(option or [], "--option"),
         topic=topic,
+        fields=_comma_list(fields),
+        channels=channels,
+        sample_format=sample_format,
         max_event=max_event,
     )
     with _Reading() as reading:
@@ -123,6 +161,13 @@ def extract_command(
             )
         ],
     )
+
+
+def _comma_list(values: list[str] | None) -> list[str] | None:
+    """``["a,b", "c"]`` (the option given once or more) as ``["a", "b", "c"]``."""
+    if not values:
+        return None
+    return [part.strip() for value in values for part in value.split(",") if part.strip()]
 
 
 def key_values(pairs: list[str], option: str, what: str = "KEY=VALUE") -> dict[str, str]:

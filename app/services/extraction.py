@@ -111,6 +111,9 @@ def extract_dataset(
     segment: float | None = None,
     options: Mapping[str, Any] | None = None,
     topic: str | None = None,
+    fields: Sequence[str] | None = None,
+    channels: int | None = None,
+    sample_format: str | None = None,
     max_event: float | None = None,
     on_progress: Callable[[str, float], None] | None = None,
 ) -> ExtractionResult:
@@ -136,7 +139,12 @@ def extract_dataset(
     options : mapping, optional
         Options of the extractor and of the event detector, in one flat mapping.
     topic : str, optional
-        The audio topic of ROS bags.
+        The topic of ROS bags to read: audio, or numeric fields.
+    fields : sequence of str, optional
+        Numeric fields of ``topic`` to read as channels.
+    channels, sample_format : optional
+        Raw PCM audio in bags without ``AudioInfo``: channels per frame and
+        ``S16LE``/``S32LE``/``F32LE``.
     max_event : float, optional
         Longest event in seconds (default 60); longer ones are cut, with a warning.
     on_progress : callable, optional
@@ -163,12 +171,24 @@ def extract_dataset(
     meta: list[dict[str, Any]] = []
     warnings: list[str] = []
     shape: tuple[float, int] | None = None
+    grid = samplerate
     for path in paths:
-        with FileReplaySource(path, samplerate=samplerate, topic=topic) as source:
+        with FileReplaySource(
+            path,
+            samplerate=grid,
+            topic=topic,
+            fields=fields,
+            channels=channels,
+            sample_format=sample_format,
+        ) as source:
             shape = _same_shape(shape, (source.samplerate, source.n_channels), path)
             instances = _extract_one(recipe, source, path, on_progress)
             origin, rate = source.start_time, source.samplerate
-        warnings += [f"{path.name}: {text}" for text in instances.warnings]
+            notes = list(source.notes)
+            if grid is None and source.resampled:
+                # Stamped recordings go on the first one's grid: one data set, one rate.
+                grid = source.samplerate
+        warnings += [f"{path.name}: {text}" for text in [*notes, *instances.warnings]]
         features.append(instances.values)
         for (first, last), details in zip(instances.spans, instances.meta, strict=True):
             start, end = origin + first / rate, origin + last / rate
@@ -280,6 +300,9 @@ def extract_and_store(
         segment=request.segment,
         options=request.options,
         topic=request.topic,
+        fields=request.fields,
+        channels=request.channels,
+        sample_format=request.sample_format,
         max_event=request.max_event,
         on_progress=on_progress,
     )

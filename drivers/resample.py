@@ -1,0 +1,145 @@
+"""Samples at uneven times onto an even grid: what ROS stamps and logged time columns need.
+
+Real stamps jitter (a 100 Hz sensor's messages arrive 3 to 17 ms apart), while every
+extractor assumes one sample every ``1 / rate`` seconds.  :func:`resample_even` puts
+samples taken at rising ``times`` onto the grid ``times[0] + k / rate`` by linear
+interpolation between the two samples around each grid time;
+:class:`EvenResampler` does the same block by block, for sources read as a stream, and
+gives the same values.  :func:`median_rate` and :func:`jitter_note` say what the stamps
+were, for a note to the user.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from drivers.errors import DriverError
+
+#: Steps within this fraction of the median step count as even (no note).
+EVEN = 0.01
+
+
+def median_rate(times: np.ndarray) -> float:
+    """Samples per second from the median step of rising ``times`` (seconds).
+
+    Raises
+    ------
+    DriverError
+        Fewer than two times, or a median step that is not positive.
+    """
+    if times.size < 2:
+        raise DriverError(f"{times.size} time stamp(s) give no rate; at least two are needed")
+    step = float(np.median(np.diff(times)))
+    if not step > 0:
+        raise DriverError("the time stamps do not rise (their median step is not positive)")
+    return 1.0 / step
+
+
+def resample_even(times: np.ndarray, values: np.ndarray, rate: float) -> np.ndarray:
+    """``values`` sampled at ``times`` onto an even grid starting at ``times[0]``.
+
+    Parameters
+    ----------
+    times : ndarray of shape (n,)
+        Seconds, strictly rising.
+    values : ndarray of shape (n_channels, n)
+        Samples of every channel at ``times``.
+    rate : float
+        Samples per second of the grid.
+
+    Returns
+    -------
+    ndarray of shape (n_channels, m), float64
+        Linear interpolation at ``times[0] + k / rate`` for ``k = 0 .. m - 1``, where
+        the last grid time is the last one not after ``times[-1]``.
+
+    Raises
+    ------
+    DriverError
+        Times that do not rise, or shapes that disagree.
+    """
+    if times.size == 0:
+        return np.zeros((values.shape[0], 0))
+    return EvenResampler(float(times[0]), rate).feed(times, values)
+
+
+class EvenResampler:
+    """:func:`resample_even` fed in consecutive pieces, with the same result.
+
+    Parameters
+    ----------
+    start : float
+        The grid's first time (the first sample's time).
+    rate : float
+        Samples per second of the grid.
+    """
+
+    def __init__(self, start: float, rate: float) -> None:
+        if not rate > 0:
+            raise DriverError(f"the resampling rate must be positive, got {rate!r}")
+        self.start = start
+        self.rate = rate
+        self.produced = 0  # grid points given so far
+        self._last_time: float | None = None
+        self._last_values: np.ndarray | None = None
+
+    def feed(self, times: np.ndarray, values: np.ndarray) -> np.ndarray:
+        """The grid points up to ``times[-1]`` not given yet.
+
+        Parameters
+        ----------
+        times : ndarray of shape (n,)
+            Seconds, strictly rising, after the times fed before.
+        values : ndarray of shape (n_channels, n)
+
+        Returns
+        -------
+        ndarray of shape (n_channels, k), float64
+        """
+        times = np.asarray(times, dtype=np.float64)
+        values = np.asarray(values, dtype=np.float64)
+        if values.ndim != 2 or values.shape[1] != times.size:
+            raise DriverError(f"{values.shape} values do not match {times.size} time stamps")
+        if times.size == 0:
+            return np.zeros((values.shape[0], 0))
+        if self._last_time is not None and self._last_values is not None:
+            times = np.concatenate([[self._last_time], times])
+            values = np.concatenate([self._last_values, values], axis=1)
+        if np.any(np.diff(times) <= 0):
+            raise DriverError("the time stamps must rise strictly to be resampled")
+        self._last_time, self._last_values = float(times[-1]), values[:, -1:].copy()
+        end = int(np.floor((times[-1] - self.start) * self.rate + 1e-9)) + 1
+        grid = self.start + np.arange(self.produced, end) / self.rate
+        self.produced = max(self.produced, end)
+        out = np.empty((values.shape[0], grid.size))
+        for channel in range(values.shape[0]):  # np.interp is one-dimensional
+            out[channel] = np.interp(grid, times, values[channel])
+        return out
+
+
+def jitter_note(times: np.ndarray, rate: float, *, what: str) -> str | None:
+    """One line on uneven ``times`` and the grid they were put on; None when even.
+
+    Parameters
+    ----------
+    times : ndarray of shape (n,)
+        Seconds, rising.
+    rate : float
+        The grid's samples per second.
+    what : str
+        What the stamps are, e.g. ``"stamps of /biotac"``.
+    """
+    if times.size < 2:
+        return None
+    steps = np.diff(times)
+    median = float(np.median(steps))
+    low, high = float(steps.min()), float(steps.max())
+    grid = f"resampled onto an even {rate:.4g} Hz grid by linear interpolation"
+    if high - low <= EVEN * median:
+        if abs(median * rate - 1.0) <= EVEN:
+            return None
+        return f"{what} are even ({1 / median:.4g} Hz); {grid}"
+    return (
+        f"{what} are uneven (steps {low * 1e3:.3g} to {high * 1e3:.3g} ms, median "
+        f"{median * 1e3:.3g} ms, {1 / median:.4g} Hz); {grid}"
+    )
