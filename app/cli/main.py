@@ -258,8 +258,10 @@ def _failed(error: Exception) -> int:
         return EXIT_USAGE
     if os.environ.get("TOUCHBENCH_DEBUG"):
         traceback.print_exc()
+    # the first line only: a driver's error adds the statement and its parameters below it
+    message = next(iter(str(error).strip().splitlines()), "")
     print(
-        f"touchbench: unexpected error: {type(error).__name__}: {error} "
+        f"touchbench: unexpected error: {type(error).__name__}: {message} "
         "(set TOUCHBENCH_DEBUG=1 for the traceback)",
         file=sys.stderr,
     )
