@@ -110,7 +110,7 @@ def test_stateful_sequences_with_each_role_meet_no_server_error(keyed_server: Se
             answered = statuses
 
             def before_call(self, case: schemathesis.Case) -> None:
-                case.headers = {**(case.headers or {}), "X-API-Key": self.api_key}
+                case.headers["X-API-Key"] = self.api_key
 
             def validate_response(
                 self, response: Any, case: schemathesis.Case, **kwargs: Any
