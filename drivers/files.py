@@ -127,12 +127,15 @@ def open_npy(path: Path) -> np.ndarray:
 
 
 def _read_csv(path: Path, samplerate: float | None) -> tuple[np.ndarray, float | None]:
+    rows: list[tuple[int, list[str]]] = []
     try:
         with path.open(newline="", encoding="utf-8") as handle:
             dialect = csv.excel_tab if path.suffix.lower() == ".tsv" else csv.excel
-            rows = [(number, row) for number, row in enumerate(csv.reader(handle, dialect), 1)]
+            rows.extend(enumerate(csv.reader(handle, dialect), 1))
     except (OSError, UnicodeDecodeError) as error:
         raise DriverError(f"{path}: cannot read as text: {error}") from None
+    except csv.Error as error:  # a field over csv.field_size_limit(), a stray quote
+        raise DriverError(f"{path}:{len(rows) + 1}: cannot read as CSV ({error})") from None
     rows = [(number, row) for number, row in rows if any(cell.strip() for cell in row)]
     if not rows:
         raise DriverError(f"{path}: the recording has no samples")

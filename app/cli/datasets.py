@@ -23,6 +23,7 @@ from app.schemas.datasets import (
     AttributeDescription,
     DatasetDescription,
     ImportResult,
+    RenameRequest,
 )
 from app.services import datasets as service
 from app.services.datasets import ImportProgress
@@ -194,7 +195,10 @@ def rename_command(
     ],
 ) -> None:
     """Give a data set another name."""
-    renamed = service.rename_dataset(get_state(ctx).store, dataset, new_name)
+    from app.cli.requests import build_request
+
+    request = build_request(RenameRequest, {"name": "NEW"}, name=new_name)
+    renamed = service.rename_dataset(get_state(ctx).store, dataset, request)
     info(f"renamed dataset {renamed.id} '{renamed.previous_name}' to '{renamed.name}'")
 
 

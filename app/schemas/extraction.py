@@ -12,6 +12,7 @@ from pydantic import Field, field_validator, model_validator
 
 from app.errors import FieldError
 from app.schemas.base import Request, Schema
+from app.schemas.names import DatasetName
 
 if TYPE_CHECKING:
     from features.recipe import Recipe
@@ -56,7 +57,7 @@ class ExtractRequest(Request):
         max_length=100,
         description="Options of the extractor and of the event detector, in one mapping.",
     )
-    name: str | None = Field(default=None, max_length=200, description="Data set name.")
+    name: DatasetName | None = Field(default=None, description="Data set name.")
     samplerate: float | None = Field(
         default=None, gt=0, le=1e9, description="Sample rate (Hz) of files that carry none."
     )

@@ -34,6 +34,7 @@ from app.schemas.datasets import (
     FileFormat,
     ImportRequest,
     ImportResult,
+    RenameRequest,
     RenameResult,
 )
 from app.services.limits import check_dataset_size
@@ -474,9 +475,9 @@ def _umask() -> int:
 # ------------------------------------------------------------------------- rename, delete
 
 
-def rename_dataset(store: Store, ref: str | int, new_name: str) -> RenameResult:
-    """Give a data set another name (unique, see :func:`~app.store.naming.check_name`)."""
-    info, previous = stored.rename_dataset(store, ref, new_name)
+def rename_dataset(store: Store, ref: str | int, request: RenameRequest) -> RenameResult:
+    """Give a data set another name (unique, see :func:`~app.schemas.names.check_name`)."""
+    info, previous = stored.rename_dataset(store, ref, request.name)
     return RenameResult(id=info.id, name=info.name, previous_name=previous)
 
 
@@ -486,15 +487,20 @@ def delete_dataset(store: Store, ref: str | int) -> DatasetSummary:
     return summary(stored.delete_dataset(store, ref))
 
 
-def read_data_file(path: Path, file_format: FileFormat | None = None) -> Dataset:
+def read_data_file(
+    path: Path, file_format: FileFormat | None = None, *, source: str | None = None
+) -> Dataset:
     """An ARFF or CSV file read into memory (to predict it; nothing is stored).
+
+    ``source`` is what messages call the file: an upload's own name, not the service's
+    copy of it (``path`` by default).
 
     Raises
     ------
     DataFormatError
         No such regular file, or a file that is not valid ARFF/CSV (with its line).
     """
-    check_regular_file(path)
+    check_regular_file(path)  # an upload is always a regular file: its path is never shown
     if (file_format or guess_format(path)) == "csv":
-        return read_csv(path, targets=None)
-    return read_arff(path)
+        return read_csv(path, targets=None, source=source)
+    return read_arff(path, source=source)

@@ -41,6 +41,7 @@ from app.store.database import Store
 from app.store.datasets import add_dataset, check_dataset_name, dataset_digest
 from benchmark.dataset import Attribute, Dataset, Schema
 from benchmark.errors import DataFormatError
+from benchmark.io.csv import csv_problem
 from drivers.replay import FileReplaySource
 from features.errors import FeatureError
 from features.extractors import Instances
@@ -404,13 +405,16 @@ def read_labels(path: Path) -> LabelTable:
         twice, or overlapping intervals of one file; with the line number.
     """
     source = str(path)
+    lines: list[tuple[int, list[str]]] = []
     try:
         with Path(path).open(newline="", encoding="utf-8-sig") as handle:
-            lines = list(enumerate(csv.reader(handle), 1))
+            lines.extend(enumerate(csv.reader(handle), 1))
     except FileNotFoundError:
         raise DataFormatError("no such labels file", source=source) from None
     except (OSError, UnicodeDecodeError) as error:
         raise DataFormatError(f"cannot read the labels file: {error}", source=source) from None
+    except csv.Error as error:
+        raise DataFormatError(csv_problem(error), source=source, line=len(lines) + 1) from None
     lines = [(number, row) for number, row in lines if any(cell.strip() for cell in row)]
     if not lines:
         raise DataFormatError("the labels file is empty", source=source)

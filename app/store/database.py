@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import functools
 import re
 import sqlite3
 from collections.abc import Iterator
@@ -11,12 +12,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
 
 from sqlalchemy import Engine, create_engine, event, inspect, text
-from sqlalchemy.engine import make_url
+from sqlalchemy.engine import ExceptionContext, make_url
 from sqlalchemy.exc import ArgumentError, DatabaseError, OperationalError
 from sqlalchemy.sql.compiler import SQLCompiler
 from sqlalchemy.sql.elements import ClauseElement
 
-from app.errors import AppError
+from app.errors import AppError, ConflictError
 
 if TYPE_CHECKING:
     from sqlalchemy.orm import Session, sessionmaker
@@ -196,7 +197,30 @@ def _create_engine(url: str) -> Engine:
         raise AppError(f"cannot use the database URL '{display_url(url)}': {error}") from None
     if parsed.get_backend_name() == "sqlite":
         event.listen(engine, "connect", _sqlite_pragmas)
+    event.listen(engine, "handle_error", functools.partial(_refuse_read_only, url))
     return engine
+
+
+#: SQLite's result code for a write to a read-only database (the low byte of the extended
+#: codes, e.g. SQLITE_READONLY_DIRECTORY); PostgreSQL's SQLSTATE for a read-only transaction.
+_SQLITE_READONLY = 8
+_PG_READ_ONLY = "25006"
+
+
+def _refuse_read_only(url: str, context: ExceptionContext) -> None:
+    """A write to a read-only store (a file or mount without write access, a standby
+    server), as the one line of a :class:`~app.errors.ConflictError` instead of the
+    driver's error with the statement and its parameters."""
+    original = context.original_exception
+    sqlite_code = getattr(original, "sqlite_errorcode", None)
+    read_only = (isinstance(sqlite_code, int) and sqlite_code & 0xFF == _SQLITE_READONLY) or (
+        getattr(original, "sqlstate", None) == _PG_READ_ONLY
+    )
+    if read_only:
+        raise ConflictError(
+            f"the store at {display_url(url)} is read-only ({first_line(original)}); give "
+            "this process write access to it, or use another store"
+        ) from None
 
 
 def _check_sqlite_file(path: Path, url: str) -> None:

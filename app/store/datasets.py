@@ -23,9 +23,10 @@ from sqlalchemy.exc import IntegrityError, OperationalError
 from sqlalchemy.orm import Session
 
 from app.errors import AppError, ConflictError, FieldError
+from app.schemas.names import check_name
 from app.store.database import Store
 from app.store.listing import DatasetInfo
-from app.store.naming import check_name, default_name, find_row, free_name, shorten
+from app.store.naming import default_name, find_row, free_name, shorten
 from app.store.ownership import owner_alive
 from app.store.tables import DatasetRow, InstanceBlockRow, InstanceRow, RunRow
 from benchmark.dataset import Dataset, InstanceBlock, Schema, dataset_blocks

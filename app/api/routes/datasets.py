@@ -14,14 +14,15 @@ from fastapi import APIRouter, File, Form, Request, Response, UploadFile, status
 from fastapi.responses import StreamingResponse
 
 from app.api.deps import PageDep, ServiceDep, StoreDep, paginate
+from app.api.downloads import attachment
 from app.api.uploads import form_request, save_upload
-from app.schemas.base import Schema
 from app.schemas.datasets import (
     DatasetDescription,
     DatasetList,
     DatasetSummary,
     ImportRequest,
     ImportResult,
+    RenameRequest,
     RenameResult,
 )
 from app.services.datasets import (
@@ -36,10 +37,6 @@ from app.store.database import Store
 from app.store.listing import count_datasets
 
 router = APIRouter(prefix="/api/datasets", tags=["datasets"])
-
-
-class RenameRequest(Schema):
-    name: str
 
 
 @router.post(
@@ -107,13 +104,13 @@ def arff(dataset: str, store: StoreDep) -> StreamingResponse:
     return StreamingResponse(
         _arff_lines(store, dataset),
         media_type="text/plain; charset=utf-8",
-        headers={"Content-Disposition": f'attachment; filename="{summary.name}.arff"'},
+        headers={"Content-Disposition": attachment(f"{summary.name}.arff")},
     )
 
 
 @router.post("/{dataset}/rename", response_model=RenameResult)
 def rename(dataset: str, body: RenameRequest, store: StoreDep) -> RenameResult:
-    return rename_dataset(store, dataset, body.name)
+    return rename_dataset(store, dataset, body)
 
 
 @router.delete("/{dataset}", response_model=DatasetSummary)

@@ -7,9 +7,8 @@ from __future__ import annotations
 import functools
 import tempfile
 import time
-from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated
 
 from fastapi import APIRouter, File, Request, Response, UploadFile, status
 
@@ -71,21 +70,19 @@ async def predict_instances(model_ref: str, body: PredictRequest, service: Servi
     content = await service.models.run(
         model_ref,
         size,
-        functools.partial(_predict_records, service, model_ref, body.instances, size),
+        functools.partial(_predict_records, service, model_ref, body, size),
     )
     return Response(content, media_type="application/json")
 
 
-def _predict_records(
-    service: Service, model_ref: str, records: Sequence[Mapping[str, Any]], size: int
-) -> bytes:
+def _predict_records(service: Service, model_ref: str, body: PredictRequest, size: int) -> bytes:
     """The prediction report as JSON (written here once, not validated again against the
     response model it was built from); its CPU time is recorded for ``size``."""
     from app.services.models import records_report
 
     info, trained = service.models.get(service.store, model_ref)
     start = time.thread_time()
-    report = records_report(info, trained, records)
+    report = records_report(info, trained, body.instances, missing=body.missing)
     service.models.record(info.id, time.thread_time() - start, size)
     return report.model_dump_json().encode()
 
@@ -104,7 +101,7 @@ def predict_upload(
     info, trained = service.models.get(service.store, model_ref)
     with tempfile.TemporaryDirectory(dir=_work_dir(service)) as folder:
         path = save_upload(file, Path(folder), "upload.arff")
-        data = read_data_file(path)
+        data = read_data_file(path, source=path.name)  # the client's name, not our folder
         return predict(trained, data, source=path.name).report(info)
 
 
