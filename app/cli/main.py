@@ -66,6 +66,12 @@ COMMANDS = (
         "Show a run's leaderboard with WEKA's significance marks (v better, * worse).",
     ),
     Subcommand(
+        "import-results",
+        "app.cli.answers",
+        "Import a WEKA Experimenter results file (InstanceResultListener ARFF) as a finished "
+        "run, so that leaderboards and reports rank the paper's classifiers beside ours.",
+    ),
+    Subcommand(
         "cancel",
         "app.cli.bench",
         "Cancel a run: a queued run at once, a running one as soon as its process hears of it.",

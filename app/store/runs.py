@@ -134,6 +134,55 @@ def create_run(
         return _infos(session, [row])[0]
 
 
+def add_finished_run(
+    store: Store,
+    *,
+    dataset_id: int,
+    kind: str,
+    targets: Sequence[str],
+    classifiers: Sequence[str],
+    config: dict[str, Any],
+    results: Sequence[TaskResult],
+) -> RunInfo:
+    """A run that is ``done`` on arrival, stored with its results in one transaction (an
+    imported one: nothing executes it, and a failure stores nothing)."""
+    now = utcnow()
+    with store.session() as session:
+        row = RunRow(
+            dataset_id=dataset_id,
+            kind=kind,
+            targets=list(targets),
+            classifiers=list(classifiers),
+            config=config,
+            status="done",
+            started_at=now,
+            finished_at=now,
+        )
+        session.add(row)
+        session.flush()
+        if results:
+            session.execute(
+                insert(FoldResultRow),
+                [
+                    {
+                        "run_id": row.id,
+                        "classifier": r.key.classifier,
+                        "repeat": r.key.repeat,
+                        "fold": r.key.fold,
+                        "status": r.status,
+                        "error": r.error,
+                        "metrics": _stored_metrics(r),
+                        "confusion": r.confusion,
+                        "n_train": r.n_train,
+                        "n_test": r.n_test,
+                        "created_at": now,
+                    }
+                    for r in results
+                ],
+            )
+        return _infos(session, [row])[0]
+
+
 def get_run(store: Store, run_id: int | str) -> RunInfo:
     with store.session() as session:
         return _infos(session, [_row(session, run_id)])[0]
