@@ -19,7 +19,12 @@ from markupsafe import Markup
 from matplotlib.figure import Figure
 
 from app.reports import figures
-from app.reports.leaderboard import leaderboard_header, leaderboard_rows, metric_columns
+from app.reports.leaderboard import (
+    beside_notes,
+    leaderboard_header,
+    leaderboard_rows,
+    metric_columns,
+)
 from app.reports.plots import svg_text
 from app.reports.run_tables import run_tables
 from app.services.compare import Comparison
@@ -174,7 +179,7 @@ def _run(report: Report, view: RunView, plots: list[_Plot]) -> dict[str, Any]:
     run_plots.append(_plan(plots, "Instances per class", partial(figures.classes_figure, view)))
     confusions = []
     for row in board.rows[: report.confusions]:
-        if row.n_ok:
+        if row.n_ok and row.classifier in run.classifiers:  # imported results have none
             confusions.append(
                 _plan(
                     plots,
@@ -193,8 +198,9 @@ def _run(report: Report, view: RunView, plots: list[_Plot]) -> dict[str, Any]:
         "config": {key: config[key] for key in sorted(config)},
         "n_classifiers": len(run.classifiers),
         "tasks": f"{run.n_results} of {run.n_tasks}",
-        "header": leaderboard_header(board, columns),
-        "rows": leaderboard_rows(board, columns),
+        "header": leaderboard_header(board, columns, view.besides),
+        "rows": leaderboard_rows(board, columns, view.besides),
+        "beside_notes": beside_notes(view.besides),
         "metric": board.metric,
         "baseline": board.baseline,
         "alpha": board.alpha,
