@@ -1,19 +1,140 @@
 """Commands that answer questions after the leaderboard: the paper's published results
-imported beside ours (``import-results``)."""
+imported beside ours (``import-results``); where and how sure the classifiers are
+(``classes``: per-class scores, confusion matrices and calibration; ``calibration``: the
+expected calibration error and the reliability diagram)."""
 
 from __future__ import annotations
 
+# Imports inside functions: start-up time. Each command loads only what it uses (the
+# store, NumPy, matplotlib), when it is chosen.
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
 from app.cli.output import JsonOption, info, print_json, table
 from app.cli.state import get_state
 
+if TYPE_CHECKING:
+    from app.schemas.certainty import RunCertainty
+
 
 def register(app: typer.Typer) -> None:
     app.command("import-results")(import_results_command)
+    app.command("classes")(classes_command)
+    app.command("calibration")(calibration_command)
+
+
+RunArgument = Annotated[
+    int, typer.Argument(metavar="RUN", help="Run id (see `touchbench runs`).", min=1)
+]
+ClassifiersOption = Annotated[
+    str | None,
+    typer.Option(
+        "--classifier",
+        "-c",
+        metavar="ID[,ID...]",
+        help="These classifiers (default: every one with a successful fold, best first).",
+    ),
+]
+
+
+def classes_command(
+    ctx: typer.Context,
+    run: RunArgument,
+    classifier: ClassifiersOption = None,
+    as_json: JsonOption = False,
+) -> None:
+    """Show per-class precision, recall and F1, the confusion matrix (summed over folds)
+    and the expected calibration error of a run's classifiers, per target."""
+    certainty = _certainty(ctx, run, classifier)
+    if as_json:
+        print_json(certainty.to_json())
+        return
+    for entry in certainty.classifiers:
+        for target in entry.targets:
+            table(
+                f"{entry.classifier} on {target.target} ({entry.n_folds} folds)",
+                ["class", "precision", "recall", "F1", "support", *target.labels],
+                [
+                    (
+                        scores.label,
+                        _score(scores.precision),
+                        _score(scores.recall),
+                        _score(scores.f1),
+                        scores.support,
+                        *row,
+                    )
+                    for scores, row in zip(target.classes, target.confusion, strict=True)
+                ],
+            )
+        calibration = entry.calibration
+        if calibration is not None:
+            info(
+                f"{entry.classifier}: expected calibration error {_score(calibration.ece)} "
+                f"over {calibration.n_instances} out-of-fold predictions"
+            )
+        else:
+            info(f"{entry.classifier}: no calibration ({entry.calibration_note})")
+    info("rows: true class; the columns after support: predicted class (counts)")
+
+
+def calibration_command(
+    ctx: typer.Context,
+    run: RunArgument,
+    classifier: ClassifiersOption = None,
+    output: Annotated[
+        Path | None,
+        typer.Option(
+            "--output", "-o", metavar="FILE.svg|png", help="Draw the reliability diagram here."
+        ),
+    ] = None,
+    top: Annotated[
+        int, typer.Option("--top", min=1, help="Classifiers in the diagram (the best first).")
+    ] = 5,
+    as_json: JsonOption = False,
+) -> None:
+    """Show the expected calibration error of a run's classifiers from their out-of-fold
+    probabilities, and draw their reliability diagram."""
+    from app.reports.plots import figure_format, save_figure
+
+    if output is not None:
+        figure_format(output)
+    certainty = _certainty(ctx, run, classifier)
+    if output is not None:
+        from app.reports.figures import reliability_figure
+
+        save_figure(reliability_figure(certainty, top), output)
+    if as_json:
+        print_json(certainty.to_json())
+    else:
+        table(
+            f"run {certainty.run_id}: calibration of the top label, out of fold",
+            ["classifier", "ECE", "instances", "folds", "note"],
+            [
+                (
+                    e.classifier,
+                    _score(e.calibration.ece) if e.calibration else "-",
+                    e.calibration.n_instances if e.calibration else "-",
+                    e.calibration.n_folds if e.calibration else "-",
+                    e.calibration_note or "",
+                )
+                for e in certainty.classifiers
+            ],
+        )
+    if output is not None:
+        info(f"wrote {output}")
+
+
+def _certainty(ctx: typer.Context, run: int, classifiers: str | None) -> RunCertainty:
+    from app.services.certainty import run_certainty
+
+    names = [c.strip() for c in classifiers.split(",") if c.strip()] if classifiers else None
+    return run_certainty(get_state(ctx).store, run, classifiers=names)
+
+
+def _score(value: float | None) -> str:
+    return "-" if value is None else f"{value:.4f}"
 
 
 def import_results_command(
@@ -52,7 +173,6 @@ def import_results_command(
 ) -> None:
     """Import a WEKA Experimenter results file (InstanceResultListener ARFF) as a finished
     run, so that leaderboards and reports rank the paper's classifiers beside ours."""
-    # start-up time: the ARFF reader and the store load with the command that uses them
     from app.cli.requests import build_request
     from app.schemas.imported import ImportResultsRequest
     from app.services.imported import import_results

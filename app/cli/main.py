@@ -72,6 +72,18 @@ COMMANDS = (
         "run, so that leaderboards and reports rank the paper's classifiers beside ours.",
     ),
     Subcommand(
+        "classes",
+        "app.cli.answers",
+        "Show per-class precision, recall and F1, the confusion matrix (summed over folds) "
+        "and the expected calibration error of a run's classifiers, per target.",
+    ),
+    Subcommand(
+        "calibration",
+        "app.cli.answers",
+        "Show the expected calibration error of a run's classifiers from their out-of-fold "
+        "probabilities, and draw their reliability diagram.",
+    ),
+    Subcommand(
         "cancel",
         "app.cli.bench",
         "Cancel a run: a queued run at once, a running one as soon as its process hears of it.",

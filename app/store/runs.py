@@ -34,6 +34,8 @@ from benchmark.results import TaskKey, TaskResult
 PER_TARGET = "per_target"
 #: Key of a result's chosen parameters inside its stored metrics (absent before tuning).
 PARAMS = "params"
+#: Key of a fold's reliability bins inside its stored metrics (absent before they were kept).
+CALIBRATION = "calibration"
 
 
 @dataclass(frozen=True)
@@ -370,6 +372,7 @@ def load_results(store: Store, run_id: int) -> list[TaskResult]:
             metrics = dict(stored)
             per_target = metrics.pop(PER_TARGET, None)
             params = metrics.pop(PARAMS, None)
+            calibration = metrics.pop(CALIBRATION, None)
             results.append(
                 TaskResult(
                     key=TaskKey(classifier, repeat, fold),
@@ -381,6 +384,7 @@ def load_results(store: Store, run_id: int) -> list[TaskResult]:
                     n_test=n_test,
                     per_target=per_target,
                     params=params,
+                    calibration=calibration,
                 )
             )
         return results
@@ -393,6 +397,8 @@ def _stored_metrics(result: TaskResult) -> dict[str, Any]:
         stored[PER_TARGET] = result.per_target
     if result.params is not None:
         stored[PARAMS] = result.params
+    if result.calibration is not None:
+        stored[CALIBRATION] = result.calibration
     return stored
 
 

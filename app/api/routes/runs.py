@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import io
 
-# Imports inside functions: start-up time: the leaderboard's text formats and the results
+# Imports inside functions: start-up time: the leaderboard's text formats, the plots and the results
 # ARFF writer load when a format other than JSON is first asked for.
 import tempfile
 from pathlib import Path
@@ -15,8 +15,10 @@ from fastapi.responses import PlainTextResponse
 
 from app.api.deps import ServiceDep, StoreDep
 from app.api.uploads import form_request, save_upload
+from app.schemas.certainty import RunCertainty
 from app.schemas.imported import ImportResultsRequest
 from app.schemas.runs import BenchRequest, LeaderboardSchema, RunCreated, RunList, RunSchema
+from app.services.certainty import run_certainty
 from app.services.imported import import_results
 from app.services.runs import create_run, run_leaderboard
 from app.store.runs import get_run, list_runs, request_cancel, requeue_run
@@ -119,3 +121,43 @@ def leaderboard(
         write_results_arff(store, run, buffer)
         text = buffer.getvalue()
     return PlainTextResponse(text, media_type=LEADERBOARD_FORMATS[format])
+
+
+ClassifiersQuery = Annotated[
+    str | None,
+    Query(
+        max_length=2000,
+        description="Comma-separated classifier ids (default: every one, best first).",
+    ),
+]
+
+
+def _classifiers(text: str | None) -> list[str] | None:
+    return [c.strip() for c in text.split(",") if c.strip()] if text else None
+
+
+@router.get("/{run_id}/classes", response_model=RunCertainty)
+def classes(run_id: int, store: StoreDep, classifier: ClassifiersQuery = None) -> RunCertainty:
+    """Per-class precision, recall and F1, confusion matrices (summed over folds) per
+    target, and out-of-fold calibration of each classifier (``touchbench classes --json``)."""
+    return run_certainty(store, run_id, classifiers=_classifiers(classifier))
+
+
+@router.get(
+    "/{run_id}/calibration.svg",
+    response_class=PlainTextResponse,
+    responses={200: {"content": {"image/svg+xml": {}}}},
+)
+def calibration_svg(
+    run_id: int,
+    store: StoreDep,
+    classifier: ClassifiersQuery = None,
+    top: Annotated[int, Query(ge=1, le=50)] = 5,
+) -> PlainTextResponse:
+    """The reliability diagram of the run's best ``top`` classifiers with probabilities."""
+    from app.reports.figures import reliability_figure
+    from app.reports.plots import svg_text
+
+    certainty = run_certainty(store, run_id, classifiers=_classifiers(classifier))
+    svg = svg_text(reliability_figure(certainty, top))
+    return PlainTextResponse(svg, media_type="image/svg+xml")

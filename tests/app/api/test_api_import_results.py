@@ -73,3 +73,24 @@ def test_bad_result_uploads_are_4xx_and_store_nothing(
     assert server.client.get("/api/runs").json() == {"runs": []}
     beside = server.client.get("/api/runs/1/leaderboard", params={"beside": 1})
     assert beside.status_code == 404
+
+
+def test_classes_and_calibration_answer_as_the_cli_does(
+    capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path
+) -> None:
+    db = server.database_url
+    data = touch_arff(tmp_path / "touch.arff", n=60, with_place=False)
+    assert run_cli(capsys, db, "import", str(data)).code == 0
+    run_id = run_cli(capsys, db, "bench", "touch", "-c", "j48,nb", "--folds", "3", "--json").json()[
+        "run_id"
+    ]
+    api = server.client.get(f"/api/runs/{run_id}/classes", params={"classifier": "nb,j48"})
+    cli = run_cli(capsys, db, "classes", str(run_id), "-c", "nb,j48", "--json")
+    assert api.status_code == 200 and api.json() == cli.json()
+    assert [e["classifier"] for e in api.json()["classifiers"]] == ["nb", "j48"]
+    svg = server.client.get(f"/api/runs/{run_id}/calibration.svg")
+    assert svg.status_code == 200 and svg.headers["content-type"].startswith("image/svg+xml")
+    assert "<svg" in svg.text and "nb (ECE" in svg.text
+    unknown = server.client.get(f"/api/runs/{run_id}/classes", params={"classifier": "rf"})
+    assert unknown.status_code == 400 and "no classifier 'rf'" in unknown.json()["error"]["message"]
+    assert server.client.get("/api/runs/99/classes").status_code == 404
