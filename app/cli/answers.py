@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from app.cli.output import JsonOption, info, print_json, table
+from app.cli.output import JsonOption, info, print_json, run_table, table
 from app.cli.state import get_state
 
 if TYPE_CHECKING:
@@ -47,31 +47,19 @@ def classes_command(
 ) -> None:
     """Show per-class precision, recall and F1, the confusion matrix (summed over folds)
     and the expected calibration error of a run's classifiers, per target."""
+    from app.reports.certainty_tables import class_tables, score
+
     certainty = _certainty(ctx, run, classifier)
     if as_json:
         print_json(certainty.to_json())
         return
+    for shown in class_tables(certainty):
+        run_table(shown)
     for entry in certainty.classifiers:
-        for target in entry.targets:
-            table(
-                f"{entry.classifier} on {target.target} ({entry.n_folds} folds)",
-                ["class", "precision", "recall", "F1", "support", *target.labels],
-                [
-                    (
-                        scores.label,
-                        _score(scores.precision),
-                        _score(scores.recall),
-                        _score(scores.f1),
-                        scores.support,
-                        *row,
-                    )
-                    for scores, row in zip(target.classes, target.confusion, strict=True)
-                ],
-            )
         calibration = entry.calibration
         if calibration is not None:
             info(
-                f"{entry.classifier}: expected calibration error {_score(calibration.ece)} "
+                f"{entry.classifier}: expected calibration error {score(calibration.ece)} "
                 f"over {calibration.n_instances} out-of-fold predictions"
             )
         else:
@@ -108,20 +96,9 @@ def calibration_command(
     if as_json:
         print_json(certainty.to_json())
     else:
-        table(
-            f"run {certainty.run_id}: calibration of the top label, out of fold",
-            ["classifier", "ECE", "instances", "folds", "note"],
-            [
-                (
-                    e.classifier,
-                    _score(e.calibration.ece) if e.calibration else "-",
-                    e.calibration.n_instances if e.calibration else "-",
-                    e.calibration.n_folds if e.calibration else "-",
-                    e.calibration_note or "",
-                )
-                for e in certainty.classifiers
-            ],
-        )
+        from app.reports.certainty_tables import calibration_table
+
+        run_table(calibration_table(certainty))
     if output is not None:
         info(f"wrote {output}")
 
@@ -131,10 +108,6 @@ def _certainty(ctx: typer.Context, run: int, classifiers: str | None) -> RunCert
 
     names = [c.strip() for c in classifiers.split(",") if c.strip()] if classifiers else None
     return run_certainty(get_state(ctx).store, run, classifiers=names)
-
-
-def _score(value: float | None) -> str:
-    return "-" if value is None else f"{value:.4f}"
 
 
 def import_results_command(

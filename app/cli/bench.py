@@ -18,6 +18,7 @@ from app.cli.output import (
     JsonOption,
     info,
     print_json,
+    run_table,
     table,
 )
 from app.cli.state import get_state
@@ -663,12 +664,7 @@ def _print_run_tables(report: LeaderboardSchema) -> None:
     from app.reports.run_tables import run_tables
 
     for shown in run_tables(report):
-        table(
-            shown.title,
-            shown.header,
-            shown.rows,
-            justify=["right" if numeric else "left" for numeric in shown.numeric],
-        )
+        run_table(shown)
 
 
 def _print_independent(result: IndependentResult, as_json: bool) -> None:

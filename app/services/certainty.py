@@ -48,7 +48,11 @@ def run_certainty(
     NotFoundError
         No such run.
     """
-    view = run_view(store, run_ref)
+    return certainty_of(run_view(store, run_ref), classifiers)
+
+
+def certainty_of(view: RunView, classifiers: Sequence[str] | None = None) -> RunCertainty:
+    """:func:`run_certainty` of a run already read (the report's run views)."""
     run = view.run
     if run.kind == "regression":
         raise ConfigurationError(f"run {run.id} is a regression: its targets have no classes")

@@ -97,3 +97,16 @@ def test_bad_certainty_requests_are_one_line_exit_2(
     ).json()["run_id"]
     refused = run_cli(capsys, store_url, "classes", str(regression))
     assert refused.code == 2 and "is a regression" in refused.err
+
+
+def test_the_report_says_how_sure(
+    capsys: pytest.CaptureFixture[str], store_url: str, run: int, tmp_path: Path
+) -> None:
+    page = tmp_path / "report.html"
+    made = run_cli(capsys, store_url, "report", str(run), "-o", str(page), "--confusions", "2")
+    assert made.code == 0, made.err
+    html = page.read_text(encoding="utf-8")
+    assert "How sure: per class and calibration" in html
+    assert html.count('data-table="classes"') == 2  # the two best classifiers
+    assert "expected calibration error, 10 bins" in html and "Reliability of the best" in html
+    assert "without probabilities" in html  # svm-rbf's note
