@@ -17,12 +17,14 @@ from app.cli.state import get_state
 
 if TYPE_CHECKING:
     from app.schemas.certainty import RunCertainty
+    from app.schemas.importance import FeatureImportance
 
 
 def register(app: typer.Typer) -> None:
     app.command("import-results")(import_results_command)
     app.command("classes")(classes_command)
     app.command("calibration")(calibration_command)
+    app.command("importance")(importance_command)
 
 
 RunArgument = Annotated[
@@ -173,4 +175,72 @@ def import_results_command(
     info(
         f"`touchbench leaderboard RUN --beside {run.id}` ranks these beside a run of yours "
         f"on {run.dataset_name}"
+    )
+
+
+def importance_command(
+    ctx: typer.Context,
+    run: RunArgument,
+    classifier: Annotated[
+        str,
+        typer.Option("--classifier", "-c", metavar="ID", help="One of the run's classifiers."),
+    ],
+    repeats: Annotated[
+        int | None,
+        typer.Option("--repeats", metavar="N", help="Shuffles per feature and fold (3)."),
+    ] = None,
+    top: Annotated[
+        int, typer.Option("--top", min=1, help="Features listed (the most important).")
+    ] = 20,
+    as_json: JsonOption = False,
+) -> None:
+    """Permutation importance of a run's classifier on each of its outer test folds, per
+    feature and per group of features (channel, feature family), with the t-test of each
+    group's drop."""
+    from app.cli.requests import build_request
+    from app.schemas.importance import ImportanceRequest
+    from app.services.importance import run_importance
+
+    request = build_request(
+        ImportanceRequest,
+        {"run": "RUN", "classifier": "--classifier"},
+        run=run,
+        classifier=classifier,
+        repeats=repeats,
+    )
+
+    def progress(done: int, total: int) -> None:
+        if not as_json:
+            info(f"fold {done} of {total} done")
+
+    found = run_importance(get_state(ctx).store, request, on_fold=progress)
+    if as_json:
+        print_json(found.to_json())
+        return
+    header = ["feature", "features", "drop", "std", "p", ""]
+    for grouping, items in found.groups.items():
+        table(
+            f"run {found.run_id}, {found.classifier} on {found.target}: each {grouping} "
+            f"shuffled ({found.metric} drop over {found.n_folds} folds, baseline "
+            f"{found.baseline:.4f})",
+            header,
+            [_importance_row(item) for item in items],
+        )
+    table(
+        f"the {min(top, len(found.features))} most important of {len(found.features)} features",
+        header,
+        [_importance_row(item) for item in found.features[:top]],
+    )
+    info("p: corrected resampled t-test of the drop against none; * significant at 0.05")
+
+
+def _importance_row(item: FeatureImportance) -> tuple[object, ...]:
+    p = "-" if item.p is None else f"{item.p:.3g}"
+    return (
+        item.name,
+        item.n_features,
+        f"{item.mean:+.4f}",
+        f"{item.std:.4f}",
+        p,
+        "*" if item.significant else "",
     )

@@ -84,6 +84,13 @@ COMMANDS = (
         "probabilities, and draw their reliability diagram.",
     ),
     Subcommand(
+        "importance",
+        "app.cli.answers",
+        "Permutation importance of a run's classifier on each of its outer test folds, per "
+        "feature and per group of features (channel, feature family), with the t-test of each "
+        "group's drop.",
+    ),
+    Subcommand(
         "cancel",
         "app.cli.bench",
         "Cancel a run: a queued run at once, a running one as soon as its process hears of it.",

@@ -355,7 +355,7 @@ def _plan_run(store: Store, request: BenchRequest) -> _Plan:
             "baseline",
             f"'{request.baseline}' is not a classifier of this run (classifiers: {', '.join(ids)})",
         )
-    plan = _folds(prepared, options)
+    plan = fold_plan(prepared, options)
     config = {
         **options.to_json(),
         "folds": max(f.fold for f in plan.folds) + 1,
@@ -436,7 +436,7 @@ def execute_run(
             run.config.get("targets_given"),
             run.config.get("position") or (),
         )
-        folds = _folds(prepared, options).folds
+        folds = fold_plan(prepared, options).folds
         done = finished_keys(store, run.id)
         callbacks.on_plan(len(run.classifiers) * len(folds), len(done))
 
@@ -798,7 +798,8 @@ def _bytes(megabytes: float | None) -> int | None:
     return None if megabytes is None else int(megabytes * 2**20)
 
 
-def _folds(prepared: PreparedProblem, options: RunOptions) -> FoldPlan:
+def fold_plan(prepared: PreparedProblem, options: RunOptions) -> FoldPlan:
+    """The folds a run with these options makes on this problem (the same on resume)."""
     from benchmark.run.folds import make_fold_plan
 
     try:

@@ -10,6 +10,7 @@ already recorded, so a resumed run never duplicates rows.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from datetime import datetime
@@ -21,6 +22,7 @@ from sqlalchemy.dialects.sqlite import insert as sqlite_insert
 from sqlalchemy.orm import Session
 
 from app.errors import ConflictError, NotFoundError
+from app.schemas.base import finite
 from app.schemas.runs import FINAL_STATUSES, RunSchema, RunStatus
 from app.store import queue
 from app.store.database import Store
@@ -373,6 +375,9 @@ def load_results(store: Store, run_id: int) -> list[TaskResult]:
             per_target = metrics.pop(PER_TARGET, None)
             params = metrics.pop(PARAMS, None)
             calibration = metrics.pop(CALIBRATION, None)
+            metrics = _undefined_as_nan(metrics)
+            if per_target is not None:
+                per_target = {t: _undefined_as_nan(scores) for t, scores in per_target.items()}
             results.append(
                 TaskResult(
                     key=TaskKey(classifier, repeat, fold),
@@ -391,15 +396,22 @@ def load_results(store: Store, run_id: int) -> list[TaskResult]:
 
 
 def _stored_metrics(result: TaskResult) -> dict[str, Any]:
-    """The metrics column: scores, and per-target scores and chosen parameters when any."""
-    stored: dict[str, Any] = dict(result.metrics)
+    """The metrics column: scores, and per-target scores and chosen parameters when any.
+    An undefined score (NaN: ROC AUC of a classifier without probabilities) is stored as
+    null, which PostgreSQL's JSON accepts and NaN it refuses."""
+    stored: dict[str, Any] = finite(dict(result.metrics))
     if result.per_target:
-        stored[PER_TARGET] = result.per_target
+        stored[PER_TARGET] = finite(result.per_target)
     if result.params is not None:
         stored[PARAMS] = result.params
     if result.calibration is not None:
         stored[CALIBRATION] = result.calibration
     return stored
+
+
+def _undefined_as_nan(scores: dict[str, Any]) -> dict[str, Any]:
+    """Scores as read: null (an undefined score) back to NaN."""
+    return {name: math.nan if value is None else value for name, value in scores.items()}
 
 
 def _keys(session: Session, run_id: int) -> set[tuple[str, int, int]]:

@@ -110,3 +110,21 @@ def test_the_report_says_how_sure(
     assert html.count('data-table="classes"') == 2  # the two best classifiers
     assert "expected calibration error, 10 bins" in html and "Reliability of the best" in html
     assert "without probabilities" in html  # svm-rbf's note
+
+
+def test_importance_explains_a_runs_classifier_on_its_folds(
+    capsys: pytest.CaptureFixture[str], store_url: str, run: int
+) -> None:
+    result = run_cli(
+        capsys, store_url, "importance", str(run), "-c", "nb", "--repeats", "1", "--json"
+    )
+    assert result.code == 0, result.err
+    found = result.json()
+    assert (found["classifier"], found["target"], found["n_folds"]) == ("nb", "gesture", 5)
+    names = [f["name"] for f in found["features"]]
+    assert sorted(names) == ["f0", "f1", "f2", "f3", "mic"]
+    assert names[0] == "f0"  # the synthetic gesture is f0's shift
+    bad = run_cli(capsys, store_url, "importance", str(run), "-c", "rf")
+    assert bad.code == 2 and bad.err.startswith("touchbench: error: --classifier: 'rf' is not")
+    many = run_cli(capsys, store_url, "importance", str(run), "-c", "nb", "--repeats", "99")
+    assert many.code == 2 and "--repeats" in many.err
