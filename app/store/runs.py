@@ -125,17 +125,33 @@ def create_run(
 ) -> RunInfo:
     """A new run, ``queued``."""
     with store.session() as session:
-        row = RunRow(
-            dataset_id=dataset_id,
-            kind=kind,
-            targets=list(targets),
-            classifiers=list(classifiers),
-            config=config,
-            status="queued",
-        )
-        session.add(row)
-        session.flush()
+        row = _new_run(session, dataset_id, kind, targets, classifiers, config, "queued")
         return _infos(session, [row])[0]
+
+
+def _new_run(
+    session: Session,
+    dataset_id: int,
+    kind: str,
+    targets: Sequence[str],
+    classifiers: Sequence[str],
+    config: dict[str, Any],
+    status: RunStatus,
+    **times: datetime,
+) -> RunRow:
+    """A run's row, added and flushed (so that it has its id)."""
+    row = RunRow(
+        dataset_id=dataset_id,
+        kind=kind,
+        targets=list(targets),
+        classifiers=list(classifiers),
+        config=config,
+        status=status,
+        **times,
+    )
+    session.add(row)
+    session.flush()
+    return row
 
 
 def add_finished_run(
@@ -152,18 +168,17 @@ def add_finished_run(
     imported one: nothing executes it, and a failure stores nothing)."""
     now = utcnow()
     with store.session() as session:
-        row = RunRow(
-            dataset_id=dataset_id,
-            kind=kind,
-            targets=list(targets),
-            classifiers=list(classifiers),
-            config=config,
-            status="done",
+        row = _new_run(
+            session,
+            dataset_id,
+            kind,
+            targets,
+            classifiers,
+            config,
+            "done",
             started_at=now,
             finished_at=now,
         )
-        session.add(row)
-        session.flush()
         if results:
             session.execute(
                 insert(FoldResultRow),
