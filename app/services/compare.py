@@ -221,8 +221,8 @@ def compare_runs(
             run_scores(replace(run, classifiers=[*run.classifiers, *names]), metric, results)
         )
         beside_notes += [
-            f"run {b.run.id} ({b.run.config.get('name') or b.run.fold_scheme}) counts as part "
-            f"of run {run.id}: {b.note}"
+            f"run {b.run.id} ({b.run.config.get('name') or b.run.fold_scheme}) joins "
+            f"run {run.id} (same data set and target); as for their folds: {b.note}"
             for b in others
         ]
     runs = [s.run for s in scores]
