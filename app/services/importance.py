@@ -61,8 +61,8 @@ def run_importance(
     names = [schema.features[c].name for c in usable_feature_columns(schema)]
     options = RunOptions.from_config(run.config)
     folds = fold_plan(prepared, options).folds
-    # the engine's fitting code: imported here so that the service module starts fast
-    from benchmark.run.importance import permutation_importance
+    # the engine's fitting code (scikit-learn): imported here so the module starts fast
+    from benchmark.run.importance import feature_groups, permutation_importance
 
     found = permutation_importance(
         prepared.problem,
@@ -90,8 +90,6 @@ def run_importance(
 
     def ranked(items: list[FeatureImportance]) -> list[FeatureImportance]:
         return sorted(items, key=lambda item: -item.mean)
-
-    from benchmark.run.importance import feature_groups
 
     sizes = {g: {n: len(c) for n, c in m.items()} for g, m in feature_groups(names).items()}
     return ImportanceResult(
