@@ -67,6 +67,31 @@ COMMANDS = (
         "Show a run's leaderboard with WEKA's significance marks (v better, * worse).",
     ),
     Subcommand(
+        "import-results",
+        "app.cli.answers",
+        "Import a WEKA Experimenter results file (InstanceResultListener ARFF) as a finished "
+        "run, so that leaderboards and reports rank the paper's classifiers beside ours.",
+    ),
+    Subcommand(
+        "classes",
+        "app.cli.answers",
+        "Show per-class precision, recall and F1, the confusion matrix (summed over folds) "
+        "and the expected calibration error of a run's classifiers, per target.",
+    ),
+    Subcommand(
+        "calibration",
+        "app.cli.answers",
+        "Show the expected calibration error of a run's classifiers from their out-of-fold "
+        "probabilities, and draw their reliability diagram.",
+    ),
+    Subcommand(
+        "importance",
+        "app.cli.answers",
+        "Permutation importance of a run's classifier on each of its outer test folds, per "
+        "feature and per group of features (channel, feature family), with the t-test of each "
+        "group's drop.",
+    ),
+    Subcommand(
         "cancel",
         "app.cli.bench",
         "Cancel a run: a queued run at once, a running one as soon as its process hears of it.",

@@ -269,6 +269,44 @@ def confusion_figure(
 
 
 @_styled
+def reliability_diagram(
+    curves: Mapping[str, tuple[np.ndarray, np.ndarray, np.ndarray, float]],
+    *,
+    title: str,
+) -> Figure:
+    """Reliability diagram: accuracy against mean confidence per bin, one line per
+    classifier, the diagonal for perfect calibration, and the share of instances per bin.
+
+    Parameters
+    ----------
+    curves : mapping of str to (confidence, accuracy, count, ece)
+        Per classifier: mean confidence, accuracy and instances of each bin (ndarrays of
+        shape (n_bins,), NaN for empty bins) and its expected calibration error.
+    title : str
+    """
+    if not curves:
+        raise AppError("no calibration to plot")
+    figure = Figure(figsize=(6.4, 5.6), layout="constrained")
+    top, bottom = figure.subplots(2, 1, sharex=True, height_ratios=(3, 1))
+    top.plot([0, 1], [0, 1], linestyle="--", color=_LINE, linewidth=0.8, label="perfect")
+    n_bins = 1
+    for name, (confidence, accuracy, count, ece) in curves.items():
+        shown = count > 0
+        top.plot(confidence[shown], accuracy[shown], marker="o", label=f"{name} (ECE {ece:.3f})")
+        n_bins = count.size
+        centres = (np.arange(n_bins) + 0.5) / n_bins
+        bottom.plot(centres, count / max(count.sum(), 1.0), marker=".", label=name)
+    top.set_xlim(0, 1)
+    top.set_ylim(0, 1)
+    top.set_ylabel("accuracy of the top label")
+    top.legend(loc="upper left", fontsize=8)
+    bottom.set_xlabel("confidence of the top label")
+    bottom.set_ylabel("share")
+    _suptitle(figure, title)
+    return figure
+
+
+@_styled
 def per_target_figure(
     summary: Mapping[str, Mapping[str, tuple[float, float]]],
     *,
