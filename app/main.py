@@ -12,11 +12,10 @@ from contextlib import asynccontextmanager
 from importlib import metadata
 
 from fastapi import Depends, FastAPI
-from starlette.middleware.cors import CORSMiddleware
 
 from app.api import main as api
 from app.api.deps import ModelCache, Service, require_api_key
-from app.api.trust import Trust
+from app.api.trust import Cors, Trust
 from app.jobs.dispatcher import Dispatcher
 from app.settings import Settings, get_settings
 from app.store.database import Store
@@ -78,7 +77,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     install_web_page(app, dependencies=[Depends(require_api_key)])
     if settings.origins:  # CORS stays closed unless origins are listed
         app.add_middleware(
-            CORSMiddleware,
+            Cors,
             allow_origins=sorted(settings.origins),
             allow_methods=["GET", "POST", "PUT", "PATCH", "DELETE"],
             allow_headers=["X-API-Key", "Content-Type"],

@@ -80,6 +80,11 @@ class Settings(BaseSettings):
     max_upload_mb : float
         Largest upload (data set, recording session, file to predict), enforced while the
         body streams in.
+    max_targets : int
+        Most targets a data set may have, at import, upload and extraction (default
+        1,000: MEKA's largest benchmark data sets have fewer).
+    max_attributes : int
+        Most attributes (targets and features) a data set may have (default 20,000).
     job_workers : int
         Jobs (runs, extractions, trainings) carried out at once on this host for the store,
         each in a worker process of its own (one service process dispatches them, however
@@ -104,6 +109,8 @@ class Settings(BaseSettings):
     allowed_hosts: str = ""
     allowed_origins: str = ""
     max_upload_mb: float = Field(default=200.0, gt=0)
+    max_targets: int = Field(default=1000, ge=1)
+    max_attributes: int = Field(default=20000, ge=2)
     job_workers: int = Field(default=1, ge=1)
     run_jobs: int = Field(default=1, ge=1)
     dask_scheduler: str | None = None

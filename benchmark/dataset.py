@@ -21,7 +21,9 @@ from benchmark.errors import ConfigurationError
 
 AttributeKind = Literal["numeric", "nominal", "string", "date"]
 
-_MEKA_TARGETS = re.compile(r"(?:^|\s)-C\s+(-?\d+)")
+#: MEKA's ``-C`` option and what follows it (a count, when the relation is valid).
+_MEKA_TARGETS = re.compile(r"(?:^|\s)-C(?:\s+(\S+)|\s*$)")
+_COUNT = re.compile(r"-?\d+")
 
 
 @dataclass(frozen=True)
@@ -321,9 +323,24 @@ def meka_target_count(relation: str) -> int | None:
 
     ``'Music: -C 6'`` gives 6 (the first six attributes are targets); ``-C -2`` gives
     -2 (the last two).
+
+    Raises
+    ------
+    ConfigurationError
+        The option is there but not followed by a whole number (``-C abc``): a file
+        meant for MEKA whose targets cannot be known, rather than WEKA's last attribute.
     """
     match = _MEKA_TARGETS.search(relation.partition(":")[2] if ":" in relation else "")
-    return int(match.group(1)) if match else None
+    if match is None:
+        return None
+    count = match.group(1) or ""
+    if not _COUNT.fullmatch(count):
+        shown = f"'{count[:40]}'" if count else "nothing"
+        raise ConfigurationError(
+            f"MEKA's -C option in the @relation must be a number of targets (-C 2: the first "
+            f"two attributes, -C -2: the last two), not {shown}"
+        )
+    return int(count)
 
 
 def resolve_targets(

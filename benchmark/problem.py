@@ -278,12 +278,12 @@ def position_columns(schema: Schema, position: Sequence[str]) -> tuple[int, ...]
             what = "not a target" if name not in targets else f"a {targets[name][1]} target"
             choice = ", ".join(numeric) if numeric else "none"
             raise ConfigurationError(
-                f"'{name}' in `position` is {what}; a position's coordinates must be numeric "
-                f"targets (numeric targets here: {choice})"
+                f"'{name}' is {what}; a position's coordinates must be numeric targets "
+                f"(numeric targets here: {choice})"
             )
     if not 2 <= len(names) <= 3 or len(set(names)) != len(names):
         raise ConfigurationError(
-            f"`position` takes 2 or 3 distinct numeric targets (x,y or x,y,z), got "
+            f"a position takes 2 or 3 distinct numeric targets (x,y or x,y,z), got "
             f"{','.join(names)}"
         )
     return tuple(targets[name][0] for name in names)

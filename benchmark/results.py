@@ -56,6 +56,10 @@ class TaskResult:
     params : dict or None
         What the classifier chose on its training fold (a tuned twin's parameters, a
         stack's members), JSON-ready; ``None`` for a classifier that chooses nothing.
+    calibration : dict or None
+        Multi-class with probabilities: the fold's reliability bins of the top-label
+        confidence (``count``, ``confidence``, ``correct``, lists of equal length; see
+        :mod:`benchmark.evaluation.calibration`); ``None`` otherwise.
     """
 
     key: TaskKey
@@ -68,6 +72,7 @@ class TaskResult:
     warnings: list[str] = field(default_factory=list)
     per_target: dict[str, dict[str, float]] | None = None
     params: dict[str, Any] | None = None
+    calibration: dict[str, list[float]] | None = None
 
     @property
     def ok(self) -> bool:
@@ -93,6 +98,7 @@ class TaskResult:
                 for target, scores in self.per_target.items()
             },
             "params": self.params,
+            "calibration": self.calibration,
         }
 
     @classmethod
@@ -114,6 +120,7 @@ class TaskResult:
                 for target, scores in per_target.items()
             },
             params=data.get("params"),  # absent from results stored before tuning existed
+            calibration=data.get("calibration"),
         )
 
 

@@ -71,12 +71,15 @@ class CsvSeries:
         The channels' names from the header, None without a header.
     notes : tuple of str
         What was done on reading (resampling, the time column's unit).
+    resampled : bool
+        True when uneven stamps were put on a grid at a rate chosen here (none given).
     """
 
     samples: np.ndarray
     samplerate: float | None
     channels: tuple[str, ...] | None
     notes: tuple[str, ...]
+    resampled: bool = False
 
 
 def read_csv_series(
@@ -113,9 +116,10 @@ def read_csv_series(
         return CsvSeries(np.ascontiguousarray(samples.T), samplerate, kept_names, ())
     times, unit = stamps_in_seconds(values[:, time])
     rate, samples, notes = _on_even_grid(path, names[time], times, lines, samples, samplerate)
+    resampled = samplerate is None and bool(notes)
     if unit != "s":
         notes.insert(0, f"column '{names[time]}' holds nanoseconds")
-    return CsvSeries(np.ascontiguousarray(samples.T), rate, kept_names, tuple(notes))
+    return CsvSeries(np.ascontiguousarray(samples.T), rate, kept_names, tuple(notes), resampled)
 
 
 def stamps_in_seconds(stamps: np.ndarray) -> tuple[np.ndarray, str]:
@@ -173,6 +177,9 @@ def _read_table(path: Path) -> tuple[list[str] | None, np.ndarray, np.ndarray]:
                     block = []
     except (OSError, UnicodeDecodeError) as error:
         raise DriverError(f"{path}: cannot read as text: {error}") from None
+    except csv.Error as error:  # a field over csv.field_size_limit(), a stray quote
+        line = numbers[-1] + 1 if numbers else 1
+        raise DriverError(f"{path}:{line}: cannot read as CSV ({error})") from None
     if block:
         blocks.append(np.array(block))
     if not blocks:
@@ -266,8 +273,9 @@ def _on_even_grid(
         return 1.0 / median, samples, []
     if even and samplerate is not None and abs(1.0 / median - samplerate) <= EVEN * samplerate:
         return samplerate, samples, []
-    rate = samplerate if samplerate is not None else jitter_of(times).rate
-    resampled, jitter = resample_even(times, samples, rate)
+    jitter = jitter_of(times)
+    rate = samplerate if samplerate is not None else jitter.rate
+    resampled = resample_even(times, samples.T, rate).T
     note = (
         f"column '{name}': {jitter.describe()}; {times.size} samples resampled to "
         f"{resampled.shape[0]} at {rate:.6g} Hz (linear interpolation)"

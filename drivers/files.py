@@ -33,7 +33,7 @@ def read_recording(
     *,
     samplerate: float | None = None,
     time_column: str | None = None,
-    channels: Sequence[str] | None = None,
+    fields: Sequence[str] | None = None,
 ) -> Recording:
     """Read one recording, choosing the reader by the file's suffix.
 
@@ -47,8 +47,8 @@ def read_recording(
         grid their stamps are resampled onto if they differ.
     time_column : str, optional
         A CSV file's time column, when it has none of the usual names.
-    channels : sequence of str, optional
-        The CSV columns to keep (names, or 1-based numbers); all by default.
+    fields : sequence of str, optional
+        The CSV columns to keep as channels (names, or 1-based numbers); all by default.
 
     Returns
     -------
@@ -68,15 +68,16 @@ def read_recording(
     if samplerate is not None:
         samplerate = check_rate(samplerate, path, "the given samplerate")
     suffix = path.suffix.lower()
-    if (time_column is not None or channels) and suffix not in _CSV_SUFFIXES:
-        raise DriverError(f"{path}: `time_column` and `channels` apply to CSV files only")
+    if (time_column is not None or fields) and suffix not in _CSV_SUFFIXES:
+        raise DriverError(f"{path}: `time_column` and `fields` apply to CSV files only")
     names: tuple[str, ...] | None = None
     notes: tuple[str, ...] = ()
+    resampled = False
     if suffix == ".npy":
         samples, rate = np.asarray(open_npy(path), dtype=np.float64), samplerate
     elif suffix in _CSV_SUFFIXES:
         series = read_csv_series(
-            path, samplerate=samplerate, time_column=time_column, channels=channels
+            path, samplerate=samplerate, time_column=time_column, channels=fields
         )
         samples, rate, names, notes = (
             series.samples,
@@ -84,12 +85,13 @@ def read_recording(
             series.channels,
             series.notes,
         )
+        resampled = series.resampled
     else:
         samples, rate = _read_audio(path, samplerate)
     if rate is None:
         raise no_sample_rate(path)
     recording = _finish(samples, rate, path)
-    return Recording(recording.samples, rate, recording.path, names, notes)
+    return Recording(recording.samples, rate, recording.path, names, notes, resampled)
 
 
 def no_sample_rate(path: str | Path) -> DriverError:

@@ -23,6 +23,8 @@ class Recording:
         The channels' names when the file has them (a CSV header), one per channel.
     notes : tuple of str
         What was done to the samples on reading (resampled stamps...), one line each.
+    resampled : bool
+        True when the reader chose ``samplerate`` itself for stamps it put on an even grid.
     """
 
     samples: np.ndarray
@@ -30,6 +32,7 @@ class Recording:
     path: str
     channels: tuple[str, ...] | None = None
     notes: tuple[str, ...] = ()
+    resampled: bool = False
 
     @property
     def n_channels(self) -> int:

@@ -3,7 +3,8 @@
 * Audio (WAV, FLAC, OGG, ... via soundfile): read block by block, never whole.
 * ``.npy``: memory-mapped, so read block by block too.
 * CSV/TSV/TXT: parsed whole (:func:`drivers.files.read_recording`), then replayed.
-* ROS bags (``.bag``, ``.mcap``, ``.db3``, or a ROS 2 bag folder): :mod:`drivers.bags`.
+* ROS bags (``.bag``, ``.mcap``, ``.db3``, or a ROS 2 bag folder): :mod:`drivers.bags`
+  (audio) and :mod:`drivers.bag_fields` (numeric fields of any topic).
 
 As fast as possible by default, or paced in real time (``realtime=True``) to stand in
 for a sound card.
@@ -46,10 +47,15 @@ class FileReplaySource(Source):
     realtime : bool
         Deliver blocks no faster than real time.
     topic : str, optional
-        The audio topic of a ROS bag.
-    time_column, channels : optional
-        A CSV file's time column and the columns to keep
-        (:func:`drivers.files.read_recording`).
+        The topic of a ROS bag to read (its audio, or its numeric fields).
+    fields : sequence of str, optional
+        Numeric fields of a bag's ``topic``, or columns of a CSV file (names or 1-based
+        numbers), to read as channels.
+    time_column : str, optional
+        A CSV file's time column (:func:`drivers.files.read_recording`).
+    channels, sample_format : optional
+        Raw PCM audio of a bag without ``AudioInfo``: channels per frame and
+        ``S16LE``/``S32LE``/``F32LE``.
     """
 
     def __init__(
@@ -60,8 +66,10 @@ class FileReplaySource(Source):
         block_length: int = DEFAULT_BLOCK,
         realtime: bool = False,
         topic: str | None = None,
+        fields: Sequence[str] | None = None,
+        channels: int | None = None,
+        sample_format: str | None = None,
         time_column: str | None = None,
-        channels: Sequence[str] | None = None,
     ) -> None:
         self.path = Path(path)
         self.name = str(path)
@@ -77,25 +85,43 @@ class FileReplaySource(Source):
         self._start = 0.0
         self._audio: soundfile.SoundFile | None = None
         self._array: np.ndarray | None = None
-        if (time_column is not None or channels) and self.path.suffix.lower() not in CSV_SUFFIXES:
-            raise DriverError(f"{path}: `time_column` and `channels` apply to CSV files only")
-        if topic is not None and not is_bag(self.path):
-            raise DriverError(f"{path}: `topic` applies to ROS bags only")
+        csv_file = self.path.suffix.lower() in CSV_SUFFIXES
+        if time_column is not None and not csv_file:
+            raise DriverError(f"{path}: `time_column` applies to CSV files only")
+        bag_only = {
+            "topic": topic,
+            "fields": None if csv_file else fields,
+            "channels": channels,
+            "sample_format": sample_format,
+        }
+        given = [option for option, value in bag_only.items() if value]
+        if given and not is_bag(self.path):
+            also = " and CSV files" if given[0] == "fields" else ""
+            raise DriverError(f"{path}: `{given[0]}` applies to ROS bags{also} only")
         if is_bag(self.path):
-            from drivers.bags import RosbagSource
+            from drivers.bags import open_bag_source
 
-            bag = RosbagSource(self.path, topic=topic)
-            self._inner, self._start = bag, bag.start_time
+            bag = open_bag_source(
+                self.path,
+                topic=topic,
+                fields=fields,
+                samplerate=samplerate,
+                channels=channels,
+                sample_format=sample_format,
+            )
+            self._inner, self._start = bag, float(getattr(bag, "start_time", 0.0))
             rate: float | None = bag.samplerate
             self.n_channels = bag.n_channels
+            self.notes, self.resampled = bag.notes, bag.resampled
         elif self.path.is_dir():
             raise DriverError(f"{path}: is a folder, not a recording (nor a ROS 2 bag)")
         elif self.path.suffix.lower() in CSV_SUFFIXES:
             recording = read_recording(
-                self.path, samplerate=samplerate, time_column=time_column, channels=channels
+                self.path, samplerate=samplerate, time_column=time_column, fields=fields
             )
             inner = RecordingSource(recording, block_length=block_length)
             self._inner, self.channel_names, self.notes = inner, inner.channel_names, inner.notes
+            self.resampled = inner.resampled
             rate, self.n_channels = recording.samplerate, recording.n_channels
         elif self.path.suffix.lower() == ".npy":
             self._array = open_npy(self.path)

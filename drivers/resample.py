@@ -1,20 +1,152 @@
-"""Samples with uneven time stamps brought onto an even grid.
+"""Samples at uneven times onto an even grid: what ROS stamps and logged time columns need.
 
-Real robots stamp their samples when a driver gets them, not when the sensor took them:
-a BioTac logged at 100 Hz shows steps of 3 to 17 ms.  The extractors assume one sample
-every ``1 / rate`` seconds, so :func:`resample_even` interpolates the samples linearly
-onto the grid ``t0, t0 + 1/rate, ...`` (from the first stamp to the last) and says how
-far the stamps were from even.
+Real stamps jitter (a 100 Hz sensor's messages arrive 3 to 17 ms apart), while every
+extractor assumes one sample every ``1 / rate`` seconds.  :func:`resample_even` puts
+samples taken at rising ``times`` onto the grid ``times[0] + k / rate`` by linear
+interpolation between the two samples around each grid time;
+:class:`EvenResampler` does the same block by block, for sources read as a stream, and
+gives the same values.  :func:`median_rate` and :func:`jitter_note` say what the stamps
+were, for a note to the user; :func:`jitter_of` measures them (:class:`Jitter`: the
+precise mean rate, the jitter, the gaps).
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from drivers.errors import DriverError
+
+#: Steps within this fraction of the median step count as even (no note).
+EVEN = 0.01
+
+
+def median_rate(times: np.ndarray) -> float:
+    """Samples per second from the median step of rising ``times`` (seconds).
+
+    Raises
+    ------
+    DriverError
+        Fewer than two times, or a median step that is not positive.
+    """
+    if times.size < 2:
+        raise DriverError(f"{times.size} time stamp(s) give no rate; at least two are needed")
+    step = float(np.median(np.diff(times)))
+    if not step > 0:
+        raise DriverError("the time stamps do not rise (their median step is not positive)")
+    return 1.0 / step
+
+
+def resample_even(times: np.ndarray, values: np.ndarray, rate: float) -> np.ndarray:
+    """``values`` sampled at ``times`` onto an even grid starting at ``times[0]``.
+
+    Parameters
+    ----------
+    times : ndarray of shape (n,)
+        Seconds, strictly rising.
+    values : ndarray of shape (n_channels, n)
+        Samples of every channel at ``times``.
+    rate : float
+        Samples per second of the grid.
+
+    Returns
+    -------
+    ndarray of shape (n_channels, m), float64
+        Linear interpolation at ``times[0] + k / rate`` for ``k = 0 .. m - 1``, where
+        the last grid time is the last one not after ``times[-1]``.
+
+    Raises
+    ------
+    DriverError
+        Times that do not rise, or shapes that disagree.
+    """
+    if times.size == 0:
+        return np.zeros((values.shape[0], 0))
+    return EvenResampler(float(times[0]), rate).feed(times, values)
+
+
+class EvenResampler:
+    """:func:`resample_even` fed in consecutive pieces, with the same result.
+
+    Parameters
+    ----------
+    start : float
+        The grid's first time (the first sample's time).
+    rate : float
+        Samples per second of the grid.
+    """
+
+    def __init__(self, start: float, rate: float) -> None:
+        if not rate > 0:
+            raise DriverError(f"the resampling rate must be positive, got {rate!r}")
+        self.start = start
+        self.rate = rate
+        self.produced = 0  # grid points given so far
+        self._last_time: float | None = None
+        self._last_values: np.ndarray | None = None
+
+    def feed(self, times: np.ndarray, values: np.ndarray) -> np.ndarray:
+        """The grid points up to ``times[-1]`` not given yet.
+
+        Parameters
+        ----------
+        times : ndarray of shape (n,)
+            Seconds, strictly rising, after the times fed before.
+        values : ndarray of shape (n_channels, n)
+
+        Returns
+        -------
+        ndarray of shape (n_channels, k), float64
+        """
+        times = np.asarray(times, dtype=np.float64)
+        values = np.asarray(values, dtype=np.float64)
+        if values.ndim != 2 or values.shape[1] != times.size:
+            raise DriverError(f"{values.shape} values do not match {times.size} time stamps")
+        if times.size == 0:
+            return np.zeros((values.shape[0], 0))
+        if self._last_time is not None and self._last_values is not None:
+            times = np.concatenate([[self._last_time], times])
+            values = np.concatenate([self._last_values, values], axis=1)
+        if np.any(np.diff(times) <= 0):
+            raise DriverError("the time stamps must rise strictly to be resampled")
+        self._last_time, self._last_values = float(times[-1]), values[:, -1:].copy()
+        end = int(np.floor((times[-1] - self.start) * self.rate + 1e-9)) + 1
+        grid = self.start + np.arange(self.produced, end) / self.rate
+        self.produced = max(self.produced, end)
+        out = np.empty((values.shape[0], grid.size))
+        for channel in range(values.shape[0]):  # np.interp is one-dimensional
+            out[channel] = np.interp(grid, times, values[channel])
+        return out
+
+
+def jitter_note(times: np.ndarray, rate: float, *, what: str) -> str | None:
+    """One line on uneven ``times`` and the grid they were put on; None when even.
+
+    Parameters
+    ----------
+    times : ndarray of shape (n,)
+        Seconds, rising.
+    rate : float
+        The grid's samples per second.
+    what : str
+        What the stamps are, e.g. ``"stamps of /biotac"``.
+    """
+    if times.size < 2:
+        return None
+    steps = np.diff(times)
+    median = float(np.median(steps))
+    low, high = float(steps.min()), float(steps.max())
+    grid = f"resampled onto an even {rate:.4g} Hz grid by linear interpolation"
+    if high - low <= EVEN * median:
+        if abs(median * rate - 1.0) <= EVEN:
+            return None
+        return f"{what} are even ({1 / median:.4g} Hz); {grid}"
+    return (
+        f"{what} are uneven (steps {low * 1e3:.3g} to {high * 1e3:.3g} ms, median "
+        f"{median * 1e3:.3g} ms, {1 / median:.4g} Hz); {grid}"
+    )
+
 
 #: A step longer than this many median steps counts as a gap (a sample lost: jitter alone
 #: stretches a step by less than one step).
@@ -72,55 +204,3 @@ def jitter_of(times: np.ndarray) -> Jitter:
         max_ms=1000.0 * float(np.abs(deviation).max()),
         gaps=int(np.count_nonzero(steps > GAP_STEPS * median)),
     )
-
-
-def resample_even(times: np.ndarray, values: np.ndarray, rate: float) -> tuple[np.ndarray, Jitter]:
-    """``values`` stamped at ``times``, linearly interpolated onto an even grid.
-
-    Parameters
-    ----------
-    times : ndarray of shape (n,)
-        Strictly rising stamps in seconds, ``n >= 2``.
-    values : ndarray of shape (n, n_channels)
-        The samples at those stamps.
-    rate : float
-        Samples per second of the grid.
-
-    Returns
-    -------
-    even : ndarray of shape (m, n_channels), float64
-        The samples at ``times[0] + k / rate`` for ``k = 0 ... m - 1``, the last grid
-        point at or before ``times[-1]`` (``m = floor((times[-1] - times[0]) rate) + 1``);
-        column-major (its ``.T`` is C-contiguous).
-    jitter : Jitter
-        How far ``times`` were from even.
-
-    Raises
-    ------
-    DriverError
-        Fewer than two stamps, stamps that do not rise, or a rate that is not positive.
-    """
-    times = np.asarray(times, dtype=np.float64)
-    values = np.asarray(values, dtype=np.float64)
-    if times.ndim != 1 or values.ndim != 2 or values.shape[0] != times.size:
-        raise DriverError(
-            f"times of shape (n,) and values of shape (n, channels) expected, got "
-            f"{times.shape} and {values.shape}"
-        )
-    if times.size < 2:
-        raise DriverError("at least two stamps are needed to resample")
-    if not math.isfinite(rate) or rate <= 0:
-        raise DriverError(f"the rate must be a positive number of Hz, got {rate!r}")
-    steps = np.diff(times)
-    if not (steps > 0).all():
-        index = int(np.flatnonzero(steps <= 0)[0]) + 1
-        raise DriverError(f"stamp {index} ({times[index]:.9g}) does not rise over the one before")
-    # A small tolerance: the last stamp on the grid itself must not be lost to rounding.
-    count = math.floor((times[-1] - times[0]) * rate + 1e-9) + 1
-    grid = times[0] + np.arange(count) / rate
-    # One channel at a time, into a channel-major buffer: no temporary of the whole
-    # recording, and callers that want (n_channels, m) get it without a copy (``.T``).
-    even = np.empty((values.shape[1], count))
-    for channel in range(values.shape[1]):
-        even[channel] = np.interp(grid, times, values[:, channel])
-    return even.T, jitter_of(times)

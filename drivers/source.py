@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import time
 from abc import ABC, abstractmethod
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from types import TracebackType
 from typing import Self
@@ -61,18 +61,23 @@ class Source(ABC):
     overflows : int
         Blocks a live source had to drop because the consumer fell behind (always 0 for
         files).
-    channel_names : tuple of str or None
+    channel_names : sequence of str or None
         The channels' names when the source has them (a CSV header), else None.
-    notes : tuple of str
-        What was done to the samples on reading (resampled stamps...), one line each.
+    notes : sequence of str
+        What the user should know about how the signal was read (stamps resampled, a
+        format guessed), one line each; filled when the source opens.
+    resampled : bool
+        True when the source chose ``samplerate`` itself for samples it put on an even
+        grid (the rate of uneven stamps); given a rate, it would use that one.
     """
 
     name: str
     samplerate: float
     n_channels: int
     overflows: int = 0
-    channel_names: tuple[str, ...] | None = None
-    notes: tuple[str, ...] = ()
+    channel_names: Sequence[str] | None = None
+    notes: Sequence[str] = ()
+    resampled: bool = False
 
     @abstractmethod
     def blocks(self) -> Iterator[Block]:
@@ -129,6 +134,7 @@ class RecordingSource(Source):
         self.n_channels = recording.n_channels
         self.channel_names = recording.channels
         self.notes = recording.notes
+        self.resampled = recording.resampled
 
     def blocks(self) -> Iterator[Block]:
         samples = self.recording.samples

@@ -13,9 +13,10 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Annotated, TypeVar
 
-from fastapi import Depends, Header, HTTPException, Request
+from fastapi import Depends, Header, HTTPException, Query, Request, Response
 
 from app.jobs.dispatcher import Dispatcher
+from app.schemas.listing import Page
 from app.settings import Role, Settings
 from app.store.database import Store
 from app.store.models import ModelInfo, model_version
@@ -258,3 +259,15 @@ def check_api_key(
 
 ServiceDep = Annotated[Service, Depends(get_service)]
 StoreDep = Annotated[Store, Depends(get_store)]
+#: Which rows of a listing to answer (``?offset=&limit=``, at most 1,000 rows).
+PageDep = Annotated[Page, Query()]
+
+
+def paginate(request: Request, response: Response, page: Page, total: int) -> None:
+    """Say how many rows the listing has (``X-Total-Count``) and, when more follow this
+    page, where the next page is (``Link: <...>; rel="next"``)."""
+    response.headers["X-Total-Count"] = str(total)
+    after = page.offset + page.limit
+    if after < total:
+        following = request.url.include_query_params(offset=after, limit=page.limit)
+        response.headers["Link"] = f'<{following.path}?{following.query}>; rel="next"'

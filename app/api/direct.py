@@ -9,7 +9,9 @@ description (its body, response model, path parameters and the API key header) a
 with a handler that does the same things directly: the API key and role check of every
 protected route (:func:`app.api.deps.check_api_key`), the body validated from its bytes in
 one pass (``model_validate_json``), errors raised as FastAPI raises them, so the service's
-error handlers answer them as for any route.
+error handlers answer them as for any route.  In front of the validation, the body's
+limited lists are counted as they are decoded (:mod:`app.api.counting`): a body over a
+limit is refused at the item that passes it, not after all of them are validated.
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from pydantic import BaseModel, ValidationError
 from starlette.requests import Request
 from starlette.responses import Response
 
+from app.api.counting import check_counts, limited_lists
 from app.api.deps import (
     action_of,
     check_api_key,
@@ -40,12 +43,13 @@ _SUPPORTED = {get_service, require_api_key}
 @dataclass(frozen=True)
 class _Plan:
     """How to call the endpoint: its path parameters (strings), its body parameter and
-    model, and the parameters that receive the service."""
+    model (with its lists' limits), and the parameters that receive the service."""
 
     path: tuple[str, ...]
     body: str
     model: type[BaseModel]
     service: tuple[str, ...]
+    lists: dict[str, int]
 
 
 class DirectRoute(APIRoute):
@@ -72,7 +76,9 @@ class DirectRoute(APIRoute):
                 action=action_of(request),
             )
             arguments: dict[str, Any] = {name: request.path_params[name] for name in plan.path}
-            arguments[plan.body] = await _body(request, plan.model)
+            arguments[plan.body] = await _body(
+                request, plan, max_keys=service.settings.max_attributes
+            )
             arguments.update(dict.fromkeys(plan.service, service))
             response = await endpoint(**arguments)
             if not isinstance(response, Response):
@@ -111,12 +117,15 @@ def _plan(route: APIRoute) -> _Plan:
         body=body.name,
         model=model,
         service=tuple(service),
+        lists=limited_lists(model),
     )
 
 
-async def _body(request: Request, model: type[BaseModel]) -> BaseModel:
-    """The request's JSON body as ``model``; a ``RequestValidationError`` (located under
-    ``body``, as FastAPI locates them) when it is not JSON or not valid.
+async def _body(request: Request, plan: _Plan, *, max_keys: int) -> BaseModel:
+    """The request's JSON body as the plan's model; a ``RequestValidationError`` (located
+    under ``body``, as FastAPI locates them) when it is not JSON or not valid, or when a
+    list holds more items than the model allows or an object in it more than ``max_keys``
+    keys (counted first, so refused before the whole body is validated).
 
     Validated on the event loop even when large: pydantic holds the GIL throughout, so a
     worker thread would not let the loop run meanwhile (measured: a 19 MB body holds other
@@ -137,8 +146,10 @@ async def _body(request: Request, model: type[BaseModel]) -> BaseModel:
                 }
             ]
         )
+    body = await request.body()
+    check_counts(body, plan.lists, max_keys=max_keys)
     try:
-        return model.model_validate_json(await request.body())
+        return plan.model.model_validate_json(body)
     except ValidationError as error:
         problems = error.errors(include_url=False, include_input=False, include_context=False)
         raise RequestValidationError(

@@ -16,6 +16,9 @@ from __future__ import annotations
 import json
 from collections.abc import Collection
 
+from starlette.datastructures import Headers
+from starlette.middleware.cors import CORSMiddleware
+from starlette.responses import JSONResponse, Response
 from starlette.types import ASGIApp, Receive, Scope, Send
 
 from app.api.errors import error_body
@@ -91,6 +94,43 @@ class Trust:
             f"pages from the origin '{sent[:100]}' may not {what} this service (neither its "
             "own origin nor listed in TOUCHBENCH_ALLOWED_ORIGINS)",
             "headers.Origin",
+        )
+
+
+class Cors(CORSMiddleware):
+    """Starlette's CORS for the origins listed in ``TOUCHBENCH_ALLOWED_ORIGINS``, with its
+    refusal of a preflight (``OPTIONS`` with ``Access-Control-Request-Method``) answered as
+    every error of the service is, in JSON, instead of Starlette's plain text."""
+
+    def preflight_response(self, request_headers: Headers) -> Response:
+        answer = super().preflight_response(request_headers)
+        if answer.status_code < 400:
+            return answer
+        refused = bytes(answer.body).decode().removeprefix("Disallowed CORS ").split(", ")
+        sent = {
+            "origin": f"the origin '{request_headers.get('origin', '')[:100]}'",
+            "method": f"the method '{request_headers.get('access-control-request-method', '')}'",
+            "headers": "the headers "
+            f"'{request_headers.get('access-control-request-headers', '')[:200]}'",
+            "private-network": "access to a private network",
+        }
+        what = ", ".join(sent.get(name, name) for name in refused)
+        header = "Origin" if refused[0] == "origin" else f"Access-Control-Request-{refused[0]}"
+        where = f"headers.{header.title()}"
+        headers = {
+            key: value
+            for key, value in answer.headers.items()
+            if key.lower() not in ("content-length", "content-type")
+        }
+        return JSONResponse(
+            error_body(
+                "Forbidden",
+                f"cross-origin requests are refused for {what} (TOUCHBENCH_ALLOWED_ORIGINS "
+                "lists the origins allowed)",
+                where,
+            ),
+            status_code=answer.status_code,
+            headers=headers,
         )
 
 

@@ -6,12 +6,21 @@ from __future__ import annotations
 # one chosen loads only what it uses (the CLI imports the module when a command of it
 # is chosen).
 import sys
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from app.cli.output import EXIT_FAILED, EXIT_INTERRUPTED, ExitWith, info, print_json, table
+from app.cli.output import (
+    EXIT_FAILED,
+    EXIT_INTERRUPTED,
+    ExitWith,
+    JsonOption,
+    info,
+    print_json,
+    run_table,
+    table,
+)
 from app.cli.state import get_state
 from app.schemas.runs import BenchRequest
 
@@ -19,13 +28,10 @@ if TYPE_CHECKING:
     from app.schemas.runs import LeaderboardSchema
     from app.services.runs import IndependentResult, RunLeaderboard
     from app.store.database import Store
-    from app.store.runs import RunInfo
-    from benchmark.evaluation.leaderboard import Leaderboard
 
 # scikit-learn, the engine and Dask are imported by the commands that use them, so that
 # this module's other commands (runs, leaderboard, cancel) start without them.
 
-JsonOption = Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")]
 FORMATS = ("table", "json", "csv", "markdown", "arff")
 
 
@@ -531,17 +537,23 @@ def _print_run_report(
     if as_json:
         print_json(report.to_json())
         return
-    _print_leaderboard(ranked.run, ranked.board)
+    _print_leaderboard(ranked)
     _print_run_tables(report)
 
 
-def _ranked(store: Store, run_id: int, metric: str | None, baseline: str | None) -> RunLeaderboard:
+def _ranked(
+    store: Store,
+    run_id: int,
+    metric: str | None,
+    baseline: str | None,
+    beside: Sequence[int] = (),
+) -> RunLeaderboard:
     """A run's leaderboard; a run without results says how to carry it out."""
     from app.errors import AppError
     from app.services.runs import NoResultsError, run_leaderboard
 
     try:
-        return run_leaderboard(store, run_id, metric=metric, baseline=baseline)
+        return run_leaderboard(store, run_id, metric=metric, baseline=baseline, beside=beside)
     except NoResultsError as missing:
         run = missing.run
         if missing.under_way:
@@ -601,6 +613,18 @@ def leaderboard_command(
             "--format", "-f", metavar="FORMAT", help="table, json, csv, markdown or arff."
         ),
     ] = "table",
+    beside: Annotated[
+        list[int] | None,
+        typer.Option(
+            "--beside",
+            metavar="RUN",
+            help=(
+                "Also rank this run's classifiers (same data set and target; repeatable), "
+                "e.g. a paper's imported WEKA results: t-tested where the folds pair, "
+                "means only where they do not."
+            ),
+        ),
+    ] = None,
     as_json: JsonOption = False,
 ) -> None:
     """Show a run's leaderboard with WEKA's significance marks (v better, * worse)."""
@@ -617,21 +641,21 @@ def leaderboard_command(
     )
 
     store = get_state(ctx).store
-    ranked = _ranked(store, run_id, metric, baseline)
+    ranked = _ranked(store, run_id, metric, baseline, beside or ())
     run, board = ranked.run, ranked.board
     columns = metric_columns(run, board)
     if output_format == "json":
         print_json(ranked.report().to_json())
     elif output_format == "csv":
-        sys.stdout.write(leaderboard_csv(board, columns))
+        sys.stdout.write(leaderboard_csv(board, columns, ranked.besides))
     elif output_format == "markdown":
-        sys.stdout.write(leaderboard_markdown(run, board, columns))
+        sys.stdout.write(leaderboard_markdown(run, board, columns, ranked.besides))
     elif output_format == "arff":
         from app.reports.results_arff import write_results_arff
 
         write_results_arff(store, run, sys.stdout)
     else:
-        _print_leaderboard(run, board)
+        _print_leaderboard(ranked)
         _print_run_tables(ranked.report())
 
 
@@ -641,12 +665,7 @@ def _print_run_tables(report: LeaderboardSchema) -> None:
     from app.reports.run_tables import run_tables
 
     for shown in run_tables(report):
-        table(
-            shown.title,
-            shown.header,
-            shown.rows,
-            justify=["right" if numeric else "left" for numeric in shown.numeric],
-        )
+        run_table(shown)
 
 
 def _print_independent(result: IndependentResult, as_json: bool) -> None:
@@ -674,18 +693,26 @@ def _print_independent(result: IndependentResult, as_json: bool) -> None:
     )
 
 
-def _print_leaderboard(run: RunInfo, board: Leaderboard) -> None:
-    from app.reports.leaderboard import leaderboard_header, leaderboard_rows, metric_columns
+def _print_leaderboard(ranked: RunLeaderboard) -> None:
+    from app.reports.leaderboard import (
+        beside_notes,
+        leaderboard_header,
+        leaderboard_rows,
+        metric_columns,
+    )
 
+    run, board = ranked.run, ranked.board
     columns = metric_columns(run, board)
     direction = " (lower is better)" if board.lower_is_better else ""
     table(
         f"run {run.id}: {run.dataset_name} ({', '.join(run.targets)}), "
         f"{run.config.get('folds')}-fold x {run.config.get('repeats')} ({run.fold_scheme}), "
         f"ranked by {board.metric}{direction}",
-        leaderboard_header(board, columns),
-        leaderboard_rows(board, columns),
+        leaderboard_header(board, columns, ranked.besides),
+        leaderboard_rows(board, columns, ranked.besides),
     )
+    for note in beside_notes(ranked.besides):
+        info(note)
     if board.baseline is None:
         info(f"no task of run {run.id} succeeded; the notes say why")
         return

@@ -15,12 +15,10 @@ from typing import Annotated
 import typer
 
 from app.cli.extract import key_values
-from app.cli.output import info, print_json, table
+from app.cli.output import JsonOption, info, print_json, table
 from app.cli.state import get_state
 from app.errors import AppError
 from drivers.source import LIVE_BLOCK
-
-JsonOption = Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")]
 
 
 def register(app: typer.Typer) -> None:

@@ -16,20 +16,19 @@ import typer
 from rich.console import Console
 from rich.progress import BarColumn, DownloadColumn, Progress, TextColumn, TimeRemainingColumn
 
-from app.cli.output import info, print_json, table
+from app.cli.output import JsonOption, info, print_json, table
 from app.cli.state import get_state
 from app.errors import AppError
 from app.schemas.datasets import (
     AttributeDescription,
     DatasetDescription,
-    DatasetList,
     ImportResult,
+    RenameRequest,
 )
 from app.services import datasets as service
 from app.services.datasets import ImportProgress
 from app.store.database import Store
 
-JsonOption = Annotated[bool, typer.Option("--json", metavar="", help="Print only JSON on stdout.")]
 DatasetArgument = Annotated[
     str, typer.Argument(metavar="DATASET", help="Data set name or id.", show_default=False)
 ]
@@ -37,7 +36,6 @@ DatasetArgument = Annotated[
 
 def register(app: typer.Typer) -> None:
     app.command("import")(import_command)
-    app.command("datasets")(datasets_command)
     app.command("show")(show_command)
     app.command("export")(export_command)
     app.command("rename")(rename_command)
@@ -125,34 +123,6 @@ def _import_progress(*, enabled: bool) -> Iterator[ImportProgress | None]:
         yield update
 
 
-def datasets_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
-    """List the data sets in the store."""
-    rows = service.list_datasets(get_state(ctx).store)
-    if as_json:
-        print_json(DatasetList(datasets=rows).to_json())
-        return
-    if not rows:
-        info("no datasets yet: `touchbench import FILE` adds one")
-        return
-    table(
-        None,
-        ["id", "name", "instances", "features", "targets", "source", "imported"],
-        [
-            (
-                row.id,
-                row.name,
-                row.n_instances,
-                row.n_features,
-                ", ".join(row.targets),
-                row.source,
-                row.created_at.strftime("%Y-%m-%d %H:%M"),
-            )
-            for row in rows
-        ],
-        justify=["right", "left", "right", "right", "left", "left", "left"],
-    )
-
-
 def show_command(ctx: typer.Context, dataset: DatasetArgument, as_json: JsonOption = False) -> None:
     """Show a data set's schema, class distribution per target and missing values."""
     description = service.describe_dataset(get_state(ctx).store, dataset)
@@ -225,7 +195,10 @@ def rename_command(
     ],
 ) -> None:
     """Give a data set another name."""
-    renamed = service.rename_dataset(get_state(ctx).store, dataset, new_name)
+    from app.cli.requests import build_request
+
+    request = build_request(RenameRequest, {"name": "NEW"}, name=new_name)
+    renamed = service.rename_dataset(get_state(ctx).store, dataset, request)
     info(f"renamed dataset {renamed.id} '{renamed.previous_name}' to '{renamed.name}'")
 
 

@@ -72,7 +72,10 @@ def extract_command(
     ctx: typer.Context,
     recordings: Annotated[
         list[Path],
-        typer.Argument(metavar="RECORDING...", help="WAV/FLAC, CSV time series or .npy files."),
+        typer.Argument(
+            metavar="RECORDING...",
+            help="WAV/FLAC, CSV time series, .npy files or ROS bags (.bag, .mcap, .db3).",
+        ),
     ],
     labels: Annotated[
         Path | None,
@@ -99,9 +102,9 @@ def extract_command(
         typer.Option(
             "--samplerate",
             help=(
-                "Sample rate (Hz) of CSV/.npy files without a time column; for CSV files "
-                "with uneven stamps, the even grid they are resampled onto (default: their "
-                "median rate)."
+                "Sample rate (Hz) of CSV/.npy files without a time column and of raw PCM in "
+                "bags without AudioInfo; for --fields and CSV files with uneven stamps, the "
+                "even grid's rate (default: the stamps' rate)."
             ),
         ),
     ] = None,
@@ -116,21 +119,42 @@ def extract_command(
             ),
         ),
     ] = None,
-    channels: Annotated[
-        str | None,
-        typer.Option(
-            "--channels",
-            metavar="A,B,...",
-            help="The CSV columns to read as channels, by name or 1-based number (all).",
-        ),
-    ] = None,
     segment: Annotated[
         float | None,
         typer.Option("--segment", help="With --events none: cut files into segments of SECONDS."),
     ] = None,
     topic: Annotated[
         str | None,
-        typer.Option("--topic", metavar="TOPIC", help="Audio topic of ROS bags (if several)."),
+        typer.Option(
+            "--topic",
+            metavar="TOPIC",
+            help="Topic of ROS bags: an audio topic (if several), or any topic to read its "
+            "numeric fields as channels.",
+        ),
+    ] = None,
+    fields: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--fields",
+            metavar="A,B,...",
+            help="Numeric fields of --topic as channels, e.g. pdc,pac,electrodes or "
+            "wrench.force (arrays give pac[0], pac[1], ...; default: its numeric fields); "
+            "for CSV files, the columns (names or 1-based numbers; default: all).",
+        ),
+    ] = None,
+    channels: Annotated[
+        int | None,
+        typer.Option(
+            "--channels", metavar="N", help="Channels of raw PCM audio in bags without AudioInfo."
+        ),
+    ] = None,
+    sample_format: Annotated[
+        str | None,
+        typer.Option(
+            "--sample-format",
+            metavar="FORMAT",
+            help="S16LE, S32LE or F32LE: raw PCM audio in bags without AudioInfo.",
+        ),
     ] = None,
     option: Annotated[
         list[str] | None,
@@ -153,9 +177,10 @@ def extract_command(
     """Detect touch events in recordings, extract features, and store them as a data set.
 
     Recordings are read block by block (memory follows the longest event, not the
-    recording); ROS bags (.bag, .mcap, .db3) are read for their audio_common audio.
-    `touchbench extractors` lists every extractor's options (-O KEY=VALUE) with their
-    type, default and meaning.
+    recording); ROS bags (.bag, .mcap, .db3) are read for their audio_common audio (raw PCM
+    or MP3), or for the numeric fields of a --topic, put on an even grid; CSV time series
+    by their time column (--fields picks columns). `touchbench extractors` lists every
+    extractor's options (-O KEY=VALUE) with their type, default and meaning.
     """
     from app.cli.requests import build_request
     from app.schemas.extraction import ExtractRequest
@@ -173,9 +198,11 @@ def extract_command(
         segment=segment,
         options=key_values(option or [], "--option"),
         topic=topic,
+        fields=_comma_list(fields),
+        channels=channels,
+        sample_format=sample_format,
         max_event=max_event,
         time_column=time_column,
-        channels=None if channels is None else [c for c in channels.split(",") if c.strip()],
     )
     with _Reading() as reading:
         summary = extract_and_store(get_state(ctx).store, request, on_progress=reading.update)
@@ -204,6 +231,13 @@ def extract_command(
             )
         ],
     )
+
+
+def _comma_list(values: list[str] | None) -> list[str] | None:
+    """``["a,b", "c"]`` (the option given once or more) as ``["a", "b", "c"]``."""
+    if not values:
+        return None
+    return [part.strip() for value in values for part in value.split(",") if part.strip()]
 
 
 def key_values(pairs: list[str], option: str, what: str = "KEY=VALUE") -> dict[str, str]:

@@ -5,6 +5,7 @@ Exit status: 0 success, 2 bad input or usage (one line on stderr), 1 anything un
 
 from __future__ import annotations
 
+import errno
 import gc
 import os
 import sys
@@ -32,7 +33,7 @@ COMMANDS = (
         "app.cli.datasets",
         "Import an ARFF or CSV file as a data set, named after the file.",
     ),
-    Subcommand("datasets", "app.cli.datasets", "List the data sets in the store."),
+    Subcommand("datasets", "app.cli.listing", "List the data sets in the store."),
     Subcommand(
         "show",
         "app.cli.datasets",
@@ -64,6 +65,31 @@ COMMANDS = (
         "leaderboard",
         "app.cli.bench",
         "Show a run's leaderboard with WEKA's significance marks (v better, * worse).",
+    ),
+    Subcommand(
+        "import-results",
+        "app.cli.answers",
+        "Import a WEKA Experimenter results file (InstanceResultListener ARFF) as a finished "
+        "run, so that leaderboards and reports rank the paper's classifiers beside ours.",
+    ),
+    Subcommand(
+        "classes",
+        "app.cli.answers",
+        "Show per-class precision, recall and F1, the confusion matrix (summed over folds) "
+        "and the expected calibration error of a run's classifiers, per target.",
+    ),
+    Subcommand(
+        "calibration",
+        "app.cli.answers",
+        "Show the expected calibration error of a run's classifiers from their out-of-fold "
+        "probabilities, and draw their reliability diagram.",
+    ),
+    Subcommand(
+        "importance",
+        "app.cli.answers",
+        "Permutation importance of a run's classifier on each of its outer test folds, per "
+        "feature and per group of features (channel, feature family), with the t-test of each "
+        "group's drop.",
     ),
     Subcommand(
         "cancel",
@@ -267,6 +293,11 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt as interrupt:
         print("touchbench: interrupted", file=sys.stderr)
         return getattr(interrupt, "exit_code", EXIT_INTERRUPTED)
+    except SystemExit as stop:  # the reader went away (`show mini | head -1`): nothing wrong
+        if not _reader_gone(stop):
+            raise
+        _discard_output()
+        return 0
     except Exception as error:
         return _failed(error)
     if returned == EXIT_INTERRUPTED:  # typer turned a Ctrl-C into this status, silently
@@ -290,12 +321,37 @@ def _failed(error: Exception) -> int:
         return EXIT_USAGE
     if os.environ.get("TOUCHBENCH_DEBUG"):
         traceback.print_exc()
+    # the first line only: a driver's error adds the statement and its parameters below it
+    message = next(iter(str(error).strip().splitlines()), "")
     print(
-        f"touchbench: unexpected error: {type(error).__name__}: {error} "
+        f"touchbench: unexpected error: {type(error).__name__}: {message} "
         "(set TOUCHBENCH_DEBUG=1 for the traceback)",
         file=sys.stderr,
     )
     return EXIT_UNEXPECTED
+
+
+def _reader_gone(stop: SystemExit) -> bool:
+    """Whether ``stop`` is how click or rich answer a closed standard output: both exit 1
+    while handling the ``BrokenPipeError`` (click for a command's output, rich for a table
+    or a help page), where the command did nothing wrong."""
+    cause: BaseException | None = stop.__context__
+    while cause is not None:
+        if isinstance(cause, OSError) and cause.errno == errno.EPIPE:
+            return True
+        cause = cause.__context__
+    return False
+
+
+def _discard_output() -> None:
+    """Send what is still to be written to the standard output nowhere, so that the flush
+    at exit does not meet the closed pipe again (Python would print that it ignored it)."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError):  # no real standard output (a test's captured one)
+        pass
 
 
 def _forget_options() -> None:

@@ -10,10 +10,8 @@ from typing import Annotated
 
 import typer
 
-from app.cli.output import info, print_json, table, warn
+from app.cli.output import JsonOption, info, print_json, table, warn
 from app.cli.state import get_state
-
-JsonOption = Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")]
 
 
 def register(app: typer.Typer) -> None:

@@ -7,8 +7,9 @@ import math
 import re
 import sys
 from collections.abc import Iterable, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Annotated, Any
 
+import typer
 from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
@@ -18,6 +19,12 @@ from app.cli.exits import EXIT_FAILED as EXIT_FAILED
 from app.cli.exits import EXIT_INTERRUPTED as EXIT_INTERRUPTED
 from app.cli.exits import ExitWith as ExitWith
 from app.schemas.base import finite
+
+if TYPE_CHECKING:
+    from app.reports.run_tables import RunTable
+
+#: The ``--json`` flag of every listing and result command.
+JsonOption = Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")]
 
 #: Pipes and files get a wide page: nobody wants a leaderboard wrapped at 80 columns.
 console = Console(highlight=False, soft_wrap=False, width=None if sys.stdout.isatty() else 160)
@@ -42,6 +49,16 @@ def info(message: str) -> None:
 def warn(message: str) -> None:
     """Something changed or left out that the user should know of, on stderr."""
     err_console.print(f"[yellow]warning:[/yellow] {escape(message)}")
+
+
+def run_table(shown: RunTable) -> None:
+    """A titled table of text cells (:mod:`app.reports.run_tables`), numbers on the right."""
+    table(
+        shown.title,
+        list(shown.header),
+        shown.rows,
+        justify=["right" if numeric else "left" for numeric in shown.numeric],
+    )
 
 
 def table(

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from app.cli.output import info, print_json, table
+from app.cli.output import JsonOption, info, print_json, table
 from app.cli.state import get_state
 
 if TYPE_CHECKING:
@@ -22,7 +22,6 @@ if TYPE_CHECKING:
 # matplotlib, scipy and the statistics are imported by the commands that use them, so that
 # `touchbench --help` starts at once.
 
-JsonOption = Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")]
 MetricOption = Annotated[
     str | None,
     typer.Option(

@@ -7,6 +7,7 @@ from __future__ import annotations
 import copy
 import ipaddress
 import os
+import socket
 from typing import Annotated, Any
 
 import typer
@@ -50,10 +51,13 @@ def serve_command(
     Settings come from TOUCHBENCH_* variables: TOUCHBENCH_API_KEY or TOUCHBENCH_API_KEYS
     (required beyond loopback), TOUCHBENCH_ALLOWED_HOSTS (required beyond loopback),
     TOUCHBENCH_ALLOWED_ORIGINS, TOUCHBENCH_JOB_WORKERS, TOUCHBENCH_RUN_JOBS,
-    TOUCHBENCH_DASK_SCHEDULER, TOUCHBENCH_MAX_UPLOAD_MB, TOUCHBENCH_RESUME_ON_START.
+    TOUCHBENCH_DASK_SCHEDULER, TOUCHBENCH_MAX_UPLOAD_MB, TOUCHBENCH_MAX_TARGETS,
+    TOUCHBENCH_MAX_ATTRIBUTES, TOUCHBENCH_RESUME_ON_START.  Ctrl-C or SIGTERM stops it within
+    a few seconds (exit 130 or 143), whatever it is computing.
     """
     import uvicorn
 
+    from app.cli.stopping import GRACE, serve
     from app.settings import get_settings
 
     state = get_state(ctx)
@@ -74,19 +78,21 @@ def serve_command(
             "(comma-separated), or listen on 127.0.0.1",
             param_hint="--host",
         )
+    _check_port(host, port)
     state.store  # noqa: B018 (open and migrate the store once, before the workers start)
     pin_native_threads()
-    uvicorn.run(
-        "app.main:create_app",
-        factory=True,
-        host=host,
-        port=port,
-        workers=workers,
-        log_level=log_level,
-        log_config=_log_config(log_level),
-        proxy_headers=False,
-        server_header=False,
-    )
+    options: dict[str, Any] = {
+        "factory": True,
+        "host": host,
+        "port": port,
+        "workers": workers,
+        "log_level": log_level,
+        "log_config": _log_config(log_level),
+        "proxy_headers": False,
+        "server_header": False,
+        "timeout_graceful_shutdown": GRACE,  # a request computing does not hold a stop
+    }
+    serve(uvicorn.Config("app.main:create_app", **options))
 
 
 #: Variables that set the thread count of numpy's BLAS and of OpenMP (scikit-learn, xgboost).
@@ -113,16 +119,45 @@ def pin_native_threads() -> None:
 
 def _log_config(level: str) -> dict[str, Any]:
     """uvicorn's logging, and the service's own log (``touchbench.*``: which key made each
-    change of state, unexpected errors) through uvicorn's handler at ``level``."""
+    change of state, unexpected errors) through uvicorn's handler at ``level``; without
+    the traceback of a request cancelled to stop (:class:`app.cli.stopping.CancelledByStop`)."""
     from uvicorn.config import LOGGING_CONFIG
 
     config = copy.deepcopy(LOGGING_CONFIG)
+    config.setdefault("filters", {})["cancelled_by_stop"] = {
+        "()": "app.cli.stopping.CancelledByStop"
+    }
+    config["loggers"]["uvicorn.error"]["filters"] = ["cancelled_by_stop"]
     config["loggers"]["touchbench"] = {
         "handlers": ["default"],
         "level": level.upper(),
         "propagate": False,
     }
     return config
+
+
+def _check_port(host: str, port: int) -> None:
+    """Refuse, in one line, an address the service could not listen on (a port another
+    process holds), before uvicorn starts and answers it with its log and exit status 3.
+
+    The probe binds as uvicorn does (``SO_REUSEADDR``), so a port left in TIME_WAIT by a
+    service that just stopped is not refused.
+    """
+    try:
+        addresses = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)
+    except socket.gaierror as error:
+        raise typer.BadParameter(f"{host}: {error.strerror}", param_hint="--host") from None
+    family, kind, protocol, _, address = addresses[0]
+    with socket.socket(family, kind, protocol) as probe:
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            probe.bind(address)
+        except OSError as error:
+            raise typer.BadParameter(
+                f"cannot listen on {host}:{port}: {error.strerror} (another process listens "
+                "there: stop it or choose another port)",
+                param_hint="--port",
+            ) from None
 
 
 def _loopback(host: str) -> bool:

@@ -6,9 +6,11 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+import numpy as np
 from matplotlib.figure import Figure
 
 from app.reports import plots
+from app.schemas.certainty import RunCertainty
 from app.schemas.datasets import DatasetDescription
 from app.services.compare import Comparison
 from app.services.report import RunView
@@ -87,6 +89,35 @@ def classes_figure(view: RunView) -> Figure:
         )
     return plots.class_distribution_figure(
         counts, title=f"{view.run.dataset_name}: instances per class in run {view.run.id}"
+    )
+
+
+def reliability_figure(certainty: RunCertainty, classifiers: int | None = None) -> Figure:
+    """The reliability diagram of a run's classifiers that kept calibration bins (the
+    first ``classifiers`` of them, best first)."""
+    curves = {}
+    for entry in certainty.classifiers:
+        calibration = entry.calibration
+        if calibration is None or calibration.ece is None:
+            continue
+        bins = calibration.bins
+        curves[entry.classifier] = (
+            np.array([np.nan if b.confidence is None else b.confidence for b in bins]),
+            np.array([np.nan if b.accuracy is None else b.accuracy for b in bins]),
+            np.array([b.count for b in bins], dtype=np.float64),
+            calibration.ece,
+        )
+        if classifiers is not None and len(curves) == classifiers:
+            break
+    if not curves:
+        raise ConfigurationError(
+            f"no classifier of run {certainty.run_id} kept calibration bins (classifiers "
+            "without probabilities, or a run carried out before the bins were kept)"
+        )
+    return plots.reliability_diagram(
+        curves,
+        title=f"run {certainty.run_id} ({certainty.dataset}, {', '.join(certainty.targets)}): "
+        "out-of-fold reliability",
     )
 
 

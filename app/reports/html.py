@@ -18,11 +18,19 @@ from jinja2 import Environment, FileSystemLoader, StrictUndefined, select_autoes
 from markupsafe import Markup
 from matplotlib.figure import Figure
 
-from app.reports import figures
-from app.reports.leaderboard import leaderboard_header, leaderboard_rows, metric_columns
+from app.reports import bounds, figures
+from app.reports.certainty_tables import calibration_table, class_tables
+from app.reports.leaderboard import (
+    beside_notes,
+    leaderboard_header,
+    leaderboard_rows,
+    metric_columns,
+)
 from app.reports.plots import svg_text
 from app.reports.run_tables import run_tables
+from app.services.certainty import certainty_of
 from app.services.compare import Comparison
+from app.services.imported import is_imported
 from app.services.report import Report, RunView
 from benchmark.errors import BenchmarkError
 
@@ -88,7 +96,9 @@ def render_report(
 
 def template_environment(*folders: Path) -> Environment:
     """The Jinja environment of the report's templates, ``folders`` searched first (the web
-    page's): autoescaped, strict about undefined names, with the ``score`` filter."""
+    page's): autoescaped, strict about undefined names, with the ``score`` filter and those
+    of :mod:`app.reports.bounds` (``names``, ``first``, ``count``, ``and_more``; its limits
+    as ``bounds.PANELS``, ...)."""
     environment = Environment(
         loader=FileSystemLoader([*folders, TEMPLATES]),
         autoescape=select_autoescape(["html", "j2"]),
@@ -97,6 +107,14 @@ def template_environment(*folders: Path) -> Environment:
         lstrip_blocks=True,
     )
     environment.filters["score"] = score
+    # what a page shows of a long list: the first items and a count of the others
+    environment.filters["names"] = bounds.names
+    environment.filters["first"] = bounds.first
+    environment.filters["count"] = bounds.count
+    environment.filters["and_more"] = bounds.and_more
+    environment.globals["bounds"] = {
+        name: getattr(bounds, name) for name in ("NAMES", "PANELS", "CLASSES", "ATTRIBUTES", "ROWS")
+    }
     return environment
 
 
@@ -174,7 +192,7 @@ def _run(report: Report, view: RunView, plots: list[_Plot]) -> dict[str, Any]:
     run_plots.append(_plan(plots, "Instances per class", partial(figures.classes_figure, view)))
     confusions = []
     for row in board.rows[: report.confusions]:
-        if row.n_ok:
+        if row.n_ok and row.classifier in run.classifiers:  # imported results have none
             confusions.append(
                 _plan(
                     plots,
@@ -182,6 +200,7 @@ def _run(report: Report, view: RunView, plots: list[_Plot]) -> dict[str, Any]:
                     partial(figures.confusion_figure, view, row.classifier),
                 )
             )
+    sure = _how_sure(view, [row.classifier for row in board.rows[: report.confusions]], plots)
     config = dict(run.config)
     return {
         "id": run.id,
@@ -193,8 +212,11 @@ def _run(report: Report, view: RunView, plots: list[_Plot]) -> dict[str, Any]:
         "config": {key: config[key] for key in sorted(config)},
         "n_classifiers": len(run.classifiers),
         "tasks": f"{run.n_results} of {run.n_tasks}",
-        "header": leaderboard_header(board, columns),
-        "rows": leaderboard_rows(board, columns),
+        "header": leaderboard_header(board, columns, view.besides),
+        "rows": leaderboard_rows(board, columns, view.besides),
+        "beside_notes": beside_notes(view.besides),
+        "mark_column": 4 if view.besides else 3,
+        "sure": sure,
         "metric": board.metric,
         "baseline": board.baseline,
         "alpha": board.alpha,
@@ -203,6 +225,37 @@ def _run(report: Report, view: RunView, plots: list[_Plot]) -> dict[str, Any]:
         "confusions": confusions,
         "fold_note": ranked if isinstance(ranked, str) else None,
         "tables": run_tables(view.report()),
+    }
+
+
+def _how_sure(view: RunView, best: list[str], plots: list[_Plot]) -> dict[str, Any] | None:
+    """Per-class tables of the best classifiers, every classifier's calibration and the
+    reliability diagram; ``None`` for a run without classes or confusion matrices."""
+    if view.run.kind == "regression" or is_imported(view.run):
+        return None
+    own_run = set(view.run.classifiers)  # not the classifiers of runs beside it
+    own = [c for c in best if c in own_run and view.board.row(c).n_ok]
+    everyone = [r.classifier for r in view.board.rows if r.n_ok and r.classifier in own_run]
+    if not own:
+        return None
+    certainty = certainty_of(view, everyone)
+    chosen = certainty.model_copy(
+        update={"classifiers": [e for e in certainty.classifiers if e.classifier in own]}
+    )
+    diagram = []
+    if any(e.calibration is not None for e in certainty.classifiers):
+        diagram.append(
+            _plan(
+                plots,
+                "Reliability of the best classifiers with probabilities: accuracy of the top "
+                "label against its confidence, out of fold",
+                partial(figures.reliability_figure, certainty, len(own)),
+            )
+        )
+    return {
+        "classes": class_tables(chosen),
+        "calibration": calibration_table(certainty),
+        "plots": diagram,
     }
 
 

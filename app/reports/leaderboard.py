@@ -9,6 +9,7 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
+from app.services.beside import Beside, row_runs
 from app.store.runs import RunInfo
 from benchmark.evaluation.leaderboard import Leaderboard, LeaderboardRow
 
@@ -26,16 +27,27 @@ def metric_columns(run: RunInfo, board: Leaderboard) -> list[str]:
     return [c for c in columns if c in available or c == board.metric]
 
 
-def leaderboard_header(board: Leaderboard, columns: Sequence[str]) -> list[str]:
+def leaderboard_header(
+    board: Leaderboard, columns: Sequence[str], besides: Sequence[Beside] = ()
+) -> list[str]:
     notes = ["notes"] if any(row.n_failed for row in board.rows) else []
-    return ["#", "classifier", "", *columns, *notes]
+    run = ["run"] if besides else []
+    return ["#", "classifier", *run, "", *columns, *notes]
 
 
-def leaderboard_rows(board: Leaderboard, columns: Sequence[str]) -> list[tuple[Any, ...]]:
-    """Rank, classifier, mark and ``mean ± std`` per column, ready for a table."""
+def leaderboard_rows(
+    board: Leaderboard, columns: Sequence[str], besides: Sequence[Beside] = ()
+) -> list[tuple[Any, ...]]:
+    """Rank, classifier, (with runs beside: the run it comes from,) mark and
+    ``mean ± std`` per column, ready for a table.  With runs beside, a classifier that only
+    compares by its mean has ``=`` (means only) where a mark would be."""
+    origins = row_runs(besides)
     out = []
     for row in board.rows:
-        cells: list[Any] = [row.rank, row.classifier, _mark(row, board)]
+        cells: list[Any] = [row.rank, row.classifier]
+        if besides:
+            cells.append(origins.get(row.classifier, "this"))
+        cells.append(_mark(row, board, means_only=bool(besides)))
         for column in columns:
             value = row.metrics.get(column)
             cells.append(mean_std(value) if isinstance(value, tuple) else "-")
@@ -45,46 +57,72 @@ def leaderboard_rows(board: Leaderboard, columns: Sequence[str]) -> list[tuple[A
     return out
 
 
-def leaderboard_csv(board: Leaderboard, columns: Sequence[str]) -> str:
+def leaderboard_csv(
+    board: Leaderboard, columns: Sequence[str], besides: Sequence[Beside] = ()
+) -> str:
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
+    origins = row_runs(besides)
     header = ["rank", "classifier", "mark"]
     for column in columns:
         header += [f"{column}_mean", f"{column}_std"]
-    writer.writerow([*header, "n_ok", "n_failed"])
+    extra = ["run", "tested"] if besides else []
+    writer.writerow([*header, "n_ok", "n_failed", *extra])
     for row in board.rows:
         cells: list[Any] = [row.rank, row.classifier, row.mark]
         for column in columns:
             value = row.metrics.get(column)
             cells += list(value) if isinstance(value, tuple) else ["", ""]
-        writer.writerow([*cells, row.n_ok, row.n_failed])
+        more = [origins.get(row.classifier, ""), row.tested] if besides else []
+        writer.writerow([*cells, row.n_ok, row.n_failed, *more])
     return buffer.getvalue()
 
 
-def leaderboard_markdown(run: RunInfo, board: Leaderboard, columns: Sequence[str]) -> str:
+def beside_notes(besides: Sequence[Beside]) -> list[str]:
+    """One line per run beside: what it is, and how its classifiers compare."""
+    out = []
+    for beside in besides:
+        run = beside.run
+        name = f" ({run.config['name']})" if run.config.get("name") else ""
+        out.append(f"run {run.id}{name}, {run.fold_scheme}: {beside.note}")
+    if any(b.test == "means" for b in besides):
+        out.append("= : means only, no t-test (folds that do not pair with the baseline's)")
+    return out
+
+
+def leaderboard_markdown(
+    run: RunInfo, board: Leaderboard, columns: Sequence[str], besides: Sequence[Beside] = ()
+) -> str:
     marks = (
         f"marks against {board.baseline} (corrected resampled t-test, alpha 0.05): "
         "v better, * worse."
         if board.baseline
         else f"no task succeeded (run {run.status})."
     )
+    run_column = " run |" if besides else ""
     lines = [
         f"Run {run.id} on {run.dataset_name} ({', '.join(run.targets)}), "
         f"{run.fold_scheme}, ranked by {board.metric}; {marks}",
         "",
-        "| rank | classifier | | " + " | ".join(columns) + " |",
-        "|---:|---|:-:|" + "---:|" * len(columns),
+        "| rank | classifier |" + run_column + " | " + " | ".join(columns) + " |",
+        "|---:|---|" + ("---:|" if besides else "") + ":-:|" + "---:|" * len(columns),
     ]
-    for row in leaderboard_rows(board, columns):
-        rank, classifier, mark, *values = row[: 3 + len(columns)]
-        lines.append(f"| {rank} | {classifier} | {mark} | " + " | ".join(values) + " |")
+    lead = 4 if besides else 3
+    for row in leaderboard_rows(board, columns, besides):
+        cells = [str(cell) for cell in row[: lead + len(columns)]]
+        lines.append("| " + " | ".join(cells) + " |")
     v, same, worse = board.summary
     lines += ["", f"(v/ /*) = ({v}/{same}/{worse})"]
+    lines += [f"- {note}" for note in beside_notes(besides)]
     return "\n".join(lines) + "\n"
 
 
-def _mark(row: LeaderboardRow, board: Leaderboard) -> str:
-    return "(base)" if row.classifier == board.baseline else row.mark
+def _mark(row: LeaderboardRow, board: Leaderboard, *, means_only: bool = False) -> str:
+    if row.classifier == board.baseline:
+        return "(base)"
+    if means_only and not row.tested and board.baseline is not None:
+        return "="
+    return row.mark
 
 
 def mean_std(value: tuple[float, float]) -> str:

@@ -30,6 +30,7 @@ from matplotlib.figure import Figure
 from numpy.typing import ArrayLike
 
 from app.errors import AppError
+from app.reports.bounds import CLASSES, PANELS, first, of_all
 
 #: Output formats of :func:`save_figure`, by file suffix.
 FORMATS = ("svg", "png")
@@ -233,8 +234,9 @@ def confusion_figure(
     """
     if not matrices:
         raise AppError("no confusion matrix to plot")
-    targets = list(matrices)
-    sizes = [len(labels[t]) for t in targets]
+    shown = first(matrices, PANELS)
+    targets = shown.items
+    sizes = [min(len(labels[t]), CLASSES) for t in targets]
     side = max(3.2, min(9.0, 0.55 * max(sizes) + 1.6))
     figure = Figure(figsize=(side * len(targets), side + 0.5), layout="constrained")
     axes = figure.subplots(1, len(targets), squeeze=False)[0]
@@ -246,19 +248,60 @@ def confusion_figure(
             raise AppError(
                 f"confusion matrix of '{target}' has shape {counts.shape} for {len(names)} labels"
             )
-        totals = counts.sum(axis=1, keepdims=True)
+        totals = counts.sum(axis=1, keepdims=True)  # over every class, shown or not
         shares = np.divide(counts, totals, out=np.full_like(counts, np.nan), where=totals > 0)
+        classes = first(names, CLASSES)
+        names, n = classes.items, len(classes.items)
+        shares, counts = shares[:n, :n], counts[:n, :n]
         image = ax.imshow(shares, cmap="Blues", vmin=0.0, vmax=1.0)
         ax.set_xticks(range(len(names)), names, rotation=45, ha="right", rotation_mode="anchor")
         ax.set_yticks(range(len(names)), names)
         ax.set_xlabel("predicted")
         ax.set_ylabel("true")
-        if len(targets) > 1:
-            ax.set_title(target)
+        if len(targets) > 1 or classes.more:
+            ax.set_title(", ".join(filter(None, [target, of_all(classes, "classes")])))
         if len(names) <= MAX_ANNOTATED_CLASSES:
             _annotate_cells(ax, shares, counts)
     if image is not None:
         figure.colorbar(image, ax=list(axes), shrink=0.8, label="share of the true class")
+    _suptitle(figure, title, of_all(shown, "targets"))
+    return figure
+
+
+@_styled
+def reliability_diagram(
+    curves: Mapping[str, tuple[np.ndarray, np.ndarray, np.ndarray, float]],
+    *,
+    title: str,
+) -> Figure:
+    """Reliability diagram: accuracy against mean confidence per bin, one line per
+    classifier, the diagonal for perfect calibration, and the share of instances per bin.
+
+    Parameters
+    ----------
+    curves : mapping of str to (confidence, accuracy, count, ece)
+        Per classifier: mean confidence, accuracy and instances of each bin (ndarrays of
+        shape (n_bins,), NaN for empty bins) and its expected calibration error.
+    title : str
+    """
+    if not curves:
+        raise AppError("no calibration to plot")
+    figure = Figure(figsize=(6.4, 5.6), layout="constrained")
+    top, bottom = figure.subplots(2, 1, sharex=True, height_ratios=(3, 1))
+    top.plot([0, 1], [0, 1], linestyle="--", color=_LINE, linewidth=0.8, label="perfect")
+    n_bins = 1
+    for name, (confidence, accuracy, count, ece) in curves.items():
+        shown = count > 0
+        top.plot(confidence[shown], accuracy[shown], marker="o", label=f"{name} (ECE {ece:.3f})")
+        n_bins = count.size
+        centres = (np.arange(n_bins) + 0.5) / n_bins
+        bottom.plot(centres, count / max(count.sum(), 1.0), marker=".", label=name)
+    top.set_xlim(0, 1)
+    top.set_ylim(0, 1)
+    top.set_ylabel("accuracy of the top label")
+    top.legend(loc="upper left", fontsize=8)
+    bottom.set_xlabel("confidence of the top label")
+    bottom.set_ylabel("share")
     _suptitle(figure, title)
     return figure
 
@@ -287,7 +330,8 @@ def per_target_figure(
         leaderboard's), error bars one standard deviation.
     """
     classifiers = list(summary)
-    targets = list(dict.fromkeys(t for by_target in summary.values() for t in by_target))
+    shown = first(dict.fromkeys(t for by_target in summary.values() for t in by_target), PANELS)
+    targets = shown.items
     if not classifiers or not targets:
         raise AppError("no per-target scores to plot")
     figure = Figure(
@@ -316,7 +360,7 @@ def per_target_figure(
         ax.set_axisbelow(True)
     axes[0].set_yticks(rows, classifiers)
     axes[0].set_ylim(len(classifiers) - 0.5, -0.5)
-    _suptitle(figure, title)
+    _suptitle(figure, title, of_all(shown, "targets"))
     return figure
 
 
@@ -330,16 +374,18 @@ def class_distribution_figure(counts: Mapping[str, Mapping[str, int]], *, title:
         target -> label -> number of instances (labels in the schema's order).
     title : str
     """
-    targets = list(counts)
+    shown = first(counts, PANELS)
+    targets = shown.items
     if not targets:
         raise AppError("no class counts to plot")
-    most = max(len(counts[t]) for t in targets)
+    most = max(min(len(counts[t]), CLASSES) for t in targets)
     figure = Figure(figsize=(3.6 * len(targets) + 0.6, 1.2 + 0.3 * most), layout="constrained")
     axes = figure.subplots(1, len(targets), squeeze=False)[0]
     for ax, target in zip(axes, targets, strict=True):
-        names = list(counts[target])
+        total = sum(int(value) for value in counts[target].values())
+        classes = first(counts[target], CLASSES)
+        names = classes.items
         values = [int(counts[target][name]) for name in names]
-        total = sum(values)
         rows = np.arange(len(names))
         ax.barh(rows, values, color=_MUTED, edgecolor=_ACCENT)
         ax.set_yticks(rows, names)
@@ -348,16 +394,18 @@ def class_distribution_figure(counts: Mapping[str, Mapping[str, int]], *, title:
             share = f" ({value / total:.0%})" if total else ""
             ax.text(value, row, f" {value}{share}", va="center", ha="left")
         ax.set_xlim(0, max([*values, 1]) * 1.35)
-        ax.set_title(f"{target} ({total} instances)")
+        shown_classes = f"; {of_all(classes, 'classes')}" if classes.more else ""
+        ax.set_title(f"{target} ({total} instances{shown_classes})")
         ax.set_xlabel("instances")
-    _suptitle(figure, title)
+    _suptitle(figure, title, of_all(shown, "targets"))
     return figure
 
 
-def _suptitle(figure: Figure, title: str) -> None:
-    """A figure title wrapped to the figure's width (about 13 characters an inch at 9 pt)."""
+def _suptitle(figure: Figure, title: str, shown: str = "") -> None:
+    """A figure title wrapped to the figure's width (about 13 characters an inch at 9 pt),
+    saying what is ``shown`` of all there is ("first 6 of 800 targets") when not empty."""
     width = int(figure.get_figwidth() * 13)
-    figure.suptitle(textwrap.fill(title, width=max(width, 20)))
+    figure.suptitle(textwrap.fill(f"{title} ({shown})" if shown else title, width=max(width, 20)))
 
 
 def svg_text(figure: Figure, *, inline: bool = False) -> str:

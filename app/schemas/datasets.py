@@ -9,6 +9,7 @@ from typing import Any, Literal
 from pydantic import Field, field_validator
 
 from app.schemas.base import Request, Schema
+from app.schemas.names import DatasetName
 
 FileFormat = Literal["arff", "csv"]
 
@@ -28,8 +29,8 @@ class ImportRequest(Request):
     """The CLI's ``import`` and ``POST /api/datasets``: an ARFF or CSV file to a data set."""
 
     file: Path = Field(description="The file to read.")
-    name: str | None = Field(
-        default=None, max_length=200, description="Name in the store (default: the file's stem)."
+    name: DatasetName | None = Field(
+        default=None, description="Name in the store (default: the file's stem)."
     )
     targets: int | list[str] | None = Field(
         default=None,
@@ -119,6 +120,12 @@ class DatasetDescription(Schema):
     class_distribution: dict[str, dict[str, int]]
     missing_values: int
     notes: list[str]
+
+
+class RenameRequest(Request):
+    """``POST /api/datasets/{id}/rename`` and the CLI's ``rename``: a data set's new name."""
+
+    name: DatasetName = Field(description="The new name.")
 
 
 class RenameResult(Schema):

@@ -6,20 +6,27 @@ from __future__ import annotations
 # Imports inside functions: start-up time: the feature stack (numpy, scipy) loads when an
 # extraction request is checked, not when a command that never extracts starts.
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any, Literal
 
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from app.errors import FieldError
 from app.schemas.base import Request, Schema
+from app.schemas.names import DatasetName
 
 if TYPE_CHECKING:
     from features.recipe import Recipe
 
+#: Suffixes of CSV time series (their `fields` are columns, not a bag topic's fields).
+CSV_SUFFIXES = frozenset({".csv", ".tsv", ".txt"})
 #: The extractor used when none is asked for.
 DEFAULT_EXTRACTOR = "uc3m-audio"
 #: Recordings one extraction may read.
 MAX_RECORDINGS = 1000
+#: Field paths one bag topic may be read for.
+MAX_FIELDS = 100
+#: Channels of raw PCM audio (audio_common's AudioInfo holds them in a uint8).
+MAX_CHANNELS = 255
 #: A day, in seconds: the longest segment or event one may ask for.
 MAX_SECONDS = 86400.0
 
@@ -52,25 +59,42 @@ class ExtractRequest(Request):
         max_length=100,
         description="Options of the extractor and of the event detector, in one mapping.",
     )
-    name: str | None = Field(default=None, max_length=200, description="Data set name.")
+    name: DatasetName | None = Field(default=None, description="Data set name.")
     samplerate: float | None = Field(
         default=None, gt=0, le=1e9, description="Sample rate (Hz) of files that carry none."
     )
     segment: float | None = Field(
         default=None, gt=0, le=MAX_SECONDS, description="Segment seconds for events 'none'."
     )
-    topic: str | None = Field(default=None, max_length=200, description="Audio topic of bags.")
+    topic: str | None = Field(
+        default=None,
+        max_length=200,
+        description="Topic of ROS bags to read: its audio, or its numeric fields.",
+    )
+    fields: list[Annotated[str, Field(min_length=1, max_length=200)]] | None = Field(
+        default=None,
+        min_length=1,
+        max_length=MAX_FIELDS,
+        description=(
+            "Numeric fields of `topic` (pdc, pac, wrench.force), or columns of CSV "
+            "recordings (names or 1-based numbers), read as channels."
+        ),
+    )
     time_column: str | None = Field(
         default=None,
         min_length=1,
         max_length=200,
         description="The time column of CSV recordings, when it has none of the usual names.",
     )
-    channels: list[Annotated[str, Field(min_length=1, max_length=200)]] | None = Field(
+    channels: int | None = Field(
         default=None,
-        min_length=1,
-        max_length=1000,
-        description="The CSV columns to read as channels (names or 1-based numbers).",
+        ge=1,
+        le=MAX_CHANNELS,
+        description="Channels of raw PCM audio in bags without an AudioInfo topic.",
+    )
+    sample_format: Literal["S16LE", "S32LE", "F32LE"] | None = Field(
+        default=None,
+        description="Sample format of raw PCM audio in bags without an AudioInfo topic.",
     )
     max_event: float | None = Field(
         default=None, ge=0.001, le=MAX_SECONDS, description="Longest event in seconds."
@@ -79,8 +103,17 @@ class ExtractRequest(Request):
         default=None, description="The service's folder holding an upload's files."
     )
 
+    @field_validator("sample_format", mode="before")
+    @classmethod
+    def _upper_case(cls, value: object) -> object:
+        return value.strip().upper() if isinstance(value, str) else value
+
     @model_validator(mode="after")
     def _checked_recipe(self) -> ExtractRequest:
+        # Fields of a bag belong to a topic; a CSV file's are its columns.
+        csv_only = all(path.suffix.lower() in CSV_SUFFIXES for path in self.recordings)
+        if self.fields and self.topic is None and not csv_only:
+            raise FieldError("fields", "needs `topic`: the bag topic the fields belong to")
         self.recipe()
         return self
 

@@ -20,13 +20,17 @@ JOB_REQUESTS: dict[JobKind, type[Request]] = {"extract": ExtractRequest, "train"
 JobStatus = Literal["queued", "running", "cancelling", "done", "failed", "cancelled", "interrupted"]
 
 
+#: Params that are the service's own business: where an upload was saved, which host's
+#: workers may take the job.
+_SERVICE_ONLY = frozenset({"folder", "host"})
+
+
 class JobSchema(Schema):
     id: int
     kind: JobKind
     status: JobStatus
     params: dict[str, Any] = Field(
-        description="What the job was asked to do: its request (TrainRequest, ExtractRequest) "
-        "and the host whose workers may take it."
+        description="What the job was asked to do: its request (TrainRequest, ExtractRequest)."
     )
     result: dict[str, Any] | None = Field(
         default=None, description="extract: the new data set; train: the new model."
@@ -38,8 +42,9 @@ class JobSchema(Schema):
 
     def for_client(self) -> JobSchema:
         """The job as the API shows it: without the service's own folder of an upload (the
-        client knows its files by their names)."""
-        params = {key: value for key, value in self.params.items() if key != "folder"}
+        client knows its files by their names) and the host whose workers may take it
+        (the service's machine is not the client's business)."""
+        params = {key: value for key, value in self.params.items() if key not in _SERVICE_ONLY}
         return self.model_copy(update={"params": params})
 
 

@@ -4,12 +4,13 @@ them and the API answers them."""
 from __future__ import annotations
 
 from datetime import datetime
-from typing import Any
+from typing import Any, Literal
 
 from pydantic import ConfigDict, Field, model_validator
 
 from app.errors import FieldError
 from app.schemas.base import Request, Schema
+from app.schemas.names import ModelName
 
 #: The largest id or seed (the store's integer columns are 32-bit on PostgreSQL).
 MAX_ID = 2**31 - 1
@@ -68,12 +69,34 @@ class PredictionReport(Schema):
     warnings: list[str] = Field(
         default_factory=list, description="What was changed or counted, and where."
     )
+    missing: dict[str, int] = Field(
+        default_factory=dict,
+        description="JSON instances: per attribute the model needs, the instances that gave "
+        'it no value (null, or left out under "missing": "allow"); attributes that '
+        "every instance gave are not listed.",
+    )
+
+
+#: What a prediction does with an instance that leaves out attributes the model needs:
+#: ``refuse`` it, as a file without the model's columns is refused, or ``allow`` it, the
+#: attributes left out being missing values.
+MissingPolicy = Literal["refuse", "allow"]
 
 
 class PredictRequest(Request):
-    """``POST /api/models/{id}/predict``: instances as attribute -> value, matched by name."""
+    """``POST /api/models/{id}/predict``: instances as attribute -> value, matched by name.
+
+    Every instance gives every attribute the model needs (``null`` for a value it does not
+    know) unless ``missing`` is ``allow``: a misspelt attribute would otherwise become a
+    missing value, and the prediction confident nonsense.
+    """
 
     instances: list[dict[str, float | int | str | None]] = Field(min_length=1, max_length=10000)
+    missing: MissingPolicy = Field(
+        default="refuse",
+        description="refuse: an instance that leaves out an attribute the model needs is "
+        "refused; allow: it is a missing value (the answer counts them per attribute).",
+    )
 
 
 class TrainRequest(Request):
@@ -90,8 +113,8 @@ class TrainRequest(Request):
     run: int | None = Field(
         default=None, ge=1, le=MAX_ID, description="Train the best classifier of this run."
     )
-    name: str | None = Field(
-        default=None, max_length=200, description="Model name (default: DATASET-CLASSIFIER)."
+    name: ModelName | None = Field(
+        default=None, description="Model name (default: DATASET-CLASSIFIER)."
     )
     seed: int = Field(default=0, ge=0, le=MAX_ID, description="Seed of the classifier.")
 

@@ -83,6 +83,14 @@ class LeaderboardRowSchema(Schema):
     n_ok: int
     n_failed: int
     errors: list[str]
+    tested: bool = Field(
+        default=False,
+        description="Whether the t-test compared it with the baseline (false: the baseline, "
+        "or a run beside whose folds do not pair with the baseline's: means only).",
+    )
+    run_id: int | None = Field(
+        default=None, description="The run beside this one that the classifier comes from."
+    )
 
 
 class MarkSummary(Schema):
@@ -116,6 +124,30 @@ class TunedComparisonSchema(Schema):
     choices: list[FoldChoiceSchema]
 
 
+#: How a run beside another is compared with it: ``paired`` (the same folds: the
+#: corrected t-test is a paired test), ``by fold number`` (same data set, target, k and
+#: repeats, but another fold assignment, e.g. WEKA's: the t-test pairs folds by number, an
+#: approximation), ``means`` (folds that do not match: means only, no test).
+BesideTest = Literal["paired", "by fold number", "means"]
+
+
+class BesideSchema(Schema):
+    """A run whose classifiers a leaderboard shows beside its own run's."""
+
+    run_id: int
+    name: str | None = Field(description="An imported run's name (the paper, the file).")
+    origin: Literal["touchbench", "imported"]
+    folds: str = Field(description="How that run's folds were made.")
+    n_folds: int
+    n_repeats: int
+    test: BesideTest
+    note: str = Field(description="Why the folds pair, or why they do not.")
+    classifiers: dict[str, str] = Field(
+        description="That run's classifier ids -> the names its rows have here (renamed "
+        "when the leaderboard's run has the same id)."
+    )
+
+
 class LeaderboardSchema(Schema):
     """A run's ranked classifiers with WEKA's significance marks."""
 
@@ -142,6 +174,11 @@ class LeaderboardSchema(Schema):
     choices: list[FoldChoiceSchema] = Field(
         default_factory=list,
         description="What each tuned twin and stack chose per fold (`tune`, `stack`).",
+    )
+    beside: list[BesideSchema] = Field(
+        default_factory=list,
+        description="Runs whose classifiers are ranked beside this run's (`beside`), and "
+        "how each is compared: t-test on paired folds, or means only.",
     )
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Literal
 
 import numpy as np
@@ -29,6 +29,8 @@ from app.schemas.compare import (
     NemenyiOut,
     PairOut,
 )
+from app.services.beside import besides, merged_results
+from app.services.imported import is_imported
 from app.store.database import Store
 from app.store.runs import RunInfo, get_run, load_results
 from benchmark.errors import ConfigurationError
@@ -203,11 +205,27 @@ def compare_runs(
     """
     if not run_refs:
         raise ConfigurationError("give at least one run to compare")
-    runs = [get_run(store, ref) for ref in run_refs]
+    runs, besides_of = with_besides([get_run(store, ref) for ref in run_refs])
     _check_distinct(runs)
     metric = metric or default_metric([run.kind for run in runs])
     lower = metric in LOWER_IS_BETTER
-    scores = [run_scores(run, metric, load_results(store, run.id)) for run in runs]
+    scores = []
+    beside_notes: list[str] = []
+    for run in runs:
+        others = besides(run, besides_of.get(run.id, []))
+        results, _ = merged_results(
+            load_results(store, run.id), [(b, load_results(store, b.run.id)) for b in others]
+        )
+        names = [name for b in others for name in b.names.values()]
+        scores.append(
+            run_scores(replace(run, classifiers=[*run.classifiers, *names]), metric, results)
+        )
+        beside_notes += [
+            f"run {b.run.id} ({b.run.config.get('name') or b.run.fold_scheme}) joins "
+            f"run {run.id} (same data set and target); as for their folds: {b.note}"
+            for b in others
+        ]
+    runs = [s.run for s in scores]
     shared = [c for c in runs[0].classifiers if all(c in run.classifiers for run in runs[1:])]
     not_shared = sorted({c for run in runs for c in run.classifiers} - set(shared))
     if len(shared) < 2:
@@ -215,7 +233,7 @@ def compare_runs(
             f"the runs share {len(shared)} classifier(s) ({', '.join(shared) or 'none'}): "
             "a comparison needs at least 2"
         )
-    notes = [
+    notes = beside_notes + [
         f"run {run.id} is {run.status}: {run.n_results} of {run.n_tasks} tasks have results"
         for run in runs
         if run.status != "done"
@@ -261,6 +279,28 @@ def compare_runs(
         pair=bayes,
         notes=notes,
     )
+
+
+def with_besides(runs: Sequence[RunInfo]) -> tuple[list[RunInfo], dict[int, list[RunInfo]]]:
+    """The runs that are blocks, and the imported runs that join a block of the same data
+    set and targets (a paper's results beside ours) by the block's run id."""
+    primary: list[RunInfo] = []
+    joined: dict[int, list[RunInfo]] = {}
+    for run in sorted(runs, key=is_imported):  # ours first: an imported run joins ours
+        host = next(
+            (
+                p
+                for p in primary
+                if is_imported(run) and (p.dataset_id, p.targets) == (run.dataset_id, run.targets)
+            ),
+            None,
+        )
+        if host is None or host.id == run.id:
+            primary.append(run)
+        else:
+            joined.setdefault(host.id, []).append(run)
+    order = {run.id: i for i, run in enumerate(runs)}
+    return sorted(primary, key=lambda run: order[run.id]), joined
 
 
 def _check_distinct(runs: Sequence[RunInfo]) -> None:

@@ -34,8 +34,11 @@ from app.schemas.datasets import (
     FileFormat,
     ImportRequest,
     ImportResult,
+    RenameRequest,
     RenameResult,
 )
+from app.services.limits import check_dataset_size
+from app.services.listing import summary
 from app.store import datasets as stored
 from app.store.database import Store
 from app.store.datasets import DatasetInfo, DatasetInMemory, InstanceSource
@@ -53,26 +56,6 @@ ImportProgress = Callable[[str, int, int], None]
 def guess_format(path: Path) -> FileFormat:
     """``csv`` for ``.csv``, ``.tsv`` and ``.txt`` files, else ``arff``."""
     return "csv" if path.suffix.lower() in {".csv", ".tsv", ".txt"} else "arff"
-
-
-def summary(info: DatasetInfo) -> DatasetSummary:
-    """The listing of a stored data set as the CLI and the API show it."""
-    return DatasetSummary(
-        id=info.id,
-        name=info.name,
-        relation=info.relation,
-        n_instances=info.n_instances,
-        n_features=info.n_features,
-        targets=info.targets,
-        source=info.source_name,
-        sha256=info.sha256,
-        created_at=info.created_at,
-    )
-
-
-def list_datasets(store: Store) -> list[DatasetSummary]:
-    """Every stored data set, oldest first."""
-    return [summary(info) for info in stored.list_datasets(store)]
 
 
 # ---------------------------------------------------------------------------------- import
@@ -104,7 +87,8 @@ def import_file(
     ------
     DataFormatError
         If the file is not a regular file, not text, or not valid ARFF/CSV; if it holds
-        no instances or infinite values; if it leaves no feature.  Nothing is stored.
+        no instances or infinite values; if it leaves no feature, or has more targets or
+        attributes than :mod:`app.services.limits` allows.  Nothing is stored.
     FieldError
         If the name is invalid.
     ConflictError
@@ -188,6 +172,9 @@ def _open_data(
 
 
 def _check_schema(schema: Schema, source: str, notes: list[str]) -> None:
+    check_dataset_size(
+        n_targets=len(schema.target_indices), n_attributes=schema.n_attributes, source=source
+    )
     if not schema.feature_indices:
         raise DataFormatError(
             "no features: every attribute is a target "
@@ -488,9 +475,9 @@ def _umask() -> int:
 # ------------------------------------------------------------------------- rename, delete
 
 
-def rename_dataset(store: Store, ref: str | int, new_name: str) -> RenameResult:
-    """Give a data set another name (unique, see :func:`~app.store.naming.check_name`)."""
-    info, previous = stored.rename_dataset(store, ref, new_name)
+def rename_dataset(store: Store, ref: str | int, request: RenameRequest) -> RenameResult:
+    """Give a data set another name (unique, see :func:`~app.schemas.names.check_name`)."""
+    info, previous = stored.rename_dataset(store, ref, request.name)
     return RenameResult(id=info.id, name=info.name, previous_name=previous)
 
 
@@ -500,15 +487,20 @@ def delete_dataset(store: Store, ref: str | int) -> DatasetSummary:
     return summary(stored.delete_dataset(store, ref))
 
 
-def read_data_file(path: Path, file_format: FileFormat | None = None) -> Dataset:
+def read_data_file(
+    path: Path, file_format: FileFormat | None = None, *, source: str | None = None
+) -> Dataset:
     """An ARFF or CSV file read into memory (to predict it; nothing is stored).
+
+    ``source`` is what messages call the file: an upload's own name, not the service's
+    copy of it (``path`` by default).
 
     Raises
     ------
     DataFormatError
         No such regular file, or a file that is not valid ARFF/CSV (with its line).
     """
-    check_regular_file(path)
+    check_regular_file(path)  # an upload is always a regular file: its path is never shown
     if (file_format or guess_format(path)) == "csv":
-        return read_csv(path, targets=None)
-    return read_arff(path)
+        return read_csv(path, targets=None, source=source)
+    return read_arff(path, source=source)

@@ -37,10 +37,12 @@ from typing import Any
 import numpy as np
 
 from app.schemas.extraction import ExtractionSummary, ExtractRequest
+from app.services.limits import check_dataset_size
 from app.store.database import Store
 from app.store.datasets import add_dataset, check_dataset_name, dataset_digest
 from benchmark.dataset import Attribute, Dataset, Schema
 from benchmark.errors import DataFormatError
+from benchmark.io.csv import csv_problem
 from drivers.replay import CSV_SUFFIXES, FileReplaySource
 from features.errors import FeatureError
 from features.extractors import Instances
@@ -115,9 +117,11 @@ def extract_dataset(
     segment: float | None = None,
     options: Mapping[str, Any] | None = None,
     topic: str | None = None,
+    fields: Sequence[str] | None = None,
+    channels: int | None = None,
+    sample_format: str | None = None,
     max_event: float | None = None,
     time_column: str | None = None,
-    channels: Sequence[str] | None = None,
     on_progress: Callable[[str, float], None] | None = None,
 ) -> ExtractionResult:
     """Turn recordings into a labelled data set, each recording read block by block.
@@ -144,11 +148,17 @@ def extract_dataset(
     options : mapping, optional
         Options of the extractor and of the event detector, in one flat mapping.
     topic : str, optional
-        The audio topic of ROS bags.
+        The topic of ROS bags to read: audio, or numeric fields.
+    fields : sequence of str, optional
+        Numeric fields of ``topic``, or columns of CSV recordings (names or 1-based
+        numbers), to read as channels.
+    channels, sample_format : optional
+        Raw PCM audio in bags without ``AudioInfo``: channels per frame and
+        ``S16LE``/``S32LE``/``F32LE``.
     max_event : float, optional
         Longest event in seconds (default 60); longer ones are cut, with a warning.
-    time_column, channels : optional
-        The time column of CSV recordings and the columns to read as channels.
+    time_column : str, optional
+        The time column of CSV recordings.
     on_progress : callable, optional
         Called as ``on_progress(file_name, seconds_read)`` after every block.
 
@@ -177,25 +187,30 @@ def extract_dataset(
     warnings: list[str] = []
     shape: tuple[float, int] | None = None
     names: tuple[str, ...] | None = None
+    grid = samplerate
 
-    def open_source(path: Path, first_rate: float | None) -> FileReplaySource:
-        # Jittered stamps give each file a slightly different median rate: without a rate
-        # given, later CSV files are read onto the first one's grid, so that they agree.
-        rate_given = samplerate
-        if rate_given is None and path.suffix.lower() in CSV_SUFFIXES:
-            rate_given = first_rate
+    def open_source(path: Path) -> FileReplaySource:
         return FileReplaySource(
-            path, samplerate=rate_given, topic=topic, time_column=time_column, channels=channels
+            path,
+            samplerate=grid,
+            topic=topic,
+            fields=fields,
+            channels=channels,
+            sample_format=sample_format,
+            time_column=time_column,
         )
 
     for index, path in enumerate(paths):
-        with open_source(path, None if shape is None else shape[0]) as source:
+        with open_source(path) as source:
             shape = _same_shape(shape, (source.samplerate, source.n_channels), path)
             names = _same_names(names, source.channel_names, path, first=index == 0)
+            if grid is None and source.resampled:
+                # Stamped recordings go on the first one's grid: one data set, one rate.
+                grid = source.samplerate
             if index == 0:
                 longest = None
                 if recipe.needs_longest():
-                    longest = _longest(paths, lambda p: open_source(p, source.samplerate))
+                    longest = _longest(paths, open_source)
                 recipe, filled = _at_rate(recipe, source.samplerate, longest, path)
                 notes += filled
             parts = _extract_one(recipe, source, path, on_progress)
@@ -226,6 +241,11 @@ def extract_dataset(
                 f"none of the {n_events} instance(s) found falls inside a labelled interval",
                 source=table.source,
             )
+    check_dataset_size(
+        n_targets=len(target_attributes),
+        n_attributes=len(target_attributes) + len(feature_names),
+        source=labels.name if labels is not None else paths[0].name,
+    )
     schema = Schema(
         relation=(
             f"{dataset_name}: -C {len(target_attributes)}" if target_attributes else dataset_name
@@ -286,13 +306,14 @@ def extract_with_recipe(path: Path, recipe: Mapping[str, Any]) -> ExtractionResu
         options=options,
         max_event=recipe.get("max_event"),
         # A CSV read by name: the columns the model was trained on, in its order.
-        channels=channels if channels and path.suffix.lower() in CSV_SUFFIXES else None,
+        fields=channels if channels and path.suffix.lower() in CSV_SUFFIXES else None,
     )
 
 
 def check_extraction(store: Store, request: ExtractRequest) -> None:
     """Refuse what can be refused before any recording is read: the request checked its
-    extractor, event detection and options when it was made; here, the data set's name.
+    extractor, event detection and options when it was made; here, the data set's name
+    and the number of targets the labels file declares.
 
     Raises
     ------
@@ -300,9 +321,16 @@ def check_extraction(store: Store, request: ExtractRequest) -> None:
         An invalid name.
     ConflictError
         The name is taken.
+    DataFormatError
+        The labels file declares more targets than :mod:`app.services.limits` allows.
     """
     if request.name is not None:
         check_dataset_name(store, request.name)
+    labels = request.labels_path()
+    if labels is not None and request.labels is not None:
+        # the header alone says how many targets: a file declaring thousands is refused
+        # before a job reads any recording
+        check_dataset_size(n_targets=count_label_targets(labels), source=str(request.labels))
 
 
 def extract_and_store(
@@ -334,9 +362,11 @@ def extract_and_store(
         segment=request.segment,
         options=request.options,
         topic=request.topic,
+        fields=request.fields,
+        channels=request.channels,
+        sample_format=request.sample_format,
         max_event=request.max_event,
         time_column=request.time_column,
-        channels=request.channels,
         on_progress=on_progress,
     )
     data = result.dataset
@@ -475,15 +505,16 @@ def _same_shape(
 
 
 def _same_names(
-    expected: tuple[str, ...] | None, found: tuple[str, ...] | None, path: Path, *, first: bool
+    expected: tuple[str, ...] | None, found: Sequence[str] | None, path: Path, *, first: bool
 ) -> tuple[str, ...] | None:
     """One list of channel names for every recording (the features are named after it)."""
-    if not first and found != expected:
+    names = None if found is None else tuple(found)
+    if not first and names != expected:
         raise FeatureError(
-            f"{path}: has channels {_few(found or ('unnamed',))} but the recordings before it "
+            f"{path}: has channels {_few(names or ('unnamed',))} but the recordings before it "
             f"{_few(expected or ('unnamed',))}; one data set needs the same channels"
         )
-    return found
+    return names
 
 
 def _more(lines: Sequence[str]) -> str:
@@ -497,6 +528,21 @@ def _few(names: Sequence[str], shown: int = 3) -> str:
     return text + (f" and {len(names) - shown} more" if len(names) > shown else "")
 
 
+def count_label_targets(path: Path) -> int:
+    """How many target columns the header of a labels CSV names (the file is read up to
+    its first non-empty row only; a file that cannot be read counts 0, and
+    :func:`read_labels` says what is wrong with it)."""
+    try:
+        with Path(path).open(newline="", encoding="utf-8-sig") as handle:
+            for row in csv.reader(handle):
+                if any(cell.strip() for cell in row):
+                    special = {"file", "start", "end"}
+                    return sum(1 for cell in row if cell.strip().lower() not in special)
+    except (OSError, UnicodeDecodeError, csv.Error):
+        pass
+    return 0
+
+
 def read_labels(path: Path) -> LabelTable:
     """Parse a labels CSV (see the module docstring).
 
@@ -507,13 +553,16 @@ def read_labels(path: Path) -> LabelTable:
         twice, or overlapping intervals of one file; with the line number.
     """
     source = str(path)
+    lines: list[tuple[int, list[str]]] = []
     try:
         with Path(path).open(newline="", encoding="utf-8-sig") as handle:
-            lines = list(enumerate(csv.reader(handle), 1))
+            lines.extend(enumerate(csv.reader(handle), 1))
     except FileNotFoundError:
         raise DataFormatError("no such labels file", source=source) from None
     except (OSError, UnicodeDecodeError) as error:
         raise DataFormatError(f"cannot read the labels file: {error}", source=source) from None
+    except csv.Error as error:
+        raise DataFormatError(csv_problem(error), source=source, line=len(lines) + 1) from None
     lines = [(number, row) for number, row in lines if any(cell.strip() for cell in row)]
     if not lines:
         raise DataFormatError("the labels file is empty", source=source)

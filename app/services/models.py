@@ -19,7 +19,12 @@ from typing import Any
 import numpy as np
 
 from app.errors import ConflictError, FieldError
-from app.schemas.models import PredictionReport, PredictionRow, TrainRequest
+from app.schemas.models import (
+    MissingPolicy,
+    PredictionReport,
+    PredictionRow,
+    TrainRequest,
+)
 from app.services.datasets import read_data_file
 from app.store.database import Store
 from app.store.datasets import find_dataset, load_dataset
@@ -326,41 +331,62 @@ def is_recording(path: Path, schema: Schema) -> bool:
 
 
 def predict_records(
-    store: Store, model_ref: str | int, records: Sequence[Mapping[str, Any]]
+    store: Store,
+    model_ref: str | int,
+    records: Sequence[Mapping[str, Any]],
+    *,
+    missing: MissingPolicy = "refuse",
 ) -> PredictionReport:
     """Predict instances given as attribute -> value mappings (the API's JSON body).
 
-    Numeric attributes take numbers, nominal ones their labels as text; a missing key or
-    ``null`` is a missing value.
+    Numeric attributes take numbers, nominal ones their labels as text; ``null`` is a
+    missing value, and so is a key left out when the request allows it.
     """
     info, model = load_model(store, model_ref)
-    return records_report(info, model, records)
+    return records_report(info, model, records, missing=missing)
 
 
 def records_report(
-    info: ModelInfo, model: TrainedModel, records: Sequence[Mapping[str, Any]]
+    info: ModelInfo,
+    model: TrainedModel,
+    records: Sequence[Mapping[str, Any]],
+    *,
+    missing: MissingPolicy = "refuse",
 ) -> PredictionReport:
     """The prediction report of a loaded model for JSON-like records (see
-    :func:`predict_records`)."""
-    return predict(model, dataset_from_records(model.schema, records), source="instances").report(
-        info
-    )
+    :func:`predict_records`), with the missing values counted per attribute."""
+    data = dataset_from_records(model.schema, records, missing=missing)
+    report = predict(model, data, source="instances").report(info)
+    counts = np.isnan(data.values).sum(axis=0)
+    report.missing = {
+        attribute.name: int(count)
+        for attribute, count in zip(data.schema.attributes, counts, strict=True)
+        if count
+    }
+    return report
 
 
-def dataset_from_records(schema: Schema, records: Sequence[Mapping[str, Any]]) -> Dataset:
+def dataset_from_records(
+    schema: Schema, records: Sequence[Mapping[str, Any]], *, missing: MissingPolicy = "refuse"
+) -> Dataset:
     """A data set with ``schema``'s features (no targets) from JSON-like records.
 
     Numeric attributes take numbers; nominal ones take their labels as text (a label the
-    model never saw is kept, so that :func:`align_features` can say so); a missing key or
-    ``null`` is a missing value.
+    model never saw is kept, so that :func:`align_features` can say so); ``null`` is a
+    missing value, and so is a key left out if ``missing`` is ``"allow"``.
 
     Raises
     ------
+    FieldError
+        ``missing`` is ``"refuse"`` and an instance leaves out attributes the model
+        needs: the first such instance, naming a few of them.
     DataFormatError
         A value of the wrong kind, naming the instance and attribute; records that share
         no attribute with the model.
     """
     features = schema.features
+    if missing == "refuse":
+        _refuse_left_out(features, records)
     given = {key for record in records for key in record}
     if given and not given & {a.name for a in features}:
         raise DataFormatError(
@@ -405,6 +431,28 @@ def dataset_from_records(schema: Schema, records: Sequence[Mapping[str, Any]]) -
     return Dataset(schema=out_schema, values=values, name="instances")
 
 
+def _refuse_left_out(features: Sequence[Attribute], records: Sequence[Mapping[str, Any]]) -> None:
+    """Refuse the first record that leaves out attributes of ``features`` (the JSON twin of
+    a file without some of the model's columns, which :func:`align_features` refuses)."""
+    for i, record in enumerate(records):
+        if all(a.name in record for a in features):
+            continue
+        left_out = [a.name for a in features if a.name not in record]
+        if left_out:
+            raise FieldError(
+                f"instances.{i}",
+                f"instance {i + 1} {_lacks(left_out)} (give null for a value not known, or "
+                'set `missing` to "allow" to read left-out attributes as missing values)',
+            )
+
+
+def _lacks(names: Sequence[str]) -> str:
+    """``lacks N attribute(s) the model needs: a, b, ...``, naming the first five."""
+    shown = ", ".join(shorten(name) for name in names[:5])
+    more = f", ... ({len(names)} in all)" if len(names) > 5 else ""
+    return f"lacks {len(names)} attribute(s) the model needs: {shown}{more}"
+
+
 def _is_finite_number(cell: object) -> bool:
     """A JSON number that fits a float64 and is finite (booleans are not numbers)."""
     if isinstance(cell, bool) or not isinstance(cell, int | float):
@@ -434,12 +482,7 @@ def align_features(
     by_name = {a.name: i for i, a in enumerate(given)}
     missing = [a.name for a in schema.features if a.name not in by_name]
     if missing:
-        shown = ", ".join(missing[:5]) + (
-            f", ... ({len(missing)} in all)" if len(missing) > 5 else ""
-        )
-        raise DataFormatError(
-            f"lacks {len(missing)} attribute(s) the model needs: {shown}", source=source
-        )
+        raise DataFormatError(_lacks(missing), source=source)
     X = np.empty((data.n_instances, len(schema.features)))
     for j, attribute in enumerate(schema.features):
         theirs = data.schema.attributes[by_name[attribute.name]]

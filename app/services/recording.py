@@ -19,6 +19,7 @@ from pathlib import Path
 import soundfile
 
 from app.errors import AppError
+from benchmark.io.csv import csv_problem
 from drivers.errors import DriverError
 from drivers.sound import SoundDeviceSource
 from features.event_streams import open_event_stream
@@ -102,8 +103,11 @@ def record_take(
 def _check_header(labels_path: Path, targets: list[str]) -> list[str]:
     header = ["file", *targets]
     if labels_path.exists():
-        with labels_path.open(newline="", encoding="utf-8") as handle:
-            found = next(csv.reader(handle), [])
+        try:
+            with labels_path.open(newline="", encoding="utf-8") as handle:
+                found = next(csv.reader(handle), [])
+        except csv.Error as error:
+            raise AppError(f"{labels_path}: {csv_problem(error)} on its first line") from None
         if found != header:
             raise AppError(
                 f"{labels_path} labels takes with {','.join(found[1:]) or 'no target'}; "

@@ -12,7 +12,7 @@ from importlib import metadata
 
 import numpy as np
 
-from app.services.compare import Comparison, compare_runs
+from app.services.compare import Comparison, compare_runs, with_besides
 from app.services.runs import (
     PerTargetSummary,
     RunLeaderboard,
@@ -21,7 +21,7 @@ from app.services.runs import (
 )
 from app.store.database import Store
 from app.store.datasets import load_schema
-from app.store.runs import RunInfo
+from app.store.runs import RunInfo, get_run
 from benchmark.errors import BenchmarkError, ConfigurationError
 from benchmark.evaluation.score_table import MissingPolicy, ScoreTable, fold_score_table
 from benchmark.results import TaskResult
@@ -94,9 +94,8 @@ class RunView(RunLeaderboard):
 
     def fold_scores(self) -> ScoreTable:
         """Per-fold scores on the leaderboard's metric, best classifier first."""
-        return fold_score_table(
-            self.results, self.metric, classifiers=[row.classifier for row in self.board.rows]
-        )
+        own = [row.classifier for row in self.board.rows if row.classifier in self.run.classifiers]
+        return fold_score_table(self.results, self.metric, classifiers=own)
 
     def confusion(self, classifier: str) -> Confusion:
         """``classifier``'s confusion matrices summed over its successful folds."""
@@ -174,11 +173,16 @@ class Report:
 
 
 def run_view(
-    store: Store, run_ref: int | str, *, metric: str | None = None, baseline: str | None = None
+    store: Store,
+    run_ref: int | str,
+    *,
+    metric: str | None = None,
+    baseline: str | None = None,
+    beside: Sequence[int | str] = (),
 ) -> RunView:
-    """A run with its leaderboard (marks against ``baseline``, default the best), results
-    and class labels."""
-    ranked = run_leaderboard(store, run_ref, metric=metric, baseline=baseline)
+    """A run with its leaderboard (marks against ``baseline``, default the best; with the
+    classifiers of the runs ``beside`` it), results and class labels."""
+    ranked = run_leaderboard(store, run_ref, metric=metric, baseline=baseline, beside=beside)
     run, board, results = ranked.run, ranked.board, ranked.results
     _, schema, _ = load_schema(store, run.dataset_id)
     labels = {}
@@ -191,7 +195,7 @@ def run_view(
         per_target = {
             r.classifier: summary[r.classifier] for r in board.rows if r.classifier in summary
         }
-    return RunView(run, board, results, labels, per_target)
+    return RunView(run, board, results, ranked.besides, labels, per_target)
 
 
 def build_report(
@@ -210,6 +214,9 @@ def build_report(
     ----------
     store : Store
     run_refs : sequence of int or str
+        The runs; an imported run (a paper's WEKA results) on the data set and targets of
+        another run given is shown beside that run's leaderboard rather than on its own
+        (:mod:`app.services.beside`).
     metric : str, optional
         Ranking metric; default each run's leaderboard default.
     alpha : float
@@ -229,11 +236,13 @@ def build_report(
         )
     views = []
     fold_ranks: dict[int, Comparison | str] = {}
-    for ref in run_refs:
-        view = run_view(store, ref, metric=metric)
+    hosts, joined = with_besides([get_run(store, ref) for ref in run_refs])
+    for host in hosts:
+        beside = [run.id for run in joined.get(host.id, [])]
+        view = run_view(store, host.id, metric=metric, beside=beside)
         try:
             fold_ranks[view.run.id] = compare_runs(
-                store, [view.run.id], metric=view.metric, alpha=alpha, missing=missing
+                store, [view.run.id, *beside], metric=view.metric, alpha=alpha, missing=missing
             )
         except BenchmarkError as error:
             fold_ranks[view.run.id] = str(error)

@@ -29,6 +29,7 @@ from app.schemas.runs import (
     RunStatus,
     TunedComparisonSchema,
 )
+from app.services.beside import Beside, besides, merged_results, row_runs
 from app.services.tuning import run_specs
 from app.store.database import Store
 from app.store.datasets import load_dataset, load_schema
@@ -48,7 +49,7 @@ from app.store.runs import (
 )
 from benchmark.dataset import Dataset
 from benchmark.errors import ConfigurationError
-from benchmark.problem import Problem, problem_from_dataset, restrict_targets
+from benchmark.problem import Problem, position_columns, problem_from_dataset, restrict_targets
 from benchmark.results import TaskKey, TaskResult
 
 if TYPE_CHECKING:  # scipy.stats (significance) loads when a leaderboard is first built
@@ -290,8 +291,7 @@ def create_run(
     NotFoundError
         An unknown data set.
     ConfigurationError
-        Anything else that would make the run fail at once: a target with one class, a
-        position that is not numeric targets.
+        Anything else that would make the run fail at once: a target with one class.
     """
     if request.independent:
         raise FieldError(
@@ -314,6 +314,12 @@ def _plan_run(store: Store, request: BenchRequest) -> _Plan:
             schema.index(request.target)
         except ConfigurationError as error:
             raise FieldError("target", str(error)) from None
+    if position:
+        run_schema = schema if targets is None else schema.with_targets([schema.index(targets[0])])
+        try:
+            position_columns(run_schema, position)
+        except ConfigurationError as error:
+            raise FieldError("position", str(error)) from None
     prepared = prepare_problem(load_dataset(store, info.id), targets, position)
     problem = prepared.problem
     if request.metric is not None:
@@ -349,7 +355,7 @@ def _plan_run(store: Store, request: BenchRequest) -> _Plan:
             "baseline",
             f"'{request.baseline}' is not a classifier of this run (classifiers: {', '.join(ids)})",
         )
-    plan = _folds(prepared, options)
+    plan = fold_plan(prepared, options)
     config = {
         **options.to_json(),
         "folds": max(f.fold for f in plan.folds) + 1,
@@ -430,7 +436,7 @@ def execute_run(
             run.config.get("targets_given"),
             run.config.get("position") or (),
         )
-        folds = _folds(prepared, options).folds
+        folds = fold_plan(prepared, options).folds
         done = finished_keys(store, run.id)
         callbacks.on_plan(len(run.classifiers) * len(folds), len(done))
 
@@ -513,11 +519,15 @@ class RunLeaderboard:
         The run's classifiers ranked, with WEKA's marks against a baseline.
     results : list of TaskResult
         Every stored fold result of the run, read once.
+    besides : tuple of Beside
+        Runs ranked beside this one (an imported paper's results), with how each is
+        compared; their results are in ``board`` but not in ``results``.
     """
 
     run: RunInfo
     board: Leaderboard
     results: list[TaskResult]
+    besides: tuple[Beside, ...]
 
     def report(self) -> LeaderboardSchema:
         """What ``leaderboard --json`` prints and the API serves: rows with their per-target
@@ -527,7 +537,9 @@ class RunLeaderboard:
         run, board, results = self.run, self.board, self.results
         per_target = per_target_summary(results)
         data = board.to_json()
+        origins = row_runs(self.besides)
         for row in data["leaderboard"]:
+            row["run_id"] = origins.get(row["classifier"])
             targets = per_target.get(row["classifier"])
             if targets:
                 row["metrics"]["per_target"] = {
@@ -553,11 +565,17 @@ class RunLeaderboard:
                 for c in compare_tuned(results, metric=board.metric, alpha=board.alpha)
             ],
             choices=[FoldChoiceSchema(**c.to_json()) for c in fold_choices(results)],
+            beside=[b.schema() for b in self.besides],
         )
 
 
 def run_leaderboard(
-    store: Store, run_id: int | str, *, metric: str | None = None, baseline: str | None = None
+    store: Store,
+    run_id: int | str,
+    *,
+    metric: str | None = None,
+    baseline: str | None = None,
+    beside: Sequence[int | str] = (),
 ) -> RunLeaderboard:
     """A run's leaderboard from its stored results.
 
@@ -566,6 +584,10 @@ def run_leaderboard(
     metric, baseline : str, optional
         Rank by this metric, mark against this classifier; default: what the run was
         asked to rank by, else its kind's metric and its best classifier.
+    beside : sequence of run ids
+        Runs of the same data set and target whose classifiers are ranked too (an
+        imported paper's results): t-tested where their folds pair with the run's, by
+        their means otherwise (:mod:`app.services.beside`).
 
     Raises
     ------
@@ -583,10 +605,15 @@ def run_leaderboard(
     if metric is not None:
         check_metric(run.kind, metric, position=bool(run.config.get("position")), run_id=run.id)
     metric = metric or run.config.get("metric") or DEFAULT_METRIC.get(run.kind, "f1_weighted")
+    others = besides(run, [get_run(store, ref) for ref in dict.fromkeys(beside)])
+    ranked, groups = merged_results(results, [(b, load_results(store, b.run.id)) for b in others])
     board = build_leaderboard(
-        results, metric=metric, baseline=baseline or run.config.get("baseline")
+        ranked,
+        metric=metric,
+        baseline=baseline or run.config.get("baseline"),
+        groups=groups if others else None,
     )
-    return RunLeaderboard(run, board, results)
+    return RunLeaderboard(run, board, results, tuple(others))
 
 
 def check_metric(kind: str, metric: str, *, position: bool, run_id: int | None = None) -> None:
@@ -771,7 +798,8 @@ def _bytes(megabytes: float | None) -> int | None:
     return None if megabytes is None else int(megabytes * 2**20)
 
 
-def _folds(prepared: PreparedProblem, options: RunOptions) -> FoldPlan:
+def fold_plan(prepared: PreparedProblem, options: RunOptions) -> FoldPlan:
+    """The folds a run with these options makes on this problem (the same on resume)."""
     from benchmark.run.folds import make_fold_plan
 
     try:

@@ -3,21 +3,24 @@
 from __future__ import annotations
 
 import contextlib
+import functools
 import re
 import sqlite3
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, cast
+from typing import TYPE_CHECKING, Any, cast
 
 from sqlalchemy import Engine, create_engine, event, inspect, text
-from sqlalchemy.engine import make_url
+from sqlalchemy.engine import ExceptionContext, make_url
 from sqlalchemy.exc import ArgumentError, DatabaseError, OperationalError
-from sqlalchemy.orm import Session, sessionmaker
 from sqlalchemy.sql.compiler import SQLCompiler
 from sqlalchemy.sql.elements import ClauseElement
 
-from app.errors import AppError
+from app.errors import AppError, ConflictError
+
+if TYPE_CHECKING:
+    from sqlalchemy.orm import Session, sessionmaker
 
 MIGRATIONS = Path(__file__).with_name("migrations")
 #: The newest migration; a test checks it against Alembic's own idea of the head.
@@ -37,7 +40,7 @@ class Store:
     def __init__(self, url: str) -> None:
         self.url = _normalise(url)
         self.engine = _create_engine(self.url)
-        self._sessions = sessionmaker(self.engine, expire_on_commit=False)
+        self._sessions: sessionmaker[Session] | None = None
         self._compiled: dict[ClauseElement, SQLCompiler] = {}
         self.migrate()
 
@@ -90,6 +93,11 @@ class Store:
     @contextmanager
     def session(self) -> Iterator[Session]:
         """A session whose transaction commits on success and rolls back on any error."""
+        if self._sessions is None:
+            # start-up time: the ORM loads with the first session, not with every command
+            from sqlalchemy.orm import sessionmaker
+
+            self._sessions = sessionmaker(self.engine, expire_on_commit=False)
         with self._sessions.begin() as session:
             yield session
 
@@ -189,7 +197,30 @@ def _create_engine(url: str) -> Engine:
         raise AppError(f"cannot use the database URL '{display_url(url)}': {error}") from None
     if parsed.get_backend_name() == "sqlite":
         event.listen(engine, "connect", _sqlite_pragmas)
+    event.listen(engine, "handle_error", functools.partial(_refuse_read_only, url))
     return engine
+
+
+#: SQLite's result code for a write to a read-only database (the low byte of the extended
+#: codes, e.g. SQLITE_READONLY_DIRECTORY); PostgreSQL's SQLSTATE for a read-only transaction.
+_SQLITE_READONLY = 8
+_PG_READ_ONLY = "25006"
+
+
+def _refuse_read_only(url: str, context: ExceptionContext) -> None:
+    """A write to a read-only store (a file or mount without write access, a standby
+    server), as the one line of a :class:`~app.errors.ConflictError` instead of the
+    driver's error with the statement and its parameters."""
+    original = context.original_exception
+    sqlite_code = getattr(original, "sqlite_errorcode", None)
+    read_only = (isinstance(sqlite_code, int) and sqlite_code & 0xFF == _SQLITE_READONLY) or (
+        getattr(original, "sqlstate", None) == _PG_READ_ONLY
+    )
+    if read_only:
+        raise ConflictError(
+            f"the store at {display_url(url)} is read-only ({first_line(original)}); give "
+            "this process write access to it, or use another store"
+        ) from None
 
 
 def _check_sqlite_file(path: Path, url: str) -> None:

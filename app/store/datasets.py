@@ -15,7 +15,6 @@ import json
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
-from datetime import UTC, datetime
 from typing import Any, Protocol
 
 import numpy as np
@@ -24,8 +23,10 @@ from sqlalchemy.exc import IntegrityError, OperationalError
 from sqlalchemy.orm import Session
 
 from app.errors import AppError, ConflictError, FieldError
+from app.schemas.names import check_name
 from app.store.database import Store
-from app.store.naming import check_name, default_name, find_row, free_name, shorten
+from app.store.listing import DatasetInfo
+from app.store.naming import default_name, find_row, free_name, shorten
 from app.store.ownership import owner_alive
 from app.store.tables import DatasetRow, InstanceBlockRow, InstanceRow, RunRow
 from benchmark.dataset import Dataset, InstanceBlock, Schema, dataset_blocks
@@ -37,51 +38,6 @@ _INSERT_BATCH = 5000
 READ_BATCH = 5000
 #: About how many bytes of values one stored block holds.
 STORED_BLOCK_BYTES = 1 << 20
-
-
-@dataclass(frozen=True)
-class DatasetInfo:
-    """What a listing shows of a stored data set."""
-
-    id: int
-    name: str
-    relation: str
-    n_instances: int
-    n_features: int
-    targets: list[str]
-    source_name: str | None
-    sha256: str
-    created_at: datetime
-
-    @classmethod
-    def of(cls, row: DatasetRow) -> DatasetInfo:
-        return cls(
-            id=row.id,
-            name=row.name,
-            relation=row.relation,
-            n_instances=row.n_instances,
-            n_features=row.n_attributes - len(row.target_names),
-            targets=list(row.target_names),
-            source_name=row.source_name,
-            sha256=row.sha256,
-            # SQLite gives back naive times; they were written in UTC.
-            created_at=row.created_at
-            if row.created_at.tzinfo is not None
-            else row.created_at.replace(tzinfo=UTC),
-        )
-
-    def to_json(self) -> dict[str, Any]:
-        return {
-            "id": self.id,
-            "name": self.name,
-            "relation": self.relation,
-            "n_instances": self.n_instances,
-            "n_features": self.n_features,
-            "targets": self.targets,
-            "source": self.source_name,
-            "sha256": self.sha256,
-            "created_at": self.created_at.isoformat(),
-        }
 
 
 class InstanceSource(Protocol):
@@ -413,12 +369,6 @@ def find_dataset(store: Store, ref: str | int) -> DatasetInfo:
     """The data set called ``ref``, or with id ``ref``."""
     with store.session() as session:
         return DatasetInfo.of(_row(session, ref))
-
-
-def list_datasets(store: Store) -> list[DatasetInfo]:
-    with store.session() as session:
-        rows = session.scalars(select(DatasetRow).order_by(DatasetRow.id))
-        return [DatasetInfo.of(row) for row in rows]
 
 
 def load_schema(store: Store, ref: str | int) -> tuple[DatasetInfo, Schema, bool]:

@@ -13,10 +13,12 @@ from sqlalchemy import select, update
 
 from app.errors import NotFoundError
 from app.schemas.jobs import JobSchema
+from app.schemas.listing import Page
 from app.store import queue
 from app.store.database import Store
 from app.store.naming import is_row_id
 from app.store.ownership import mark_lost, owner_alive, process_owner
+from app.store.paging import count_rows, paged
 from app.store.states import LOST_AS
 from app.store.tables import JobRow, utcnow
 
@@ -50,9 +52,15 @@ def get_job(store: Store, job_id: int | str) -> JobSchema:
         return _schema(_row(session, job_id))
 
 
-def list_jobs(store: Store) -> list[JobSchema]:
+def list_jobs(store: Store, *, page: Page | None = None) -> list[JobSchema]:
+    """The jobs, oldest first (those of ``page``, when given)."""
     with store.session() as session:
-        return [_schema(row) for row in session.scalars(select(JobRow).order_by(JobRow.id))]
+        rows = session.scalars(paged(select(JobRow).order_by(JobRow.id), page))
+        return [_schema(row) for row in rows]
+
+
+def count_jobs(store: Store) -> int:
+    return count_rows(store, JobRow)
 
 
 def queued_jobs(store: Store) -> list[JobSchema]:

@@ -20,9 +20,11 @@ from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session
 
 from app.errors import AppError, ConflictError, FieldError
+from app.schemas.listing import Page
 from app.schemas.models import ModelSchema
 from app.store.database import Store
 from app.store.naming import find_row, free_name, is_decimal, is_row_id, may_be_name, shorten
+from app.store.paging import count_rows, paged
 from app.store.tables import DatasetRow, ModelArtifactRow, ModelRow
 
 #: The only artifact format that is loaded (see :mod:`benchmark.artifacts`).
@@ -163,12 +165,16 @@ def _taken(name: str) -> str:
     return f"a model named '{shorten(name)}' already exists; choose another name"
 
 
-def list_models(store: Store) -> list[ModelInfo]:
-    """Every model, without reading any artifact."""
+def list_models(store: Store, *, page: Page | None = None) -> list[ModelInfo]:
+    """Every model (those of ``page``), oldest first, without reading any artifact."""
     with store.session() as session:
-        rows = list(session.scalars(select(ModelRow).order_by(ModelRow.id)))
+        rows = list(session.scalars(paged(select(ModelRow).order_by(ModelRow.id), page)))
         names = _dataset_names(session, rows)
         return [_info(session, row, names) for row in rows]
+
+
+def count_models(store: Store) -> int:
+    return count_rows(store, ModelRow)
 
 
 def get_model(store: Store, ref: str | int) -> ModelInfo:

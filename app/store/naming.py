@@ -1,4 +1,5 @@
-"""Rows that users address by name or by numeric id: lookup, name rules, unique names."""
+"""Rows that users address by name or by numeric id: lookup, unique names (the rule of a
+name itself is :func:`app.schemas.names.check_name`)."""
 
 from __future__ import annotations
 
@@ -8,14 +9,13 @@ from typing import Any, Protocol, TypeVar
 from sqlalchemy import func, select
 from sqlalchemy.orm import InstrumentedAttribute, Session
 
-from app.errors import AppError, NotFoundError
+from app.errors import NotFoundError
+from app.schemas.names import CONTROL as _CONTROL
+from app.schemas.names import MAX_NAME
+from app.schemas.names import shown as shorten
 
-#: The longest name the store keeps (the ``name`` columns are ``String(200)``).
-MAX_NAME = 200
-#: Names listed in a "no such ..." message, and the characters shown of each.
+#: Names listed in a "no such ..." message.
 _NAMES_SHOWN = 10
-_NAME_SHOWN = 40
-_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]")
 _UNSAFE = re.compile(r"[^\w.-]+")
 
 
@@ -84,36 +84,6 @@ def find_row(session: Session, model: type[RowT], ref: str | int, *, kind: str, 
     return row
 
 
-def check_name(name: str, *, kind: str) -> str:
-    """``name`` if it can name a ``kind`` (a new one, or a renamed one).
-
-    A name is not empty, has at most :data:`MAX_NAME` characters, no control characters,
-    no spaces at its ends, and is not a number (a number is read as an id).
-
-    Raises
-    ------
-    AppError
-        Saying which rule the name breaks.
-    """
-    if not name.strip():
-        raise AppError(f"a {kind} name cannot be empty")
-    if len(name) > MAX_NAME:
-        raise AppError(
-            f"a {kind} name has at most {MAX_NAME} characters; '{shorten(name)}' has {len(name)}"
-        )
-    control = _CONTROL.search(name)
-    if control is not None:
-        raise AppError(
-            f"a {kind} name cannot hold control characters: '{shorten(name)}' has "
-            f"{control.group()!r} at position {control.start() + 1}"
-        )
-    if name != name.strip():
-        raise AppError(f"a {kind} name cannot start or end with spaces: '{name}'")
-    if is_decimal(name):
-        raise AppError(f"a {kind} name cannot be a number ('{name}' would read as an id)")
-    return name
-
-
 def default_name(text: str, *, fallback: str = "dataset") -> str:
     """A valid name made from ``text`` (a file stem, a relation): unsafe characters folded
     to ``_``, cut to leave room for a numeric suffix, a number given a ``fallback-`` prefix."""
@@ -131,9 +101,3 @@ def free_name(session: Session, model: type[Named], base: str) -> str:
     while f"{base}-{suffix}" in taken:
         suffix += 1
     return f"{base}-{suffix}"
-
-
-def shorten(text: str, limit: int = _NAME_SHOWN) -> str:
-    """``text`` for a message: control characters as ``?``, cut to ``limit`` characters."""
-    text = _CONTROL.sub("?", text)
-    return text if len(text) <= limit else text[: limit - 1] + "…"

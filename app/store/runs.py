@@ -10,6 +10,7 @@ already recorded, so a resumed run never duplicates rows.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from datetime import datetime
@@ -21,11 +22,14 @@ from sqlalchemy.dialects.sqlite import insert as sqlite_insert
 from sqlalchemy.orm import Session
 
 from app.errors import ConflictError, NotFoundError
+from app.schemas.base import finite
+from app.schemas.listing import Page
 from app.schemas.runs import FINAL_STATUSES, RunSchema, RunStatus
 from app.store import queue
 from app.store.database import Store
 from app.store.naming import is_row_id
 from app.store.ownership import aware, mark_lost, owner_alive, process_owner
+from app.store.paging import count_rows, paged
 from app.store.states import ACTIVE, LOST_AS, check_claim, check_resume
 from app.store.tables import DatasetRow, FoldResultRow, RunRow, utcnow
 from benchmark.results import TaskKey, TaskResult
@@ -34,6 +38,8 @@ from benchmark.results import TaskKey, TaskResult
 PER_TARGET = "per_target"
 #: Key of a result's chosen parameters inside its stored metrics (absent before tuning).
 PARAMS = "params"
+#: Key of a fold's reliability bins inside its stored metrics (absent before they were kept).
+CALIBRATION = "calibration"
 
 
 @dataclass(frozen=True)
@@ -121,16 +127,80 @@ def create_run(
 ) -> RunInfo:
     """A new run, ``queued``."""
     with store.session() as session:
-        row = RunRow(
-            dataset_id=dataset_id,
-            kind=kind,
-            targets=list(targets),
-            classifiers=list(classifiers),
-            config=config,
-            status="queued",
+        row = _new_run(session, dataset_id, kind, targets, classifiers, config, "queued")
+        return _infos(session, [row])[0]
+
+
+def _new_run(
+    session: Session,
+    dataset_id: int,
+    kind: str,
+    targets: Sequence[str],
+    classifiers: Sequence[str],
+    config: dict[str, Any],
+    status: RunStatus,
+    **times: datetime,
+) -> RunRow:
+    """A run's row, added and flushed (so that it has its id)."""
+    row = RunRow(
+        dataset_id=dataset_id,
+        kind=kind,
+        targets=list(targets),
+        classifiers=list(classifiers),
+        config=config,
+        status=status,
+        **times,
+    )
+    session.add(row)
+    session.flush()
+    return row
+
+
+def add_finished_run(
+    store: Store,
+    *,
+    dataset_id: int,
+    kind: str,
+    targets: Sequence[str],
+    classifiers: Sequence[str],
+    config: dict[str, Any],
+    results: Sequence[TaskResult],
+) -> RunInfo:
+    """A run that is ``done`` on arrival, stored with its results in one transaction (an
+    imported one: nothing executes it, and a failure stores nothing)."""
+    now = utcnow()
+    with store.session() as session:
+        row = _new_run(
+            session,
+            dataset_id,
+            kind,
+            targets,
+            classifiers,
+            config,
+            "done",
+            started_at=now,
+            finished_at=now,
         )
-        session.add(row)
-        session.flush()
+        if results:
+            session.execute(
+                insert(FoldResultRow),
+                [
+                    {
+                        "run_id": row.id,
+                        "classifier": r.key.classifier,
+                        "repeat": r.key.repeat,
+                        "fold": r.key.fold,
+                        "status": r.status,
+                        "error": r.error,
+                        "metrics": _stored_metrics(r),
+                        "confusion": r.confusion,
+                        "n_train": r.n_train,
+                        "n_test": r.n_test,
+                        "created_at": now,
+                    }
+                    for r in results
+                ],
+            )
         return _infos(session, [row])[0]
 
 
@@ -139,12 +209,27 @@ def get_run(store: Store, run_id: int | str) -> RunInfo:
         return _infos(session, [_row(session, run_id)])[0]
 
 
-def list_runs(store: Store, *, status: str | None = None) -> list[RunInfo]:
+def list_runs(
+    store: Store,
+    *,
+    status: str | None = None,
+    dataset_id: int | None = None,
+    page: Page | None = None,
+) -> list[RunInfo]:
+    """The runs, oldest first: those with ``status``, on ``dataset_id``, of ``page``."""
     with store.session() as session:
         query = select(RunRow).order_by(RunRow.id)
         if status is not None:
             query = query.where(RunRow.status == status)
-        return _infos(session, list(session.scalars(query)))
+        if dataset_id is not None:
+            query = query.where(RunRow.dataset_id == dataset_id)
+        return _infos(session, list(session.scalars(paged(query, page))))
+
+
+def count_runs(store: Store, *, dataset_id: int | None = None) -> int:
+    """How many runs there are (on ``dataset_id``)."""
+    where = () if dataset_id is None else (RunRow.dataset_id == dataset_id,)
+    return count_rows(store, RunRow, *where)
 
 
 def claim_run(store: Store, run_id: int, *, owner: str | None = None) -> RunInfo:
@@ -321,6 +406,10 @@ def load_results(store: Store, run_id: int) -> list[TaskResult]:
             metrics = dict(stored)
             per_target = metrics.pop(PER_TARGET, None)
             params = metrics.pop(PARAMS, None)
+            calibration = metrics.pop(CALIBRATION, None)
+            metrics = _undefined_as_nan(metrics)
+            if per_target is not None:
+                per_target = {t: _undefined_as_nan(scores) for t, scores in per_target.items()}
             results.append(
                 TaskResult(
                     key=TaskKey(classifier, repeat, fold),
@@ -332,19 +421,29 @@ def load_results(store: Store, run_id: int) -> list[TaskResult]:
                     n_test=n_test,
                     per_target=per_target,
                     params=params,
+                    calibration=calibration,
                 )
             )
         return results
 
 
 def _stored_metrics(result: TaskResult) -> dict[str, Any]:
-    """The metrics column: scores, and per-target scores and chosen parameters when any."""
-    stored: dict[str, Any] = dict(result.metrics)
+    """The metrics column: scores, and per-target scores and chosen parameters when any.
+    An undefined score (NaN: ROC AUC of a classifier without probabilities) is stored as
+    null, which PostgreSQL's JSON accepts and NaN it refuses."""
+    stored: dict[str, Any] = finite(dict(result.metrics))
     if result.per_target:
-        stored[PER_TARGET] = result.per_target
+        stored[PER_TARGET] = finite(result.per_target)
     if result.params is not None:
         stored[PARAMS] = result.params
+    if result.calibration is not None:
+        stored[CALIBRATION] = result.calibration
     return stored
+
+
+def _undefined_as_nan(scores: dict[str, Any]) -> dict[str, Any]:
+    """Scores as read: null (an undefined score) back to NaN."""
+    return {name: math.nan if value is None else value for name, value in scores.items()}
 
 
 def _keys(session: Session, run_id: int) -> set[tuple[str, int, int]]:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from collections import defaultdict
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -45,6 +45,10 @@ class LeaderboardRow:
         Successful and failed (error or timeout) tasks.
     errors : list of str
         Distinct failure messages, at most three.
+    tested : bool
+        Whether the t-test compared it with the baseline: ``False`` for the baseline and
+        for a classifier whose folds cannot be paired with the baseline's (another
+        comparison group: only the means compare).
     """
 
     rank: int
@@ -54,6 +58,7 @@ class LeaderboardRow:
     n_ok: int = 0
     n_failed: int = 0
     errors: list[str] = field(default_factory=list)
+    tested: bool = False
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -67,6 +72,7 @@ class LeaderboardRow:
             "n_ok": self.n_ok,
             "n_failed": self.n_failed,
             "errors": list(self.errors),
+            "tested": self.tested,
         }
 
 
@@ -128,6 +134,7 @@ def build_leaderboard(
     metric: str = "f1_weighted",
     baseline: str | None = None,
     alpha: float = 0.05,
+    groups: Mapping[str, str] | None = None,
 ) -> Leaderboard:
     """Rank the classifiers of a run and mark significant differences from a baseline.
 
@@ -141,6 +148,10 @@ def build_leaderboard(
         The classifier to compare against; default the best ranked.
     alpha : float
         Significance level.
+    groups : mapping of str to str, optional
+        Comparison group of each classifier (default: one for all).  Only classifiers in
+        the baseline's group are t-tested against it, fold by fold; the others are
+        ranked by their means alone (results from runs whose folds do not pair).
 
     Raises
     ------
@@ -186,8 +197,9 @@ def build_leaderboard(
         raise ConfigurationError(f"baseline '{baseline}' has no successful fold with {metric}")
     counts = {"v": 0, "": 0, "*": 0}
     ratio = _test_train_ratio(results)
+    group = (groups or {}).get(baseline, "")
     for row in rows:
-        if row.classifier == baseline:
+        if row.classifier == baseline or (groups or {}).get(row.classifier, "") != group:
             continue
         scores = scores_by_fold(by_classifier[row.classifier], metric)
         paired = sorted(set(scores) & set(base_scores))
@@ -200,6 +212,7 @@ def build_leaderboard(
             alpha=alpha,
             lower_is_better=lower,
         )
+        row.tested = True
         counts[row.mark] += 1
     return Leaderboard(metric, baseline, rows, (counts["v"], counts[""], counts["*"]), alpha)
 

@@ -314,7 +314,11 @@ def loads_arff(
 
 
 def read_arff(
-    path: str | os.PathLike[str], *, targets: TargetSpec = None, parser: Parser = "auto"
+    path: str | os.PathLike[str],
+    *,
+    targets: TargetSpec = None,
+    parser: Parser = "auto",
+    source: str | None = None,
 ) -> Dataset:
     """Read an ARFF file.
 
@@ -326,6 +330,9 @@ def read_arff(
         As in :func:`loads_arff`.
     parser : {"auto", "vectorised", "tokenizer"}
         As in :class:`ArffReader`.
+    source : str, optional
+        The name messages give the file (an upload's name when ``path`` is a temporary
+        copy); ``path`` by default.
 
     Returns
     -------
@@ -337,5 +344,5 @@ def read_arff(
     DataFormatError
         If the file does not exist, cannot be read, or is not valid ARFF.
     """
-    with open_arff(path, targets=targets, parser=parser) as reader:
+    with open_arff(path, targets=targets, parser=parser, source=source) as reader:
         return reader.read()

@@ -56,7 +56,10 @@ def sniff_delimiter(text: str) -> str:
     consistent: list[tuple[int, str]] = []
     header_counts: list[tuple[int, str]] = []
     for delimiter in _DELIMITERS:
-        counts = [len(row) for row in csv.reader(io.StringIO(sample), delimiter=delimiter)]
+        try:
+            counts = [len(row) for row in csv.reader(io.StringIO(sample), delimiter=delimiter)]
+        except csv.Error:  # a field over the limit: the reading proper says where
+            continue
         counts = [count for count in counts if count]
         if not counts:
             continue
@@ -81,10 +84,20 @@ def _records(text: str, delimiter: str, source: str) -> list[Record]:
                 records.append((start, [cell.strip() for cell in row]))
             start = reader.line_num + 1
     except csv.Error as error:
-        raise DataFormatError(
-            f"malformed CSV ({error})", source=source, line=reader.line_num
-        ) from None
+        raise DataFormatError(csv_problem(error), source=source, line=reader.line_num) from None
     return records
+
+
+def csv_problem(error: csv.Error) -> str:
+    """What ``csv``'s ``error`` means, in the words of a file's author.
+
+    A field longer than ``csv.field_size_limit()`` characters (131,072 unless raised) is
+    the one error whose text names no CSV rule; the others say what rule was broken.
+    """
+    text = str(error)
+    if text.startswith("field larger than field limit"):
+        return f"a field is longer than {csv.field_size_limit():,} characters"
+    return f"malformed CSV ({text})"
 
 
 def _check_header(line: int, names: list[str], source: str) -> None:

@@ -19,6 +19,7 @@ import numpy as np
 
 from benchmark.catalogue import ClassifierSpec
 from benchmark.estimators import build_estimator
+from benchmark.evaluation.calibration import reliability
 from benchmark.evaluation.metrics import confusion_matrix, expand_proba, multiclass_scores
 from benchmark.problem import Problem
 from benchmark.results import Status, TaskKey, TaskResult
@@ -125,6 +126,8 @@ def _run_multiclass(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResul
         int(fold.train.size),
         int(fold.test.size),
         params=chosen_params(model),
+        # the bins, not the probabilities: they add up over folds, 30 numbers a fold
+        calibration=None if proba is None else reliability(y[fold.test], proba).to_json(),
     )
 
 

@@ -49,7 +49,11 @@ def store_url(request: pytest.FixtureRequest, tmp_path: Path) -> str:
     """URL of an empty store, on SQLite then on PostgreSQL."""
     if request.param == "sqlite":
         return f"sqlite:///{tmp_path / 'touchbench.db'}"
-    url: str = request.getfixturevalue("postgres_database")
+    return emptied(request.getfixturevalue("postgres_database"))
+
+
+def emptied(url: str) -> str:
+    """``url``, a PostgreSQL database, once its tables are all dropped."""
     engine = create_engine(url, isolation_level="AUTOCOMMIT")
     with engine.connect() as connection:
         connection.execute(text("DROP SCHEMA public CASCADE"))

@@ -13,6 +13,7 @@ import pytest
 
 from app.schemas.datasets import ImportRequest
 from app.services import datasets as dataset_service
+from app.services.listing import list_datasets
 from app.store import datasets as store_datasets
 from app.store.database import Store
 from app.store.tables import RunRow
@@ -386,7 +387,7 @@ def test_an_upload_is_named_and_reported_by_its_own_file_name(
         store, ImportRequest(file=temporary, source_name="robot arm.arff")
     )
     assert (result.name, result.created) == ("robot_arm", True)
-    assert dataset_service.list_datasets(store)[0].source == "robot arm.arff"
+    assert list_datasets(store)[0].source == "robot arm.arff"
     broken = write(tmp_path, "upload-4d5e6f.tmp", TOUCH_ARFF.replace("0.75", "oops"))
     with pytest.raises(DataFormatError) as caught:
         dataset_service.import_file(store, ImportRequest(file=broken, source_name="bad.arff"))

@@ -90,7 +90,7 @@ def test_classification_leaderboards_name_their_folds_and_refuse_regression_metr
     [
         (("-c", "ridge", "--metric", "f1_weighted"), "'f1_weighted' is not a regression metric"),
         (("-c", "j48"), "classifier 'j48' has no regressor: the targets are numeric"),
-        (("-c", "ridge", "--position", "x,mic"), "'mic' in `position` is not a target"),
+        (("-c", "ridge", "--position", "x,mic"), "--position: 'mic' is not a target"),
         (("-c", "ridge", "--metric", "euclidean_error"), "'euclidean_error' needs coordinates"),
         (("--independent",), "a regression benchmarks its targets together"),
         (("-c", "rf", "--tune"), "--tune: works on classification runs"),
@@ -114,5 +114,5 @@ def test_regression_metric_and_position_on_a_classification_bench(
     )
     refused(
         run_cli(capsys, db, "bench", "touch", "-c", "bcc:nb", "--position", "gesture,place"),
-        "'gesture' in `position` is a nominal target",
+        "--position: 'gesture' is a nominal target",
     )

@@ -112,7 +112,7 @@ def test_a_biotac_export_keeps_its_names_and_says_it_resampled(
         "1",
         "-O",
         "length=10",
-        "--channels",
+        "--fields",
         "pac1,pac2",
         "--name",
         "biotac",
@@ -127,10 +127,10 @@ def test_a_biotac_export_keeps_its_names_and_says_it_resampled(
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["--channels", "ele1"], "slip.csv: has no channel 'ele1' (channels: tdc, tac)"),
+        (["--fields", "ele1"], "slip.csv: has no channel 'ele1' (channels: tdc, tac)"),
         (["--time-column", "when"], "slip.csv: has no column 'when' to read times from"),
         (["--time-column", ""], "--time-column:"),
-        (["--channels", "x" * 300], "--channels: String should have at most 200 characters"),
+        (["--fields", "x" * 300], "--fields: String should have at most 200 characters"),
     ],
 )
 def test_bad_series_options_exit_2_in_one_line(

@@ -14,7 +14,8 @@ import numpy as np
 
 from app.errors import AppError
 from app.store.database import Store
-from app.store.datasets import DatasetInMemory, add_dataset_stream, list_datasets
+from app.store.datasets import DatasetInMemory, add_dataset_stream
+from app.store.listing import list_datasets
 from benchmark.dataset import Attribute, Dataset, InstanceBlock, Schema
 from tests.app.test_cli_datasets import TOUCH_ARFF
 

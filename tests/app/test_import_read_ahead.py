@@ -17,7 +17,8 @@ import app.services.datasets as services
 import app.store.datasets as store_datasets
 import benchmark.io.arff_reader as arff_reader
 from app.store.database import Store
-from app.store.datasets import list_datasets, load_dataset
+from app.store.datasets import load_dataset
+from app.store.listing import list_datasets
 from app.store.tables import InstanceBlockRow
 from benchmark.errors import DataFormatError
 from benchmark.io.arff import read_arff

@@ -23,7 +23,7 @@ import pytest
 from sqlalchemy import func, select
 
 from app.store.database import Store
-from app.store.datasets import list_datasets
+from app.store.listing import list_datasets
 from app.store.tables import InstanceBlockRow, InstanceRow
 
 REPOSITORY = Path(__file__).resolve().parents[2]

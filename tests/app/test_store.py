@@ -17,9 +17,9 @@ from app.store.datasets import (
     dataset_digest,
     delete_dataset,
     find_dataset,
-    list_datasets,
     load_dataset,
 )
+from app.store.listing import DATASETS, list_datasets
 from app.store.tables import DatasetRow, InstanceBlockRow, InstanceRow
 from benchmark.dataset import Attribute, Dataset, Schema
 
@@ -131,6 +131,19 @@ def test_a_failure_while_importing_leaves_nothing_behind(
         add_dataset(store, small_dataset(), sha256="f" * 64)
     assert calls["n"] == 3
     assert count_rows(store) == (0, 0, 0)
+
+
+def test_the_listing_reads_columns_of_the_datasets_table_with_their_types(
+    store: Store,
+) -> None:
+    orm_columns = DatasetRow.__table__.columns
+    for name, listed in DATASETS.columns.items():
+        assert name in orm_columns, name
+        assert type(listed.type) is type(orm_columns[name].type), name
+    add_dataset(store, small_dataset(), sha256="1" * 64, name="mini")
+    (listed,) = list_datasets(store)
+    assert (listed.name, listed.n_instances, listed.targets) == ("mini", 7, ["gesture"])
+    assert listed.created_at.tzinfo is not None
 
 
 def test_reopening_a_store_keeps_its_data(store_url: str) -> None:

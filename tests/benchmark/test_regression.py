@@ -67,9 +67,9 @@ def test_classification_problems_are_unchanged() -> None:
 @pytest.mark.parametrize(
     ("position", "message"),
     [
-        (("x", "f0"), "'f0' in `position` is not a target"),
-        (("x", "c"), "'c' in `position` is a nominal target"),
-        (("x",), "`position` takes 2 or 3 distinct numeric targets"),
+        (("x", "f0"), "'f0' is not a target"),
+        (("x", "c"), "'c' is a nominal target"),
+        (("x",), "a position takes 2 or 3 distinct numeric targets"),
     ],
 )
 def test_a_position_must_be_two_or_three_numeric_targets(

@@ -77,23 +77,23 @@ def test_channels_are_picked_by_name_or_number(tmp_path: Path) -> None:
     path = tmp_path / "pick.csv"
     samples = np.arange(4 * 20.0).reshape(4, 20)
     write_biotac_csv(path, samples, jitter=0.0, start=0.0)
-    recording = read_recording(path, channels=["pac1", "TDC"])
+    recording = read_recording(path, fields=["pac1", "TDC"])
     assert recording.channels == ("pac1", "tdc")
     assert np.allclose(recording.samples, samples[[3, 0]])
-    assert read_recording(path, channels=["2"]).channels == ("tac",)
+    assert read_recording(path, fields=["2"]).channels == ("tac",)
     with pytest.raises(
         DriverError, match=r"has no channel 'ele1' \(channels: tdc, tac, pdc, pac1\)"
     ):
-        read_recording(path, channels=["ele1"])
+        read_recording(path, fields=["ele1"])
     with pytest.raises(DriverError, match="has no channel 'timestamp'"):
-        read_recording(path, channels=["timestamp"])
+        read_recording(path, fields=["timestamp"])
 
 
 def test_many_channels_are_named_a_few_at_a_time(tmp_path: Path) -> None:
     path = tmp_path / "wide.csv"
     write_biotac_csv(path, np.zeros((25, 10)), jitter=0.0, start=0.0)
     with pytest.raises(DriverError, match=r"pac5 and 17 more\)$"):
-        read_recording(path, channels=["nope"])
+        read_recording(path, fields=["nope"])
 
 
 def test_a_trailing_comma_is_accepted_without_a_header_too(tmp_path: Path) -> None:
@@ -107,12 +107,12 @@ def test_a_trailing_comma_is_accepted_without_a_header_too(tmp_path: Path) -> No
 def test_the_replay_source_carries_names_and_notes(tmp_path: Path) -> None:
     path = tmp_path / "replay.csv"
     write_biotac_csv(path, _sines(300))
-    with FileReplaySource(path, channels=["tac"]) as source:
+    with FileReplaySource(path, fields=["tac"]) as source:
         assert source.channel_names == ("tac",) and source.n_channels == 1
         assert len(source.notes) == 1
         total = sum(block.samples.shape[1] for block in source.blocks())
     assert total > 290
     wav = tmp_path / "x.npy"
     np.save(wav, np.zeros(10))
-    with pytest.raises(DriverError, match="apply to CSV files only"):
-        FileReplaySource(wav, samplerate=10, channels=["1"])
+    with pytest.raises(DriverError, match="`fields` applies to ROS bags and CSV files only"):
+        FileReplaySource(wav, samplerate=10, fields=["1"])

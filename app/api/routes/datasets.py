@@ -10,18 +10,19 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Annotated
 
-from fastapi import APIRouter, File, Form, Response, UploadFile, status
+from fastapi import APIRouter, File, Form, Request, Response, UploadFile, status
 from fastapi.responses import StreamingResponse
 
-from app.api.deps import ServiceDep, StoreDep
+from app.api.deps import PageDep, ServiceDep, StoreDep, paginate
+from app.api.downloads import attachment
 from app.api.uploads import form_request, save_upload
-from app.schemas.base import Schema
 from app.schemas.datasets import (
     DatasetDescription,
     DatasetList,
     DatasetSummary,
     ImportRequest,
     ImportResult,
+    RenameRequest,
     RenameResult,
 )
 from app.services.datasets import (
@@ -29,16 +30,13 @@ from app.services.datasets import (
     describe_dataset,
     export_dataset,
     import_file,
-    list_datasets,
     rename_dataset,
 )
+from app.services.listing import list_datasets
 from app.store.database import Store
+from app.store.listing import count_datasets
 
 router = APIRouter(prefix="/api/datasets", tags=["datasets"])
-
-
-class RenameRequest(Schema):
-    name: str
 
 
 @router.post(
@@ -77,8 +75,11 @@ def upload(
 
 
 @router.get("", response_model=DatasetList)
-def datasets(store: StoreDep) -> DatasetList:
-    return DatasetList(datasets=list_datasets(store))
+def datasets(store: StoreDep, page: PageDep, request: Request, response: Response) -> DatasetList:
+    """The data sets, oldest first, a page of at most 1,000 (``X-Total-Count`` says how
+    many there are, ``Link`` where the next page is)."""
+    paginate(request, response, page, count_datasets(store))
+    return DatasetList(datasets=list_datasets(store, page=page))
 
 
 @router.get("/{dataset}", response_model=DatasetDescription)
@@ -103,13 +104,13 @@ def arff(dataset: str, store: StoreDep) -> StreamingResponse:
     return StreamingResponse(
         _arff_lines(store, dataset),
         media_type="text/plain; charset=utf-8",
-        headers={"Content-Disposition": f'attachment; filename="{summary.name}.arff"'},
+        headers={"Content-Disposition": attachment(f"{summary.name}.arff")},
     )
 
 
 @router.post("/{dataset}/rename", response_model=RenameResult)
 def rename(dataset: str, body: RenameRequest, store: StoreDep) -> RenameResult:
-    return rename_dataset(store, dataset, body.name)
+    return rename_dataset(store, dataset, body)
 
 
 @router.delete("/{dataset}", response_model=DatasetSummary)

@@ -2,18 +2,20 @@
 
 from __future__ import annotations
 
-from fastapi import APIRouter
+from fastapi import APIRouter, Request, Response
 
-from app.api.deps import StoreDep
+from app.api.deps import PageDep, StoreDep, paginate
 from app.schemas.jobs import JobList, JobSchema
-from app.store.jobs import get_job, list_jobs, request_job_cancel
+from app.store.jobs import count_jobs, get_job, list_jobs, request_job_cancel
 
 router = APIRouter(prefix="/api/jobs", tags=["jobs"])
 
 
 @router.get("", response_model=JobList)
-def jobs(store: StoreDep) -> JobList:
-    return JobList(jobs=[job.for_client() for job in list_jobs(store)])
+def jobs(store: StoreDep, page: PageDep, request: Request, response: Response) -> JobList:
+    """The jobs, oldest first, a page of at most 1,000 (``X-Total-Count``, ``Link``)."""
+    paginate(request, response, page, count_jobs(store))
+    return JobList(jobs=[job.for_client() for job in list_jobs(store, page=page)])
 
 
 @router.get("/{job_id}", response_model=JobSchema)

@@ -7,13 +7,12 @@ from __future__ import annotations
 import functools
 import tempfile
 import time
-from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated
 
-from fastapi import APIRouter, File, Response, UploadFile, status
+from fastapi import APIRouter, File, Request, Response, UploadFile, status
 
-from app.api.deps import Service, ServiceDep, StoreDep, request_size
+from app.api.deps import PageDep, Service, ServiceDep, StoreDep, paginate, request_size
 from app.api.direct import DirectRoute
 from app.api.uploads import save_upload
 from app.schemas.jobs import JobCreated
@@ -25,7 +24,7 @@ from app.schemas.models import (
     TrainRequest,
 )
 from app.services.jobs import submit_training
-from app.store.models import delete_model, get_model, list_models
+from app.store.models import count_models, delete_model, get_model, list_models
 
 router = APIRouter(prefix="/api/models", tags=["models"])
 #: Predictions of JSON instances: documented by FastAPI, answered by a direct handler (the
@@ -45,8 +44,10 @@ def train(body: TrainRequest, service: ServiceDep) -> JobCreated:
 
 
 @router.get("", response_model=ModelList)
-def models(store: StoreDep) -> ModelList:
-    return ModelList(models=[m.to_schema() for m in list_models(store)])
+def models(store: StoreDep, page: PageDep, request: Request, response: Response) -> ModelList:
+    """The models, oldest first, a page of at most 1,000 (``X-Total-Count``, ``Link``)."""
+    paginate(request, response, page, count_models(store))
+    return ModelList(models=[m.to_schema() for m in list_models(store, page=page)])
 
 
 @router.get("/{model_ref}", response_model=ModelSchema)
@@ -69,21 +70,19 @@ async def predict_instances(model_ref: str, body: PredictRequest, service: Servi
     content = await service.models.run(
         model_ref,
         size,
-        functools.partial(_predict_records, service, model_ref, body.instances, size),
+        functools.partial(_predict_records, service, model_ref, body, size),
     )
     return Response(content, media_type="application/json")
 
 
-def _predict_records(
-    service: Service, model_ref: str, records: Sequence[Mapping[str, Any]], size: int
-) -> bytes:
+def _predict_records(service: Service, model_ref: str, body: PredictRequest, size: int) -> bytes:
     """The prediction report as JSON (written here once, not validated again against the
     response model it was built from); its CPU time is recorded for ``size``."""
     from app.services.models import records_report
 
     info, trained = service.models.get(service.store, model_ref)
     start = time.thread_time()
-    report = records_report(info, trained, records)
+    report = records_report(info, trained, body.instances, missing=body.missing)
     service.models.record(info.id, time.thread_time() - start, size)
     return report.model_dump_json().encode()
 
@@ -102,7 +101,7 @@ def predict_upload(
     info, trained = service.models.get(service.store, model_ref)
     with tempfile.TemporaryDirectory(dir=_work_dir(service)) as folder:
         path = save_upload(file, Path(folder), "upload.arff")
-        data = read_data_file(path)
+        data = read_data_file(path, source=path.name)  # the client's name, not our folder
         return predict(trained, data, source=path.name).report(info)
 
 

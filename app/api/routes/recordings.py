@@ -35,11 +35,18 @@ def upload_session(
     samplerate: Annotated[float | None, Form()] = None,
     segment: Annotated[float | None, Form()] = None,
     topic: Annotated[str | None, Form()] = None,
+    fields: Annotated[
+        list[str] | None,
+        Form(description="Numeric fields of `topic`, or CSV columns, read as channels."),
+    ] = None,
     time_column: Annotated[
         str | None, Form(description="The time column of CSV recordings, if not a usual name.")
     ] = None,
     channels: Annotated[
-        str | None, Form(description="CSV columns to read as channels: A,B,... (names or numbers).")
+        int | None, Form(description="Channels of raw PCM in bags without AudioInfo.")
+    ] = None,
+    sample_format: Annotated[
+        str | None, Form(description="S16LE, S32LE or F32LE: raw PCM in bags without AudioInfo.")
     ] = None,
 ) -> JobCreated:
     """Save the session and queue its extraction (answer: the job's id, status 202).
@@ -48,29 +55,31 @@ def upload_session(
     exists: the extractor, event detection and bounds before anything is saved, the data
     set's name before the job is queued (the saved files are then removed).
     """
-    fields = {
+    values = {
         "extractor": extractor,
         "events": events,
         "name": name,
         "samplerate": samplerate,
         "segment": segment,
         "topic": topic,
+        "fields": fields,
         "time_column": time_column,
-        "channels": None if channels is None else [c for c in channels.split(",") if c.strip()],
+        "channels": channels,
+        "sample_format": sample_format,
     }
     # Checked before a byte is saved (the files' names stand for them), so that a refused
     # request leaves nothing on the disk.
     form_request(
         ExtractRequest,
         recordings=[r.filename or "recording" for r in recordings],
-        **fields,
+        **values,
     )
     folder = service.settings.work_dir / "uploads" / uuid.uuid4().hex
     try:
         names = [save_upload(r, folder, f"recording-{i}").name for i, r in enumerate(recordings)]
         labels_name = save_upload(labels, folder, "labels.csv").name if labels else None
         request = form_request(
-            ExtractRequest, recordings=names, labels=labels_name, folder=folder, **fields
+            ExtractRequest, recordings=names, labels=labels_name, folder=folder, **values
         )
         job = submit_extraction(service.store, request)
     except BaseException:

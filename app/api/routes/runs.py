@@ -4,17 +4,24 @@ from __future__ import annotations
 
 import io
 
-# Imports inside functions: start-up time: the leaderboard's text formats and the results
+# Imports inside functions: start-up time: the leaderboard's text formats, the plots and the results
 # ARFF writer load when a format other than JSON is first asked for.
+import tempfile
+from pathlib import Path
 from typing import Annotated, Literal
 
-from fastapi import APIRouter, Query, status
+from fastapi import APIRouter, File, Form, Query, Request, Response, UploadFile, status
 from fastapi.responses import PlainTextResponse
 
-from app.api.deps import ServiceDep, StoreDep
+from app.api.deps import PageDep, ServiceDep, StoreDep, paginate
+from app.api.uploads import form_request, save_upload
+from app.schemas.certainty import RunCertainty
+from app.schemas.imported import ImportResultsRequest
 from app.schemas.runs import BenchRequest, LeaderboardSchema, RunCreated, RunList, RunSchema
+from app.services.certainty import run_certainty
+from app.services.imported import import_results
 from app.services.runs import create_run, run_leaderboard
-from app.store.runs import get_run, list_runs, request_cancel, requeue_run
+from app.store.runs import count_runs, get_run, list_runs, request_cancel, requeue_run
 
 router = APIRouter(prefix="/api/runs", tags=["runs"])
 
@@ -27,9 +34,30 @@ def start_run(body: BenchRequest, service: ServiceDep) -> RunCreated:
     return RunCreated(id=run.id, status=run.status)
 
 
+@router.post("/import-results", status_code=status.HTTP_201_CREATED, response_model=RunSchema)
+def import_results_file(
+    service: ServiceDep,
+    file: Annotated[UploadFile, File(description="A WEKA Experimenter results ARFF file.")],
+    name: Annotated[str | None, Form(max_length=200)] = None,
+    dataset: Annotated[str | None, Form(max_length=200)] = None,
+    target: Annotated[str | None, Form(max_length=200)] = None,
+) -> RunSchema:
+    """Store a WEKA Experimenter results file (InstanceResultListener ARFF: one row per
+    run, fold and scheme) as a finished run of its own (``touchbench import-results``)."""
+    service.settings.work_dir.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(dir=service.settings.work_dir) as folder:
+        fields = {"name": name, "dataset": dataset, "target": target}
+        form_request(ImportResultsRequest, file=Path(folder) / "upload", **fields)
+        path = save_upload(file, Path(folder), "results.arff")
+        request = form_request(ImportResultsRequest, file=path, source_name=path.name, **fields)
+        return import_results(service.store, request).schema()
+
+
 @router.get("", response_model=RunList)
-def runs(store: StoreDep) -> RunList:
-    return RunList(runs=[run.schema() for run in list_runs(store)])
+def runs(store: StoreDep, page: PageDep, request: Request, response: Response) -> RunList:
+    """The runs, oldest first, a page of at most 1,000 (``X-Total-Count``, ``Link``)."""
+    paginate(request, response, page, count_runs(store))
+    return RunList(runs=[run.schema() for run in list_runs(store, page=page)])
 
 
 @router.get("/{run_id}", response_model=RunSchema)
@@ -71,10 +99,13 @@ def leaderboard(
     metric: Annotated[str | None, Query(max_length=100)] = None,
     baseline: Annotated[str | None, Query(max_length=200)] = None,
     format: Annotated[Literal["json", "csv", "markdown", "arff"], Query()] = "json",
+    beside: Annotated[list[int] | None, Query(max_length=20)] = None,
 ) -> LeaderboardSchema | PlainTextResponse:
     """The run's classifiers ranked by ``metric`` with WEKA's marks against ``baseline``
-    (JSON: the same rows as ``touchbench leaderboard --json``)."""
-    ranked = run_leaderboard(store, run_id, metric=metric, baseline=baseline)
+    (JSON: the same rows as ``touchbench leaderboard --json``); ``beside`` adds other runs'
+    classifiers (same data set and target: a paper's imported results), t-tested where the
+    folds pair and by their means where they do not."""
+    ranked = run_leaderboard(store, run_id, metric=metric, baseline=baseline, beside=beside or ())
     run, board = ranked.run, ranked.board
     if format == "json":
         return ranked.report()
@@ -82,9 +113,9 @@ def leaderboard(
 
     columns = metric_columns(run, board)
     if format == "csv":
-        text = leaderboard_csv(board, columns)
+        text = leaderboard_csv(board, columns, ranked.besides)
     elif format == "markdown":
-        text = leaderboard_markdown(run, board, columns)
+        text = leaderboard_markdown(run, board, columns, ranked.besides)
     else:
         from app.reports.results_arff import write_results_arff
 
@@ -92,3 +123,43 @@ def leaderboard(
         write_results_arff(store, run, buffer)
         text = buffer.getvalue()
     return PlainTextResponse(text, media_type=LEADERBOARD_FORMATS[format])
+
+
+ClassifiersQuery = Annotated[
+    str | None,
+    Query(
+        max_length=2000,
+        description="Comma-separated classifier ids (default: every one, best first).",
+    ),
+]
+
+
+def _classifiers(text: str | None) -> list[str] | None:
+    return [c.strip() for c in text.split(",") if c.strip()] if text else None
+
+
+@router.get("/{run_id}/classes", response_model=RunCertainty)
+def classes(run_id: int, store: StoreDep, classifier: ClassifiersQuery = None) -> RunCertainty:
+    """Per-class precision, recall and F1, confusion matrices (summed over folds) per
+    target, and out-of-fold calibration of each classifier (``touchbench classes --json``)."""
+    return run_certainty(store, run_id, classifiers=_classifiers(classifier))
+
+
+@router.get(
+    "/{run_id}/calibration.svg",
+    response_class=PlainTextResponse,
+    responses={200: {"content": {"image/svg+xml": {}}}},
+)
+def calibration_svg(
+    run_id: int,
+    store: StoreDep,
+    classifier: ClassifiersQuery = None,
+    top: Annotated[int, Query(ge=1, le=50)] = 5,
+) -> PlainTextResponse:
+    """The reliability diagram of the run's best ``top`` classifiers with probabilities."""
+    from app.reports.figures import reliability_figure
+    from app.reports.plots import svg_text
+
+    certainty = run_certainty(store, run_id, classifiers=_classifiers(classifier))
+    svg = svg_text(reliability_figure(certainty, top))
+    return PlainTextResponse(svg, media_type="image/svg+xml")

@@ -12,8 +12,10 @@ from fastapi import APIRouter, Query
 from fastapi.responses import HTMLResponse
 
 from app.errors import AppError
-from app.store.runs import list_runs
+from app.reports.bounds import Shown
+from app.store.runs import RunInfo, count_runs, list_runs
 from app.web.deps import StoreDep
+from app.web.listing import newest
 from app.web.rendering import draw, render
 from benchmark.errors import BenchmarkError
 
@@ -33,7 +35,7 @@ def compare(
     from app.services.compare import compare_runs
 
     context: dict[str, object] = {
-        "runs": [run for run in list_runs(store) if run.n_results > 0],
+        "runs": _with_results(newest(count_runs(store), partial(list_runs, store))),
         "chosen": runs,
         "metric": metric or "",
         "alpha": alpha,
@@ -50,3 +52,8 @@ def compare(
             context["comparison"] = comparison_context(comparison)
             context["plot"] = draw("Critical-difference diagram", partial(cd_figure, comparison))
     return render("fragments/compare.html.j2", **context)
+
+
+def _with_results(listed: Shown[RunInfo]) -> Shown[RunInfo]:
+    """The runs with results among the newest, and how many runs are older."""
+    return Shown([run for run in listed.items if run.n_results > 0], listed.more)

@@ -9,9 +9,12 @@ from functools import partial
 from fastapi import APIRouter
 from fastapi.responses import HTMLResponse
 
-from app.services.datasets import describe_dataset, list_datasets
-from app.store.runs import list_runs
+from app.services.datasets import describe_dataset
+from app.services.listing import list_datasets
+from app.store.listing import count_datasets
+from app.store.runs import count_runs, list_runs
 from app.web.deps import StoreDep
+from app.web.listing import newest
 from app.web.rendering import draw, render
 from app.web.routes.pages import Ref
 
@@ -20,7 +23,9 @@ router = APIRouter(prefix="/fragments/datasets", include_in_schema=False)
 
 @router.get("", response_class=HTMLResponse)
 def datasets(store: StoreDep) -> HTMLResponse:
-    return render("fragments/datasets.html.j2", datasets=list_datasets(store))
+    """The newest data sets and how many are older."""
+    listed = newest(count_datasets(store), partial(list_datasets, store))
+    return render("fragments/datasets.html.j2", datasets=listed)
 
 
 @router.get("/{dataset}", response_class=HTMLResponse)
@@ -33,5 +38,8 @@ def dataset(dataset: Ref, store: StoreDep) -> HTMLResponse:
         "fragments/dataset.html.j2",
         dataset=description,
         plot=draw("Instances per class", partial(dataset_classes_figure, description)),
-        runs=[run for run in list_runs(store) if run.dataset_id == description.id],
+        runs=newest(
+            count_runs(store, dataset_id=description.id),
+            partial(list_runs, store, dataset_id=description.id),
+        ),
     )

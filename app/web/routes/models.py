@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+from functools import partial
+
 from fastapi import APIRouter
 from fastapi.responses import HTMLResponse
 
 from app.schemas.runs import FINAL_STATUSES
-from app.store.jobs import list_jobs
-from app.store.models import get_model, list_models
+from app.store.jobs import count_jobs, list_jobs
+from app.store.models import count_models, get_model, list_models
 from app.web.deps import StoreDep
+from app.web.listing import newest
 from app.web.rendering import render
 from app.web.routes.pages import Ref
 from benchmark.dataset import Schema
@@ -19,10 +22,10 @@ router = APIRouter(prefix="/fragments/models", include_in_schema=False)
 @router.get("", response_class=HTMLResponse)
 def models(store: StoreDep) -> HTMLResponse:
     """Every model; polled while a training job is queued or running."""
-    training = [
-        job for job in list_jobs(store) if job.kind == "train" and job.status not in FINAL_STATUSES
-    ]
-    return render("fragments/models.html.j2", models=list_models(store), training=training)
+    recent = newest(count_jobs(store), partial(list_jobs, store)).items
+    training = [job for job in recent if job.kind == "train" and job.status not in FINAL_STATUSES]
+    listed = newest(count_models(store), partial(list_models, store))
+    return render("fragments/models.html.j2", models=listed, training=training)
 
 
 @router.get("/{model}", response_class=HTMLResponse)

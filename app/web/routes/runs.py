@@ -15,10 +15,12 @@ from fastapi.responses import HTMLResponse
 from app.errors import NotFoundError
 from app.reports.run_tables import run_tables
 from app.schemas.runs import FINAL_STATUSES
-from app.services.datasets import list_datasets
+from app.services.listing import list_datasets
 from app.services.runs import NoResultsError, run_leaderboard
-from app.store.runs import RunInfo, get_run, list_runs
+from app.store.listing import count_datasets
+from app.store.runs import count_runs, get_run, list_runs
 from app.web.deps import StoreDep
+from app.web.listing import newest
 from app.web.rendering import draw, render
 from app.web.routes.pages import Ref
 
@@ -26,7 +28,7 @@ from app.web.routes.pages import Ref
 # them, so that the service starts at once.
 if TYPE_CHECKING:
     from app.services.report import RunView
-    from benchmark.evaluation.leaderboard import Leaderboard
+    from app.services.runs import RunLeaderboard
 
 router = APIRouter(prefix="/fragments/runs", include_in_schema=False)
 
@@ -37,11 +39,11 @@ Baseline = Annotated[str | None, Query(max_length=200)]
 @router.get("", response_class=HTMLResponse)
 def runs(store: StoreDep) -> HTMLResponse:
     """Every run with its progress; polled while one is queued or running."""
-    listed = list_runs(store)
+    listed = newest(count_runs(store), partial(list_runs, store))
     return render(
         "fragments/runs.html.j2",
         runs=listed,
-        active=any(run.status not in FINAL_STATUSES for run in listed),
+        active=any(run.status not in FINAL_STATUSES for run in listed.items),
     )
 
 
@@ -55,7 +57,7 @@ def run_form(
 
     return render(
         "fragments/run_form.html.j2",
-        datasets=list_datasets(store),
+        datasets=newest(count_datasets(store), partial(list_datasets, store)),
         chosen=dataset,
         suites=SUITES,
         catalogue=[(spec.id, spec.description) for spec in CATALOGUE.values()],
@@ -72,18 +74,30 @@ def progress(run_id: int, store: StoreDep) -> HTMLResponse:
 
 @router.get("/{run_id}/leaderboard", response_class=HTMLResponse)
 def leaderboard(
-    run_id: int, store: StoreDep, metric: Metric = None, baseline: Baseline = None
+    run_id: int,
+    store: StoreDep,
+    metric: Metric = None,
+    baseline: Baseline = None,
+    beside: Annotated[list[int] | None, Query(max_length=20)] = None,
 ) -> HTMLResponse:
-    """The run's classifiers ranked by ``metric`` with WEKA's marks against ``baseline``."""
+    """The run's classifiers ranked by ``metric`` with WEKA's marks against ``baseline``;
+    ``beside``: other runs' classifiers too (a paper's imported results), t-tested where
+    the folds pair and by their means where they do not."""
     try:
-        ranked = run_leaderboard(store, run_id, metric=metric or None, baseline=baseline or None)
+        ranked = run_leaderboard(
+            store,
+            run_id,
+            metric=metric or None,
+            baseline=baseline or None,
+            beside=beside or (),
+        )
     except NoResultsError as missing:
         return render("fragments/leaderboard.html.j2", run=missing.run, board=None)
     return render(
         "fragments/leaderboard.html.j2",
         run=ranked.run,
         board=ranked.board,
-        table=_table(ranked.run, ranked.board, chosen_baseline=baseline or None),
+        table=_table(ranked, chosen_baseline=baseline or None),
         tables=run_tables(ranked.report()),
     )
 
@@ -134,7 +148,28 @@ def classifier(
         ),
         folds=_folds(view, shown),
         reference=reference,
+        sure=_how_sure(view, classifier),
     )
+
+
+def _how_sure(view: RunView, classifier: str) -> dict[str, Any] | None:
+    """The classifier's per-class tables and its calibration (none for a regression)."""
+    from app.reports import figures
+    from app.reports.certainty_tables import class_tables
+    from app.services.certainty import certainty_of
+
+    if view.run.kind == "regression" or not view.board.row(classifier).n_ok:
+        return None
+    certainty = certainty_of(view, [classifier])
+    [entry] = certainty.classifiers
+    diagram = None
+    if entry.calibration is not None:
+        diagram = draw(
+            f"Reliability of {classifier}: accuracy of the top label against its "
+            "confidence, out of fold",
+            partial(figures.reliability_figure, certainty),
+        )
+    return {"tables": class_tables(certainty), "entry": entry, "diagram": diagram}
 
 
 def _folds(view: RunView, shown: list[str]) -> dict[str, Any]:
@@ -152,17 +187,27 @@ def _folds(view: RunView, shown: list[str]) -> dict[str, Any]:
     }
 
 
-def _table(run: RunInfo, board: Leaderboard, *, chosen_baseline: str | None) -> dict[str, Any]:
-    """The leaderboard's header (metric columns sortable), rows, and the pickers' options."""
-    from app.reports.leaderboard import leaderboard_header, leaderboard_rows, metric_columns
+def _table(ranked: RunLeaderboard, *, chosen_baseline: str | None) -> dict[str, Any]:
+    """The leaderboard's header (metric columns sortable), rows, and the pickers' options;
+    with runs beside it, where each row comes from and how it is compared."""
+    from app.reports.leaderboard import (
+        beside_notes,
+        leaderboard_header,
+        leaderboard_rows,
+        metric_columns,
+    )
     from benchmark.evaluation.metrics import LOWER_IS_BETTER
 
+    run, board, besides = ranked.run, ranked.board, ranked.besides
     columns = metric_columns(run, board)
     metrics = sorted({name for row in board.rows for name in row.metrics})
     return {
-        "header": leaderboard_header(board, columns),
+        "header": leaderboard_header(board, columns, besides),
         "columns": columns,
-        "rows": leaderboard_rows(board, columns),
+        "rows": leaderboard_rows(board, columns, besides),
+        "mark_column": 4 if besides else 3,
+        "beside_notes": beside_notes(besides),
+        "beside": [b.run.id for b in besides],
         "metrics": metrics,
         "baselines": [row.classifier for row in board.rows if row.n_ok],
         "chosen_baseline": chosen_baseline,

@@ -157,7 +157,10 @@ async function startRun(form, outcome) {
 function instanceOf(form) {
   const instance = {};
   for (const field of findAll(form, "[data-kind]")) {
-    if (field.value === "") continue;
+    if (field.value === "") {
+      instance[field.dataset.feature] = null; // a value not known: a missing value
+      continue;
+    }
     const value = field.dataset.kind === "numeric" ? Number(field.value) : field.value;
     instance[field.dataset.feature] = value;
   }

@@ -52,6 +52,13 @@ REFUSALS: list[tuple[dict[str, Any], str, str]] = [
     ({"dataset": "contact", "classifiers": ["ridge"], "stack": 1}, "stack", "numeric"),
     ({"dataset": "contact", "classifiers": ["ridge"], "tune": True}, "tune", "numeric"),
     ({"dataset": "contact", "weka": ["J48"], "classifiers": None}, "weka", "numeric"),
+    ({"target": "gesture", "position": ["x", "y"]}, "position", "'x' is not a target"),
+    (
+        {"dataset": "contact", "classifiers": ["ridge"], "position": ["x", "mic"]},
+        "position",
+        "'mic' is not a target",
+    ),
+    ({"dataset": "contact", "classifiers": ["ridge"], "position": ["x"]}, "position", "at least 2"),
 ]
 
 

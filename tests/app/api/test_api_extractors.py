@@ -45,7 +45,7 @@ def test_extractors_are_listed_as_the_cli_lists_them(
                 "extractor": "window",
                 "events": "none",
                 "segment": "1",
-                "channels": "pdc,tac",
+                "fields": ["pdc", "tac"],
                 "name": "slip",
             },
         )

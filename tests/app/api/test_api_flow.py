@@ -74,7 +74,8 @@ def test_run_leaderboard_model_and_predictions_over_http(
             "instances": [
                 {"f0": 0.0, "f1": 0.0, "f2": 0, "f3": 0, "mic": "left"},
                 {"f0": 4.0, "f1": 2.0, "mic": "elbow"},
-            ]
+            ],
+            "missing": "allow",  # the second leaves out f2 and f3
         },
     )
     assert predicted.status_code == 200, predicted.text
@@ -96,7 +97,7 @@ def test_run_leaderboard_model_and_predictions_over_http(
     assert from_file.json()["predictions"] == cli_predicted.json()["predictions"]
 
     # The service caches loaded models: what other processes do to the store still shows.
-    one = {"instances": [{"f0": 0.0, "f1": 0.0, "mic": "left"}]}
+    one = {"instances": [{"f0": 0.0, "f1": 0.0, "f2": 0.0, "f3": 0.0, "mic": "left"}]}
     store = Store(server.database_url)
     try:
         rename_model(store, "best", "renamed")

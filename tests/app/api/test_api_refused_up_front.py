@@ -60,6 +60,10 @@ def test_a_recordings_upload_is_refused_before_any_job(server: Server, tmp_path:
     assert message == "only applies to `events` 'none', not 'snr'"
     _error(_upload_session(server, samplerate="-5"), 422, "body.samplerate")
     _error(_upload_session(server, name="42"), 422, "body.name")
+    message = _error(_upload_session(server, fields="pdc"), 422, "body.fields")
+    assert message == "needs `topic`: the bag topic the fields belong to"
+    _error(_upload_session(server, sample_format="U8"), 422, "body.sample_format")
+    _error(_upload_session(server, channels="0"), 422, "body.channels")
     message = _error(_upload_session(server, name="touch"), 409)
     assert message.startswith("a dataset named 'touch' already exists (id 1)")
 

@@ -119,7 +119,7 @@ def test_twenty_clients_at_once_lose_and_duplicate_nothing(
                     started = True
                 predicted = api.post(
                     "/api/models/touch-nb/predict",
-                    json={"instances": [{"f0": 1.0, "f1": 0.5, "mic": "left"}]},
+                    json={"instances": [{"f0": 1.0, "f1": 0.5, "f2": 0, "f3": 0, "mic": "left"}]},
                 )
                 record("predict", predicted)
 

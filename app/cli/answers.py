@@ -1,0 +1,246 @@
+"""Commands that answer questions after the leaderboard: the paper's published results
+imported beside ours (``import-results``); where and how sure the classifiers are
+(``classes``: per-class scores, confusion matrices and calibration; ``calibration``: the
+expected calibration error and the reliability diagram)."""
+
+from __future__ import annotations
+
+# Imports inside functions: start-up time. Each command loads only what it uses (the
+# store, NumPy, matplotlib), when it is chosen.
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated
+
+import typer
+
+from app.cli.output import JsonOption, info, print_json, run_table, table
+from app.cli.state import get_state
+
+if TYPE_CHECKING:
+    from app.schemas.certainty import RunCertainty
+    from app.schemas.importance import FeatureImportance
+
+
+def register(app: typer.Typer) -> None:
+    app.command("import-results")(import_results_command)
+    app.command("classes")(classes_command)
+    app.command("calibration")(calibration_command)
+    app.command("importance")(importance_command)
+
+
+RunArgument = Annotated[
+    int, typer.Argument(metavar="RUN", help="Run id (see `touchbench runs`).", min=1)
+]
+ClassifiersOption = Annotated[
+    str | None,
+    typer.Option(
+        "--classifier",
+        "-c",
+        metavar="ID[,ID...]",
+        help="These classifiers (default: every one with a successful fold, best first).",
+    ),
+]
+
+
+def classes_command(
+    ctx: typer.Context,
+    run: RunArgument,
+    classifier: ClassifiersOption = None,
+    as_json: JsonOption = False,
+) -> None:
+    """Show per-class precision, recall and F1, the confusion matrix (summed over folds)
+    and the expected calibration error of a run's classifiers, per target."""
+    from app.reports.certainty_tables import class_tables, score
+
+    certainty = _certainty(ctx, run, classifier)
+    if as_json:
+        print_json(certainty.to_json())
+        return
+    for shown in class_tables(certainty):
+        run_table(shown)
+    for entry in certainty.classifiers:
+        calibration = entry.calibration
+        if calibration is not None:
+            info(
+                f"{entry.classifier}: expected calibration error {score(calibration.ece)} "
+                f"over {calibration.n_instances} out-of-fold predictions"
+            )
+        else:
+            info(f"{entry.classifier}: no calibration ({entry.calibration_note})")
+    info("rows: true class; the columns after support: predicted class (counts)")
+
+
+def calibration_command(
+    ctx: typer.Context,
+    run: RunArgument,
+    classifier: ClassifiersOption = None,
+    output: Annotated[
+        Path | None,
+        typer.Option(
+            "--output", "-o", metavar="FILE.svg|png", help="Draw the reliability diagram here."
+        ),
+    ] = None,
+    top: Annotated[
+        int, typer.Option("--top", min=1, help="Classifiers in the diagram (the best first).")
+    ] = 5,
+    as_json: JsonOption = False,
+) -> None:
+    """Show the expected calibration error of a run's classifiers from their out-of-fold
+    probabilities, and draw their reliability diagram."""
+    from app.reports.plots import figure_format, save_figure
+
+    if output is not None:
+        figure_format(output)
+    certainty = _certainty(ctx, run, classifier)
+    if output is not None:
+        from app.reports.figures import reliability_figure
+
+        save_figure(reliability_figure(certainty, top), output)
+    if as_json:
+        print_json(certainty.to_json())
+    else:
+        from app.reports.certainty_tables import calibration_table
+
+        run_table(calibration_table(certainty))
+    if output is not None:
+        info(f"wrote {output}")
+
+
+def _certainty(ctx: typer.Context, run: int, classifiers: str | None) -> RunCertainty:
+    from app.services.certainty import run_certainty
+
+    names = [c.strip() for c in classifiers.split(",") if c.strip()] if classifiers else None
+    return run_certainty(get_state(ctx).store, run, classifiers=names)
+
+
+def import_results_command(
+    ctx: typer.Context,
+    file: Annotated[
+        Path,
+        typer.Argument(metavar="FILE", help="WEKA Experimenter results ARFF.", show_default=False),
+    ],
+    name: Annotated[
+        str | None,
+        typer.Option("--name", metavar="NAME", help="The run's name (default: WEKA FILE)."),
+    ] = None,
+    dataset: Annotated[
+        str | None,
+        typer.Option(
+            "--dataset",
+            metavar="DATASET",
+            help=(
+                "The stored data set the results are of (default: the one whose relation "
+                "the file's Key_Dataset names)."
+            ),
+        ),
+    ] = None,
+    target: Annotated[
+        str | None,
+        typer.Option(
+            "--target",
+            metavar="NAME",
+            help=(
+                "The target the schemes predicted (default: the data set's only target, or "
+                "the one WEKA's Remove filter in Key_Dataset left)."
+            ),
+        ),
+    ] = None,
+    as_json: JsonOption = False,
+) -> None:
+    """Import a WEKA Experimenter results file (InstanceResultListener ARFF) as a finished
+    run, so that leaderboards and reports rank the paper's classifiers beside ours."""
+    from app.cli.requests import build_request
+    from app.schemas.imported import ImportResultsRequest
+    from app.services.imported import import_results
+
+    request = build_request(
+        ImportResultsRequest,
+        {"file": "FILE"},
+        file=file,
+        name=name,
+        dataset=dataset,
+        target=target,
+    )
+    run = import_results(get_state(ctx).store, request)
+    if as_json:
+        print_json(run.to_json())
+        return
+    schemes = run.config.get("schemes", [])
+    table(
+        f"run {run.id}: {run.config.get('name')} on {run.dataset_name} "
+        f"({', '.join(run.targets)}), {run.config.get('folds')} folds x "
+        f"{run.config.get('repeats')} runs, {run.n_results} results",
+        ["classifier", "WEKA scheme", "options"],
+        [(s["classifier"], s["scheme"], s["options"]) for s in schemes],
+    )
+    info(
+        f"`touchbench leaderboard RUN --beside {run.id}` ranks these beside a run of yours "
+        f"on {run.dataset_name}"
+    )
+
+
+def importance_command(
+    ctx: typer.Context,
+    run: RunArgument,
+    classifier: Annotated[
+        str,
+        typer.Option("--classifier", "-c", metavar="ID", help="One of the run's classifiers."),
+    ],
+    repeats: Annotated[
+        int | None,
+        typer.Option("--repeats", metavar="N", help="Shuffles per feature and fold (3)."),
+    ] = None,
+    top: Annotated[
+        int, typer.Option("--top", min=1, help="Features listed (the most important).")
+    ] = 20,
+    as_json: JsonOption = False,
+) -> None:
+    """Permutation importance of a run's classifier on each of its outer test folds, per
+    feature and per group of features (channel, feature family), with the t-test of each
+    group's drop."""
+    from app.cli.requests import build_request
+    from app.schemas.importance import ImportanceRequest
+    from app.services.importance import run_importance
+
+    request = build_request(
+        ImportanceRequest,
+        {"run": "RUN", "classifier": "--classifier"},
+        run=run,
+        classifier=classifier,
+        repeats=repeats,
+    )
+
+    def progress(done: int, total: int) -> None:
+        if not as_json:
+            info(f"fold {done} of {total} done")
+
+    found = run_importance(get_state(ctx).store, request, on_fold=progress)
+    if as_json:
+        print_json(found.to_json())
+        return
+    header = ["feature", "features", "drop", "std", "p", ""]
+    for grouping, items in found.groups.items():
+        table(
+            f"run {found.run_id}, {found.classifier} on {found.target}: each {grouping} "
+            f"shuffled ({found.metric} drop over {found.n_folds} folds, baseline "
+            f"{found.baseline:.4f})",
+            header,
+            [_importance_row(item) for item in items],
+        )
+    table(
+        f"the {min(top, len(found.features))} most important of {len(found.features)} features",
+        header,
+        [_importance_row(item) for item in found.features[:top]],
+    )
+    info("p: corrected resampled t-test of the drop against none; * significant at 0.05")
+
+
+def _importance_row(item: FeatureImportance) -> tuple[object, ...]:
+    p = "-" if item.p is None else f"{item.p:.3g}"
+    return (
+        item.name,
+        item.n_features,
+        f"{item.mean:+.4f}",
+        f"{item.std:.4f}",
+        p,
+        "*" if item.significant else "",
+    )

@@ -1,0 +1,165 @@
+"""How sure: a run's per-class precision, recall and F1 and confusion matrices per
+classifier and target, and the calibration of its classifiers' probabilities.
+
+Everything comes from what the store keeps of each fold: its confusion matrix (per target)
+and, for multi-class folds of classifiers with probabilities, its reliability bins
+(:mod:`benchmark.evaluation.calibration`; runs carried out before the bins were kept, and
+multi-target runs, have none, and say so).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from app.schemas.certainty import (
+    Calibration,
+    ClassifierCertainty,
+    ClassScores,
+    ReliabilityBin,
+    RunCertainty,
+    TargetClasses,
+)
+from app.services.imported import is_imported
+from app.services.report import RunView, run_view
+from app.store.database import Store
+from benchmark.errors import ConfigurationError
+from benchmark.evaluation.calibration import Reliability, merge
+from benchmark.results import TaskResult
+
+
+def run_certainty(
+    store: Store, run_ref: int | str, *, classifiers: Sequence[str] | None = None
+) -> RunCertainty:
+    """Per-class scores, confusion matrices and calibration of a run's classifiers.
+
+    Parameters
+    ----------
+    classifiers : sequence of str, optional
+        These classifiers, in this order; default every classifier of the run with a
+        successful fold, best first.
+
+    Raises
+    ------
+    ConfigurationError
+        A regression run (no classes), a classifier not in the run, or one without a
+        successful fold.
+    NotFoundError
+        No such run.
+    """
+    return certainty_of(run_view(store, run_ref), classifiers)
+
+
+def certainty_of(view: RunView, classifiers: Sequence[str] | None = None) -> RunCertainty:
+    """:func:`run_certainty` of a run already read (the report's run views)."""
+    run = view.run
+    if run.kind == "regression":
+        raise ConfigurationError(f"run {run.id} is a regression: its targets have no classes")
+    if is_imported(run):
+        raise ConfigurationError(
+            f"run {run.id} was imported from a WEKA results file, which keeps no confusion "
+            "matrices or probabilities"
+        )
+    if classifiers:
+        unknown = [c for c in classifiers if c not in run.classifiers]
+        if unknown:
+            raise ConfigurationError(
+                f"run {run.id} has no classifier '{unknown[0]}' "
+                f"(classifiers: {', '.join(run.classifiers)})"
+            )
+        chosen = list(dict.fromkeys(classifiers))
+    else:
+        chosen = [row.classifier for row in view.board.rows if row.n_ok]
+    return RunCertainty(
+        run_id=run.id,
+        dataset=run.dataset_name,
+        kind=run.kind,
+        targets=run.targets,
+        metric=view.metric,
+        classifiers=[_classifier(view, name) for name in chosen],
+    )
+
+
+def class_scores(confusion: np.ndarray, labels: Sequence[str]) -> list[ClassScores]:
+    """Precision, recall and F1 of each class of a confusion matrix (rows true); ``None``
+    where undefined (a class never predicted, or never present)."""
+    counts = np.asarray(confusion, dtype=np.float64)
+    hits = np.diag(counts)
+    support = counts.sum(axis=1)
+    predicted = counts.sum(axis=0)
+    out = []
+    for k, label in enumerate(labels):
+        precision = hits[k] / predicted[k] if predicted[k] else None
+        recall = hits[k] / support[k] if support[k] else None
+        f1 = None
+        if precision is not None and recall is not None:
+            f1 = 2 * precision * recall / (precision + recall) if precision + recall else 0.0
+        out.append(
+            ClassScores(
+                label=label,
+                precision=None if precision is None else float(precision),
+                recall=None if recall is None else float(recall),
+                f1=None if f1 is None else float(f1),
+                support=int(support[k]),
+            )
+        )
+    return out
+
+
+def calibration_of(results: Sequence[TaskResult]) -> Calibration | None:
+    """The summed reliability bins of the results that have them (``None`` if none has)."""
+    kept = [r for r in results if r.ok and r.calibration is not None]
+    merged = merge(Reliability.from_json(r.calibration) for r in kept if r.calibration)
+    if merged is None:
+        return None
+    edges = merged.edges
+    confidence, accuracy = merged.mean_confidence(), merged.accuracy()
+    return Calibration(
+        ece=merged.ece(),
+        n_instances=int(merged.count.sum()),
+        n_folds=len(kept),
+        bins=[
+            ReliabilityBin(
+                lower=float(edges[b]),
+                upper=float(edges[b + 1]),
+                count=int(merged.count[b]),
+                confidence=_number(confidence[b]),
+                accuracy=_number(accuracy[b]),
+            )
+            for b in range(merged.n_bins)
+        ],
+    )
+
+
+def _classifier(view: RunView, name: str) -> ClassifierCertainty:
+    confusion = view.confusion(name)
+    mine = [r for r in view.results if r.key.classifier == name and r.ok]
+    calibration = calibration_of(mine)
+    note = None
+    if calibration is None:
+        note = (
+            "multi-target folds keep no probabilities"
+            if view.run.kind == "multitarget"
+            else "no fold kept its probabilities' bins (a classifier without probabilities, "
+            "or a run carried out before they were kept)"
+        )
+    return ClassifierCertainty(
+        classifier=name,
+        n_folds=confusion.n_folds,
+        targets=[
+            TargetClasses(
+                target=target,
+                labels=view.labels[target],
+                confusion=matrix.astype(int).tolist(),
+                classes=class_scores(matrix, view.labels[target]),
+            )
+            for target, matrix in confusion.matrices.items()
+        ],
+        calibration=calibration,
+        calibration_note=note,
+    )
+
+
+def _number(value: float) -> float | None:
+    return None if np.isnan(value) else float(value)
