@@ -197,7 +197,7 @@ class _NeuralSequenceModel(BaseEstimator):
         inputs = self._scaled(sequences, others)
         with _torch_settings() as torch:
             self.weights_, self.n_epochs_, self.best_epoch_ = _train(torch, self, inputs, targets)
-        self._network = None
+        self._network: Any = None  # the built network, kept for the next predictions
 
     def _outputs(self, X: np.ndarray) -> np.ndarray:
         """The network's outputs, (n_samples, n_outputs), for a feature matrix."""
@@ -205,12 +205,13 @@ class _NeuralSequenceModel(BaseEstimator):
         X = validate_data(self, X, reset=False)
         sequences, others = self._scaled(*self._split(X))
         with _torch_settings() as torch:
-            if getattr(self, "_network", None) is None:
+            network = getattr(self, "_network", None)
+            if network is None:
                 from benchmark.catalogue.networks import load_network  # PyTorch: on use
 
-                self._network = load_network(self.architecture_, self.weights_)
+                network = self._network = load_network(self.architecture_, self.weights_)
             with torch.inference_mode():
-                outputs = self._network(torch.from_numpy(sequences), torch.from_numpy(others))
+                outputs = network(torch.from_numpy(sequences), torch.from_numpy(others))
             return np.asarray(outputs.numpy(), dtype=np.float64)
 
     def _split(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
