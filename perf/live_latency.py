@@ -88,7 +88,7 @@ def networks(
     )  # fmt: skip
     extract_and_store(store, frames)
     print(
-        f"\n1b. Neural networks on MFCC frames (32 frames x 13), {LIVE_BLOCK}-sample blocks, "
+        f"\n1b. Neural networks on MFCC frames (mfcc frames=32), {LIVE_BLOCK}-sample blocks, "
         f"one thread, ms per touch"
     )
     print(f"{'':<46} {'p50':>8} {'p90':>8} {'p99':>8} {'max':>8}")
