@@ -39,9 +39,13 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import soundfile
+
+if TYPE_CHECKING:
+    from app.store.database import Store
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -69,9 +73,7 @@ def percentiles(values: list[float]) -> str:
     return f"{p50:8.1f} {p90:8.1f} {p99:8.1f} {max(values):8.1f}"
 
 
-def networks(
-    store: object, here: Path, recordings: list[Path], labels: Path, sessions: int
-) -> None:
+def networks(store: Store, here: Path, recordings: list[Path], labels: Path, sessions: int) -> None:
     """Per-touch latency of the neural entries (``cnn1d``, ``bilstm``) on MFCC frames."""
     from app.schemas.extraction import ExtractRequest
     from app.schemas.models import TrainRequest

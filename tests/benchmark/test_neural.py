@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 import skops.io
 from sklearn.base import clone
+from sklearn.pipeline import Pipeline
 
 from benchmark.artifacts import dumps_artifact, loads_artifact
 from benchmark.catalogue import build_pipeline, get_spec
@@ -29,16 +30,16 @@ from benchmark.dataset import Attribute, Dataset, Schema
 from benchmark.errors import ConfigurationError
 from benchmark.estimators import check_classifier
 from benchmark.model import dumps_model, fit_model, loads_model, model_digest
-from benchmark.problem import problem_from_dataset
+from benchmark.problem import Problem, problem_from_dataset
 from benchmark.run.engine import run_tasks
-from benchmark.run.folds import make_folds
+from benchmark.run.folds import Fold, make_folds
 from benchmark.sequence import SequenceLayout, sequence_names
 from tests.benchmark.test_sequences import sequence_dataset, shapes
 
 QUICK = {"max_epochs": 6, "learning_rate": 0.01}
 
 
-def quick(classifier_id: str, layout: SequenceLayout, **params: object) -> object:
+def quick(classifier_id: str, layout: SequenceLayout, **params: object) -> Pipeline:
     model = build_pipeline(classifier_id, n_features=layout.stop, sequence=layout)
     return model.set_params(**{f"classifier__{k}": v for k, v in {**QUICK, **params}.items()})
 
@@ -78,7 +79,7 @@ def test_early_stopping_keeps_the_best_epoch_of_the_inner_validation_split() -> 
 
 
 @pytest.fixture(scope="module")
-def problem_and_fold() -> tuple[object, list[object]]:
+def problem_and_fold() -> tuple[Problem, list[Fold]]:
     problem, _ = problem_from_dataset(sequence_dataset(*shapes(40)))
     folds, _ = make_folds(problem.Y, n_folds=2, seed=0)
     return problem, folds[:1]
