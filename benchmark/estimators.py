@@ -101,9 +101,11 @@ def check_classifier(
     if problem.kind == "regression":
         from benchmark.catalogue.regressors import regressor_spec
 
-        return regressor_spec(
+        regressor = regressor_spec(
             classifier_id, n_targets=problem.n_targets, n_instances=problem.n_instances
         )
+        check_sequence_input(regressor, problem.sequence)
+        return regressor
     names = ", ".join(problem.target_names)
     if is_multitarget_id(classifier_id):
         _, base = parse_config(classifier_id)

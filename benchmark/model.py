@@ -119,10 +119,11 @@ class TrainedModel:
     def predict_with_proba(self, X: np.ndarray) -> tuple[np.ndarray, list[np.ndarray] | None]:
         """Codes and probabilities at once, in one pass where the classifier allows it.
 
-        Forests, trees, logistic regression, Gaussian naive Bayes and k-nearest neighbours
-        predict the class of highest probability (their probabilities are a monotone map
-        of what ``predict`` maximises), so their codes are read off the probabilities
-        instead of running the model twice: live and served predictions pay for each pass.
+        Forests, trees, logistic regression, Gaussian naive Bayes, k-nearest neighbours
+        and the neural sequence classifiers predict the class of highest probability
+        (their probabilities are a monotone map of what ``predict`` maximises), so their
+        codes are read off the probabilities instead of running the model twice: live and
+        served predictions pay for each pass.
         Other classifiers (an SVM's Platt scaling, calibration, voting) predict in their
         own way.
 
@@ -148,6 +149,8 @@ class TrainedModel:
         from sklearn.neighbors import KNeighborsClassifier
         from sklearn.tree import BaseDecisionTree
 
+        from benchmark.catalogue.neural import NeuralSequenceClassifier
+
         if len(self.schema.target_indices) != 1:
             return False
         final = self.estimator[-1] if hasattr(self.estimator, "steps") else self.estimator
@@ -157,6 +160,7 @@ class TrainedModel:
             LogisticRegression,
             GaussianNB,
             KNeighborsClassifier,
+            NeuralSequenceClassifier,  # argmax of the softmax: one pass of the network
         )
         return isinstance(final, most_probable)
 

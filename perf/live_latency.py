@@ -13,7 +13,9 @@ Run from the repository root::
    the wait for the block holding the end plus the computing), the computing alone
    (extraction of the event and prediction), and the two predictions alone
    (``predict`` and ``predict_proba`` of the forest on one instance).  Goal: p50 under
-   20 ms, p99 under 50 ms.
+   20 ms, p99 under 50 ms.  Then the neural entries ``cnn1d`` and ``bilstm`` on MFCC
+   frames (``mfcc`` with ``frames=32``) of the same sessions, one thread: the computing
+   per touch and the prediction alone.  Goal: p99 under 20 ms on one core.
 2. Capture.  The same model runs on PortAudio capture of 3 channels at 44.1 kHz through
    ALSA's file plugin (a ``replay`` device in a temporary HOME, as the tests do), pinned
    to one core.  That device is not paced (it delivers as fast as it can), so the
@@ -37,9 +39,13 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import soundfile
+
+if TYPE_CHECKING:
+    from app.store.database import Store
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -65,6 +71,53 @@ print(seconds / (time.perf_counter() - began), touches, source.dropped, source.x
 def percentiles(values: list[float]) -> str:
     p50, p90, p99 = np.percentile(values, [50, 90, 99])
     return f"{p50:8.1f} {p90:8.1f} {p99:8.1f} {max(values):8.1f}"
+
+
+def networks(store: Store, here: Path, recordings: list[Path], labels: Path, sessions: int) -> None:
+    """Per-touch latency of the neural entries (``cnn1d``, ``bilstm``) on MFCC frames."""
+    from app.schemas.extraction import ExtractRequest
+    from app.schemas.models import TrainRequest
+    from app.services.extraction import extract_and_store
+    from app.services.live import open_live
+    from app.services.models import load_model, train
+    from app.services.simulation import write_session
+    from drivers.replay import FileReplaySource
+    from drivers.source import LIVE_BLOCK
+
+    frames = ExtractRequest(
+        recordings=recordings, labels=labels, name="frames", extractor="mfcc", events="snr",
+        options={"frames": "32"},
+    )  # fmt: skip
+    extract_and_store(store, frames)
+    print(
+        f"\n1b. Neural networks on MFCC frames (mfcc frames=32), {LIVE_BLOCK}-sample blocks, "
+        f"one thread, ms per touch"
+    )
+    print(f"{'':<46} {'p50':>8} {'p90':>8} {'p99':>8} {'max':>8}")
+    for classifier in ("cnn1d", "bilstm"):
+        began = time.perf_counter()
+        train(store, TrainRequest(dataset="frames", classifier=classifier, target="gesture"))
+        fitted = time.perf_counter() - began
+        _, model = load_model(store, f"frames-{classifier}")
+        computing = []
+        for seed in range(sessions):
+            wav, _ = write_session(here, f"fresh{seed}", n_touches=16, seed=1000 + seed)
+            with FileReplaySource(wav, block_length=LIVE_BLOCK) as source:
+                session = open_live(store, f"frames-{classifier}", samplerate=44100.0, n_channels=3)
+                for block in source.blocks():
+                    start = time.perf_counter()
+                    if session.feed(block.samples, block.time, arrived=start):
+                        computing.append(1000 * (time.perf_counter() - start))
+        alone = []
+        X = np.zeros((1, len(model.schema.features)))
+        model.predict_with_proba(X)  # the network is rebuilt from its weights once
+        for _ in range(200):
+            start = time.perf_counter()
+            model.predict_with_proba(X)
+            alone.append(1000 * (time.perf_counter() - start))
+        print(f"{f'computing (extract + predict), {classifier}':<46} {percentiles(computing)}")
+        print(f"{f'predict_with_proba alone, {classifier}':<46} {percentiles(alone)}")
+        print(f"  ({classifier} trained in {fitted:.1f} s on {len(recordings) * 16} touches)")
 
 
 def main() -> None:
@@ -129,6 +182,8 @@ def main() -> None:
         print(f"{'':<46} {'p50':>8} {'p90':>8} {'p99':>8} {'max':>8}")
         for label, values in rows:
             print(f"{label:<46} {percentiles(values)}")
+
+        networks(store, here, recordings, labels, arguments.sessions)
 
         print(
             f"\n2. Capture path, 3 ch x 44.1 kHz in {LIVE_BLOCK}-sample blocks through "

@@ -84,7 +84,7 @@ def classifiers_command(
         from benchmark.catalogue.regressors import REGRESSORS, regression_suite
 
         ids = (
-            regression_suite(suite_name, n_targets=1, n_instances=0)
+            regression_suite(suite_name, n_targets=1, n_instances=0, sequences=True)
             if suite_name
             else list(REGRESSORS)
         )

@@ -194,7 +194,9 @@ def default_classifiers(
     if regression_size is not None:
         from benchmark.catalogue.regressors import regression_suite
 
-        return regression_suite(suite_name, n_targets=n_targets, n_instances=regression_size)
+        return regression_suite(
+            suite_name, n_targets=n_targets, n_instances=regression_size, sequences=sequences
+        )
     if n_targets > 1:
         from benchmark.multitarget.suites import multitarget_suite
 

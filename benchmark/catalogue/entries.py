@@ -48,6 +48,7 @@ from sklearn.tree import DecisionTreeClassifier, ExtraTreeClassifier
 from benchmark.catalogue.boosters import CatBoostNominalClassifier, LightGBMClassifier
 from benchmark.catalogue.estimators import LabelEncodedClassifier, OneRuleClassifier
 from benchmark.catalogue.model_trees import LogisticModelTree
+from benchmark.catalogue.neural import NeuralSequenceClassifier
 from benchmark.catalogue.rules import OrderedRuleClassifier
 from benchmark.catalogue.spec import ClassifierSpec, make_spec
 from benchmark.catalogue.time_series import IntervalForestClassifier, RocketClassifier
@@ -244,6 +245,34 @@ def _weka(
     return _spec(
         id, factory, params, weka=W + weka, missing=True, nominal=True, limits=WEKA_NATIVE, **fields
     )
+
+
+#: The neural entries: id, parameters, description, shortest sequence (the regression
+#: catalogue offers the same networks on numeric targets).
+NEURAL_ENTRIES: tuple[tuple[str, dict[str, Any], str, int], ...] = (
+    (
+        "bilstm",
+        {"network": "bilstm", "hidden": 64, "layers": 1},
+        "Bidirectional LSTM (64 units a direction) over the time steps (PyTorch)",
+        2,
+    ),
+    (
+        "cnn1d",
+        {"network": "cnn1d", "filters": 32, "kernel": 5, "hidden": 64},
+        "Three 1-D convolution blocks over channels, global pooling, dense layer (PyTorch)",
+        4,
+    ),
+    (
+        "resnet1d",
+        {"network": "resnet1d", "filters": 32},
+        "Time-series ResNet: 3 residual blocks of 1-D convolutions, global pooling (PyTorch)",
+        8,
+    ),
+)
+NEURAL_LIMITS = (
+    "sequence data sets only; missing values imputed by the training mean; early stopping "
+    "on 15 % of the training fold; CPU, one thread per worker"
+)
 
 
 SPECS: tuple[ClassifierSpec, ...] = (
@@ -1242,5 +1271,20 @@ SPECS: tuple[ClassifierSpec, ...] = (
         min_sequence=2,
         limits="sequence data sets only; one draw of intervals for the forest (aeon's "
         "RandomIntervalClassifier), not a draw per tree as DrCIF; no catch22 features",
+    ),
+    # Neural networks on the windows (PyTorch, imported only where one fits or predicts)
+    *(
+        _spec(
+            id,
+            NeuralSequenceClassifier,
+            params,
+            family="neural-network",
+            description=description,
+            cost="slow",
+            suites=ALL_ONLY,  # minutes per fold on a few thousand windows
+            min_sequence=minimum,
+            limits=NEURAL_LIMITS,
+        )
+        for id, params, description, minimum in NEURAL_ENTRIES
     ),
 )

@@ -48,6 +48,8 @@ from sklearn.svm import SVR, LinearSVR
 from sklearn.tree import DecisionTreeRegressor
 
 from benchmark.catalogue import CATALOGUE, SUITES, unknown_classifier_message
+from benchmark.catalogue.entries import NEURAL_ENTRIES, NEURAL_LIMITS
+from benchmark.catalogue.neural import NeuralSequenceRegressor
 from benchmark.catalogue.spec import ClassifierSpec, make_spec
 from benchmark.errors import ConfigurationError
 
@@ -265,6 +267,22 @@ _SPECS: tuple[ClassifierSpec, ...] = (
         description="Multilayer perceptron, one hidden layer of 100, standardised targets",
         scaling="standard",
     ),
+    # Networks on a sequence data set's windows, every target at once
+    *(
+        _spec(
+            id,
+            NeuralSequenceRegressor,
+            params,
+            family="neural-network",
+            description=f"{description}, standardised targets",
+            cost="slow",
+            suites=_ALL_ONLY,
+            min_sequence=minimum,
+            limits=NEURAL_LIMITS,
+        )
+        for id, params, description, minimum in NEURAL_ENTRIES
+        if id in ("bilstm", "cnn1d")
+    ),
 )
 
 #: Regressors by id (the ids classifiers of the same family have, plus linear and ridge).
@@ -273,6 +291,7 @@ REGRESSORS: Mapping[str, ClassifierSpec] = MappingProxyType({s.id: s for s in _S
 #: Regressors that fit several targets with one model.
 NATIVE_MULTI_OUTPUT: frozenset[str] = frozenset(
     {"zeror", "linear", "ridge", "cart", "ibk", "knn5", "rf", "extra-trees", "xgb", "gp", "mlp"}
+    | {"bilstm", "cnn1d"}
 )
 
 
@@ -304,6 +323,11 @@ def regressor_spec(
             f"data set has {n_instances}"
         )
     if prefix:
+        if spec.needs_sequence:
+            raise ConfigurationError(
+                f"'{regressor_id}': the sequence regressor '{base}' predicts every target "
+                f"with one network; use '{base}'"
+            )
         if prefix not in CHAIN_PREFIXES:
             raise ConfigurationError(
                 f"unknown multi-output method '{prefix}' in '{regressor_id}'; numeric targets "
@@ -320,11 +344,14 @@ def regressor_spec(
     return spec
 
 
-def regression_suite(name: str, *, n_targets: int, n_instances: int) -> list[str]:
+def regression_suite(
+    name: str, *, n_targets: int, n_instances: int, sequences: bool = False
+) -> list[str]:
     """The regressor ids of a suite for a regression of this size.
 
-    The Gaussian process is left out above :data:`GP_MAX_INSTANCES` instances; several
-    targets add the suite's regressor chains (``rc:ID``).
+    The Gaussian process is left out above :data:`GP_MAX_INSTANCES` instances; sequence
+    regressors are in only for a sequence data set (``sequences``); several targets add
+    the suite's regressor chains (``rc:ID``).
     """
     if name not in SUITES:
         raise ConfigurationError(f"unknown suite '{name}' (suites: {', '.join(SUITES)})")
@@ -333,11 +360,16 @@ def regression_suite(name: str, *, n_targets: int, n_instances: int) -> list[str
         for spec in _SPECS
         if (name == "all" or name in spec.suites)
         and not (spec.id == "gp" and n_instances > GP_MAX_INSTANCES)
+        and (sequences or not spec.needs_sequence)
     ]
     if n_targets > 1 and name != "fast":
         chains = [f"rc:{i}" for i in ids] if name == "all" else list(_DEFAULT_CHAINS)
-        ids += [c for c in chains if c.split(":", 1)[1] in ids]
+        ids += [c for c in chains if c.split(":", 1)[1] in ids and not _reads_sequences(c)]
     return ids
+
+
+def _reads_sequences(regressor_id: str) -> bool:
+    return REGRESSORS[regressor_id.rpartition(":")[2]].needs_sequence
 
 
 def _base_spec(base: str, regressor_id: str) -> ClassifierSpec:

@@ -154,3 +154,28 @@ def test_live_session_takes_a_recipe_given_explicitly(
     samples, _ = soundfile.read(unseen, always_2d=True)
     touches = session.feed(samples.T, 10.0) + session.finish()
     assert len(touches) == 6 and touches[0].start > 10.0
+
+
+def test_a_network_predicts_live_what_predict_says(tmp_path: Path) -> None:
+    store = Store(f"sqlite:///{tmp_path / 'net.db'}")  # one store kind: the model is the point
+    recordings, rows = [], []
+    for seed in range(2):
+        wav, touches = write_session(tmp_path, f"s{seed}", n_touches=8, seed=seed)
+        recordings.append(wav)
+        rows += [(wav.name, *touch) for touch in touches]
+    frames = {"extractor": "mfcc", "events": "snr", "options": {"frames": "8"}}
+    labels = write_labels(tmp_path / "labels.csv", rows)
+    request = ExtractRequest(recordings=recordings, labels=labels, name="frames", **frames)
+    extract_and_store(store, request)
+    model = train(store, TrainRequest(dataset="frames", classifier="cnn1d", target="gesture"))
+    unseen, _ = write_session(tmp_path, "unseen", n_touches=4, seed=99)
+    offline = extract_dataset([unseen], labels=None, **frames).dataset  # type: ignore[arg-type]
+    _, network = load_model(store, model.name)
+    expected = predict(network, offline)
+    with FileReplaySource(unseen, block_length=512) as source:
+        session = open_live(store, model.name, samplerate=source.samplerate, n_channels=3)
+        touches = [t for b in source.blocks() for t in session.feed(b.samples, b.time)]
+        touches += session.finish()
+    assert len(touches) == offline.n_instances == 4
+    assert [t.predictions["gesture"][0] for t in touches] == expected.labels["gesture"]
+    store.dispose()

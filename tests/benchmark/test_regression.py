@@ -23,6 +23,7 @@ from benchmark.evaluation.regression import regression_scores
 from benchmark.problem import Problem, problem_from_dataset
 from benchmark.results import TaskKey, TaskResult
 from benchmark.run.folds import make_fold_plan
+from benchmark.sequence import SequenceLayout
 
 
 def numeric_dataset(n: int = 40, *, nominal_target: bool = False, seed: int = 0) -> Dataset:
@@ -130,14 +131,21 @@ def test_a_lower_error_ranks_first_and_is_marked_better() -> None:
     assert against_best.baseline == "good" and against_best.row("bad").mark == "*"
 
 
-def tiny_problem(n_targets: int, n: int = 30) -> Problem:
+def tiny_problem(n_targets: int, n: int = 30, *, windows: bool = False) -> Problem:
+    """``windows``: 2-channel windows of 8 steps follow the features (a sequence data set)."""
     problem, _ = problem_from_dataset(numeric_dataset(n))
+    X, sequence = problem.X, None
+    if windows:
+        noise = np.random.default_rng(0).normal(size=(n, 16))
+        X = np.column_stack([X, noise + problem.Y[:, :1]])
+        sequence = SequenceLayout(start=problem.X.shape[1], channels=("a", "b"), length=8)
     return Problem(
-        X=problem.X,
+        X=X,
         Y=problem.Y[:, :n_targets],
         n_classes=(),
         target_names=problem.target_names[:n_targets],
         nominal_features=problem.nominal_features,
+        sequence=sequence,
         task="regression",
     )
 
@@ -145,8 +153,10 @@ def tiny_problem(n_targets: int, n: int = 30) -> Problem:
 @pytest.mark.parametrize("regressor_id", list(REGRESSORS))
 def test_every_regressor_fits_one_and_several_targets(regressor_id: str) -> None:
     for n_targets in (1, 2):
-        problem = tiny_problem(n_targets)
+        problem = tiny_problem(n_targets, windows=REGRESSORS[regressor_id].needs_sequence)
         model = build_estimator(regressor_id, problem, random_state=0)
+        if "classifier__max_epochs" in model.get_params():  # networks: a few quick epochs
+            model.set_params(classifier__max_epochs=3)
         Y = problem.Y if n_targets > 1 else problem.Y[:, 0]
         with threadpool_limits(limits=1):  # boosting's OpenMP threads spin on a shared machine
             predicted = np.asarray(model.fit(problem.X, Y).predict(problem.X[:5]))

@@ -13,6 +13,7 @@ from threadpoolctl import threadpool_limits
 
 from benchmark.artifacts import is_trusted_type
 from benchmark.catalogue import build_pipeline
+from benchmark.catalogue.neural import KINDS as NETWORKS
 from benchmark.dataset import Attribute, Dataset, Schema
 from benchmark.errors import ConfigurationError
 from benchmark.estimators import check_classifier, reads_sequences
@@ -148,7 +149,7 @@ def test_sequence_classifiers_refuse_flat_data_sets_in_one_line() -> None:
         np.column_stack([y, np.arange(8) // 2 % 2, summary_statistics(sequences)[:, :5]]),
     )
     problem, _ = problem_from_dataset(flat)
-    for classifier in ("minirocket", "multirocket", "interval-forest"):
+    for classifier in ("minirocket", "multirocket", "interval-forest", *NETWORKS):
         with pytest.raises(ConfigurationError) as error:
             check_classifier(classifier, problem)
         message = str(error.value)

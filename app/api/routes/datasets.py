@@ -34,6 +34,7 @@ from app.services.datasets import (
 )
 from app.services.listing import list_datasets
 from app.store.database import Store
+from app.store.datasets import find_dataset
 from app.store.listing import count_datasets
 
 router = APIRouter(prefix="/api/datasets", tags=["datasets"])
@@ -95,16 +96,11 @@ def dataset(dataset: str, store: StoreDep) -> DatasetDescription:
 )
 def arff(dataset: str, store: StoreDep) -> StreamingResponse:
     """The data set as ARFF (MEKA's -C header for several targets), streamed."""
-    summary = next(
-        (d for d in list_datasets(store) if d.name == dataset or str(d.id) == dataset), None
-    )
-    if summary is None:
-        describe_dataset(store, dataset)  # raises the 404 with the usual message
-    assert summary is not None
+    info = find_dataset(store, dataset)  # the 404 with the usual message
     return StreamingResponse(
         _arff_lines(store, dataset),
         media_type="text/plain; charset=utf-8",
-        headers={"Content-Disposition": attachment(f"{summary.name}.arff")},
+        headers={"Content-Disposition": attachment(f"{info.name}.arff")},
     )
 
 

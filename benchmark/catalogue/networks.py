@@ -1,0 +1,152 @@
+"""The PyTorch side of the neural sequence models: networks built from plain descriptions.
+
+Only :mod:`benchmark.catalogue.neural` imports this module, inside its estimators' ``fit``
+and ``predict``, so that listing the catalogue or starting the CLI never loads PyTorch.
+
+A network is rebuilt from its *architecture*, a dict of plain values that
+:func:`benchmark.catalogue.neural.check_architecture` has checked against an allowlist
+(known kinds, known keys, bounded sizes), and from its weights in the safetensors format
+(a JSON header and raw little-endian arrays: loading them runs no code, unlike
+``torch.load`` of a pickle).  Nothing else of a stored model reaches PyTorch.
+
+Every network reads sequences of shape (n, n_channels, length) and the other columns of
+the instance, of shape (n, n_others), appended to the learnt features before the output
+layer; it returns (n, n_outputs): class scores (logits) or standardised target values.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Mapping
+from typing import Any
+
+import torch
+from safetensors.torch import load as load_tensors
+from safetensors.torch import save as save_tensors
+from torch import nn
+
+
+class BiLSTM(nn.Module):
+    """Bidirectional LSTM over the time steps; the last hidden state of each direction.
+
+    The set-up of the oscillatory-actuation paper (contact localisation from MFCC frames).
+    """
+
+    def __init__(self, a: Mapping[str, Any]) -> None:
+        super().__init__()
+        self.lstm = nn.LSTM(
+            input_size=a["n_channels"],
+            hidden_size=a["hidden"],
+            num_layers=a["layers"],
+            batch_first=True,
+            bidirectional=True,
+            dropout=a["dropout"] if a["layers"] > 1 else 0.0,
+        )
+        self.dropout = nn.Dropout(a["dropout"])
+        self.out = nn.Linear(2 * a["hidden"] + a["n_others"], a["n_outputs"])
+
+    def forward(self, sequences: torch.Tensor, others: torch.Tensor) -> torch.Tensor:
+        _, (hidden, _) = self.lstm(sequences.transpose(1, 2))  # (n, length, n_channels) in
+        last = torch.cat([hidden[-2], hidden[-1]], dim=1)  # forward and backward directions
+        return self.out(torch.cat([self.dropout(last), others], dim=1))
+
+
+class CNN1D(nn.Module):
+    """Three convolution blocks over time (the slip paper's CNN3 over channels), global
+    average pooling, one hidden dense layer.
+
+    Each block: convolution (``filters``, then twice as many), ReLU, max pooling by 2
+    while the sequence is long enough.
+    """
+
+    def __init__(self, a: Mapping[str, Any]) -> None:
+        super().__init__()
+        widths = (a["n_channels"], a["filters"], 2 * a["filters"], 2 * a["filters"])
+        blocks: list[nn.Module] = []
+        length = a["length"]
+        for before, after in itertools.pairwise(widths):
+            blocks += [nn.Conv1d(before, after, a["kernel"], padding="same"), nn.ReLU()]
+            if length >= 4:
+                blocks.append(nn.MaxPool1d(2))
+                length //= 2
+        self.features = nn.Sequential(*blocks)
+        self.hidden = nn.Sequential(
+            nn.Linear(widths[-1] + a["n_others"], a["hidden"]), nn.ReLU(), nn.Dropout(a["dropout"])
+        )
+        self.out = nn.Linear(a["hidden"], a["n_outputs"])
+
+    def forward(self, sequences: torch.Tensor, others: torch.Tensor) -> torch.Tensor:
+        pooled = self.features(sequences).mean(dim=2)
+        return self.out(self.hidden(torch.cat([pooled, others], dim=1)))
+
+
+class _Residual(nn.Module):
+    """Three convolutions with batch normalisation, and a shortcut.
+
+    Kernels 7, 5 and 3 (Wang et al. use 8, 5, 3; an odd kernel pads "same" without a copy).
+    """
+
+    def __init__(self, before: int, after: int) -> None:
+        super().__init__()
+        layers: list[nn.Module] = []
+        for i, kernel in enumerate((7, 5, 3)):
+            layers += [
+                nn.Conv1d(before if i == 0 else after, after, kernel, padding="same"),
+                nn.BatchNorm1d(after),
+            ]
+            if i < 2:
+                layers.append(nn.ReLU())
+        self.body = nn.Sequential(*layers)
+        self.shortcut = nn.Sequential(nn.Conv1d(before, after, 1), nn.BatchNorm1d(after))
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        return torch.relu(self.body(x) + self.shortcut(x))
+
+
+class ResNet1D(nn.Module):
+    """Wang et al.'s (2017) time-series ResNet: three residual blocks of ``filters``,
+    twice and twice as many filters, global average pooling, the output layer."""
+
+    def __init__(self, a: Mapping[str, Any]) -> None:
+        super().__init__()
+        widths = (a["n_channels"], a["filters"], 2 * a["filters"], 2 * a["filters"])
+        self.blocks = nn.Sequential(*(_Residual(b, w) for b, w in itertools.pairwise(widths)))
+        self.out = nn.Linear(widths[-1] + a["n_others"], a["n_outputs"])
+
+    def forward(self, sequences: torch.Tensor, others: torch.Tensor) -> torch.Tensor:
+        pooled = self.blocks(sequences).mean(dim=2)
+        return self.out(torch.cat([pooled, others], dim=1))
+
+
+#: The networks a description may name (``architecture["kind"]``); nothing else is built.
+NETWORKS: Mapping[str, type[nn.Module]] = {"bilstm": BiLSTM, "cnn1d": CNN1D, "resnet1d": ResNet1D}
+
+
+def build_network(architecture: Mapping[str, Any]) -> nn.Module:
+    """A new network of ``architecture`` (already checked), weights initialised by the
+    current seed of PyTorch's generator."""
+    return NETWORKS[architecture["kind"]](architecture)
+
+
+def network_bytes(network: nn.Module) -> bytes:
+    """The network's weights and buffers in the safetensors format."""
+    state = {name: tensor.detach().contiguous() for name, tensor in network.state_dict().items()}
+    return bytes(save_tensors(state))
+
+
+def load_network(architecture: Mapping[str, Any], weights: bytes) -> nn.Module:
+    """The network of ``architecture`` with ``weights`` (safetensors bytes), in eval mode.
+
+    Raises
+    ------
+    ValueError
+        The weights are not safetensors, or their names or shapes differ from what the
+        architecture builds.
+    """
+    network = build_network(architecture)
+    try:
+        state = load_tensors(weights)
+        network.load_state_dict(state, strict=True)
+    except Exception as exc:  # safetensors' own error types, torch's RuntimeError
+        raise ValueError(f"the network's weights do not fit its architecture: {exc}") from None
+    return network.eval()

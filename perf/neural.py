@@ -1,0 +1,198 @@
+"""Neural sequence entries against the seeds' other models, on the oscillating link.
+
+The oscillatory-actuation paper localises contact on a rigid link (5 contact points) with
+a BiLSTM on MFCC frames: 97.1 % accuracy in 5-fold cross-validation, ahead of an MLP on
+FFT band peaks (95.6 %).  This script measures the same comparison on the simulator
+(``touchbench simulate oscillating-link``: 3-axis accelerometer at 3200 Hz, one instance
+per second of a trial), contact points p1 to p5 only (the trials without contact are
+left out), folds grouped by trial and stratified as ``touchbench bench`` makes them:
+
+* ``bilstm`` and ``minirocket`` (and ``cnn1d``, ``resnet1d`` with ``--all``) on MFCC
+  frames (``mfcc`` with ``frames=N``: 13 coefficients x N frames a channel);
+* ``rf`` and ``mlp`` on FFT band peaks (``band-peaks``).
+
+Printed per entry: accuracy (mean ± std over folds) and fit seconds per fold (the
+engine's workers, one thread each).  Then, per entry, one fit on every window in a fresh
+process: epochs run, seconds per epoch and peak resident memory.  ``--install`` also
+installs PyTorch (the CPU wheel, ``torch==2.13.0``) and safetensors into a throwaway
+virtual environment and prints the time and the size added; without it the size of the
+installed distributions is printed.  Goal: ``bilstm`` >= 0.95.
+
+    .venv/bin/python perf/neural.py [--trials 60] [--folds 5] [--jobs 2] [--frames 32]
+                                    [--all] [--install]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Sequence
+from importlib import metadata
+from pathlib import Path
+
+import numpy as np
+
+from app.services.extraction import extract_dataset
+from app.services.simulation import write_link_trials
+from benchmark.dataset import Dataset
+from benchmark.evaluation.leaderboard import build_leaderboard
+from benchmark.problem import problem_from_dataset, restrict_targets
+from benchmark.run.engine import run_tasks
+from benchmark.run.folds import make_folds
+
+ROOT = Path(__file__).resolve().parents[1]
+#: Distributions ``pip install torch==2.13.0 safetensors`` adds to this project's venv.
+ADDED = ("torch", "safetensors", "sympy", "mpmath", "filelock")
+
+
+def link_data(folder: Path, trials: int, extractor: str, options: dict[str, str]) -> Dataset:
+    """The link's 1-s windows as ``extractor`` makes them, contact points only."""
+    recordings, labels = write_link_trials(folder, trials=trials, seed=1)
+    extracted = extract_dataset(
+        recordings,
+        labels=labels,
+        extractor=extractor,
+        events="none",
+        segment=1.0,
+        options=options,
+    )
+    data = restrict_targets(extracted.dataset, ["contact"])
+    target = data.schema.targets[0]
+    codes = data.Y[:, 0]
+    return data.subset(np.flatnonzero(codes != target.values.index("none")))
+
+
+def cross_validate(
+    data: Dataset, classifiers: Sequence[str], *, folds: int, jobs: int
+) -> dict[str, tuple[float, float, float]]:
+    """Accuracy (mean, std over folds) and fit seconds per fold of each classifier."""
+    problem, _ = problem_from_dataset(data)
+    splits, _ = make_folds(problem.Y, n_folds=folds, groups=problem.groups, seed=0)
+    results = run_tasks(problem, classifiers, splits, jobs=jobs, timeout=3600)
+    board = build_leaderboard(results)
+    shape = problem.sequence.describe() if problem.sequence else f"{problem.n_features} features"
+    print(f"    {problem.n_instances} instances, {shape}")
+    scores = {}
+    for row in board.rows:
+        if row.n_failed:
+            print(f"      {row.classifier}: failed: {row.errors[0]}")
+            continue
+        mean, std = row.metrics["accuracy"]
+        fit = row.metrics["fit_time"][0]
+        scores[row.classifier] = (mean, std, fit)
+        print(f"      {row.classifier:12s} accuracy {mean:.3f} ± {std:.3f}   fit {fit:7.2f} s/fold")
+    return scores
+
+
+MEASURE = """
+import pickle, resource, sys, time
+from benchmark.estimators import build_estimator
+problem = pickle.load(open(sys.argv[1], "rb"))
+model = build_estimator(sys.argv[2], problem, random_state=0)
+began = time.perf_counter()
+model.fit(problem.X, problem.Y[:, 0])
+seconds = time.perf_counter() - began
+epochs = getattr(model[-1], "n_epochs_", 0)
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+print(seconds, epochs, peak)
+"""
+
+
+def fit_costs(data: Dataset, classifiers: Sequence[str], folder: Path) -> None:
+    """One fit of each classifier on every window, each in a fresh single-thread process."""
+    import pickle
+
+    problem, _ = problem_from_dataset(data)
+    path = folder / f"problem-{id(data)}.pickle"
+    path.write_bytes(pickle.dumps(problem))
+    environment = {**os.environ, "PYTHONPATH": str(ROOT), "OMP_NUM_THREADS": "1"}
+    for name in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+        environment[name] = "1"
+    for classifier in classifiers:
+        done = subprocess.run(
+            [sys.executable, "-c", MEASURE, str(path), classifier],
+            capture_output=True,
+            text=True,
+            env=environment,
+            check=True,
+        )
+        seconds, epochs, peak = (float(v) for v in done.stdout.split())
+        per_epoch = f"{seconds / epochs:6.2f} s/epoch x {int(epochs):3d}" if epochs else " " * 20
+        print(
+            f"      {classifier:12s} fit {seconds:7.2f} s   {per_epoch}   peak {peak:6.0f} MB "
+            f"({problem.n_instances} windows)"
+        )
+
+
+def installed_size() -> None:
+    total = 0.0
+    for name in ADDED:
+        try:
+            files = metadata.files(name) or []
+        except metadata.PackageNotFoundError:
+            continue
+        total += sum(f.size or 0 for f in files) / 2**20
+    print(f"  installed size of {', '.join(ADDED)}: {total:.0f} MB")
+
+
+def install(folder: Path) -> None:
+    """Time and size of installing the CPU wheel into a fresh virtual environment."""
+    venv = folder / "venv"
+    subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
+    site = next((venv / "lib").glob("python*/site-packages"))
+    before = sum(f.stat().st_size for f in site.rglob("*") if f.is_file())
+    began = time.perf_counter()
+    subprocess.run(
+        [str(venv / "bin/pip"), "install", "-q", "torch==2.13.0", "safetensors"], check=True
+    )
+    seconds = time.perf_counter() - began
+    after = sum(f.stat().st_size for f in site.rglob("*") if f.is_file())
+    print(
+        f"  pip install torch==2.13.0 safetensors in a fresh venv: {seconds:.0f} s, "
+        f"{(after - before) / 2**20:.0f} MB added"
+    )
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--trials", type=int, default=60, help="link trials of 3 s")
+    parser.add_argument("--folds", type=int, default=5)
+    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--frames", type=int, default=32, help="MFCC frames per 1-s window")
+    parser.add_argument("--all", action="store_true", help="also cnn1d and resnet1d")
+    parser.add_argument("--install", action="store_true", help="time a fresh install")
+    arguments = parser.parse_args()
+    load = ", ".join(f"{value:.1f}" for value in os.getloadavg())
+    print(f"Machine load average (1, 5, 15 min): {load} on {os.cpu_count()} cores")
+    networks = ("bilstm", "cnn1d", "resnet1d") if arguments.all else ("bilstm",)
+    with tempfile.TemporaryDirectory() as name:
+        folder = Path(name)
+        print(
+            f"Oscillating link: {arguments.trials} trials of 3 s, 5 contact points, "
+            f"{arguments.folds}-fold by trial"
+        )
+        frames = link_data(folder, arguments.trials, "mfcc", {"frames": str(arguments.frames)})
+        peaks = link_data(folder, arguments.trials, "band-peaks", {})
+        print(f"  MFCC frames ({arguments.frames} a window)")
+        common = {"folds": arguments.folds, "jobs": arguments.jobs}
+        sequence = cross_validate(frames, (*networks, "minirocket"), **common)
+        print("  FFT band peaks")
+        flat = cross_validate(peaks, ("rf", "mlp"), **common)
+        best = max({**sequence, **flat}.items(), key=lambda item: item[1][0])
+        bilstm = sequence.get("bilstm", (float("nan"),))[0]
+        print(f"  => bilstm {bilstm:.3f} (goal 0.95); best {best[0]} {best[1][0]:.3f}")
+        print("  One fit on every window, one thread, fresh process")
+        fit_costs(frames, (*networks, "minirocket"), folder)
+        fit_costs(peaks, ("rf", "mlp"), folder)
+        print("PyTorch")
+        installed_size()
+        if arguments.install:
+            install(folder)
+
+
+if __name__ == "__main__":
+    main()
