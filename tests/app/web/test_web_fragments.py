@@ -19,7 +19,7 @@ from tests.app.synthetic import touch_arff
 from tests.app.test_plots import FETCHES
 from tests.app.web.conftest import figure_texts
 
-MARKUP_NAME = "<i>mark</i>"
+MARKUP_NAME = "<i>mark<i>"  # markup, without the slash a name may not hold
 MARKUP_ATTRIBUTE = "<img src=x onerror=alert(1)>"
 DATA_URI = re.compile(r'src="(data:image/svg\+xml;base64,[^"]+)"')
 
@@ -54,7 +54,7 @@ def test_frames_fragments_escaping_errors_and_policy(
     db, api = server.database_url, server.client
     path = _markup_arff(tmp_path / "markup.arff")
     assert run_cli(capsys, db, "import", str(path), "--name", MARKUP_NAME).code == 0
-    ref = api.get("/api/datasets").json()["datasets"][0]["id"]  # a name may hold a slash
+    ref = api.get("/api/datasets").json()["datasets"][0]["id"]
 
     # every answer of the page carries the policy; frames hold no data
     for url in ("/", f"/datasets/{ref}", "/runs/new", "/runs/1", "/compare", "/models/x"):
@@ -67,7 +67,7 @@ def test_frames_fragments_escaping_errors_and_policy(
     assert listing.headers["content-security-policy"] == CONTENT_SECURITY_POLICY
 
     # what the store holds is escaped wherever it shows
-    assert "&lt;i&gt;mark&lt;/i&gt;" in listing.text and MARKUP_NAME not in listing.text
+    assert "&lt;i&gt;mark&lt;i&gt;" in listing.text and MARKUP_NAME not in listing.text
     described = api.get(f"/fragments/datasets/{ref}")
     assert described.status_code == 200, described.text
     assert "&lt;img src=x onerror=alert(1)&gt;" in described.text
