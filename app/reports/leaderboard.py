@@ -27,22 +27,38 @@ def metric_columns(run: RunInfo, board: Leaderboard) -> list[str]:
 
 
 def leaderboard_header(board: Leaderboard, columns: Sequence[str]) -> list[str]:
-    notes = ["notes"] if any(row.n_failed for row in board.rows) else []
+    notes = ["notes"] if _has_notes(board) else []
     return ["#", "classifier", "", *columns, *notes]
 
 
 def leaderboard_rows(board: Leaderboard, columns: Sequence[str]) -> list[tuple[Any, ...]]:
-    """Rank, classifier, mark and ``mean ± std`` per column, ready for a table."""
+    """Rank, classifier, mark and ``mean ± std`` per column, ready for a table; a notes
+    column when a row failed or stopped early (``dropped after fold 3 (p ..., mean so far
+    ...), 3 folds``)."""
     out = []
     for row in board.rows:
         cells: list[Any] = [row.rank, row.classifier, _mark(row, board)]
         for column in columns:
             value = row.metrics.get(column)
             cells.append(mean_std(value) if isinstance(value, tuple) else "-")
-        if any(r.n_failed for r in board.rows):
-            cells.append(f"{row.n_failed} failed: {row.errors[0]}" if row.errors else "")
+        if _has_notes(board):
+            cells.append(row_note(row))
         out.append(tuple(cells))
     return out
+
+
+def row_note(row: LeaderboardRow) -> str:
+    """Why a row stopped early and what failed, in one line; empty when neither."""
+    parts = []
+    if row.dropped is not None:
+        parts.append(f"{row.dropped.describe()}, {row.n_ok + row.n_failed} folds run")
+    if row.errors:
+        parts.append(f"{row.n_failed} failed: {row.errors[0]}")
+    return "; ".join(parts)
+
+
+def _has_notes(board: Leaderboard) -> bool:
+    return any(row.n_failed or row.dropped is not None for row in board.rows)
 
 
 def leaderboard_csv(board: Leaderboard, columns: Sequence[str]) -> str:
@@ -51,17 +67,21 @@ def leaderboard_csv(board: Leaderboard, columns: Sequence[str]) -> str:
     header = ["rank", "classifier", "mark"]
     for column in columns:
         header += [f"{column}_mean", f"{column}_std"]
-    writer.writerow([*header, "n_ok", "n_failed"])
+    writer.writerow([*header, "n_ok", "n_failed", "p_value", "dropped_after_fold", "note"])
     for row in board.rows:
         cells: list[Any] = [row.rank, row.classifier, row.mark]
         for column in columns:
             value = row.metrics.get(column)
             cells += list(value) if isinstance(value, tuple) else ["", ""]
-        writer.writerow([*cells, row.n_ok, row.n_failed])
+        p_value = "" if math.isnan(row.p_value) else row.p_value
+        after = "" if row.dropped is None else row.dropped.after_fold
+        writer.writerow([*cells, row.n_ok, row.n_failed, p_value, after, row_note(row)])
     return buffer.getvalue()
 
 
-def leaderboard_markdown(run: RunInfo, board: Leaderboard, columns: Sequence[str]) -> str:
+def leaderboard_markdown(
+    run: RunInfo, board: Leaderboard, columns: Sequence[str], notes: Sequence[str] = ()
+) -> str:
     marks = (
         f"marks against {board.baseline} (corrected resampled t-test, alpha 0.05): "
         "v better, * worse."
@@ -75,11 +95,13 @@ def leaderboard_markdown(run: RunInfo, board: Leaderboard, columns: Sequence[str
         "| rank | classifier | | " + " | ".join(columns) + " |",
         "|---:|---|:-:|" + "---:|" * len(columns),
     ]
-    for row in leaderboard_rows(board, columns):
+    for row, board_row in zip(leaderboard_rows(board, columns), board.rows, strict=True):
         rank, classifier, mark, *values = row[: 3 + len(columns)]
-        lines.append(f"| {rank} | {classifier} | {mark} | " + " | ".join(values) + " |")
+        note = row_note(board_row)
+        shown = f"{classifier} ({note})" if note and board_row.dropped is not None else classifier
+        lines.append(f"| {rank} | {shown} | {mark} | " + " | ".join(values) + " |")
     v, same, worse = board.summary
-    lines += ["", f"(v/ /*) = ({v}/{same}/{worse})"]
+    lines += ["", f"(v/ /*) = ({v}/{same}/{worse})", *(f"{note}." for note in notes)]
     return "\n".join(lines) + "\n"
 
 

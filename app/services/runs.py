@@ -22,16 +22,19 @@ import numpy as np
 from app.errors import AppError, FieldError
 from app.schemas.runs import (
     BenchRequest,
+    BudgetSchema,
     FoldChoiceSchema,
     LeaderboardRowSchema,
     LeaderboardSchema,
     MarkSummary,
+    RaceSchema,
     RunStatus,
     TunedComparisonSchema,
 )
 from app.services.tuning import run_specs
 from app.store.database import Store
 from app.store.datasets import load_dataset, load_schema
+from app.store.drops import forget_budget_cuts, load_drops, record_drop
 from app.store.ownership import process_owner
 from app.store.runs import (
     RunInfo,
@@ -49,13 +52,16 @@ from app.store.runs import (
 from benchmark.dataset import Dataset
 from benchmark.errors import ConfigurationError
 from benchmark.problem import Problem, problem_from_dataset, restrict_targets
-from benchmark.results import TaskKey, TaskResult
+from benchmark.results import Drop, TaskKey, TaskResult
 
 if TYPE_CHECKING:  # scipy.stats (significance) loads when a leaderboard is first built
     from benchmark.catalogue import ClassifierSpec
     from benchmark.evaluation.leaderboard import Leaderboard
     from benchmark.run.folds import FoldPlan
+    from benchmark.run.racing import RaceRule
 
+#: The race's test, as the leaderboards name it.
+RACE_TEST = "corrected resampled t-test against the leader"
 #: Metric a leaderboard is ranked by unless asked otherwise, per kind of run.
 DEFAULT_METRIC = {"multiclass": "f1_weighted", "multitarget": "hamming_score", "regression": "mae"}
 
@@ -364,6 +370,8 @@ def _plan_run(store: Store, request: BenchRequest) -> _Plan:
         "position": position or None,
         "metric": request.metric,
         "baseline": request.baseline,
+        "race": {"alpha": request.race_alpha} if request.race else None,
+        "budget_total": request.budget_total,
     }
     return _Plan(
         info.id, problem.kind, prepared.target_names, ids, config, prepared.warnings + plan.notes
@@ -431,12 +439,21 @@ def execute_run(
             run.config.get("position") or (),
         )
         folds = _folds(prepared, options).folds
-        done = finished_keys(store, run.id)
+        race = race_rule(run)
+        # a race replays its decisions from the stored scores; a plain run needs their keys
+        previous = load_results(store, run.id) if race is not None else []
+        done = {r.key for r in previous} if race is not None else finished_keys(store, run.id)
         callbacks.on_plan(len(run.classifiers) * len(folds), len(done))
+        forget_budget_cuts(store, run.id)
+        budget = run.config.get("budget_total")
 
         def persist(result: TaskResult) -> None:
             record_result(store, run.id, result)
             callbacks.on_result(result)
+
+        def dropped(drop: Drop) -> None:
+            record_drop(store, run.id, drop)
+            callbacks.on_note(f"{drop.classifier}: {drop.describe()}")
 
         from benchmark.run.engine import RunStopped, run_tasks
 
@@ -456,6 +473,10 @@ def execute_run(
                 max_memory=_bytes(options.max_memory_mb),
                 stop=stop.is_set,
                 extra_specs=run_specs(run.config, run.classifiers),
+                race=race,
+                budget=None if budget is None else float(budget) * 60.0,
+                previous=previous,
+                on_drop=dropped,
             )
         except RunStopped:
             finish_run(store, run.id, "cancelled")
@@ -476,6 +497,22 @@ def execute_run(
     status, error_text = _outcome(load_results(store, run.id))
     finish_run(store, run.id, status, error=error_text)
     return get_run(store, run.id)
+
+
+def race_rule(run: RunInfo) -> RaceRule | None:
+    """How a run races, from its config: its ranking metric, level and baseline; ``None``
+    for a run that is not raced."""
+    race = run.config.get("race")
+    if not race:
+        return None
+    from benchmark.run.racing import RaceRule
+
+    baseline = run.config.get("baseline")
+    return RaceRule(
+        metric=run.config.get("metric") or DEFAULT_METRIC.get(run.kind, "f1_weighted"),
+        alpha=float(race["alpha"]),
+        protected=frozenset({baseline} if baseline else ()),
+    )
 
 
 #: Why a run has no results yet, when it is under way.
@@ -513,11 +550,52 @@ class RunLeaderboard:
         The run's classifiers ranked, with WEKA's marks against a baseline.
     results : list of TaskResult
         Every stored fold result of the run, read once.
+    drops : dict of str to Drop
+        The classifiers that stopped before their last fold (raced or budgeted runs).
     """
 
     run: RunInfo
     board: Leaderboard
     results: list[TaskResult]
+    drops: dict[str, Drop] = field(default_factory=dict)
+
+    def notes(self) -> list[str]:
+        """What a raced or budgeted run's leaderboard says under its table."""
+        return [part.note for part in (self.race(), self.budget()) if part is not None]
+
+    def race(self) -> RaceSchema | None:
+        """How the run raced; ``None`` for a run that did not."""
+        race = self.run.config.get("race")
+        if not race:
+            return None
+        alpha = float(race["alpha"])
+        dropped = sum(1 for d in self.drops.values() if d.reason == "race")
+        return RaceSchema(
+            alpha=alpha,
+            test=RACE_TEST,
+            dropped=dropped,
+            note=f"raced at alpha {alpha:g} ({RACE_TEST}); {dropped} dropped",
+        )
+
+    def budget(self) -> BudgetSchema | None:
+        """What the run's total budget cut; ``None`` for a run without one."""
+        minutes = self.run.config.get("budget_total")
+        if minutes is None:
+            return None
+        cut = [c for c, d in self.drops.items() if d.reason == "budget"]
+        raced_out = sum(
+            self.run.n_tasks // max(len(self.run.classifiers), 1) - d.after_fold
+            for d in self.drops.values()
+            if d.reason == "race"
+        )
+        missing = max(self.run.n_tasks - len(self.results) - raced_out, 0)
+        cut_text = f"; cut: {', '.join(cut)}" if cut else ""
+        return BudgetSchema(
+            minutes=float(minutes),
+            cut=cut,
+            tasks_not_run=missing,
+            note=f"total budget {float(minutes):g} min: {missing} task(s) not run{cut_text}",
+        )
 
     def report(self) -> LeaderboardSchema:
         """What ``leaderboard --json`` prints and the API serves: rows with their per-target
@@ -553,6 +631,8 @@ class RunLeaderboard:
                 for c in compare_tuned(results, metric=board.metric, alpha=board.alpha)
             ],
             choices=[FoldChoiceSchema(**c.to_json()) for c in fold_choices(results)],
+            race=self.race(),
+            budget=self.budget(),
         )
 
 
@@ -583,10 +663,11 @@ def run_leaderboard(
     if metric is not None:
         check_metric(run.kind, metric, position=bool(run.config.get("position")), run_id=run.id)
     metric = metric or run.config.get("metric") or DEFAULT_METRIC.get(run.kind, "f1_weighted")
+    drops = load_drops(store, run.id)
     board = build_leaderboard(
-        results, metric=metric, baseline=baseline or run.config.get("baseline")
+        results, metric=metric, baseline=baseline or run.config.get("baseline"), drops=drops
     )
-    return RunLeaderboard(run, board, results)
+    return RunLeaderboard(run, board, results, drops)
 
 
 def check_metric(kind: str, metric: str, *, position: bool, run_id: int | None = None) -> None:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from collections import defaultdict
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -19,7 +19,7 @@ import numpy as np
 from benchmark.errors import ConfigurationError
 from benchmark.evaluation.metrics import LOWER_IS_BETTER
 from benchmark.evaluation.significance import corrected_resampled_ttest
-from benchmark.results import TaskResult
+from benchmark.results import Drop, TaskResult
 
 Mark = Literal["v", "*", ""]
 
@@ -45,6 +45,11 @@ class LeaderboardRow:
         Successful and failed (error or timeout) tasks.
     errors : list of str
         Distinct failure messages, at most three.
+    p_value : float
+        The t-test's p-value against the baseline (NaN for the baseline itself and below
+        two paired folds).
+    dropped : Drop or None
+        Why the classifier stopped before its last fold (a raced or budgeted run).
     """
 
     rank: int
@@ -54,6 +59,8 @@ class LeaderboardRow:
     n_ok: int = 0
     n_failed: int = 0
     errors: list[str] = field(default_factory=list)
+    p_value: float = math.nan
+    dropped: Drop | None = None
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -67,6 +74,8 @@ class LeaderboardRow:
             "n_ok": self.n_ok,
             "n_failed": self.n_failed,
             "errors": list(self.errors),
+            "p_value": finite(self.p_value),
+            "dropped": None if self.dropped is None else self.dropped.to_json(),
         }
 
 
@@ -128,6 +137,7 @@ def build_leaderboard(
     metric: str = "f1_weighted",
     baseline: str | None = None,
     alpha: float = 0.05,
+    drops: Mapping[str, Drop] | None = None,
 ) -> Leaderboard:
     """Rank the classifiers of a run and mark significant differences from a baseline.
 
@@ -141,6 +151,9 @@ def build_leaderboard(
         The classifier to compare against; default the best ranked.
     alpha : float
         Significance level.
+    drops : mapping of str to Drop, optional
+        Classifiers that stopped early (a raced or budgeted run): their rows say so, and
+        the default baseline is the best classifier that did not stop.
 
     Raises
     ------
@@ -170,9 +183,16 @@ def build_leaderboard(
         )
     lower = metric in LOWER_IS_BETTER
     rows = [_summarise(classifier, rs, available) for classifier, rs in by_classifier.items()]
+    # a classifier the budget cut before its first fold is listed too, without scores
+    rows += [_summarise(c, [], available) for c in drops or {} if c not in by_classifier]
     rows.sort(key=lambda row: _sort_key(row, metric, lower))
     _assign_ranks(rows, metric)
+    for row in rows:
+        row.dropped = (drops or {}).get(row.classifier)
     ranked = [row for row in rows if not math.isnan(row.metrics[metric][0])]
+    finished = [row for row in ranked if row.dropped is None]
+    if baseline is None and finished:
+        ranked = finished
     if baseline is None:
         if not ranked:
             raise ConfigurationError(f"no classifier has a {metric} score: every task failed")
@@ -193,7 +213,7 @@ def build_leaderboard(
         paired = sorted(set(scores) & set(base_scores))
         if len(paired) < 2:
             continue
-        _, _, row.mark = mark_against(
+        _, row.p_value, row.mark = mark_against(
             np.array([scores[k] for k in paired]),
             np.array([base_scores[k] for k in paired]),
             test_train_ratio=ratio,

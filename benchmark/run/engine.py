@@ -138,7 +138,9 @@ def run_tasks(
     """
     check_limits(jobs=jobs, timeout=timeout, max_memory=max_memory)
     if budget is not None and not (budget > 0 and math.isfinite(budget)):
-        raise ConfigurationError(f"budget must be a positive, finite number of seconds, got {budget}")
+        raise ConfigurationError(
+            f"budget must be a positive, finite number of seconds, got {budget}"
+        )
     skip = set(skip) | {r.key for r in previous}
     specs, tasks = plan_tasks(problem, classifiers, folds, skip=skip, extra_specs=extra_specs)
     if not tasks:

@@ -16,7 +16,6 @@ from dataclasses import dataclass
 from multiprocessing.connection import wait
 
 from benchmark.errors import BenchmarkError
-from benchmark.results import TaskKey
 from benchmark.run.backend import (
     STOP_POLL,
     ResultCallback,

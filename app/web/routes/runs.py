@@ -85,6 +85,7 @@ def leaderboard(
         board=ranked.board,
         table=_table(ranked.run, ranked.board, chosen_baseline=baseline or None),
         tables=run_tables(ranked.report()),
+        notes=ranked.notes(),
     )
 
 
@@ -165,6 +166,7 @@ def _table(run: RunInfo, board: Leaderboard, *, chosen_baseline: str | None) -> 
         "rows": leaderboard_rows(board, columns),
         "metrics": metrics,
         "baselines": [row.classifier for row in board.rows if row.n_ok],
+        "dropped": [row.classifier for row in board.rows if row.dropped is not None],
         "chosen_baseline": chosen_baseline,
         "direction": "lower is better" if board.metric in LOWER_IS_BETTER else "higher is better",
     }
