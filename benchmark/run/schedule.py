@@ -197,7 +197,8 @@ class RoundSchedule:
     def _make_decisions(self) -> None:
         while self._race is not None and self._decided + 1 < self._n_rounds:
             index = self._decided + 1
-            if any(index not in self._arrived[e] for e in self._live):
+            # every round up to this one: the first decision covers the rounds before it
+            if any(len(self._arrived[e] & set(range(index + 1))) <= index for e in self._live):
                 return
             scores = {
                 e: {r: s for r, s in self._scores[e].items() if r <= index} for e in self._live
