@@ -557,7 +557,7 @@ class RunLeaderboard:
     run: RunInfo
     board: Leaderboard
     results: list[TaskResult]
-    drops: dict[str, Drop] = field(default_factory=dict)
+    drops: dict[str, Drop]
 
     def notes(self) -> list[str]:
         """What a raced or budgeted run's leaderboard says under its table."""
