@@ -144,12 +144,14 @@ class RoundSchedule:
         """The cheapest unstarted task of the earliest round that may start, if any."""
         now = self._clock()
         horizon = min(self._decided + 2, self._n_rounds - 1)
+        calibration = self._calibration()  # once per call: it reads every timed entry
         for index in range(self._n_rounds):
             if index > horizon:
                 break
             waiting = [e for e in self._live if index not in self._started[e]]
-            for entry in sorted(waiting, key=self._cost):
-                if self._deadline is not None and now + self._cost(entry) > self._deadline:
+            costs = {e: self._cost(e, calibration) for e in waiting}
+            for entry in sorted(waiting, key=costs.__getitem__):
+                if self._deadline is not None and now + costs[entry] > self._deadline:
                     self._cut_entry(entry)
                     continue
                 self._started[entry].add(index)
@@ -181,7 +183,7 @@ class RoundSchedule:
 
     def cost(self, entry: str) -> float:
         """Predicted seconds of one more fold of ``entry``."""
-        return self._cost(entry)
+        return self._cost(entry, self._calibration())
 
     # the race ------------------------------------------------------------------------
 
@@ -227,11 +229,11 @@ class RoundSchedule:
 
     # the budget ------------------------------------------------------------------------
 
-    def _cost(self, entry: str) -> float:
+    def _cost(self, entry: str, calibration: float) -> float:
         timed = self._seconds.get(entry)
         if timed:
             return statistics.fmean(timed)
-        return self._hints.get(entry, 1.0) * self._calibration()
+        return self._hints.get(entry, 1.0) * calibration
 
     def _calibration(self) -> float:
         ratios = [
