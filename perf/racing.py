@@ -30,6 +30,7 @@ import sys
 import time
 from collections import Counter
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from scipy.stats import rankdata, studentized_range
@@ -80,12 +81,12 @@ def suite_ids(problem: Problem, name: str) -> list[str]:
     return [i for i in suite(name) if not reads_sequences(i)]
 
 
-def timed(problem: Problem, ids: list[str], folds: list, jobs: int, **options: object):
+def timed(problem: Problem, ids: list[str], folds: list, jobs: int, **options: Any):
     drops: list[Drop] = []
     start = time.perf_counter()
     results = run_tasks(
         problem, ids, folds, jobs=jobs, timeout=TIMEOUT, on_drop=drops.append, **options
-    )  # type: ignore[arg-type]
+    )
     return results, {d.classifier: d for d in drops}, time.perf_counter() - start
 
 

@@ -4,9 +4,9 @@ significantly worse than the current leader.
 The test is the leaderboard's own, WEKA's corrected resampled t-test (Nadeau and Bengio),
 of an entry's per-fold scores against the leader's on the folds both ran, at a stricter
 level than the leaderboard's (``alpha`` 0.01 by default).  Why not Friedman's test with
-Nemenyi's post-hoc comparisons (F-race): with the 58 entries of the default suite, Nemenyi's
+Nemenyi's post-hoc comparisons (F-race): with the 57 entries of the default suite, Nemenyi's
 critical difference of mean ranks at 0.01 is 60 after 3 folds and 33 after 10, while mean
-ranks can differ by 57 at most, so it drops nothing in the early rounds where racing saves
+ranks can differ by 56 at most, so it drops nothing in the early rounds where racing saves
 time; and a rank test makes an entry's fate depend on which others are still in the race,
 so a dropped entry's mark could not be checked against a full run on the same folds
 (``perf/racing.py`` prints both rules' drops on the full run's scores).

@@ -8,6 +8,7 @@ import threading
 from collections import Counter
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -45,7 +46,7 @@ def folds(problem: Problem) -> list:
     return make_folds(problem.Y, n_folds=6)[0]
 
 
-def race(problem: Problem, folds: list, classifiers: list[str], **options: object):
+def race(problem: Problem, folds: list, classifiers: list[str], **options: Any):
     drops: list[Drop] = []
     results = run_tasks(
         problem,
@@ -54,7 +55,7 @@ def race(problem: Problem, folds: list, classifiers: list[str], **options: objec
         jobs=2,
         timeout=TIMEOUT,
         on_drop=drops.append,
-        **options,  # type: ignore[arg-type]
+        **options,
     )
     return results, drops
 
