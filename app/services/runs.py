@@ -443,16 +443,22 @@ def execute_run(
         # a race replays its decisions from the stored scores; a plain run needs their keys
         previous = load_results(store, run.id) if race is not None else []
         done = {r.key for r in previous} if race is not None else finished_keys(store, run.id)
-        callbacks.on_plan(len(run.classifiers) * len(folds), len(done))
+        # tasks in all and done, for the caller's progress: a drop takes its entry's later
+        # folds off the total
+        counts = [len(run.classifiers) * len(folds), len(done)]
+        callbacks.on_plan(*counts)
         forget_budget_cuts(store, run.id)
         budget = run.config.get("budget_total")
 
         def persist(result: TaskResult) -> None:
             record_result(store, run.id, result)
+            counts[1] += 1
             callbacks.on_result(result)
 
         def dropped(drop: Drop) -> None:
             record_drop(store, run.id, drop)
+            counts[0] -= len(folds) - drop.after_fold
+            callbacks.on_plan(*counts)
             callbacks.on_note(f"{drop.classifier}: {drop.describe()}")
 
         from benchmark.run.engine import RunStopped, run_tasks
