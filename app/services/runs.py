@@ -21,6 +21,7 @@ import numpy as np
 
 from app.errors import AppError, FieldError
 from app.schemas.runs import (
+    RACE_MIN_FOLDS,
     BenchRequest,
     BudgetSchema,
     FoldChoiceSchema,
@@ -356,6 +357,12 @@ def _plan_run(store: Store, request: BenchRequest) -> _Plan:
             f"'{request.baseline}' is not a classifier of this run (classifiers: {', '.join(ids)})",
         )
     plan = _folds(prepared, options)
+    if request.race and len(plan.folds) < RACE_MIN_FOLDS:
+        raise FieldError(
+            "race",
+            f"needs at least {RACE_MIN_FOLDS} folds in all, and the data allow "
+            f"{len(plan.folds)} ({'; '.join(plan.notes)})",
+        )
     config = {
         **options.to_json(),
         "folds": max(f.fold for f in plan.folds) + 1,

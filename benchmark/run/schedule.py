@@ -253,7 +253,13 @@ class RoundSchedule:
         return sum(self._n_rounds - len(self._started[e]) for e in self._cut)
 
     def finish(self) -> None:
-        """The backend is done: report the budget's cuts with the folds each entry ran."""
+        """The backend is done: hand on what the race still holds of entries it did not
+        drop (a budget cut the entries its next decision waited for), and report the
+        budget's cuts with the folds each entry ran."""
+        held, self._held = self._held, []
+        for result in held:
+            if result.key.classifier not in self.dropped:
+                self._deliver(result)
         for entry in self._entries:
             if entry in self._cut:
                 self._on_drop(Drop(entry, "budget", len(self._arrived[entry])))

@@ -286,3 +286,41 @@ def test_cost_hints_account_for_the_data_shape() -> None:
     assert estimate_seconds(xgb, wide) > 100 * estimate_seconds(xgb, reference)
     # naive Bayes grows too, but stays far cheaper than boosting on the same data
     assert estimate_seconds(nb, wide) < estimate_seconds(xgb, wide) / 5
+
+
+def test_a_race_with_a_budget_ends_and_hands_on_every_result_it_keeps() -> None:
+    """Each result takes 10 s of the test's clock; 75 s of budget cut the race mid-way (the
+    rounds a decision waits for are never complete), and nothing stays held back."""
+    clock = FakeClock()
+    delivered: list[TaskKey] = []
+    drops: list[Drop] = []
+    schedule = RoundSchedule(
+        ["a", "b", "c"],
+        [(0, f) for f in range(5)],
+        lambda r: delivered.append(r.key),
+        hints={"a": 1.0, "b": 1.0, "c": 1.0},
+        race=RaceRule("accuracy"),
+        test_train_ratio=1 / 9,
+        budget=75.0,
+        on_drop=drops.append,
+        clock=clock,
+    )
+    running: list[TaskKey] = []
+    arrived = 0
+    while not schedule.exhausted or running:
+        while len(running) < 3 and (key := schedule.next_task()) is not None:
+            running.append(key)
+        if not running:
+            break
+        key = running.pop(0)
+        clock.now += 10.0
+        arrived += 1
+        schedule.arrived(result(key.classifier, key.fold, SCORES[key.classifier][key.fold]))
+    schedule.finish()
+    # c's speculative fourth fold may be discarded with it; nothing else is lost
+    raced_out = sum(1 for d in drops if d.reason == "race")
+    assert schedule.exhausted and arrived - raced_out <= len(delivered) <= arrived
+    cut = {d.classifier for d in drops if d.reason == "budget"}
+    assert cut and schedule.cut_tasks() > 0
+    ran = Counter(k.classifier for k in delivered)
+    assert all(d.after_fold == ran[d.classifier] for d in drops if d.reason == "budget")
