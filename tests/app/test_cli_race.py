@@ -148,3 +148,19 @@ def test_a_race_interrupted_by_ctrl_c_resumes_to_the_uninterrupted_leaderboard(
     assert resumed == uninterrupted
     gate_row = next(row for row in resumed if row[1] == "gate")
     assert gate_row[6]["after_fold"] == 3 and gate_row[4] == 3
+
+
+def test_a_race_on_data_that_allow_fewer_folds_is_refused_before_it_exists(
+    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+) -> None:
+    path = tmp_path / "tiny.arff"
+    rows = "".join(f"{i},{label}\n" for i, label in enumerate("xxyyzz"))
+    path.write_text(f"@relation tiny\n@attribute a numeric\n@attribute c {{x,y,z}}\n@data\n{rows}")
+    run_cli(capsys, store_url, "import", str(path))
+    result = run_cli(capsys, store_url, "bench", "tiny", "-c", "zeror,nb", "--race", "-k", "3")
+    assert result.code == 2
+    assert result.err.strip() == (
+        "touchbench: error: --race: needs at least 3 folds in all, and the data allow 2 (the "
+        "smallest class has only 2 instance(s): using 2 folds instead of 3)"
+    )
+    assert _scalar(store_url, "SELECT count(*) FROM runs") == 0
