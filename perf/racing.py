@@ -168,7 +168,7 @@ def main() -> int:
             full_board = build_leaderboard(full, metric=metric)
             raced_board = build_leaderboard(raced, metric=metric, drops=drops)
             top = [row.classifier for row in full_board.rows[:5]]
-            kept = [entry for entry in top if entry not in drops]
+            top_live = [entry for entry in top if entry not in drops]
             full_best = full_board.rows[0]
             raced_best = next(row for row in raced_board.rows if row.dropped is None)
             difference = abs(full_best.metrics[metric][0] - raced_best.metrics[metric][0])
@@ -179,7 +179,18 @@ def main() -> int:
                 f"(after fold: {when})"
             )
             print(f"  wall ratio raced/full: {raced_wall / full_wall:.3f} (goal <= 0.5)")
-            print(f"  full top 5 live at the end of the race: {len(kept)}/5 ({', '.join(top)})")
+            # the floor of that ratio: the share of the full run's fit and predict seconds
+            # spent on what the race still runs
+            seconds = {r.key: r.metrics.get("fit_time", 0.0) + r.metrics.get("predict_time", 0.0)
+                       for r in full if r.ok}  # fmt: skip
+            kept = {r.key for r in raced}
+            share = sum(v for k, v in seconds.items() if k in kept) / max(
+                sum(seconds.values()), 1e-9
+            )
+            print(
+                f"  share of the full run's fit+predict seconds the race still spends: {share:.3f}"
+            )
+            print(f"  full top 5 live at the end of the race: {len(top_live)}/5 ({', '.join(top)})")
             print(
                 f"  winner: full {full_best.classifier} {full_best.metrics[metric][0]:.4f}, "
                 f"raced {raced_best.classifier} {raced_best.metrics[metric][0]:.4f}; "
