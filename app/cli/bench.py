@@ -366,6 +366,42 @@ def bench_command(
             ),
         ),
     ] = False,
+    race: Annotated[
+        bool,
+        typer.Option(
+            "--race",
+            help=(
+                "Race: every classifier on fold 1, then fold 2, ... (cheap first); after each "
+                "fold from the third, those significantly worse than the leader (corrected "
+                "resampled t-test at --race-alpha) stop, marked `dropped after fold k`. The "
+                "leader and the baseline never stop. Needs 3 folds or more."
+            ),
+        ),
+    ] = False,
+    race_alpha: Annotated[
+        float | None,
+        typer.Option(
+            "--race-alpha",
+            metavar="ALPHA",
+            help=f"With --race: the t-test's level, 0 < ALPHA < 0.5 (default "
+            f"{_default('race_alpha'):g}).",
+            show_default=False,
+        ),
+    ] = None,
+    budget_total: Annotated[
+        float | None,
+        typer.Option(
+            "--budget-total",
+            metavar="MINUTES",
+            help=(
+                "Wall minutes for the whole run: folds run fold-major, cheap first, and a task "
+                "whose predicted cost (its classifier's timed folds, else a hint from the "
+                "data's shape) does not fit the time left is not started; the leaderboard "
+                "says what was cut."
+            ),
+            show_default=False,
+        ),
+    ] = None,
     as_json: JsonOption = False,
 ) -> None:
     """Cross-validate classifiers on a data set; every finished fold is stored at once.
@@ -401,6 +437,9 @@ def bench_command(
         "budget": budget,
         "stack": stack,
         "independent": independent,
+        "race": race,
+        "race_alpha": race_alpha,
+        "budget_total": budget_total,
     }
     if resume is not None:
         _check_resume(values)
@@ -465,6 +504,9 @@ BENCH_OPTIONS = {
     "budget": "--budget",
     "stack": "--stack",
     "independent": "--independent",
+    "race": "--race",
+    "race_alpha": "--race-alpha",
+    "budget_total": "--budget-total",
 }
 #: Fields that only say how ``bench`` prints the leaderboard of a resumed run.
 _REPORT_FIELDS = ("metric", "baseline")
@@ -649,11 +691,11 @@ def leaderboard_command(
     elif output_format == "csv":
         sys.stdout.write(leaderboard_csv(board, columns, ranked.besides))
     elif output_format == "markdown":
-        sys.stdout.write(leaderboard_markdown(run, board, columns, ranked.besides))
+        sys.stdout.write(leaderboard_markdown(run, board, columns, ranked.besides, ranked.notes()))
     elif output_format == "arff":
         from app.reports.results_arff import write_results_arff
 
-        write_results_arff(store, run, sys.stdout)
+        write_results_arff(ranked, sys.stdout)
     else:
         _print_leaderboard(ranked)
         _print_run_tables(ranked.report())
@@ -721,3 +763,5 @@ def _print_leaderboard(ranked: RunLeaderboard) -> None:
         f"marks against {board.baseline}: v significantly better, * significantly worse "
         f"(corrected resampled t-test, alpha 0.05); (v/ /*) = ({v}/{same}/{worse})"
     )
+    for note in ranked.notes():
+        info(note)

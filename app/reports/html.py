@@ -225,6 +225,7 @@ def _run(report: Report, view: RunView, plots: list[_Plot]) -> dict[str, Any]:
         "confusions": confusions,
         "fold_note": ranked if isinstance(ranked, str) else None,
         "tables": run_tables(view.report()),
+        "notes": view.notes(),
     }
 
 

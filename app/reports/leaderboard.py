@@ -30,7 +30,7 @@ def metric_columns(run: RunInfo, board: Leaderboard) -> list[str]:
 def leaderboard_header(
     board: Leaderboard, columns: Sequence[str], besides: Sequence[Beside] = ()
 ) -> list[str]:
-    notes = ["notes"] if any(row.n_failed for row in board.rows) else []
+    notes = ["notes"] if _has_notes(board) else []
     run = ["run"] if besides else []
     return ["#", "classifier", *run, "", *columns, *notes]
 
@@ -39,8 +39,10 @@ def leaderboard_rows(
     board: Leaderboard, columns: Sequence[str], besides: Sequence[Beside] = ()
 ) -> list[tuple[Any, ...]]:
     """Rank, classifier, (with runs beside: the run it comes from,) mark and
-    ``mean ± std`` per column, ready for a table.  With runs beside, a classifier that only
-    compares by its mean has ``=`` (means only) where a mark would be."""
+    ``mean ± std`` per column, ready for a table; a notes column when a row failed or
+    stopped early (``dropped after fold 3 (p ..., mean so far ...), 3 folds``).  With runs
+    beside, a classifier that only compares by its mean has ``=`` (means only) where a
+    mark would be."""
     origins = row_runs(besides)
     out = []
     for row in board.rows:
@@ -51,10 +53,24 @@ def leaderboard_rows(
         for column in columns:
             value = row.metrics.get(column)
             cells.append(mean_std(value) if isinstance(value, tuple) else "-")
-        if any(r.n_failed for r in board.rows):
-            cells.append(f"{row.n_failed} failed: {row.errors[0]}" if row.errors else "")
+        if _has_notes(board):
+            cells.append(row_note(row))
         out.append(tuple(cells))
     return out
+
+
+def row_note(row: LeaderboardRow) -> str:
+    """Why a row stopped early and what failed, in one line; empty when neither."""
+    parts = []
+    if row.dropped is not None:
+        parts.append(f"{row.dropped.describe()}, {row.n_ok + row.n_failed} folds run")
+    if row.errors:
+        parts.append(f"{row.n_failed} failed: {row.errors[0]}")
+    return "; ".join(parts)
+
+
+def _has_notes(board: Leaderboard) -> bool:
+    return any(row.n_failed or row.dropped is not None for row in board.rows)
 
 
 def leaderboard_csv(
@@ -67,14 +83,16 @@ def leaderboard_csv(
     for column in columns:
         header += [f"{column}_mean", f"{column}_std"]
     extra = ["run", "tested"] if besides else []
-    writer.writerow([*header, "n_ok", "n_failed", *extra])
+    writer.writerow([*header, "n_ok", "n_failed", "p_value", "dropped_after_fold", "note", *extra])
     for row in board.rows:
         cells: list[Any] = [row.rank, row.classifier, row.mark]
         for column in columns:
             value = row.metrics.get(column)
             cells += list(value) if isinstance(value, tuple) else ["", ""]
+        p_value = "" if math.isnan(row.p_value) else row.p_value
+        after = "" if row.dropped is None else row.dropped.after_fold
         more = [origins.get(row.classifier, ""), row.tested] if besides else []
-        writer.writerow([*cells, row.n_ok, row.n_failed, *more])
+        writer.writerow([*cells, row.n_ok, row.n_failed, p_value, after, row_note(row), *more])
     return buffer.getvalue()
 
 
@@ -91,7 +109,11 @@ def beside_notes(besides: Sequence[Beside]) -> list[str]:
 
 
 def leaderboard_markdown(
-    run: RunInfo, board: Leaderboard, columns: Sequence[str], besides: Sequence[Beside] = ()
+    run: RunInfo,
+    board: Leaderboard,
+    columns: Sequence[str],
+    besides: Sequence[Beside] = (),
+    notes: Sequence[str] = (),
 ) -> str:
     marks = (
         f"marks against {board.baseline} (corrected resampled t-test, alpha 0.05): "
@@ -108,11 +130,14 @@ def leaderboard_markdown(
         "|---:|---|" + ("---:|" if besides else "") + ":-:|" + "---:|" * len(columns),
     ]
     lead = 4 if besides else 3
-    for row in leaderboard_rows(board, columns, besides):
+    for row, board_row in zip(leaderboard_rows(board, columns, besides), board.rows, strict=True):
         cells = [str(cell) for cell in row[: lead + len(columns)]]
+        note = row_note(board_row)
+        if note and board_row.dropped is not None:
+            cells[1] = f"{cells[1]} ({note})"
         lines.append("| " + " | ".join(cells) + " |")
     v, same, worse = board.summary
-    lines += ["", f"(v/ /*) = ({v}/{same}/{worse})"]
+    lines += ["", f"(v/ /*) = ({v}/{same}/{worse})", *(f"{note}." for note in notes)]
     lines += [f"- {note}" for note in beside_notes(besides)]
     return "\n".join(lines) + "\n"
 

@@ -4,24 +4,33 @@ from __future__ import annotations
 
 from typing import TextIO
 
+from app.reports.leaderboard import row_note
+from app.services.runs import RunLeaderboard
 from app.services.tuning import run_specs
-from app.store.database import Store
-from app.store.runs import RunInfo, load_results
 from benchmark.catalogue import CATALOGUE
 from benchmark.errors import ConfigurationError
 from benchmark.evaluation.results_arff import results_to_dataset
 from benchmark.io.arff import write_arff
 
 
-def write_results_arff(store: Store, run: RunInfo, stream: TextIO) -> None:
-    """Write every successful fold of a multi-class run, one row per (run, fold, scheme)."""
+def write_results_arff(ranked: RunLeaderboard, stream: TextIO) -> None:
+    """Write every successful fold of a multi-class run, one row per (run, fold, scheme).
+
+    A raced or budgeted run's file opens with ``%`` comments (which WEKA skips) saying how
+    it raced and which classifiers stopped early, after which fold and why.
+    """
+    run = ranked.run
     if run.kind != "multiclass":
         what = "a regression" if run.kind == "regression" else "multi-target"
         raise ConfigurationError(
             f"run {run.id} is {what}; WEKA's results format holds multi-class runs "
             "(the csv and json formats hold every kind)"
         )
-    results = load_results(store, run.id)
     name = f"{run.dataset_name}: {', '.join(run.targets)}"
     specs = {**CATALOGUE, **run_specs(run.config, run.classifiers)}
-    write_arff(results_to_dataset(results, dataset_name=name, specs=specs), stream)
+    notes = ranked.notes() + [
+        f"{row.classifier}: {row_note(row)}" for row in ranked.board.rows if row.dropped
+    ]
+    for note in notes:
+        stream.write(f"% {note}\n")
+    write_arff(results_to_dataset(ranked.results, dataset_name=name, specs=specs), stream)

@@ -72,6 +72,20 @@ class MetricValue(Schema):
 PerTargetScores = dict[str, dict[str, MetricValue]]
 
 
+class DropSchema(Schema):
+    """Why a classifier stopped before its last fold."""
+
+    reason: Literal["race", "budget"] = Field(
+        description="race: significantly worse than the leader; budget: the run's total "
+        "budget left no time for its next fold."
+    )
+    after_fold: int = Field(description="Folds it ran.")
+    p_value: float | None = Field(description="The race's t-test against the leader.")
+    leader: str | None = Field(description="The leader it was compared with.")
+    mean: float | None = Field(description="Its mean of the ranking metric over its folds.")
+    note: str = Field(description="`dropped after fold k (...)`, as every view says it.")
+
+
 class LeaderboardRowSchema(Schema):
     """One classifier's line; ``metrics.per_target`` holds a multi-target row's scores per
     target (target -> metric -> mean/std)."""
@@ -91,6 +105,30 @@ class LeaderboardRowSchema(Schema):
     run_id: int | None = Field(
         default=None, description="The run beside this one that the classifier comes from."
     )
+    p_value: float | None = Field(
+        default=None, description="The t-test's p-value against the baseline."
+    )
+    dropped: DropSchema | None = Field(
+        default=None, description="Set when the classifier stopped before its last fold."
+    )
+
+
+class RaceSchema(Schema):
+    """How a raced run dropped classifiers."""
+
+    alpha: float = Field(description="Level of the t-test against the leader.")
+    test: str
+    dropped: int = Field(description="Classifiers dropped.")
+    note: str = Field(description="`raced at alpha 0.01 ...`, as every view says it.")
+
+
+class BudgetSchema(Schema):
+    """What a run's total budget cut."""
+
+    minutes: float
+    cut: list[str] = Field(description="Classifiers whose later folds were not started.")
+    tasks_not_run: int = Field(description="Tasks of the run without a result.")
+    note: str
 
 
 class MarkSummary(Schema):
@@ -180,6 +218,10 @@ class LeaderboardSchema(Schema):
         description="Runs whose classifiers are ranked beside this run's (`beside`), and "
         "how each is compared: t-test on paired folds, or means only.",
     )
+    race: RaceSchema | None = Field(default=None, description="Set on a raced run.")
+    budget: BudgetSchema | None = Field(
+        default=None, description="Set on a run with a total budget."
+    )
 
 
 #: The suites of classifiers a run may name instead of classifier ids.
@@ -189,6 +231,9 @@ Suite = Literal["fast", "default", "all"]
 MAX_MEMORY_MB = 2**20
 #: Longest time limit of a task, in seconds (a week).
 MAX_TIMEOUT = 7 * 24 * 3600.0
+
+#: Folds a race runs before its first test (:data:`benchmark.run.racing.FIRST_ROUND`).
+RACE_MIN_FOLDS = 3
 
 #: Fields that a benchmark of each target on its own (``independent``) cannot honour.
 _NOT_INDEPENDENT = {
@@ -200,6 +245,8 @@ _NOT_INDEPENDENT = {
     "stack": "compares each target's plain classifiers",
     "metric": "picks each target's best classifier by weighted F1",
     "baseline": "picks each target's best classifier by weighted F1",
+    "race": "runs each target's classifiers to the end",
+    "budget_total": "runs each target's classifiers to the end",
 }
 
 
@@ -293,6 +340,26 @@ class BenchRequest(Request):
         description="Several targets: benchmark each target on its own with multi-class "
         "classifiers, one run per target, carried out at once rather than queued.",
     )
+    race: bool = Field(
+        default=False,
+        description="Race the classifiers: every one on fold 1, then fold 2, ... (cheap "
+        "first); after each fold from the third, those significantly worse than the leader "
+        "(corrected resampled t-test at `race_alpha`) stop. The leader and the baseline "
+        "never stop.",
+    )
+    race_alpha: float = Field(
+        default=0.01,
+        gt=0,
+        lt=0.5,
+        description="With `race`: the t-test's level for stopping a classifier.",
+    )
+    budget_total: float | None = Field(
+        default=None,
+        gt=0,
+        le=MAX_TIMEOUT / 60,
+        description="Wall minutes for the whole run: tasks run fold-major, cheap first, and "
+        "a task whose predicted cost does not fit the time left is not started.",
+    )
 
     @field_validator("dataset", mode="before")
     @classmethod
@@ -317,4 +384,12 @@ class BenchRequest(Request):
             raise FieldError("suite", "is not used with `classifiers`: give one or the other")
         if self.budget is not None and not self.tune:
             raise FieldError("budget", "is only meaningful with `tune`")
+        if self.race and self.folds * self.repeats < RACE_MIN_FOLDS:
+            raise FieldError(
+                "race",
+                f"needs at least {RACE_MIN_FOLDS} folds in all (it first tests after the "
+                f"third); `folds` {self.folds} x {self.repeats} repeat(s) is too few",
+            )
+        if "race_alpha" in self.model_fields_set and not self.race:
+            raise FieldError("race_alpha", "is only meaningful with `race`")
         return self

@@ -195,7 +195,7 @@ def run_view(
         per_target = {
             r.classifier: summary[r.classifier] for r in board.rows if r.classifier in summary
         }
-    return RunView(run, board, results, ranked.besides, labels, per_target)
+    return RunView(run, board, results, ranked.besides, ranked.drops, labels, per_target)
 
 
 def build_report(

@@ -21,11 +21,14 @@ import numpy as np
 
 from app.errors import AppError, FieldError
 from app.schemas.runs import (
+    RACE_MIN_FOLDS,
     BenchRequest,
+    BudgetSchema,
     FoldChoiceSchema,
     LeaderboardRowSchema,
     LeaderboardSchema,
     MarkSummary,
+    RaceSchema,
     RunStatus,
     TunedComparisonSchema,
 )
@@ -33,6 +36,7 @@ from app.services.beside import Beside, besides, merged_results, row_runs
 from app.services.tuning import run_specs
 from app.store.database import Store
 from app.store.datasets import load_dataset, load_schema
+from app.store.drops import forget_budget_cuts, load_drops, record_drop
 from app.store.ownership import process_owner
 from app.store.runs import (
     RunInfo,
@@ -50,13 +54,16 @@ from app.store.runs import (
 from benchmark.dataset import Dataset
 from benchmark.errors import ConfigurationError
 from benchmark.problem import Problem, position_columns, problem_from_dataset, restrict_targets
-from benchmark.results import TaskKey, TaskResult
+from benchmark.results import Drop, TaskKey, TaskResult
 
 if TYPE_CHECKING:  # scipy.stats (significance) loads when a leaderboard is first built
     from benchmark.catalogue import ClassifierSpec
     from benchmark.evaluation.leaderboard import Leaderboard
     from benchmark.run.folds import FoldPlan
+    from benchmark.run.racing import RaceRule
 
+#: The race's test, as the leaderboards name it.
+RACE_TEST = "corrected resampled t-test against the leader"
 #: Metric a leaderboard is ranked by unless asked otherwise, per kind of run.
 DEFAULT_METRIC = {"multiclass": "f1_weighted", "multitarget": "hamming_score", "regression": "mae"}
 
@@ -358,6 +365,12 @@ def _plan_run(store: Store, request: BenchRequest) -> _Plan:
             f"'{request.baseline}' is not a classifier of this run (classifiers: {', '.join(ids)})",
         )
     plan = fold_plan(prepared, options)
+    if request.race and len(plan.folds) < RACE_MIN_FOLDS:
+        raise FieldError(
+            "race",
+            f"needs at least {RACE_MIN_FOLDS} folds in all, and the data allow "
+            f"{len(plan.folds)} ({'; '.join(plan.notes)})",
+        )
     config = {
         **options.to_json(),
         "folds": max(f.fold for f in plan.folds) + 1,
@@ -372,6 +385,8 @@ def _plan_run(store: Store, request: BenchRequest) -> _Plan:
         "position": position or None,
         "metric": request.metric,
         "baseline": request.baseline,
+        "race": {"alpha": request.race_alpha} if request.race else None,
+        "budget_total": request.budget_total,
     }
     return _Plan(
         info.id, problem.kind, prepared.target_names, ids, config, prepared.warnings + plan.notes
@@ -439,12 +454,27 @@ def execute_run(
             run.config.get("position") or (),
         )
         folds = fold_plan(prepared, options).folds
-        done = finished_keys(store, run.id)
-        callbacks.on_plan(len(run.classifiers) * len(folds), len(done))
+        race = race_rule(run)
+        # a race replays its decisions from the stored scores; a plain run needs their keys
+        previous = load_results(store, run.id) if race is not None else []
+        done = {r.key for r in previous} if race is not None else finished_keys(store, run.id)
+        # tasks in all and done, for the caller's progress: a drop takes its entry's later
+        # folds off the total
+        counts = [len(run.classifiers) * len(folds), len(done)]
+        callbacks.on_plan(*counts)
+        forget_budget_cuts(store, run.id)
+        budget = run.config.get("budget_total")
 
         def persist(result: TaskResult) -> None:
             record_result(store, run.id, result)
+            counts[1] += 1
             callbacks.on_result(result)
+
+        def dropped(drop: Drop) -> None:
+            record_drop(store, run.id, drop)
+            counts[0] -= len(folds) - drop.after_fold
+            callbacks.on_plan(*counts)
+            callbacks.on_note(f"{drop.classifier}: {drop.describe()}")
 
         from benchmark.run.engine import RunStopped, run_tasks
 
@@ -464,6 +494,10 @@ def execute_run(
                 max_memory=_bytes(options.max_memory_mb),
                 stop=stop.is_set,
                 extra_specs=run_specs(run.config, run.classifiers),
+                race=race,
+                budget=None if budget is None else float(budget) * 60.0,
+                previous=previous,
+                on_drop=dropped,
             )
         except RunStopped:
             finish_run(store, run.id, "cancelled")
@@ -484,6 +518,22 @@ def execute_run(
     status, error_text = _outcome(load_results(store, run.id))
     finish_run(store, run.id, status, error=error_text)
     return get_run(store, run.id)
+
+
+def race_rule(run: RunInfo) -> RaceRule | None:
+    """How a run races, from its config: its ranking metric, level and baseline; ``None``
+    for a run that is not raced."""
+    race = run.config.get("race")
+    if not race:
+        return None
+    from benchmark.run.racing import RaceRule
+
+    baseline = run.config.get("baseline")
+    return RaceRule(
+        metric=run.config.get("metric") or DEFAULT_METRIC.get(run.kind, "f1_weighted"),
+        alpha=float(race["alpha"]),
+        protected=frozenset({baseline} if baseline else ()),
+    )
 
 
 #: Why a run has no results yet, when it is under way.
@@ -524,12 +574,53 @@ class RunLeaderboard:
     besides : tuple of Beside
         Runs ranked beside this one (an imported paper's results), with how each is
         compared; their results are in ``board`` but not in ``results``.
+    drops : dict of str to Drop
+        The classifiers that stopped before their last fold (raced or budgeted runs).
     """
 
     run: RunInfo
     board: Leaderboard
     results: list[TaskResult]
     besides: tuple[Beside, ...]
+    drops: dict[str, Drop]
+
+    def notes(self) -> list[str]:
+        """What a raced or budgeted run's leaderboard says under its table."""
+        return [part.note for part in (self.race(), self.budget()) if part is not None]
+
+    def race(self) -> RaceSchema | None:
+        """How the run raced; ``None`` for a run that did not."""
+        race = self.run.config.get("race")
+        if not race:
+            return None
+        alpha = float(race["alpha"])
+        dropped = sum(1 for d in self.drops.values() if d.reason == "race")
+        return RaceSchema(
+            alpha=alpha,
+            test=RACE_TEST,
+            dropped=dropped,
+            note=f"raced at alpha {alpha:g} ({RACE_TEST}); {dropped} dropped",
+        )
+
+    def budget(self) -> BudgetSchema | None:
+        """What the run's total budget cut; ``None`` for a run without one."""
+        minutes = self.run.config.get("budget_total")
+        if minutes is None:
+            return None
+        cut = [c for c, d in self.drops.items() if d.reason == "budget"]
+        raced_out = sum(
+            self.run.n_tasks // max(len(self.run.classifiers), 1) - d.after_fold
+            for d in self.drops.values()
+            if d.reason == "race"
+        )
+        missing = max(self.run.n_tasks - len(self.results) - raced_out, 0)
+        cut_text = f"; cut: {', '.join(cut)}" if cut else ""
+        return BudgetSchema(
+            minutes=float(minutes),
+            cut=cut,
+            tasks_not_run=missing,
+            note=f"total budget {float(minutes):g} min: {missing} task(s) not run{cut_text}",
+        )
 
     def report(self) -> LeaderboardSchema:
         """What ``leaderboard --json`` prints and the API serves: rows with their per-target
@@ -568,6 +659,8 @@ class RunLeaderboard:
             ],
             choices=[FoldChoiceSchema(**c.to_json()) for c in fold_choices(results)],
             beside=[b.schema() for b in self.besides],
+            race=self.race(),
+            budget=self.budget(),
         )
 
 
@@ -609,13 +702,15 @@ def run_leaderboard(
     metric = metric or run.config.get("metric") or DEFAULT_METRIC.get(run.kind, "f1_weighted")
     others = besides(run, [get_run(store, ref) for ref in dict.fromkeys(beside)])
     ranked, groups = merged_results(results, [(b, load_results(store, b.run.id)) for b in others])
+    drops = load_drops(store, run.id)
     board = build_leaderboard(
         ranked,
         metric=metric,
         baseline=baseline or run.config.get("baseline"),
         groups=groups if others else None,
+        drops=drops,
     )
-    return RunLeaderboard(run, board, results, tuple(others))
+    return RunLeaderboard(run, board, results, tuple(others), drops)
 
 
 def check_metric(kind: str, metric: str, *, position: bool, run_id: int | None = None) -> None:

@@ -17,6 +17,7 @@ from typing import Any
 from sqlalchemy import (
     JSON,
     DateTime,
+    Float,
     ForeignKey,
     Integer,
     LargeBinary,
@@ -132,6 +133,23 @@ class FoldResultRow(Base):
     n_train: Mapped[int] = mapped_column(Integer)
     n_test: Mapped[int] = mapped_column(Integer)
     created_at: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=utcnow)
+
+
+class EntryDropRow(Base):
+    """A classifier of a run that stopped before its last fold: dropped by the run's race
+    (``reason`` ``race``: its p-value against the leader then, and its mean so far) or cut
+    by the run's total budget (``budget``)."""
+
+    __tablename__ = "entry_drops"
+
+    run_id: Mapped[int] = mapped_column(ForeignKey("runs.id", ondelete="CASCADE"), primary_key=True)
+    classifier: Mapped[str] = mapped_column(String(100), primary_key=True)
+    reason: Mapped[str] = mapped_column(String(20))
+    #: Folds the classifier ran (the round after which the race dropped it).
+    after_fold: Mapped[int] = mapped_column(Integer)
+    p_value: Mapped[float | None] = mapped_column(Float)
+    leader: Mapped[str | None] = mapped_column(String(100))
+    mean: Mapped[float | None] = mapped_column(Float)
 
 
 class ModelRow(Base):

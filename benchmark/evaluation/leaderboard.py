@@ -19,7 +19,7 @@ import numpy as np
 from benchmark.errors import ConfigurationError
 from benchmark.evaluation.metrics import LOWER_IS_BETTER
 from benchmark.evaluation.significance import corrected_resampled_ttest
-from benchmark.results import TaskResult
+from benchmark.results import Drop, TaskResult
 
 Mark = Literal["v", "*", ""]
 
@@ -49,6 +49,11 @@ class LeaderboardRow:
         Whether the t-test compared it with the baseline: ``False`` for the baseline and
         for a classifier whose folds cannot be paired with the baseline's (another
         comparison group: only the means compare).
+    p_value : float
+        The t-test's p-value against the baseline (NaN for the baseline itself and below
+        two paired folds).
+    dropped : Drop or None
+        Why the classifier stopped before its last fold (a raced or budgeted run).
     """
 
     rank: int
@@ -59,6 +64,8 @@ class LeaderboardRow:
     n_failed: int = 0
     errors: list[str] = field(default_factory=list)
     tested: bool = False
+    p_value: float = math.nan
+    dropped: Drop | None = None
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -73,6 +80,8 @@ class LeaderboardRow:
             "n_failed": self.n_failed,
             "errors": list(self.errors),
             "tested": self.tested,
+            "p_value": finite(self.p_value),
+            "dropped": None if self.dropped is None else self.dropped.to_json(),
         }
 
 
@@ -135,6 +144,7 @@ def build_leaderboard(
     baseline: str | None = None,
     alpha: float = 0.05,
     groups: Mapping[str, str] | None = None,
+    drops: Mapping[str, Drop] | None = None,
 ) -> Leaderboard:
     """Rank the classifiers of a run and mark significant differences from a baseline.
 
@@ -152,6 +162,9 @@ def build_leaderboard(
         Comparison group of each classifier (default: one for all).  Only classifiers in
         the baseline's group are t-tested against it, fold by fold; the others are
         ranked by their means alone (results from runs whose folds do not pair).
+    drops : mapping of str to Drop, optional
+        Classifiers that stopped early (a raced or budgeted run): their rows say so, and
+        the default baseline is the best classifier that did not stop.
 
     Raises
     ------
@@ -181,9 +194,16 @@ def build_leaderboard(
         )
     lower = metric in LOWER_IS_BETTER
     rows = [_summarise(classifier, rs, available) for classifier, rs in by_classifier.items()]
+    # a classifier the budget cut before its first fold is listed too, without scores
+    rows += [_summarise(c, [], available) for c in drops or {} if c not in by_classifier]
     rows.sort(key=lambda row: _sort_key(row, metric, lower))
     _assign_ranks(rows, metric)
+    for row in rows:
+        row.dropped = (drops or {}).get(row.classifier)
     ranked = [row for row in rows if not math.isnan(row.metrics[metric][0])]
+    finished = [row for row in ranked if row.dropped is None]
+    if baseline is None and finished:
+        ranked = finished
     if baseline is None:
         if not ranked:
             raise ConfigurationError(f"no classifier has a {metric} score: every task failed")
@@ -205,7 +225,7 @@ def build_leaderboard(
         paired = sorted(set(scores) & set(base_scores))
         if len(paired) < 2:
             continue
-        _, _, row.mark = mark_against(
+        _, row.p_value, row.mark = mark_against(
             np.array([scores[k] for k in paired]),
             np.array([base_scores[k] for k in paired]),
             test_train_ratio=ratio,

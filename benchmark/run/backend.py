@@ -10,10 +10,11 @@ once.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from typing import Protocol, runtime_checkable
 
 from benchmark.results import TaskKey, TaskResult
+from benchmark.run.schedule import TaskSource
 from benchmark.run.task import failed_result
 
 __all__ = [
@@ -49,7 +50,7 @@ class Backend(Protocol):
 
     def run(
         self,
-        tasks: Sequence[TaskKey],
+        tasks: TaskSource,
         on_start: StartCallback,
         deliver: ResultCallback,
         stop: StopCheck,
@@ -58,8 +59,9 @@ class Backend(Protocol):
 
         Parameters
         ----------
-        tasks : sequence of TaskKey
-            The tasks, started in this order.
+        tasks : TaskSource
+            The tasks: asked for the next one whenever a worker is free; a result is
+            delivered before the source is asked again, so what starts may depend on it.
         on_start : callable
             Called in the calling thread with a task's key when it is handed to a worker.
         deliver : callable

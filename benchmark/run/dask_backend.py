@@ -14,8 +14,6 @@ import contextlib
 import re
 import threading
 import uuid
-from collections import deque
-from collections.abc import Sequence
 from dataclasses import dataclass
 from queue import Empty, SimpleQueue
 from typing import TYPE_CHECKING, Any
@@ -31,6 +29,7 @@ from benchmark.run.backend import (
     timed_out,
     worker_could_not_start,
 )
+from benchmark.run.schedule import TaskSource
 from benchmark.run.task import failed_result
 from benchmark.run.worker import Worker, WorkerDiedError
 
@@ -108,7 +107,7 @@ class DaskBackend:
 
     def run(
         self,
-        tasks: Sequence[TaskKey],
+        tasks: TaskSource,
         on_start: StartCallback,
         deliver: ResultCallback,
         stop: StopCheck,
@@ -128,16 +127,14 @@ class DaskBackend:
         try:
             [data] = client.scatter([self.context], broadcast=True, hash=False)
             slots = max(1, sum(client.nthreads().values()))
-            queue = deque(tasks)
             in_flight: dict[Future, TaskKey] = {}
             # Dask calls the callbacks in its own thread; this thread waits on the queue.
             finished: SimpleQueue[Future] = SimpleQueue()
-            while queue or in_flight:
+            while not tasks.exhausted or in_flight:
                 if stop():
                     client.cancel(list(in_flight))
                     raise RunStopped
-                while queue and len(in_flight) < slots:
-                    key = queue.popleft()
+                while len(in_flight) < slots and (key := tasks.next_task()) is not None:
                     on_start(key)
                     future = client.submit(
                         run_remote_task,

@@ -8,6 +8,8 @@ distributed cluster (:mod:`benchmark.run.dask_backend`).
 
 Every finished task is reported at once through ``on_result`` (in the calling process),
 so that the caller can store it; ``skip`` resumes a run without repeating what is done.
+A plain run hands the tasks out classifier-major; a raced run or one with a total budget
+runs them fold-major, cheap first (:mod:`benchmark.run.schedule`).
 """
 
 from __future__ import annotations
@@ -15,21 +17,26 @@ from __future__ import annotations
 import math
 import os
 import pickle
+import time
 from collections.abc import Callable, Collection, Mapping, Sequence
 
 from benchmark.catalogue import ClassifierSpec
+from benchmark.catalogue.costs import Shape, estimate_seconds
 from benchmark.errors import ConfigurationError
-from benchmark.estimators import check_classifier
+from benchmark.estimators import check_classifier, classifier_spec, is_multitarget_id
 from benchmark.problem import Problem
-from benchmark.results import TaskKey, TaskResult
+from benchmark.results import Drop, TaskKey, TaskResult
 from benchmark.run.backend import Backend, RunStopped, StartCallback, StopCheck
 from benchmark.run.dask_backend import DaskBackend
 from benchmark.run.folds import Fold
 from benchmark.run.local_backend import LocalBackend
+from benchmark.run.racing import RaceRule
+from benchmark.run.schedule import RoundSchedule, TaskList, TaskSource, test_train_ratio
 from benchmark.run.task import TaskContext
 
 __all__ = [
     "Problem",
+    "RaceRule",
     "RunStopped",
     "TaskKey",
     "TaskResult",
@@ -58,6 +65,11 @@ def run_tasks(
     extra_specs: Mapping[str, ClassifierSpec] | None = None,
     max_memory: int | None = None,
     stop: StopCheck | None = None,
+    race: RaceRule | None = None,
+    budget: float | None = None,
+    previous: Sequence[TaskResult] = (),
+    on_drop: Callable[[Drop], None] | None = None,
+    clock: Callable[[], float] = time.monotonic,
 ) -> list[TaskResult]:
     """Cross-validate classifiers on a problem.
 
@@ -96,13 +108,30 @@ def run_tasks(
         Cheap (such as ``threading.Event().is_set``); checked about ten times a second
         while tasks run.  When it returns true, running tasks are killed, no task starts
         any more and :class:`RunStopped` is raised (the results reported so far stand).
+    race : RaceRule, optional
+        Race the classifiers: fold-major rounds, and after each round from the third the
+        classifiers significantly worse than the leader stop (:mod:`benchmark.run.racing`).
+    budget : float, optional
+        Wall seconds for the whole call: tasks run fold-major, cheap first, and a task whose
+        predicted cost (its classifier's timed folds, else its shape-aware cost hint) does
+        not fit the time left is not started, nor are its classifier's later folds.
+    previous : sequence of TaskResult
+        The stored results of a resumed run (their keys are skipped); a race replays its
+        decisions from them and goes on.
+    on_drop : callable, optional
+        Hears each classifier the race drops (at once) and each one the budget cut short
+        (when the tasks are over).
+    clock : callable
+        Monotonic seconds the budget is measured by (a test's own clock decides when a
+        task's cost no longer fits, without waiting).
 
     Returns
     -------
     list of TaskResult
         One per task run, classifier-major in the order of ``classifiers`` and ``folds``.
         Classifiers that raise, run out of memory, crash or time out give results with
-        status ``error`` or ``timeout``; the run goes on.
+        status ``error`` or ``timeout``; the run goes on.  A raced classifier's results
+        stop at the fold after which it was dropped.
 
     Raises
     ------
@@ -113,6 +142,11 @@ def run_tasks(
         ``stop`` returned true.
     """
     check_limits(jobs=jobs, timeout=timeout, max_memory=max_memory)
+    if budget is not None and not (budget > 0 and math.isfinite(budget)):
+        raise ConfigurationError(
+            f"budget must be a positive, finite number of seconds, got {budget}"
+        )
+    skip = set(skip) | {r.key for r in previous}
     specs, tasks = plan_tasks(problem, classifiers, folds, skip=skip, extra_specs=extra_specs)
     if not tasks:
         return []
@@ -130,18 +164,75 @@ def run_tasks(
                     f"exceeded the memory limit of {max_memory / 2**20:g} MB per task "
                     f"({result.error})"
                 )
+        if isinstance(source, RoundSchedule):
+            source.arrived(result)  # it hands the result on, or holds it for its race
+        else:
+            hand_on(result)
+
+    def hand_on(result: TaskResult) -> None:
         results[result.key] = result
         if on_result is not None:
             on_result(result)
 
+    source: TaskSource = TaskList(tasks)
+    if race is not None or budget is not None:
+        if race is not None and len(folds) < race.first_round:
+            raise ConfigurationError(
+                f"a race needs at least {race.first_round} folds, got {len(folds)}"
+            )
+        source = RoundSchedule(
+            list(dict.fromkeys(classifiers)),
+            [(f.repeat, f.fold) for f in folds],
+            hand_on,
+            hints=cost_hints(problem, classifiers, specs, folds),
+            previous=previous,
+            race=race,
+            test_train_ratio=test_train_ratio(sizes.values()),
+            budget=budget,
+            on_drop=on_drop,
+            clock=clock,
+        )
     backend: Backend
     if scheduler:
         backend = DaskBackend(scheduler, context, timeout=timeout, max_memory=max_memory)
     else:
         workers = available_cores() if jobs == -1 else jobs
         backend = LocalBackend(context, workers=workers, timeout=timeout, max_memory=max_memory)
-    backend.run(tasks, on_start or _ignore, deliver, stop or _never)
+    backend.run(source, on_start or _ignore, deliver, stop or _never)
+    if isinstance(source, RoundSchedule):
+        source.finish()
     return [results[key] for key in tasks if key in results]
+
+
+def cost_hints(
+    problem: Problem,
+    classifiers: Sequence[str],
+    specs: Mapping[str, ClassifierSpec],
+    folds: Sequence[Fold],
+) -> dict[str, float]:
+    """Predicted seconds of one fold of each classifier on this problem's shape
+    (:func:`benchmark.catalogue.costs.estimate_seconds`); a multi-target configuration
+    costs its base classifier once per target."""
+    from benchmark.multitarget import parse_config  # loads scikit-learn's meta-estimators
+
+    n_train = max(int(f.train.size) for f in folds)
+    n_classes = max(problem.n_classes) if problem.kind != "regression" else 1
+    hints = {}
+    for classifier in dict.fromkeys(classifiers):
+        base, n_models = classifier, 1
+        if problem.kind != "regression" and is_multitarget_id(classifier):
+            base = parse_config(classifier)[1] or "zeror"
+            n_models = problem.n_targets
+        spec = specs.get(base)
+        if spec is None:
+            try:
+                spec = classifier_spec(base, specs)
+            except ConfigurationError:  # a plugin or regressor id: the catalogue's guess
+                hints[classifier] = 1.0
+                continue
+        shape = Shape(n_train, int(problem.X.shape[1]), n_classes, n_models)
+        hints[classifier] = estimate_seconds(spec, shape)
+    return hints
 
 
 def check_limits(*, jobs: int, timeout: float | None, max_memory: int | None) -> None:

@@ -11,13 +11,11 @@ replacement.
 from __future__ import annotations
 
 import time
-from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
 from multiprocessing.connection import wait
 
 from benchmark.errors import BenchmarkError
-from benchmark.results import TaskKey
 from benchmark.run.backend import (
     STOP_POLL,
     ResultCallback,
@@ -27,6 +25,7 @@ from benchmark.run.backend import (
     timed_out,
     worker_could_not_start,
 )
+from benchmark.run.schedule import TaskSource
 from benchmark.run.task import failed_result
 from benchmark.run.worker import Worker, WorkerDiedError
 
@@ -58,21 +57,23 @@ class LocalBackend:
 
     def run(
         self,
-        tasks: Sequence[TaskKey],
+        tasks: TaskSource,
         on_start: StartCallback,
         deliver: ResultCallback,
         stop: StopCheck,
     ) -> None:
         """Run ``tasks`` (see :meth:`benchmark.run.backend.Backend.run`)."""
-        queue, timeout = deque(tasks), self.timeout
-        pool = [self._spawn() for _ in range(min(self.workers, len(queue)))]
+        timeout = self.timeout
+        pool = [self._spawn() for _ in range(min(self.workers, tasks.remaining()))]
         try:
-            while queue or any(w.task is not None for w in pool):
+            while not tasks.exhausted or any(w.task is not None for w in pool):
                 if stop():
                     raise RunStopped
                 for worker in pool:
-                    if worker.ready and worker.task is None and queue:
-                        key = queue.popleft()
+                    if worker.ready and worker.task is None and not tasks.exhausted:
+                        key = tasks.next_task()
+                        if key is None:
+                            break  # the next tasks wait for a result
                         on_start(key)
                         worker.submit(key, timeout)
                 arrived = wait([w.connection for w in pool], timeout=_wait_time(pool))
@@ -93,7 +94,7 @@ class LocalBackend:
                         survivors.append(worker)
                         continue
                     worker.close()
-                    if queue:
+                    if not tasks.exhausted:
                         survivors.append(self._spawn())
                 pool = survivors
         finally:

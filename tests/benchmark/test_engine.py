@@ -23,6 +23,7 @@ from benchmark.run.dask_backend import DaskBackend
 from benchmark.run.engine import Problem, TaskKey, TaskResult, plan_tasks, run_tasks
 from benchmark.run.folds import make_folds
 from benchmark.run.local_backend import LocalBackend
+from benchmark.run.schedule import TaskList
 from benchmark.run.task import TaskContext
 
 # Deliberately misbehaving classifiers.  The engine's workers import them from this module.
@@ -453,7 +454,7 @@ def test_both_backends_run_the_same_plan_to_the_same_results(
         assert isinstance(backend, Backend)
         started: list[TaskKey] = []
         delivered: list[TaskResult] = []
-        backend.run(tasks, started.append, delivered.append, lambda: False)
+        backend.run(TaskList(tasks), started.append, delivered.append, lambda: False)
         assert started == tasks
         ordered = sorted(delivered, key=lambda r: r.key)
         assert [r.key for r in ordered] == sorted(tasks)

@@ -115,12 +115,12 @@ def leaderboard(
     if format == "csv":
         text = leaderboard_csv(board, columns, ranked.besides)
     elif format == "markdown":
-        text = leaderboard_markdown(run, board, columns, ranked.besides)
+        text = leaderboard_markdown(run, board, columns, ranked.besides, ranked.notes())
     else:
         from app.reports.results_arff import write_results_arff
 
         buffer = io.StringIO()
-        write_results_arff(store, run, buffer)
+        write_results_arff(ranked, buffer)
         text = buffer.getvalue()
     return PlainTextResponse(text, media_type=LEADERBOARD_FORMATS[format])
 

@@ -99,6 +99,7 @@ def leaderboard(
         board=ranked.board,
         table=_table(ranked, chosen_baseline=baseline or None),
         tables=run_tables(ranked.report()),
+        notes=ranked.notes(),
     )
 
 
@@ -210,6 +211,7 @@ def _table(ranked: RunLeaderboard, *, chosen_baseline: str | None) -> dict[str, 
         "beside": [b.run.id for b in besides],
         "metrics": metrics,
         "baselines": [row.classifier for row in board.rows if row.n_ok],
+        "dropped": [row.classifier for row in board.rows if row.dropped is not None],
         "chosen_baseline": chosen_baseline,
         "direction": "lower is better" if board.metric in LOWER_IS_BETTER else "higher is better",
     }

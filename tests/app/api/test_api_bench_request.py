@@ -59,6 +59,13 @@ REFUSALS: list[tuple[dict[str, Any], str, str]] = [
         "'mic' is not a target",
     ),
     ({"dataset": "contact", "classifiers": ["ridge"], "position": ["x"]}, "position", "at least 2"),
+    # racing and the total budget
+    ({"race": True, "folds": 2}, "race", "needs at least 3 folds"),
+    ({"race": True, "race_alpha": 0}, "race_alpha", "greater than 0"),
+    ({"race": True, "race_alpha": 0.5}, "race_alpha", "less than 0.5"),
+    ({"race_alpha": 0.05}, "race_alpha", "is only meaningful with `race`"),
+    ({"budget_total": -1}, "budget_total", "greater than 0"),
+    ({"independent": True, "race": True}, "race", "is not used with `independent`"),
 ]
 
 
@@ -96,3 +103,20 @@ def test_every_refusal_names_its_field_and_leaves_no_run(
     assert board.json() == cli_board.json()
     wrong = api.get(f"/api/runs/{run['id']}/leaderboard", params={"metric": "euclidean_error"})
     assert wrong.status_code == 400 and not CLI_WORDS.search(wrong.json()["error"]["message"])
+
+    # a raced run: its drop in the API's leaderboard and on the web page
+    raced = api.post(
+        "/api/runs",
+        json={**BASE, "dataset": 1, "target": "gesture", "classifiers": ["zeror", "nb", "j48"],
+              "folds": 5, "race": True},
+    )  # fmt: skip
+    assert raced.status_code == 202, raced.text
+    run = server.wait_for(f"/api/runs/{raced.json()['id']}", finished)
+    assert run["status"] == "done" and run["config"]["race"] == {"alpha": 0.01}
+    board = api.get(f"/api/runs/{run['id']}/leaderboard").json()
+    assert board["race"]["dropped"] == 1
+    zeror = next(row for row in board["leaderboard"] if row["classifier"] == "zeror")
+    assert zeror["dropped"]["reason"] == "race" and zeror["n_ok"] == zeror["dropped"]["after_fold"]
+    page = api.get(f"/fragments/runs/{run['id']}/leaderboard").text
+    assert zeror["dropped"]["note"] in page and board["race"]["note"] in page
+    assert 'class="dropped"' in page

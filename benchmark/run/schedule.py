@@ -1,0 +1,271 @@
+"""Which task a free worker starts next: the order of a run's tasks, its race and its budget.
+
+A backend asks its :class:`TaskSource` for a task whenever a worker is free, and hands every
+result back through the engine, so that what starts next may depend on what has finished.
+
+- :class:`TaskList`: a fixed order (classifier-major, what a plain run does).
+- :class:`RoundSchedule`: fold-major rounds (every live entry on fold 1, then fold 2, ...),
+  cheap entries first within a round; with a :class:`~benchmark.run.racing.RaceRule` the
+  entries significantly worse than the leader are dropped after each round from the third;
+  with a budget, tasks whose predicted cost does not fit the time left are not started.
+
+A race's decisions depend on the scores alone: a result of round ``r + 1`` of an entry is
+held back until the decision after round ``r`` is made, and dropped with its entry, so that
+the results handed on (and stored) are the same whatever the timing, and a resumed race
+replays the decisions of the stored results and goes on where it stopped.
+"""
+
+from __future__ import annotations
+
+import statistics
+import time
+from collections import deque
+from collections.abc import Callable, Collection, Mapping, Sequence
+from typing import Protocol, runtime_checkable
+
+from benchmark.results import Drop, TaskKey, TaskResult
+from benchmark.run.racing import RaceRule, decide
+
+__all__ = ["RoundSchedule", "TaskList", "TaskSource"]
+
+#: A task's predicted cost is its entry's timed folds' mean, or the entry's hint times how
+#: much slower the timed entries ran than their hints: this machine's speed, at least this.
+MIN_CALIBRATION = 0.05
+
+
+@runtime_checkable
+class TaskSource(Protocol):
+    """The tasks a backend runs, handed out one at a time."""
+
+    def next_task(self) -> TaskKey | None:
+        """The task to start now; ``None`` when none may start until a result arrives."""
+        ...
+
+    @property
+    def exhausted(self) -> bool:
+        """Whether no task will ever start again."""
+        ...
+
+    def remaining(self) -> int:
+        """Tasks that may still start, at most (how many workers are worth starting)."""
+        ...
+
+
+class TaskList:
+    """Tasks in a fixed order."""
+
+    def __init__(self, tasks: Sequence[TaskKey]) -> None:
+        self._queue = deque(tasks)
+
+    def next_task(self) -> TaskKey | None:
+        return self._queue.popleft() if self._queue else None
+
+    @property
+    def exhausted(self) -> bool:
+        return not self._queue
+
+    def remaining(self) -> int:
+        return len(self._queue)
+
+
+class RoundSchedule:
+    """Fold-major rounds, cheap entries first, with an optional race and budget.
+
+    Parameters
+    ----------
+    entries : sequence of str
+        Classifier ids.
+    rounds : sequence of (int, int)
+        ``(repeat, fold)`` of each round, in order.
+    deliver : callable
+        Hears every result handed on (a race holds some back; see the module's notes).
+    hints : mapping of str to float
+        Predicted seconds of one fold per entry, before it has been timed.
+    previous : sequence of TaskResult
+        Results of a resumed run (not run again, not delivered again).
+    race : RaceRule, optional
+    test_train_ratio : float
+        ``n_test / n_train`` of the folds, for the race's t-test.
+    budget : float, optional
+        Seconds from now after which no task may still be running by prediction.
+    on_drop : callable, optional
+        Hears each entry dropped by the race (at once) or cut by the budget (by
+        :meth:`finish`).
+    clock : callable
+        Monotonic seconds (tests give their own).
+    """
+
+    def __init__(
+        self,
+        entries: Sequence[str],
+        rounds: Sequence[tuple[int, int]],
+        deliver: Callable[[TaskResult], None],
+        *,
+        hints: Mapping[str, float],
+        previous: Sequence[TaskResult] = (),
+        race: RaceRule | None = None,
+        test_train_ratio: float = 0.0,
+        budget: float | None = None,
+        on_drop: Callable[[Drop], None] | None = None,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self._entries = list(dict.fromkeys(entries))
+        self._rounds = {key: index for index, key in enumerate(rounds)}
+        self._n_rounds = len(rounds)
+        self._round_keys = list(rounds)
+        self._deliver = deliver
+        self._hints = dict(hints)
+        self._race = race
+        self._ratio = test_train_ratio
+        self._on_drop = on_drop or (lambda drop: None)
+        self._clock = clock
+        self._deadline = None if budget is None else clock() + budget
+        self._live = list(self._entries)
+        self._arrived: dict[str, set[int]] = {e: set() for e in self._entries}
+        self._started: dict[str, set[int]] = {e: set() for e in self._entries}
+        self._scores: dict[str, dict[int, float]] = {e: {} for e in self._entries}
+        self._held: list[TaskResult] = []
+        self._began: dict[TaskKey, float] = {}
+        self._seconds: dict[str, list[float]] = {}
+        self._cut: set[str] = set()
+        #: rounds up to this index are decided; the next one is certain, the one after
+        #: may start ahead of the decision (its results are held back)
+        self._decided = race.first_round - 2 if race is not None else self._n_rounds
+        self.dropped: dict[str, Drop] = {}
+        for result in previous:
+            self._note(result)
+        for entry in self._entries:
+            self._started[entry] = set(self._arrived[entry])
+        self._make_decisions()
+
+    # the backend's side -------------------------------------------------------------
+
+    def next_task(self) -> TaskKey | None:
+        """The cheapest unstarted task of the earliest round that may start, if any."""
+        now = self._clock()
+        horizon = min(self._decided + 2, self._n_rounds - 1)
+        calibration = self._calibration()  # once per call: it reads every timed entry
+        for index in range(self._n_rounds):
+            if index > horizon:
+                break
+            waiting = [e for e in self._live if index not in self._started[e]]
+            costs = {e: self._cost(e, calibration) for e in waiting}
+            for entry in sorted(waiting, key=costs.__getitem__):
+                if self._deadline is not None and now + costs[entry] > self._deadline:
+                    self._cut_entry(entry)
+                    continue
+                self._started[entry].add(index)
+                key = TaskKey(entry, *self._round_keys[index])
+                self._began[key] = now
+                return key
+        return None
+
+    @property
+    def exhausted(self) -> bool:
+        return self.remaining() == 0
+
+    def remaining(self) -> int:
+        return sum(self._n_rounds - len(self._started[e]) for e in self._live)
+
+    def arrived(self, result: TaskResult) -> None:
+        """Take a result: hand it on (or hold it back), and decide the rounds it completes."""
+        began = self._began.pop(result.key, None)
+        if began is not None:
+            self._seconds.setdefault(result.key.classifier, []).append(self._clock() - began)
+        if result.key.classifier in self.dropped:
+            return  # started ahead of the decision that dropped its entry
+        index = self._note(result)
+        if index > self._decided + 1:
+            self._held.append(result)
+        else:
+            self._deliver(result)
+        self._make_decisions()
+
+    def cost(self, entry: str) -> float:
+        """Predicted seconds of one more fold of ``entry``."""
+        return self._cost(entry, self._calibration())
+
+    # the race ------------------------------------------------------------------------
+
+    def _note(self, result: TaskResult) -> int:
+        entry, index = result.key.classifier, self._rounds[(result.key.repeat, result.key.fold)]
+        self._arrived.setdefault(entry, set()).add(index)
+        metric = self._race.metric if self._race is not None else None
+        value = result.metrics.get(metric) if metric is not None and result.ok else None
+        if value is not None and value == value:  # not NaN
+            self._scores.setdefault(entry, {})[index] = float(value)
+        return index
+
+    def _make_decisions(self) -> None:
+        while self._race is not None and self._decided + 1 < self._n_rounds:
+            index = self._decided + 1
+            # every round up to this one: the first decision covers the rounds before it
+            if any(len(self._arrived[e] & set(range(index + 1))) <= index for e in self._live):
+                return
+            scores = {
+                e: {r: s for r, s in self._scores[e].items() if r <= index} for e in self._live
+            }
+            drops = decide(self._race, scores, self._live, index, test_train_ratio=self._ratio)
+            for drop in drops:
+                self.dropped[drop.classifier] = drop
+                self._live.remove(drop.classifier)
+                self._on_drop(drop)
+            self._decided = index
+            self._release()
+
+    def _release(self) -> None:
+        """Hand on the held results the decisions now allow; forget the dropped entries'."""
+        held, self._held = self._held, []
+        for result in held:
+            entry = result.key.classifier
+            index = self._rounds[(result.key.repeat, result.key.fold)]
+            if entry in self.dropped:
+                self._arrived[entry].discard(index)
+                self._scores[entry].pop(index, None)
+            elif index > self._decided + 1:
+                self._held.append(result)
+            else:
+                self._deliver(result)
+
+    # the budget ------------------------------------------------------------------------
+
+    def _cost(self, entry: str, calibration: float) -> float:
+        timed = self._seconds.get(entry)
+        if timed:
+            return statistics.fmean(timed)
+        return self._hints.get(entry, 1.0) * calibration
+
+    def _calibration(self) -> float:
+        ratios = [
+            statistics.fmean(s) / self._hints[e]
+            for e, s in self._seconds.items()
+            if s and self._hints.get(e, 0) > 0
+        ]
+        return max(statistics.median(ratios), MIN_CALIBRATION) if ratios else 1.0
+
+    def _cut_entry(self, entry: str) -> None:
+        self._cut.add(entry)
+        self._live.remove(entry)
+        self._make_decisions()
+
+    def cut_tasks(self) -> int:
+        """Tasks the budget did not start."""
+        return sum(self._n_rounds - len(self._started[e]) for e in self._cut)
+
+    def finish(self) -> None:
+        """The backend is done: hand on what the race still holds of entries it did not
+        drop (a budget cut the entries its next decision waited for), and report the
+        budget's cuts with the folds each entry ran."""
+        held, self._held = self._held, []
+        for result in held:
+            if result.key.classifier not in self.dropped:
+                self._deliver(result)
+        for entry in self._entries:
+            if entry in self._cut:
+                self._on_drop(Drop(entry, "budget", len(self._arrived[entry])))
+
+
+def test_train_ratio(sizes: Collection[tuple[int, int]]) -> float:
+    """Mean ``n_test / n_train`` of folds given as ``(n_train, n_test)``."""
+    ratios = [test / train for train, test in sizes if train > 0]
+    return statistics.fmean(ratios) if ratios else 0.0

@@ -1,0 +1,237 @@
+"""Racing against the full run, side by side: the same top of the leaderboard in less time?
+
+For each robot (Mini, Maggie) and task (``gesture`` multi-class, ``gesture+place``
+multi-target), the suite runs under k-fold cross-validation twice with the same seed: in
+full, and raced (``--race``, alpha 0.01).  Printed per data set:
+
+- wall seconds of each and their ratio raced / full (goal <= 0.5);
+- the full run's top 5: how many are still live at the end of the race (goal 5 of 5), and
+  the raced winner's score beside the full winner's (goal within 0.005);
+- with ``--budget-fraction F`` a third run with a total budget of F x the full run's wall
+  time: what it completed and cut, and its wall time against the budget;
+- on the full run's per-fold scores, the two racing rules the issue weighs, replayed round
+  by round: the corrected resampled t-test against the leader (what ``--race`` does) and
+  Friedman's test with Nemenyi's critical difference of mean ranks (F-race's post-hoc):
+  entries each drops, tasks saved, and whether the full top 5 survive.
+
+    .venv/bin/python perf/racing.py [--robots mini,maggie] [--tasks gesture,gesture+place]
+        [--suite default] [--folds 10] [--jobs 2] [--budget-fraction 0.333]
+
+The data are ``../shared/datasets/uc3m-touch`` (see its README); without them the script
+says so and stops.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+import time
+from collections import Counter
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from scipy.stats import rankdata, studentized_range
+
+from benchmark.evaluation.leaderboard import build_leaderboard, scores_by_fold
+from benchmark.io.arff import read_arff
+from benchmark.results import Drop, TaskResult
+from benchmark.run.engine import Problem, RaceRule, run_tasks
+from benchmark.run.folds import make_folds
+from benchmark.run.racing import FIRST_ROUND, decide
+
+#: ``../shared/datasets`` beside the project; ``TOUCHBENCH_DATASETS`` names another place
+#: (a git worktree of the project sits elsewhere).
+DATASETS = (
+    Path(
+        os.environ.get(
+            "TOUCHBENCH_DATASETS", Path(__file__).resolve().parents[2] / "shared/datasets"
+        )
+    )
+    / "uc3m-touch"
+)
+TIMEOUT = 600.0
+
+
+def load(robot: str, task: str) -> Problem:
+    """``gesture`` alone (multi-class) or ``gesture+place`` (multi-target) of a robot."""
+    data = read_arff(DATASETS / robot / "gesture_and_place.arff")
+    names = list(data.schema.target_names)
+    wanted = task.split("+")
+    targets = [data.schema.target_indices[names.index(name)] for name in wanted]
+    features = [i for i in range(data.schema.n_attributes) if i not in data.schema.target_indices]
+    return Problem(
+        X=data.values[:, features],
+        Y=data.values[:, targets].astype(np.int64),
+        n_classes=tuple(len(data.schema.targets[names.index(n)].values) for n in wanted),
+        target_names=tuple(wanted),
+    )
+
+
+def suite_ids(problem: Problem, name: str) -> list[str]:
+    if problem.n_targets > 1:
+        from benchmark.multitarget.suites import multitarget_suite
+
+        return multitarget_suite(name)
+    from benchmark.catalogue import suite
+    from benchmark.estimators import reads_sequences
+
+    return [i for i in suite(name) if not reads_sequences(i)]
+
+
+def timed(problem: Problem, ids: list[str], folds: list, jobs: int, **options: Any):
+    drops: list[Drop] = []
+    start = time.perf_counter()
+    results = run_tasks(
+        problem, ids, folds, jobs=jobs, timeout=TIMEOUT, on_drop=drops.append, **options
+    )
+    return results, {d.classifier: d for d in drops}, time.perf_counter() - start
+
+
+def per_fold(results: list[TaskResult], metric: str) -> dict[str, dict[int, float]]:
+    """Entry -> round -> score (rounds in fold order)."""
+    by_entry: dict[str, list[TaskResult]] = {}
+    for result in results:
+        by_entry.setdefault(result.key.classifier, []).append(result)
+    return {
+        entry: {fold: score for (_, fold), score in scores_by_fold(rs, metric).items()}
+        for entry, rs in by_entry.items()
+    }
+
+
+def replay_ttest(scores, metric: str, alpha: float, ratio: float, n_rounds: int):
+    """Entries the t-test race drops on these scores, with the round of each drop."""
+    live, dropped = list(scores), {}
+    rule = RaceRule(metric, alpha)
+    for index in range(n_rounds):
+        upto = {e: {r: s for r, s in scores[e].items() if r <= index} for e in live}
+        for drop in decide(rule, upto, live, index, test_train_ratio=ratio):
+            dropped[drop.classifier] = index + 1
+            live.remove(drop.classifier)
+    return dropped
+
+
+def nemenyi_cd(k: int, n: int, alpha: float) -> float:
+    """Nemenyi's critical difference of mean ranks for k entries on n blocks."""
+    q = studentized_range.ppf(1 - alpha, k, 1e6) / math.sqrt(2)
+    return float(q * math.sqrt(k * (k + 1) / (6.0 * n)))
+
+
+def replay_nemenyi(scores, lower: bool, alpha: float, n_rounds: int):
+    """Entries F-race's post-hoc drops: mean rank (over the rounds so far, among the live
+    entries) more than Nemenyi's critical difference behind the best."""
+    live, dropped = [e for e in scores if len(scores[e]) == n_rounds], {}
+    for index in range(FIRST_ROUND - 1, n_rounds):
+        table = np.array([[scores[e][r] for r in range(index + 1)] for e in live])
+        ranks = np.apply_along_axis(rankdata, 0, table if lower else -table)
+        mean_ranks = ranks.mean(axis=1)
+        cd = nemenyi_cd(len(live), index + 1, alpha)
+        best = mean_ranks.min()
+        for entry, rank in zip(list(live), mean_ranks, strict=True):
+            if rank - best > cd:
+                dropped[entry] = index + 1
+                live.remove(entry)
+    return dropped
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--robots", default="mini,maggie")
+    parser.add_argument("--tasks", default="gesture,gesture+place")
+    parser.add_argument("--suite", default="default")
+    parser.add_argument("--folds", type=int, default=10)
+    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--alpha", type=float, default=0.01)
+    parser.add_argument("--budget-fraction", type=float, default=None)
+    args = parser.parse_args()
+    if not DATASETS.is_dir():
+        print(f"skipped: {DATASETS} is absent (the shared reference data sets)")
+        return 0
+    for robot in args.robots.split(","):
+        for task in args.tasks.split(","):
+            problem = load(robot, task)
+            ids = suite_ids(problem, args.suite)
+            metric = "hamming_score" if problem.n_targets > 1 else "f1_weighted"
+            folds = make_folds(
+                problem.Y, n_folds=args.folds, seed=args.seed, target_names=problem.target_names
+            )[0]
+            ratio = float(np.mean([f.test.size / f.train.size for f in folds]))
+            print(f"\n{robot} {task}: {len(ids)} entries ({args.suite}), {len(folds)} folds")
+            full, _, full_wall = timed(problem, ids, folds, args.jobs, random_state=args.seed)
+            race = RaceRule(metric, args.alpha)
+            raced, drops, raced_wall = timed(
+                problem, ids, folds, args.jobs, random_state=args.seed, race=race
+            )
+            full_board = build_leaderboard(full, metric=metric)
+            raced_board = build_leaderboard(raced, metric=metric, drops=drops)
+            top = [row.classifier for row in full_board.rows[:5]]
+            top_live = [entry for entry in top if entry not in drops]
+            full_best = full_board.rows[0]
+            raced_best = next(row for row in raced_board.rows if row.dropped is None)
+            difference = abs(full_best.metrics[metric][0] - raced_best.metrics[metric][0])
+            print(f"  full : {full_wall:7.1f} s, {len(full)} tasks")
+            when = dict(sorted(Counter(d.after_fold for d in drops.values()).items()))
+            print(
+                f"  raced: {raced_wall:7.1f} s, {len(raced)} tasks, {len(drops)} dropped "
+                f"(after fold: {when})"
+            )
+            print(f"  wall ratio raced/full: {raced_wall / full_wall:.3f} (goal <= 0.5)")
+            # the floor of that ratio: the share of the full run's fit and predict seconds
+            # spent on what the race still runs
+            seconds = {r.key: r.metrics.get("fit_time", 0.0) + r.metrics.get("predict_time", 0.0)
+                       for r in full if r.ok}  # fmt: skip
+            kept = {r.key for r in raced}
+            share = sum(v for k, v in seconds.items() if k in kept) / max(
+                sum(seconds.values()), 1e-9
+            )
+            print(
+                f"  share of the full run's fit+predict seconds the race still spends: {share:.3f}"
+            )
+            print(f"  full top 5 live at the end of the race: {len(top_live)}/5 ({', '.join(top)})")
+            print(
+                f"  winner: full {full_best.classifier} {full_best.metrics[metric][0]:.4f}, "
+                f"raced {raced_best.classifier} {raced_best.metrics[metric][0]:.4f}; "
+                f"difference {difference:.4f} (goal <= 0.005)"
+            )
+            scores = per_fold(full, metric)
+            lower = race.lower_is_better
+            for name, dropped in (
+                ("t-test vs leader", replay_ttest(scores, metric, args.alpha, ratio, len(folds))),
+                ("Friedman/Nemenyi", replay_nemenyi(scores, lower, args.alpha, len(folds))),
+            ):
+                saved = sum(len(folds) - k for k in dropped.values())
+                lost = [entry for entry in top if entry in dropped]
+                print(
+                    f"  replay {name}: {len(dropped)} dropped, {saved}/{len(full)} tasks "
+                    f"saved, top 5 dropped: {', '.join(lost) or 'none'}"
+                )
+            live = len(ids)
+            print(
+                "  Nemenyi critical difference at alpha "
+                f"{args.alpha:g} with {live} entries: "
+                + ", ".join(
+                    f"{nemenyi_cd(live, n, args.alpha):.1f} after {n} folds"
+                    for n in sorted({FIRST_ROUND, len(folds)})
+                )
+                + f" (mean ranks differ by {live - 1} at most)"
+            )
+            if args.budget_fraction:
+                budget = full_wall * args.budget_fraction
+                cut, cuts, cut_wall = timed(
+                    problem, ids, folds, args.jobs, random_state=args.seed, budget=budget
+                )
+                complete = Counter(r.key.classifier for r in cut)
+                whole = [e for e in top if complete[e] == len(folds)]
+                print(
+                    f"  budget {budget:.1f} s ({args.budget_fraction:g} x full): ended after "
+                    f"{cut_wall:.1f} s, {len(cut)}/{len(full)} tasks, {len(cuts)} entries cut, "
+                    f"full top 5 with every fold: {len(whole)}/5"
+                )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
