@@ -147,7 +147,8 @@ def classes(run_id: int, store: StoreDep, classifier: ClassifiersQuery = None) -
 
 @router.get(
     "/{run_id}/calibration.svg",
-    response_class=PlainTextResponse,
+    # Response, not PlainTextResponse: the errors' JSON is documented as JSON then
+    response_class=Response,
     responses={200: {"content": {"image/svg+xml": {}}}},
 )
 def calibration_svg(
@@ -155,11 +156,11 @@ def calibration_svg(
     store: StoreDep,
     classifier: ClassifiersQuery = None,
     top: Annotated[int, Query(ge=1, le=50)] = 5,
-) -> PlainTextResponse:
+) -> Response:
     """The reliability diagram of the run's best ``top`` classifiers with probabilities."""
     from app.reports.figures import reliability_figure
     from app.reports.plots import svg_text
 
     certainty = run_certainty(store, run_id, classifiers=_classifiers(classifier))
     svg = svg_text(reliability_figure(certainty, top))
-    return PlainTextResponse(svg, media_type="image/svg+xml")
+    return Response(svg, media_type="image/svg+xml")
