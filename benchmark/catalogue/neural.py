@@ -35,6 +35,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import resource
 import struct
 from collections.abc import Iterator, Mapping
 from typing import Any
@@ -349,14 +350,22 @@ def _threads() -> int:
         return 1
 
 
+def _memory_limited() -> bool:
+    """Whether this process runs under a data-size limit (the engine's ``max_memory``)."""
+    return resource.getrlimit(resource.RLIMIT_DATA)[0] != resource.RLIM_INFINITY
+
+
 @contextlib.contextmanager
 def _torch_settings() -> Iterator[Any]:
     """PyTorch with the process's thread count and deterministic algorithms; an
     allocation it cannot make becomes a ``MemoryError``, as NumPy's does."""
     try:
         import torch  # PyTorch costs seconds to import: only the processes that fit or predict
-    except (ImportError, OSError) as exc:
-        if "memory" in str(exc).lower() or "map" in str(exc).lower():
+    except (ImportError, OSError, SystemError) as exc:
+        # Under the engine's memory limit (RLIMIT_DATA) a failed allocation while PyTorch
+        # loads shows as any of these; a SystemError "returned NULL without setting an
+        # exception" is CPython's word for an allocation a C module did not report.
+        if "memory" in str(exc).lower() or "map" in str(exc).lower() or _memory_limited():
             raise MemoryError(f"cannot load PyTorch: {exc}") from None
         raise
     torch.set_num_threads(_threads())
