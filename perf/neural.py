@@ -36,13 +36,13 @@ from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # perf.sequences, run as a script
+
 from app.services.extraction import extract_dataset
 from app.services.simulation import write_link_trials
 from benchmark.dataset import Dataset
-from benchmark.evaluation.leaderboard import build_leaderboard
 from benchmark.problem import problem_from_dataset, restrict_targets
-from benchmark.run.engine import run_tasks
-from benchmark.run.folds import make_folds
+from perf.sequences import cross_validate_data
 
 ROOT = Path(__file__).resolve().parents[1]
 #: Distributions ``pip install torch==2.13.0 safetensors`` adds to this project's venv.
@@ -64,28 +64,6 @@ def link_data(folder: Path, trials: int, extractor: str, options: dict[str, str]
     target = data.schema.targets[0]
     codes = data.Y[:, 0]
     return data.subset(np.flatnonzero(codes != target.values.index("none")))
-
-
-def cross_validate(
-    data: Dataset, classifiers: Sequence[str], *, folds: int, jobs: int
-) -> dict[str, tuple[float, float, float]]:
-    """Accuracy (mean, std over folds) and fit seconds per fold of each classifier."""
-    problem, _ = problem_from_dataset(data)
-    splits, _ = make_folds(problem.Y, n_folds=folds, groups=problem.groups, seed=0)
-    results = run_tasks(problem, classifiers, splits, jobs=jobs, timeout=3600)
-    board = build_leaderboard(results)
-    shape = problem.sequence.describe() if problem.sequence else f"{problem.n_features} features"
-    print(f"    {problem.n_instances} instances, {shape}")
-    scores = {}
-    for row in board.rows:
-        if row.n_failed:
-            print(f"      {row.classifier}: failed: {row.errors[0]}")
-            continue
-        mean, std = row.metrics["accuracy"]
-        fit = row.metrics["fit_time"][0]
-        scores[row.classifier] = (mean, std, fit)
-        print(f"      {row.classifier:12s} accuracy {mean:.3f} ± {std:.3f}   fit {fit:7.2f} s/fold")
-    return scores
 
 
 MEASURE = """
@@ -179,9 +157,9 @@ def main() -> None:
         peaks = link_data(folder, arguments.trials, "band-peaks", {})
         print(f"  MFCC frames ({arguments.frames} a window)")
         common = {"folds": arguments.folds, "jobs": arguments.jobs}
-        sequence = cross_validate(frames, (*networks, "minirocket"), **common)
+        sequence = cross_validate_data(frames, (*networks, "minirocket"), **common)
         print("  FFT band peaks")
-        flat = cross_validate(peaks, ("rf", "mlp"), **common)
+        flat = cross_validate_data(peaks, ("rf", "mlp"), **common)
         best = max({**sequence, **flat}.items(), key=lambda item: item[1][0])
         bilstm = sequence.get("bilstm", (float("nan"),))[0]
         print(f"  => bilstm {bilstm:.3f} (goal 0.95); best {best[0]} {best[1][0]:.3f}")
