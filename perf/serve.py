@@ -80,11 +80,16 @@ def start_service(db: str, folder: Path, workers: int) -> tuple[subprocess.Popen
         str(workers),
     ]
     process = subprocess.Popen(command, cwd=ROOT, env=environment)
+    return process, wait_until_up(port)
+
+
+def wait_until_up(port: int) -> str:
+    """The URL of the service on ``port`` once ``/healthz`` answers 200 (at most ~2 min)."""
     url = f"http://127.0.0.1:{port}"
     for _ in range(600):
         try:
             if httpx.get(f"{url}/healthz", timeout=1).status_code == 200:
-                return process, url
+                return url
         except httpx.HTTPError:
             time.sleep(0.2)
     raise SystemExit("the service did not start")

@@ -32,7 +32,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from perf.serve import free_port, percentile  # noqa: E402 (after the path is set)
+from perf.serve import free_port, percentile, wait_until_up  # noqa: E402 (after the path is set)
 from tests.app.synthetic import touch_arff  # noqa: E402
 
 
@@ -48,14 +48,7 @@ def start_service(db: str, folder: Path) -> tuple[subprocess.Popen[bytes], str]:
     process = subprocess.Popen(
         [*command, "--log-level", "warning"], cwd=ROOT, env=environment, start_new_session=True
     )
-    url = f"http://127.0.0.1:{port}"
-    for _ in range(600):
-        try:
-            if httpx.get(f"{url}/healthz", timeout=1).status_code == 200:
-                return process, url
-        except httpx.HTTPError:
-            time.sleep(0.2)
-    raise SystemExit("the service did not start")
+    return process, wait_until_up(port)
 
 
 def peak_rss_mb(pid: int) -> float:
