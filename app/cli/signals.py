@@ -7,18 +7,29 @@ and ``kill -INT`` would do nothing; a command asked to stop by a signal sent on 
 should stop, so the handler is installed whatever the inherited disposition.  SIGTERM
 (``kill PID``, a CI time-out, systemd stopping a unit) would otherwise end the process at
 once, leaving a run ``running`` until its heartbeat goes stale.
+
+An interrupt raised while Python runs a finaliser (a ``__del__``, a weakref callback of the
+cyclic collector) cannot propagate: Python prints it as "Exception ignored in ..." with a
+traceback and carries on, and the Ctrl-C is lost.  :func:`redeliver_lost_interrupts` sends
+such an interrupt again, so it lands in ordinary code a moment later and ends the command
+as any other does.
 """
 
 from __future__ import annotations
 
 import signal
+import sys
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from types import FrameType
+from typing import Any
 
 #: Signals that interrupt a command.
 INTERRUPTS = (signal.SIGINT, signal.SIGTERM)
+
+#: Seconds after which an interrupt a finaliser swallowed is sent again.
+REDELIVERY_DELAY = 0.01
 
 
 class Interrupted(KeyboardInterrupt):
@@ -57,3 +68,27 @@ def interrupts() -> Iterator[None]:
 
 def _interrupt(signum: int, frame: FrameType | None) -> None:
     raise Interrupted(signum)
+
+
+def redeliver_lost_interrupts() -> None:
+    """Install a ``sys.unraisablehook`` that re-sends an interrupt a finaliser swallowed.
+
+    Other unraisable exceptions go to the hook that was there before.
+    """
+    previous: Callable[[Any], object] = sys.unraisablehook
+
+    def hook(unraisable: Any) -> None:
+        error = unraisable.exc_value
+        if isinstance(error, KeyboardInterrupt):
+            # Sent from here, the signal's handler would run at once, inside the finaliser
+            # again; sent from a timer thread a moment later, it runs in the main thread
+            # once this hook has returned (should that be in another finaliser, it comes
+            # back here).
+            signum = getattr(error, "signum", signal.SIGINT)
+            later = threading.Timer(REDELIVERY_DELAY, signal.raise_signal, args=(signum,))
+            later.daemon = True
+            later.start()
+            return
+        previous(unraisable)
+
+    sys.unraisablehook = hook

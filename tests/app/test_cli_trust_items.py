@@ -175,3 +175,40 @@ def test_an_early_ctrl_c_of_import_prints_no_traceback(tmp_path: Path, delay: fl
     if process.returncode != 0:  # the import may have finished before the signal
         assert process.returncode in (130, -signal.SIGINT), process.returncode
         assert err.decode().strip() == "touchbench: interrupted"
+
+
+FINALISER_INTERRUPTED = """
+import signal, sys, time
+import app.cli
+from app.cli.signals import Interrupted, interrupts
+
+class Finalised:
+    def __del__(self):
+        signal.raise_signal(signal.SIGINT)
+        for _ in range(10_000):  # the handler runs here, inside the finaliser
+            pass
+
+with interrupts():
+    try:
+        Finalised()
+        time.sleep(5)  # the command goes on; the interrupt comes back within it
+    except Interrupted as interrupt:
+        print("interrupted after the finaliser:", interrupt)
+        sys.exit(0)
+print("the interrupt was lost")
+sys.exit(1)
+"""
+
+
+def test_a_ctrl_c_inside_a_finaliser_is_not_lost() -> None:
+    """Python cannot raise from a finaliser (a weakref callback of SQLAlchemy's, in the CI
+    run that found this): the interrupt comes again, in ordinary code, without a traceback."""
+    done = subprocess.run(
+        [sys.executable, "-c", FINALISER_INTERRUPTED],
+        capture_output=True,
+        env=_environment(),
+        timeout=60,
+    )
+    assert done.stderr == b"", done.stderr.decode()
+    assert done.stdout.decode().strip() == "interrupted after the finaliser: SIGINT"
+    assert done.returncode == 0
