@@ -6,7 +6,7 @@ Run from the repository root::
 
 Writes a 3-channel 44.1 kHz 16-bit WAV of noise with a tap every 2 s (``--minutes``
 long, 15 MB a minute, in a temporary folder), then measures in a fresh process each the
-peak resident memory (``ru_maxrss``) and the time of:
+peak resident memory (``VmHWM``) and the time of:
 
 * streamed: :func:`app.services.extraction.extract_dataset`, block by block (the goal:
   under 500 MB for the hour, flat as the recording grows);
@@ -32,17 +32,25 @@ import soundfile
 
 RATE = 44100
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
 
-STREAMED = """
-import resource, sys
+from perf.memory import PEAK_MIB  # noqa: E402 (after the path is set)
+
+STREAMED = (
+    PEAK_MIB
+    + """
+import sys
 from pathlib import Path
 from app.services.extraction import extract_dataset
 result = extract_dataset([Path(sys.argv[1])], labels=None, extractor="uc3m-audio")
-print(result.n_events, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss // 1024)
+print(result.n_events, peak_mib())
 """
+)
 
-WHOLE = """
-import resource, sys
+WHOLE = (
+    PEAK_MIB
+    + """
+import sys
 from drivers.files import read_recording
 from features.events import detect_events
 from features.extractors import make_extractor
@@ -51,8 +59,9 @@ detection = detect_events("snr", recording.samples, samplerate=recording.sampler
 instances = make_extractor("uc3m-audio").extract(
     recording.samples, samplerate=recording.samplerate, detection=detection
 )
-print(len(instances.values), resource.getrusage(resource.RUSAGE_SELF).ru_maxrss // 1024)
+print(len(instances.values), peak_mib())
 """
+)
 
 
 def write_session(path: Path, minutes: float) -> None:

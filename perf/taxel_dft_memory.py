@@ -10,7 +10,7 @@ Writes a BioTac-like recording (``--channels`` channels of noise at 100 Hz, ``--
 long) as a ``.npy`` file, as a plain CSV (an even ``time`` column) and as a real export
 (a ``timestamp`` column of jittered ROS stamps, a comma at the end of every row, which
 versions before issue 22 refuse), then measures in a fresh process for each the
-peak resident memory (``ru_maxrss``) of
+peak resident memory (``VmHWM``) of
 :func:`app.services.extraction.extract_dataset` with ``taxel-dft`` (64-sample windows,
 step 8, ``drop=4``, the values every version accepts), beside the bytes of the feature
 matrix it returns.  Not a test: nothing is asserted.
@@ -30,9 +30,14 @@ import numpy as np
 
 RATE = 100.0
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
 
-EXTRACT = """
-import resource, sys
+from perf.memory import PEAK_MIB  # noqa: E402 (after the path is set)
+
+EXTRACT = (
+    PEAK_MIB
+    + """
+import sys
 from pathlib import Path
 from app.services.extraction import extract_dataset
 rate = None if sys.argv[1].endswith(".csv") else 100.0
@@ -40,9 +45,10 @@ result = extract_dataset(
     [Path(sys.argv[1])], labels=None, extractor="taxel-dft", samplerate=rate,
     options={"drop": 4},
 )
-peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss // 1024
+peak = peak_mib()
 print(result.dataset.values.shape[0], result.dataset.values.nbytes // 2**20, peak)
 """
+)
 
 
 def write_recordings(folder: Path, minutes: float, channels: int) -> list[Path]:
