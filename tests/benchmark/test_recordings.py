@@ -44,7 +44,9 @@ def test_one_label_per_recording_is_checked() -> None:
 
 def _scores(problem: Problem, classifier: str, metric: str) -> tuple[float, float]:
     """Mean of ``metric`` over 4 group folds, per window and per recording."""
-    folds, _ = make_folds(problem.Y, n_folds=4, groups=problem.groups, regression=True)
+    folds, _ = make_folds(
+        problem.Y, n_folds=4, groups=problem.groups, regression=problem.kind == "regression"
+    )
     means = []
     for by_recording in (False, True):
         context = TaskContext(problem, CATALOGUE, folds, 0, by_recording)
@@ -53,6 +55,19 @@ def _scores(problem: Problem, classifier: str, metric: str) -> tuple[float, floa
         assert {r.n_test for r in results} == {30}  # windows: the t-test's ratio is unchanged
         means.append(float(np.mean([r.metrics[metric] for r in results])))
     return means[0], means[1]
+
+
+def test_recordings_scored_whole_beat_their_noisy_windows() -> None:
+    # one feature: the recording's class plus noise of the gap's size
+    rng = np.random.default_rng(5)
+    X = np.column_stack([CLASS + rng.normal(scale=0.8, size=CLASS.size), rng.normal(size=120)])
+    problem = Problem(
+        X=X, Y=CLASS[:, None], n_classes=(2,), target_names=("gesture",), groups=GROUPS
+    )
+    # nb pools its probabilities, ridge (no probabilities) votes
+    for classifier in ("nb", "ridge"):
+        by_window, by_recording = _scores(problem, classifier, "f1_weighted")
+        assert by_window < 0.8 and by_recording > 0.85, (classifier, by_window, by_recording)
 
 
 def test_a_regression_per_recording_scores_the_mean_prediction() -> None:
