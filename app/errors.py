@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 from benchmark.errors import BenchmarkError
 from drivers.errors import DriverError
 from features.errors import FeatureError
@@ -45,3 +47,11 @@ class FieldError(AppError):
 
 #: Exceptions that mean the user's input is wrong: exit status 2 on the CLI, 4xx on the API.
 USER_ERRORS: tuple[type[Exception], ...] = (AppError, BenchmarkError, FeatureError, DriverError)
+
+
+def client_words(message: str, folder: str | None) -> str:
+    """``message`` with the upload folder left out of its paths: the client knows its files
+    by their names, and the service's folders are not its business."""
+    if not folder:
+        return message
+    return message.replace(folder.rstrip(os.sep) + os.sep, "").replace(folder, "the upload")

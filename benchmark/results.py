@@ -17,7 +17,7 @@ __all__ = ["Drop", "DropReason", "Status", "TaskKey", "TaskResult"]
 Status = Literal["ok", "error", "timeout"]
 #: Why an entry stopped before its last fold: the race found it significantly worse than
 #: the leader, or the run's total budget left no time for its next task.
-DropReason = Literal["race", "budget"]
+DropReason = Literal["race", "budget", "not started"]
 
 
 @dataclass(frozen=True, order=True)
@@ -134,7 +134,9 @@ class Drop:
     Parameters
     ----------
     classifier : str
-    reason : {"race", "budget"}
+    reason : {"race", "budget", "not started"}
+        ``not started``: a run that stopped (cancelled, interrupted) before any of the
+        entry's tasks began.
     after_fold : int
         Folds it ran (1-based count of rounds, repeat-major), the round of the decision.
     p_value : float or None
@@ -153,10 +155,12 @@ class Drop:
     mean: float | None = None
 
     def describe(self) -> str:
-        """``dropped after fold 3 (p 0.0012 against rf, mean so far 0.4120)``, or
-        ``cut by the budget after fold 2``: the words every view uses."""
+        """``dropped after fold 3 (p 0.0012 against rf, mean so far 0.4120)``, ``cut by
+        the budget after fold 2`` or ``never started``: the words every view uses."""
         if self.reason == "budget":
             return f"cut by the budget after fold {self.after_fold}"
+        if self.reason == "not started":
+            return "never started"
         details = []
         if self.p_value is not None:
             details.append(f"p {self.p_value:.2g} against {self.leader}")

@@ -111,7 +111,7 @@ class FileReplaySource(Source):
             )
             self._inner, self._start = bag, float(getattr(bag, "start_time", 0.0))
             rate: float | None = bag.samplerate
-            self.n_channels = bag.n_channels
+            self.n_channels, self.channel_names = bag.n_channels, bag.channel_names
             self.notes, self.resampled = bag.notes, bag.resampled
         elif self.path.is_dir():
             raise DriverError(f"{path}: is a folder, not a recording (nor a ROS 2 bag)")

@@ -6,6 +6,8 @@ from __future__ import annotations
 import json
 import re
 import shutil
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -15,7 +17,7 @@ from pydantic import ValidationError
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from app.api.errors import UploadTooLarge, error_body
-from app.errors import AppError
+from app.errors import USER_ERRORS, AppError, client_words
 from app.schemas.base import Request
 
 RequestType = TypeVar("RequestType", bound=Request)
@@ -81,6 +83,23 @@ def save_upload(upload: UploadFile, folder: Path, fallback: str) -> Path:
     with target.open("wb") as out:
         shutil.copyfileobj(upload.file, out, CHUNK)
     return target
+
+
+@contextmanager
+def in_client_words(folder: Path) -> Iterator[None]:
+    """Bad input met reading the uploaded files of ``folder`` is answered naming them as
+    the client does (``take.wav: ...``), never by the service's own folder."""
+    try:
+        yield
+    except USER_ERRORS as error:
+        for name in ("message", "source"):  # the parts a DataFormatError words itself from
+            value = getattr(error, name, None)
+            if isinstance(value, str):
+                setattr(error, name, client_words(value, str(folder)))
+        error.args = tuple(
+            client_words(arg, str(folder)) if isinstance(arg, str) else arg for arg in error.args
+        )
+        raise
 
 
 def form_request(kind: type[RequestType], **fields: Any) -> RequestType:

@@ -402,6 +402,20 @@ def bench_command(
             show_default=False,
         ),
     ] = None,
+    aggregate: Annotated[
+        str | None,
+        typer.Option(
+            "--aggregate",
+            metavar="window|recording",
+            help=(
+                "recording: score each recording's windows as one prediction (the mean of "
+                "their class probabilities; a majority vote for classifiers without them; the "
+                "mean prediction of numeric targets); needs a data set extracted from "
+                "recordings, one label per recording. Default: window (each window scored)."
+            ),
+            show_default=False,
+        ),
+    ] = None,
     as_json: JsonOption = False,
 ) -> None:
     """Cross-validate classifiers on a data set; every finished fold is stored at once.
@@ -440,6 +454,7 @@ def bench_command(
         "race": race,
         "race_alpha": race_alpha,
         "budget_total": budget_total,
+        "aggregate": aggregate,
     }
     if resume is not None:
         _check_resume(values)
@@ -507,6 +522,7 @@ BENCH_OPTIONS = {
     "race": "--race",
     "race_alpha": "--race-alpha",
     "budget_total": "--budget-total",
+    "aggregate": "--aggregate",
 }
 #: Fields that only say how ``bench`` prints the leaderboard of a resumed run.
 _REPORT_FIELDS = ("metric", "baseline")
@@ -746,10 +762,11 @@ def _print_leaderboard(ranked: RunLeaderboard) -> None:
     run, board = ranked.run, ranked.board
     columns = metric_columns(run, board)
     direction = " (lower is better)" if board.lower_is_better else ""
+    scored = ", scored per recording" if ranked.per_recording else ""
     table(
         f"run {run.id}: {run.dataset_name} ({', '.join(run.targets)}), "
         f"{run.config.get('folds')}-fold x {run.config.get('repeats')} ({run.fold_scheme}), "
-        f"ranked by {board.metric}{direction}",
+        f"ranked by {board.metric}{direction}{scored}",
         leaderboard_header(board, columns, ranked.besides),
         leaderboard_rows(board, columns, ranked.besides),
     )
@@ -757,11 +774,11 @@ def _print_leaderboard(ranked: RunLeaderboard) -> None:
         info(note)
     if board.baseline is None:
         info(f"no task of run {run.id} succeeded; the notes say why")
-        return
-    v, same, worse = board.summary
-    info(
-        f"marks against {board.baseline}: v significantly better, * significantly worse "
-        f"(corrected resampled t-test, alpha 0.05); (v/ /*) = ({v}/{same}/{worse})"
-    )
+    else:
+        v, same, worse = board.summary
+        info(
+            f"marks against {board.baseline}: v significantly better, * significantly worse "
+            f"(corrected resampled t-test, alpha 0.05); (v/ /*) = ({v}/{same}/{worse})"
+        )
     for note in ranked.notes():
         info(note)

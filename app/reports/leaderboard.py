@@ -62,7 +62,9 @@ def leaderboard_rows(
 def row_note(row: LeaderboardRow) -> str:
     """Why a row stopped early and what failed, in one line; empty when neither."""
     parts = []
-    if row.dropped is not None:
+    if row.dropped is not None and row.dropped.reason == "not started":
+        parts.append(row.dropped.describe())
+    elif row.dropped is not None:
         parts.append(f"{row.dropped.describe()}, {row.n_ok + row.n_failed} folds run")
     if row.errors:
         parts.append(f"{row.n_failed} failed: {row.errors[0]}")

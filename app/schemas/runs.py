@@ -75,9 +75,10 @@ PerTargetScores = dict[str, dict[str, MetricValue]]
 class DropSchema(Schema):
     """Why a classifier stopped before its last fold."""
 
-    reason: Literal["race", "budget"] = Field(
+    reason: Literal["race", "budget", "not started"] = Field(
         description="race: significantly worse than the leader; budget: the run's total "
-        "budget left no time for its next fold."
+        "budget left no time for its next fold; not started: the run stopped (cancelled, "
+        "interrupted) before any of its tasks began."
     )
     after_fold: int = Field(description="Folds it ran.")
     p_value: float | None = Field(description="The race's t-test against the leader.")
@@ -222,7 +223,27 @@ class LeaderboardSchema(Schema):
     budget: BudgetSchema | None = Field(
         default=None, description="Set on a run with a total budget."
     )
+    aggregate: Aggregate = Field(
+        default="window",
+        description="What one prediction of the scores is: a window, or a recording's "
+        "windows pooled (`recording`, see `notes`).",
+    )
+    notes: list[str] = Field(
+        default_factory=list,
+        description="What every view says under the table: how the scores were pooled, the "
+        "race, the budget, classifiers that never started.",
+    )
 
+
+#: What a run scores as one prediction: each window, or each recording's windows pooled.
+Aggregate = Literal["window", "recording"]
+
+#: What a leaderboard says under its table of a run scored per recording.
+PER_RECORDING_NOTE = (
+    "scored per recording: each test recording's windows pooled into one prediction (the "
+    "mean of their class probabilities; a majority vote for classifiers without "
+    "probabilities; the mean prediction of numeric targets)"
+)
 
 #: The suites of classifiers a run may name instead of classifier ids.
 Suite = Literal["fast", "default", "all"]
@@ -360,6 +381,14 @@ class BenchRequest(Request):
         description="Wall minutes for the whole run: tasks run fold-major, cheap first, and "
         "a task whose predicted cost does not fit the time left is not started.",
     )
+    aggregate: Aggregate = Field(
+        default="window",
+        description="What one prediction is: `window` (every window scored on its own) or "
+        "`recording` (a recording's windows pooled: the mean of their class probabilities, "
+        "a majority vote for classifiers without probabilities, the mean prediction of "
+        "numeric targets). `recording` needs a data set extracted from recordings, one "
+        "label per recording; its folds already keep each recording whole.",
+    )
 
     @field_validator("dataset", mode="before")
     @classmethod
@@ -389,6 +418,10 @@ class BenchRequest(Request):
                 "race",
                 f"needs at least {RACE_MIN_FOLDS} folds in all (it first tests after the "
                 f"third); `folds` {self.folds} x {self.repeats} repeat(s) is too few",
+            )
+        if self.independent and self.aggregate == "recording":
+            raise FieldError(
+                "aggregate", "is not used with `independent`, which scores every window"
             )
         if "race_alpha" in self.model_fields_set and not self.race:
             raise FieldError("race_alpha", "is only meaningful with `race`")

@@ -19,7 +19,7 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from app.errors import USER_ERRORS, AppError
+from app.errors import USER_ERRORS, AppError, client_words
 from app.schemas.base import Request
 from app.schemas.extraction import ExtractRequest
 from app.schemas.jobs import JOB_REQUESTS, JobKind, JobSchema
@@ -115,10 +115,10 @@ def execute_job(store: Store, job_id: int) -> JobSchema | None:
             raise
         stopper.finish("cancelled")
     except USER_ERRORS as error:
-        stopper.finish("failed", error=_client_words(str(error), folder))
+        stopper.finish("failed", error=client_words(str(error), folder))
     except Exception as error:
         message = f"unexpected {type(error).__name__}: {error}"
-        stopper.finish("failed", error=_client_words(message, folder))
+        stopper.finish("failed", error=client_words(message, folder))
     else:
         stopper.finish("done", result=result)
     finally:
@@ -168,14 +168,6 @@ class _Stopper:
             if self._folder:
                 shutil.rmtree(self._folder, ignore_errors=True)
         os._exit(1)
-
-
-def _client_words(message: str, folder: str | None) -> str:
-    """``message`` with the upload folder left out of its paths: the client knows its files
-    by their names, and the service's folders are not its business."""
-    if not folder:
-        return message
-    return message.replace(folder.rstrip(os.sep) + os.sep, "").replace(folder, "the upload")
 
 
 def _carry_out(store: Store, request: Request) -> dict[str, Any]:

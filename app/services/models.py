@@ -291,16 +291,28 @@ def _predict_values(
 
 
 def predict_file(store: Store, model_ref: str | int, path: Path) -> PredictionReport:
+    """:func:`predict_path` with a stored model."""
+    info, model = load_model(store, model_ref)
+    return predict_path(info, model, path)
+
+
+def predict_path(
+    info: ModelInfo, model: TrainedModel, path: Path, *, source: str | None = None
+) -> PredictionReport:
     """Predict every instance of an ARFF or CSV file (attributes matched by name), or of
     a raw recording, when the model was trained on extracted features: the recording's
     instances are then extracted with the model's own recipe (:func:`is_recording`).
+
+    Parameters
+    ----------
+    source : str, optional
+        What messages call the file (an upload's own name); default: its path.
 
     Raises
     ------
     DataFormatError, DriverError, FeatureError
         A file that is neither, or a recording its recipe cannot read.
     """
-    info, model = load_model(store, model_ref)
     if info.extraction is not None and is_recording(path, model.schema):
         # Imported here: only raw recordings need the extraction stack.
         from app.services.extraction import extract_with_recipe
@@ -309,7 +321,7 @@ def predict_file(store: Store, model_ref: str | int, path: Path) -> PredictionRe
         predictions = predict(model, extracted.dataset, source=path.name)
         predictions.warnings[:0] = extracted.notes + extracted.warnings
         return predictions.report(info)
-    data = read_data_file(path)
+    data = read_data_file(path, source=source)
     return predict(model, data, source=path.name).report(info)
 
 

@@ -21,6 +21,7 @@ import numpy as np
 
 from app.errors import AppError, FieldError
 from app.schemas.runs import (
+    PER_RECORDING_NOTE,
     RACE_MIN_FOLDS,
     BenchRequest,
     BudgetSchema,
@@ -364,6 +365,13 @@ def _plan_run(store: Store, request: BenchRequest) -> _Plan:
             "baseline",
             f"'{request.baseline}' is not a classifier of this run (classifiers: {', '.join(ids)})",
         )
+    if request.aggregate == "recording":
+        from benchmark.evaluation.recordings import check_one_label
+
+        try:
+            check_one_label(problem.Y, problem.groups, prepared.target_names, info.name)
+        except ConfigurationError as error:
+            raise FieldError("aggregate", str(error)) from None
     plan = fold_plan(prepared, options)
     if request.race and len(plan.folds) < RACE_MIN_FOLDS:
         raise FieldError(
@@ -387,6 +395,7 @@ def _plan_run(store: Store, request: BenchRequest) -> _Plan:
         "baseline": request.baseline,
         "race": {"alpha": request.race_alpha} if request.race else None,
         "budget_total": request.budget_total,
+        "aggregate": request.aggregate,
     }
     return _Plan(
         info.id, problem.kind, prepared.target_names, ids, config, prepared.warnings + plan.notes
@@ -498,6 +507,7 @@ def execute_run(
                 budget=None if budget is None else float(budget) * 60.0,
                 previous=previous,
                 on_drop=dropped,
+                by_recording=run.config.get("aggregate") == "recording",
             )
         except RunStopped:
             finish_run(store, run.id, "cancelled")
@@ -584,9 +594,24 @@ class RunLeaderboard:
     besides: tuple[Beside, ...]
     drops: dict[str, Drop]
 
+    @property
+    def per_recording(self) -> bool:
+        """Whether the run scored each recording's windows as one prediction."""
+        return self.run.config.get("aggregate") == "recording"
+
     def notes(self) -> list[str]:
-        """What a raced or budgeted run's leaderboard says under its table."""
-        return [part.note for part in (self.race(), self.budget()) if part is not None]
+        """What the leaderboard of a run scored per recording, raced, budgeted or stopped
+        says under its table."""
+        notes = [PER_RECORDING_NOTE] if self.per_recording else []
+        notes += [part.note for part in (self.race(), self.budget()) if part is not None]
+        unstarted = [c for c, d in self.drops.items() if d.reason == "not started"]
+        if unstarted:
+            more = f" and {len(unstarted) - 10} more" if len(unstarted) > 10 else ""
+            notes.append(
+                f"{len(unstarted)} classifier(s) never started (the run is {self.run.status}): "
+                f"{', '.join(unstarted[:10])}{more}"
+            )
+        return notes
 
     def race(self) -> RaceSchema | None:
         """How the run raced; ``None`` for a run that did not."""
@@ -661,6 +686,8 @@ class RunLeaderboard:
             beside=[b.schema() for b in self.besides],
             race=self.race(),
             budget=self.budget(),
+            aggregate="recording" if self.per_recording else "window",
+            notes=self.notes(),
         )
 
 
@@ -702,7 +729,7 @@ def run_leaderboard(
     metric = metric or run.config.get("metric") or DEFAULT_METRIC.get(run.kind, "f1_weighted")
     others = besides(run, [get_run(store, ref) for ref in dict.fromkeys(beside)])
     ranked, groups = merged_results(results, [(b, load_results(store, b.run.id)) for b in others])
-    drops = load_drops(store, run.id)
+    drops = {**never_started(run, results), **load_drops(store, run.id)}
     board = build_leaderboard(
         ranked,
         metric=metric,
@@ -711,6 +738,20 @@ def run_leaderboard(
         drops=drops,
     )
     return RunLeaderboard(run, board, results, tuple(others), drops)
+
+
+#: Statuses of a run that stopped before its end: its entries without a result never
+#: started, and its leaderboard lists them so.
+STOPPED_EARLY = frozenset({"cancelling", "cancelled", "interrupted", "failed"})
+
+
+def never_started(run: RunInfo, results: Sequence[TaskResult]) -> dict[str, Drop]:
+    """The entries of a stopped run (cancelled, interrupted) that have no result, by id:
+    a leaderboard lists them (marked ``never started``) rather than leave them out."""
+    if run.status not in STOPPED_EARLY:
+        return {}
+    started = {result.key.classifier for result in results}
+    return {c: Drop(c, "not started", 0) for c in run.classifiers if c not in started}
 
 
 def check_metric(kind: str, metric: str, *, position: bool, run_id: int | None = None) -> None:

@@ -163,8 +163,9 @@ def build_leaderboard(
         the baseline's group are t-tested against it, fold by fold; the others are
         ranked by their means alone (results from runs whose folds do not pair).
     drops : mapping of str to Drop, optional
-        Classifiers that stopped early (a raced or budgeted run): their rows say so, and
-        the default baseline is the best classifier that did not stop.
+        Classifiers that stopped early (a raced or budgeted run) or never started (a
+        cancelled run): their rows say so, and the default baseline is the best classifier
+        that did not stop.
 
     Raises
     ------
@@ -184,8 +185,10 @@ def build_leaderboard(
         by_classifier[result.key.classifier].append(result)
     if not any(result.ok for result in results):
         failed = [_summarise(c, rs, []) for c, rs in sorted(by_classifier.items())]
+        failed += [_summarise(c, [], []) for c in drops or {} if c not in by_classifier]
         for position, row in enumerate(failed, start=1):
             row.rank = position
+            row.dropped = (drops or {}).get(row.classifier)
         return Leaderboard(metric, None, failed, (0, 0, 0), alpha)
     available = sorted({name for r in results if r.ok for name in r.metrics})
     if metric not in available:
@@ -194,7 +197,8 @@ def build_leaderboard(
         )
     lower = metric in LOWER_IS_BETTER
     rows = [_summarise(classifier, rs, available) for classifier, rs in by_classifier.items()]
-    # a classifier the budget cut before its first fold is listed too, without scores
+    # a classifier the budget cut, or a stopped run left, before its first fold is listed
+    # too, without scores
     rows += [_summarise(c, [], available) for c in drops or {} if c not in by_classifier]
     rows.sort(key=lambda row: _sort_key(row, metric, lower))
     _assign_ranks(rows, metric)

@@ -70,6 +70,7 @@ def run_tasks(
     previous: Sequence[TaskResult] = (),
     on_drop: Callable[[Drop], None] | None = None,
     clock: Callable[[], float] = time.monotonic,
+    by_recording: bool = False,
 ) -> list[TaskResult]:
     """Cross-validate classifiers on a problem.
 
@@ -124,6 +125,10 @@ def run_tasks(
     clock : callable
         Monotonic seconds the budget is measured by (a test's own clock decides when a
         task's cost no longer fits, without waiting).
+    by_recording : bool
+        Score each test recording (``problem.groups``) as one prediction pooled over its
+        windows (:mod:`benchmark.evaluation.recordings`); the caller checks that the
+        problem has groups and one label per recording.
 
     Returns
     -------
@@ -151,7 +156,8 @@ def run_tasks(
     if not tasks:
         return []
     context = pickle.dumps(
-        TaskContext(problem, specs, list(folds), random_state), protocol=pickle.HIGHEST_PROTOCOL
+        TaskContext(problem, specs, list(folds), random_state, by_recording),
+        protocol=pickle.HIGHEST_PROTOCOL,
     )
     sizes = {(f.repeat, f.fold): (int(f.train.size), int(f.test.size)) for f in folds}
     results: dict[TaskKey, TaskResult] = {}

@@ -21,6 +21,7 @@ from benchmark.catalogue import ClassifierSpec
 from benchmark.estimators import build_estimator
 from benchmark.evaluation.calibration import reliability
 from benchmark.evaluation.metrics import confusion_matrix, expand_proba, multiclass_scores
+from benchmark.evaluation.recordings import Recordings
 from benchmark.problem import Problem
 from benchmark.results import Status, TaskKey, TaskResult
 from benchmark.run.choices import chosen_params
@@ -42,12 +43,22 @@ class TaskContext:
     folds : sequence of Fold
     random_state : int
         Seed of every classifier.
+    by_recording : bool
+        Score each test recording (``problem.groups``) as one prediction, pooled over its
+        windows (:mod:`benchmark.evaluation.recordings`), rather than each window.
     """
 
     problem: Problem
     specs: Mapping[str, ClassifierSpec]
     folds: Sequence[Fold]
     random_state: int = 0
+    by_recording: bool = False
+
+    def recordings(self, fold: Fold) -> Recordings | None:
+        """The recordings of ``fold``'s test windows when scored per recording."""
+        if not self.by_recording or self.problem.groups is None:
+            return None
+        return Recordings.of(self.problem.groups[fold.test])
 
     def fold(self, repeat: int, fold: int) -> Fold:
         for candidate in self.folds:
@@ -115,7 +126,12 @@ def _run_multiclass(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResul
     if context.specs[key.classifier].probabilities:
         proba = expand_proba(model.predict_proba(X_test), model.classes_, n_classes=n_classes)
     predict_time, predict_cpu = timer.lap()
-    scores, confusion = multiclass_scores(y[fold.test], y_pred, proba, n_classes=n_classes)
+    y_test = y[fold.test]
+    recordings = context.recordings(fold)
+    if recordings is not None:
+        y_test = recordings.truth(y_test)
+        y_pred, proba = recordings.classes(y_pred, proba, n_classes)
+    scores, confusion = multiclass_scores(y_test, y_pred, proba, n_classes=n_classes)
     scores.update(_costs(fit_time, fit_cpu, predict_time, predict_cpu, model))
     return TaskResult(
         key,
@@ -127,7 +143,7 @@ def _run_multiclass(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResul
         int(fold.test.size),
         params=chosen_params(model),
         # the bins, not the probabilities: they add up over folds, 30 numbers a fold
-        calibration=None if proba is None else reliability(y[fold.test], proba).to_json(),
+        calibration=None if proba is None else reliability(y_test, proba).to_json(),
     )
 
 
@@ -142,9 +158,13 @@ def _run_regression(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResul
     fit_time, fit_cpu = timer.lap()
     Y_pred = np.asarray(model.predict(problem.X[fold.test]), dtype=np.float64)
     predict_time, predict_cpu = timer.lap()
+    Y_test, Y_pred = problem.Y[fold.test], Y_pred.reshape(len(fold.test), -1)
+    recordings = context.recordings(fold)
+    if recordings is not None:
+        Y_test, Y_pred = recordings.truth(Y_test), recordings.mean(Y_pred)
     metrics, per_target = regression_scores(
-        problem.Y[fold.test],
-        Y_pred.reshape(len(fold.test), -1),
+        Y_test,
+        Y_pred,
         target_names=problem.target_names,
         coordinates=problem.coordinates,
     )
@@ -181,6 +201,9 @@ def _run_multitarget(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResu
             probas = None
     predict_time, predict_cpu = timer.lap()
     Y_test = problem.Y[fold.test]
+    recordings = context.recordings(fold)
+    if recordings is not None:
+        Y_test, Y_pred, probas = _pooled_targets(recordings, Y_test, Y_pred, probas, problem)
     scores = dict(
         multitarget_scores(
             Y_test,
@@ -208,6 +231,25 @@ def _run_multitarget(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResu
         per_target=per_target,
         params=chosen_params(model, problem.target_names),
     )
+
+
+def _pooled_targets(
+    recordings: Recordings,
+    Y_test: np.ndarray,
+    Y_pred: np.ndarray,
+    probas: list[np.ndarray] | None,
+    problem: Problem,
+) -> tuple[np.ndarray, np.ndarray, list[np.ndarray] | None]:
+    """Each target's windows pooled per recording: truth, predictions and probabilities
+    (shapes (n_recordings, n_targets) and n_targets x (n_recordings, n_classes))."""
+    pooled = [
+        recordings.classes(Y_pred[:, t], None if probas is None else probas[t], k)
+        for t, k in enumerate(problem.n_classes)
+    ]
+    labels = np.stack([p[0] for p in pooled], axis=1)
+    means = [p[1] for p in pooled]
+    kept = None if any(m is None for m in means) else [m for m in means if m is not None]
+    return recordings.truth(Y_test), labels, kept
 
 
 class _Timer:

@@ -254,11 +254,21 @@ def test_extract_reads_numeric_fields_of_tactile_topics(
         "window",
         "--events",
         "none",
+        "--name",
+        "biotac",
         "--json",
     )
     assert result.code == 0, result.err
     summary = result.json()
     assert summary["n_features"] == 25 * (1 + 19 + 1)
+    # the fields name the channels, as a CSV header does: never ch1, ch2, ...
+    store = Store(store_url)
+    try:
+        names = list(load_dataset(store, "biotac").schema.feature_names)
+    finally:
+        store.dispose()
+    assert names[:3] == ["t0_pdc", "t1_pdc", "t2_pdc"]
+    assert {"t0_electrodes[0]", "t24_electrodes[18]", "t24_tdc"} <= set(names)
     assert summary["events_labelled"] == 2
     jitter = [w for w in summary["notes"] if "stamps of '/biotac' are uneven" in w]
     assert [w.split(":")[0] for w in jitter] == ["press.bag", "slide.bag"]

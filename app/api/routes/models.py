@@ -14,7 +14,7 @@ from fastapi import APIRouter, File, Request, Response, UploadFile, status
 
 from app.api.deps import PageDep, Service, ServiceDep, StoreDep, paginate, request_size
 from app.api.direct import DirectRoute
-from app.api.uploads import save_upload
+from app.api.uploads import in_client_words, save_upload
 from app.schemas.jobs import JobCreated
 from app.schemas.models import (
     ModelList,
@@ -91,18 +91,25 @@ def _predict_records(service: Service, model_ref: str, body: PredictRequest, siz
 def predict_upload(
     model_ref: str,
     service: ServiceDep,
-    file: Annotated[UploadFile, File(description="ARFF or CSV with the model's attributes.")],
+    file: Annotated[
+        UploadFile,
+        File(
+            description="ARFF or CSV with the model's attributes, or a raw recording (WAV, "
+            "FLAC, a CSV time series, a bag) of a model trained on extracted features."
+        ),
+    ],
 ) -> PredictionReport:
     """Predict every instance of an uploaded ARFF or CSV file (accuracy when it carries the
-    targets)."""
-    from app.services.datasets import read_data_file
-    from app.services.models import predict
+    targets), or of a raw recording, whose instances are extracted with the model's own
+    recipe (as ``touchbench predict MODEL take.wav``).  The upload is bounded by the
+    service's upload limit (``max_upload_mb``), and so is the extraction's work."""
+    from app.services.models import predict_path
 
     info, trained = service.models.get(service.store, model_ref)
     with tempfile.TemporaryDirectory(dir=_work_dir(service)) as folder:
         path = save_upload(file, Path(folder), "upload.arff")
-        data = read_data_file(path, source=path.name)  # the client's name, not our folder
-        return predict(trained, data, source=path.name).report(info)
+        with in_client_words(Path(folder)):  # the client's names, not our folder
+            return predict_path(info, trained, path, source=path.name)
 
 
 def _work_dir(service: ServiceDep) -> Path:
