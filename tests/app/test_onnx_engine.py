@@ -20,6 +20,7 @@ from app.services.models import train
 from app.services.simulation import write_labels, write_session
 from app.store.database import Store
 from tests.app.api.conftest import Server, _servers
+from tests.app.api.test_api_live import _pcm_blocks, _stream, _ws_url
 from tests.app.cli_runner import run_cli
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -143,7 +144,7 @@ def test_live_answers_the_same_with_either_engine(
 def test_the_service_serves_the_graph_and_predicts_with_the_engine_asked(
     trained: tuple[str, Path, Path], make_server_on: Callable[[str], Server]
 ) -> None:
-    url, _, _ = trained
+    url, _, unseen = trained
     server = make_server_on(url)
     graph = server.client.get("/api/models/touch-rf/onnx")
     assert graph.status_code == 200, graph.text
@@ -165,6 +166,19 @@ def test_the_service_serves_the_graph_and_predicts_with_the_engine_asked(
         "/api/models/touch-j48/predict", json={"instances": [instance], "engine": "onnx"}
     )
     assert no_twin.status_code in (400, 422) and "engine" in no_twin.text
+
+    # the live WebSocket, with each engine, on the same samples
+    rate, channels, blocks = _pcm_blocks(unseen)
+    labels = {}
+    for engine in ("native", "onnx"):
+        header = {"samplerate": rate, "channels": channels, "format": "S16LE", "engine": engine}
+        messages, code, reason = _stream(_ws_url(server, "touch-rf"), header, blocks)
+        assert (code, reason) == (1000, "stream ended")
+        labels[engine] = [m["predictions"]["gesture"]["value"] for m in messages]
+    assert len(labels["onnx"]) == 4 and labels["onnx"] == labels["native"]
+    header = {"samplerate": rate, "channels": channels, "engine": "fast"}
+    _, code, reason = _stream(_ws_url(server, "touch-rf"), header, [])
+    assert (code, reason) == (1007, "header: 'engine' must be auto, onnx or native")
 
 
 @pytest.fixture
