@@ -105,7 +105,8 @@ def latency(
 ) -> list[float]:
     times = []
     body = {"instances": [record], "engine": engine}
-    with httpx.Client(base_url=url, timeout=60) as client:
+    # the first request loads the model: minutes on a machine at load 30
+    with httpx.Client(base_url=url, timeout=600) as client:
         for _ in range(20):  # warm-up: load the model into the cache, open the connection
             client.post(f"/api/models/{model}/predict", json=body)
         for _ in range(n):
@@ -357,7 +358,13 @@ def main() -> None:
             info, trained = load_predictor(store, f"mini-{classifier}", engine)  # type: ignore[arg-type]
             X = align_features(trained.schema, data)[:1]
             record: dict[str, object] = {
-                attribute.name: (float(value) if np.isfinite(value) else None)
+                attribute.name: (
+                    None
+                    if not np.isfinite(value)
+                    else attribute.label(value)
+                    if attribute.kind == "nominal"
+                    else float(value)
+                )  # a nominal attribute by its label, as a client sends it
                 for attribute, value in zip(trained.schema.features, X[0], strict=True)
             }
             path = f"{url}/api/models/{info.name}/predict"

@@ -145,6 +145,7 @@ _NO_CONVERTER = frozenset(
     {
         "OutputCodeClassifier",
         "GaussianProcessClassifier",
+        "GaussianProcessRegressor",
         "TransformedTargetRegressor",
         "RegressorChain",
         "KBinsDiscretizer",
@@ -539,14 +540,21 @@ def _check_twin(model: TrainedModel, twin: OnnxModel, X: np.ndarray) -> None:
 
 
 def _check_close(model: TrainedModel, what: str, native: np.ndarray, mine: np.ndarray) -> None:
-    difference = np.abs(np.asarray(native, dtype=np.float64) - mine)
+    """Refuse a difference over :data:`TOLERANCE`: absolute for probabilities, relative to
+    the value (at least 1) for a regressor's values, which float32 holds to ~1e-7 of
+    their size."""
+    native = np.asarray(native, dtype=np.float64)
+    difference = np.abs(native - mine)
+    if what == "value":
+        difference = difference / np.maximum(1.0, np.abs(native))
     if difference.size == 0 or not np.nanmax(difference) > TOLERANCE:
         return
     i, j = np.unravel_index(int(np.nanargmax(difference)), difference.shape)
+    relative = " (relative)" if what == "value" else ""
     raise ConfigurationError(
         f"classifier '{model.classifier}': the ONNX graph's {what} differs from the model's "
-        f"by {difference[i, j]:.3g} (instance {i + 1}, column {j + 1}; at most {TOLERANCE:g} "
-        "allowed); not exported"
+        f"by {difference[i, j]:.3g}{relative} (instance {i + 1}, column {j + 1}; at most "
+        f"{TOLERANCE:g} allowed); not exported"
     )
 
 

@@ -133,3 +133,18 @@ def test_a_graph_that_predicts_otherwise_is_refused_naming_the_difference() -> N
         ConfigurationError, match=r"(another label for|differs from the model.s by)"
     ):
         check_twin(other, graph, data.X)
+
+
+@pytest.mark.filterwarnings("ignore")
+@pytest.mark.parametrize("regressor", ["linear", "rf", "xgb"])
+def test_a_regressor_exports_its_values(regressor: str) -> None:
+    rng = np.random.default_rng(0)
+    a, b = rng.normal(size=30), rng.normal(size=30)
+    values = np.column_stack([a, b, 2 * a - b + 0.1 * rng.normal(size=30)])
+    attributes = (Attribute("a", "numeric"), Attribute("b", "numeric"), Attribute("y", "numeric"))
+    data = Dataset(Schema("r", attributes, (2,)), values)
+    model = fit_model(data, regressor)
+    twin = OnnxModel(data.schema, regressor, export_onnx(model, data.X))
+    np.testing.assert_allclose(
+        twin.predict_values(data.X), model.predict_values(data.X), rtol=1e-5, atol=1e-5
+    )
