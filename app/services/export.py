@@ -15,7 +15,7 @@ from app.services.models import align_features, load_model
 from app.store.database import Store
 from app.store.datasets import load_dataset
 from app.store.exports import load_export, save_export
-from app.store.models import ModelInfo
+from app.store.models import ModelInfo, get_model
 from benchmark.dataset import Schema
 from benchmark.errors import ConfigurationError
 from benchmark.model import Predictor
@@ -74,8 +74,6 @@ def export_model(store: Store, request: ExportRequest) -> tuple[ExportSchema, by
 def stored_export(store: Store, ref: str | int) -> tuple[ModelInfo, bytes, bool]:
     """A model's stored ONNX twin, exported (and stored) first if it has none; and whether
     it was exported now."""
-    from app.store.models import get_model
-
     info = get_model(store, ref)
     graph = load_export(store, info.id, "onnx")
     if graph is not None:
@@ -96,8 +94,6 @@ def load_predictor(
     FieldError
         ``engine`` is ``onnx`` and the model has no twin (for ``engine``).
     """
-    from app.store.models import get_model
-
     if engine == "native" or (engine == "auto" and not AUTO_PREFERS_ONNX):
         return load_model(store, ref)
     info = get_model(store, ref)
