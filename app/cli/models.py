@@ -209,11 +209,14 @@ def export_model_command(
     force: Annotated[bool, typer.Option("--force", help="Overwrite FILE if it exists.")] = False,
     as_json: JsonOption = False,
 ) -> None:
-    """Write a model as one ONNX graph: input `features` (float32, one column per attribute
-    in the order the metadata key touchbench.features lists them; a nominal attribute as
-    the index of its label), outputs `label` (index into touchbench.labels) and
-    `probabilities`. It is checked against the model on its training instances first, and
-    kept in the store: `predict` and `live` then run it in ONNX Runtime."""
+    """Write a model as one ONNX graph (preprocessing and classifier), checked against the
+    model on its training instances; predictions then run it in ONNX Runtime.
+
+    The graph's input is `features` (float32, one column per attribute in the order the
+    metadata key touchbench.features lists them; a nominal attribute as the index of its
+    label), its outputs `label` (an index into touchbench.labels) and `probabilities`. It
+    is kept in the store: `predict` and `live` run it (--engine).
+    """
     from app.cli.requests import build_request
     from app.errors import FieldError
     from app.schemas.models import ExportRequest
