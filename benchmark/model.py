@@ -12,7 +12,7 @@ from __future__ import annotations
 import hashlib
 from dataclasses import dataclass, field
 from importlib import metadata
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 from sklearn.base import BaseEstimator
@@ -174,6 +174,21 @@ class TrainedModel:
                 f"{X.shape}"
             )
         return feature_matrix(self.schema, X)[0]
+
+
+class Predictor(Protocol):
+    """What predicting callers (served predictions, live sessions) use of a model: a
+    :class:`TrainedModel`, or its ONNX twin (:class:`benchmark.export.onnx.OnnxModel`)."""
+
+    @property
+    def schema(self) -> Schema: ...
+
+    @property
+    def regression(self) -> bool: ...
+
+    def predict_with_proba(self, X: np.ndarray) -> tuple[np.ndarray, list[np.ndarray] | None]: ...
+
+    def predict_values(self, X: np.ndarray) -> np.ndarray: ...
 
 
 def fit_model(dataset: Dataset, classifier_id: str, *, random_state: int = 0) -> TrainedModel:

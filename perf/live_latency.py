@@ -23,6 +23,11 @@ Run from the repository root::
    detection, extraction, prediction) runs: above 1 with margin, a paced sound card
    never fills the queue.  Blocks dropped from a full queue and PortAudio's own input
    overflows (xruns: the unpaced device outrunning its callback thread) are printed.
+3. Engines.  ``rf``, ``xgb``, ``logistic`` and ``svm-rbf`` trained on the same features,
+   exported as ONNX (``export-model``'s service), and one row predicted by the model
+   itself (``native``) and by its ONNX twin in ONNX Runtime (``onnx``), alternately, row
+   after row of the training features: per-row latency p50/p99 and the ratio native/ONNX
+   (what ``--engine auto`` was chosen by).  ``--engines-only`` runs this part alone.
 
 Not a test: nothing is asserted.
 """
@@ -120,6 +125,39 @@ def networks(store: Store, here: Path, recordings: list[Path], labels: Path, ses
         print(f"  ({classifier} trained in {fitted:.1f} s on {len(recordings) * 16} touches)")
 
 
+def engines(store: Store, repeats: int) -> None:
+    """Per-row latency of each entry's own estimator and of its ONNX twin, alternately."""
+    from app.schemas.models import ExportRequest, TrainRequest
+    from app.services.export import export_model, load_predictor
+    from app.services.models import train
+    from app.store.datasets import load_dataset
+
+    X = load_dataset(store, "touch").X
+    print(f"\n3. One row, native vs ONNX Runtime ({repeats} rows each, alternating), ms")
+    header = f"{'':<12} {'native p50':>10} {'p99':>8} {'onnx p50':>10} {'p99':>8} {'p50 ratio':>10}"
+    print(header)
+    for classifier in ("rf", "xgb", "logistic", "svm-rbf"):
+        name = f"touch-{classifier}"
+        if classifier != "rf":
+            train(store, TrainRequest(dataset="touch", classifier=classifier, target="gesture"))
+        export_model(store, ExportRequest(model=name))
+        predictors = {
+            engine: load_predictor(store, name, engine)[1] for engine in ("native", "onnx")
+        }
+        times: dict[str, list[float]] = {"native": [], "onnx": []}
+        for i in range(repeats):
+            row = X[i % len(X) : i % len(X) + 1]
+            for engine in ("native", "onnx") if i % 2 else ("onnx", "native"):
+                began = time.perf_counter()
+                predictors[engine].predict_with_proba(row)
+                times[engine].append(1000 * (time.perf_counter() - began))
+        native, onnx = (np.percentile(times[e][10:], [50, 99]) for e in ("native", "onnx"))
+        print(
+            f"{classifier:<12} {native[0]:>10.3f} {native[1]:>8.3f} {onnx[0]:>10.3f} "
+            f"{onnx[1]:>8.3f} {native[0] / onnx[0]:>9.1f}x"
+        )
+
+
 def main() -> None:
     from app.schemas.extraction import ExtractRequest
     from app.schemas.models import TrainRequest
@@ -134,6 +172,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sessions", type=int, default=8, help="fresh sessions replayed")
     parser.add_argument("--capture-seconds", type=float, default=60.0)
+    parser.add_argument("--engines-only", action="store_true", help="only part 3")
+    parser.add_argument("--rows", type=int, default=400, help="rows per engine in part 3")
     arguments = parser.parse_args()
     load = ", ".join(f"{value:.1f}" for value in os.getloadavg())
     print(f"Machine load average (1, 5, 15 min): {load} on {os.cpu_count()} cores")
@@ -150,6 +190,9 @@ def main() -> None:
         extract_and_store(store, ExtractRequest(recordings=recordings, labels=labels, name="touch"))
         train(store, TrainRequest(dataset="touch", classifier="rf", target="gesture"))
         _, model = load_model(store, "touch-rf")
+        if arguments.engines_only:
+            engines(store, arguments.rows)
+            return
 
         rows = []
         for block_length in sorted({LIVE_BLOCK, 1024}):
@@ -224,6 +267,7 @@ def main() -> None:
             factor, touches, dropped, xruns = done.stdout.split()
             label = f"{queue:g} s" + (" (default)" if queue == 5.0 else " (holds it all)")
             print(f"{label:<28} {float(factor):>12.1f} {touches:>8} {dropped:>8} {xruns:>8}")
+        engines(store, arguments.rows)  # last: it gives touch-rf its twin, which live takes
 
 
 if __name__ == "__main__":

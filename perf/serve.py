@@ -4,6 +4,11 @@ the same run from the CLI.
 
     .venv/bin/python perf/serve.py [--requests 400] [--seconds 10] [--workers 1]
                                    [--client wrk|httpx] [--run-classifiers nb,j48,logistic,rf]
+                                   [--classifiers logistic,rf] [--engines native,onnx]
+
+``--engines``: each model's predictions are measured with each engine the request names
+(``native``: the model's own estimator; ``onnx``: its ONNX twin in ONNX Runtime, exported
+first), beside the same engine in process.
 
 ``--workers`` is ``touchbench serve --workers``: service processes sharing the port.
 ``--client``: the HTTP client that measures. ``wrk`` (Debian's package; the default when it
@@ -95,22 +100,26 @@ def wait_until_up(port: int) -> str:
     raise SystemExit("the service did not start")
 
 
-def latency(url: str, model: str, record: dict[str, object], n: int) -> list[float]:
+def latency(
+    url: str, model: str, record: dict[str, object], n: int, engine: str = "auto"
+) -> list[float]:
     times = []
-    with httpx.Client(base_url=url, timeout=60) as client:
+    body = {"instances": [record], "engine": engine}
+    # the first request loads the model: minutes on a machine at load 30
+    with httpx.Client(base_url=url, timeout=600) as client:
         for _ in range(20):  # warm-up: load the model into the cache, open the connection
-            client.post(f"/api/models/{model}/predict", json={"instances": [record]})
+            client.post(f"/api/models/{model}/predict", json=body)
         for _ in range(n):
             start = time.perf_counter()
-            response = client.post(f"/api/models/{model}/predict", json={"instances": [record]})
+            response = client.post(f"/api/models/{model}/predict", json=body)
             times.append(time.perf_counter() - start)
             assert response.status_code == 200, response.text
     return times
 
 
-def wrk_script(folder: Path, record: dict[str, object]) -> Path:
+def wrk_script(folder: Path, record: dict[str, object], engine: str = "auto") -> Path:
     """A wrk script that POSTs one instance as JSON."""
-    body = json.dumps({"instances": [record]})
+    body = json.dumps({"instances": [record], "engine": engine})
     script = folder / "predict.lua"
     script.write_text(
         'wrk.method = "POST"\n'
@@ -150,18 +159,24 @@ def wrk(
 
 
 def in_process(trained: object, X: np.ndarray, n: int) -> list[float]:
+    """Seconds of ``predict_with_proba`` (what a served prediction runs) on ``X``."""
     times = []
     for _ in range(20):
-        trained.predict_proba(X)  # type: ignore[attr-defined]
+        trained.predict_with_proba(X)  # type: ignore[attr-defined]
     for _ in range(n):
         start = time.perf_counter()
-        trained.predict_proba(X)  # type: ignore[attr-defined]
+        trained.predict_with_proba(X)  # type: ignore[attr-defined]
         times.append(time.perf_counter() - start)
     return times
 
 
 def throughput(
-    url: str, model: str, record: dict[str, object], clients: int, seconds: float
+    url: str,
+    model: str,
+    record: dict[str, object],
+    clients: int,
+    seconds: float,
+    engine: str = "auto",
 ) -> float:
     done = 0
     lock = threading.Lock()
@@ -171,7 +186,10 @@ def throughput(
         nonlocal done
         with httpx.Client(base_url=url, timeout=60) as client:
             while time.monotonic() < stop:
-                response = client.post(f"/api/models/{model}/predict", json={"instances": [record]})
+                response = client.post(
+                    f"/api/models/{model}/predict",
+                    json={"instances": [record], "engine": engine},
+                )
                 assert response.status_code == 200
                 with lock:
                     done += 1
@@ -294,6 +312,12 @@ def main() -> None:
         help="leave the prediction latency and throughput out (the run comparison only)",
     )
     parser.add_argument(
+        "--classifiers", default="logistic,rf", help="models whose predictions are measured"
+    )
+    parser.add_argument(
+        "--engines", default="native,onnx", help="engines each model's predictions run with"
+    )
+    parser.add_argument(
         "--client",
         choices=("wrk", "httpx"),
         default="wrk" if shutil.which("wrk") else "httpx",
@@ -302,9 +326,10 @@ def main() -> None:
     args = parser.parse_args()
 
     from app.schemas.datasets import ImportRequest
-    from app.schemas.models import TrainRequest
+    from app.schemas.models import ExportRequest, TrainRequest
     from app.services.datasets import import_file
-    from app.services.models import align_features, load_model, train
+    from app.services.export import export_model, load_predictor
+    from app.services.models import align_features, train
     from app.store.database import Store
     from benchmark.io import read_arff
 
@@ -313,28 +338,39 @@ def main() -> None:
     store = Store(db)
     source = data_file(folder)
     imported = import_file(store, ImportRequest(file=source, name="mini"))
-    for classifier in ("logistic", "rf"):
+    classifiers = args.classifiers.split(",")
+    engines = args.engines.split(",")
+    for classifier in classifiers:
         train(
             store,
             TrainRequest(
                 dataset="mini", classifier=classifier, target="gesture", name=f"mini-{classifier}"
             ),
         )
+        if "onnx" in engines:
+            export_model(store, ExportRequest(model=f"mini-{classifier}"))
     data = read_arff(source)
     process, url = start_service(db, folder, args.workers)
     rows = []
     try:
-        for classifier in () if args.no_predictions else ("logistic", "rf"):
-            info, trained = load_model(store, f"mini-{classifier}")
+        measured = [(c, e) for c in classifiers for e in engines]
+        for classifier, engine in [] if args.no_predictions else measured:
+            info, trained = load_predictor(store, f"mini-{classifier}", engine)  # type: ignore[arg-type]
             X = align_features(trained.schema, data)[:1]
             record: dict[str, object] = {
-                attribute.name: (float(value) if np.isfinite(value) else None)
+                attribute.name: (
+                    None
+                    if not np.isfinite(value)
+                    else attribute.label(value)
+                    if attribute.kind == "nominal"
+                    else float(value)
+                )  # a nominal attribute by its label, as a client sends it
                 for attribute, value in zip(trained.schema.features, X[0], strict=True)
             }
             path = f"{url}/api/models/{info.name}/predict"
-            latency(url, info.name, record, 20)  # load the model, open a connection
+            latency(url, info.name, record, 20, engine)  # load the model, open a connection
             if args.client == "wrk":
-                script = wrk_script(folder, record)
+                script = wrk_script(folder, record, engine)
                 wrk(path, script, 8, 5.0, warm_up=True)  # every service process loads the model
             # Rounds of in-process then HTTP, so that both see the machine in the same state
             # (its speed drifts by a third from minute to minute here); medians of the rounds.
@@ -345,7 +381,7 @@ def main() -> None:
                 if args.client == "wrk":
                     p50, p99, _ = wrk(path, script, 1, args.seconds / args.rounds)
                 else:
-                    http_times = latency(url, info.name, record, args.requests)
+                    http_times = latency(url, info.name, record, args.requests, engine)
                     p50, p99 = percentile(http_times, 50), percentile(http_times, 99)
                 remote.append((p50, p99))
             p50, p99 = (statistics.median(r[k] for r in remote) for k in (0, 1))
@@ -353,7 +389,7 @@ def main() -> None:
             overhead = statistics.median(r[0] - q[0] for r, q in zip(remote, local, strict=True))
             rows.append(
                 (
-                    f"{classifier} one instance: HTTP p50 / p99 (ms)",
+                    f"{classifier} ({engine}) one instance: HTTP p50 / p99 (ms)",
                     f"{p50:.2f} / {p99:.2f}",
                     f"in-process {l50:.2f} / {l99:.2f}",
                     f"overhead p50 {overhead:.2f} ms",
@@ -367,11 +403,11 @@ def main() -> None:
                     if args.client == "wrk":
                         rates.append(wrk(path, script, clients, seconds)[2])
                     else:
-                        rates.append(throughput(url, info.name, record, clients, seconds))
+                        rates.append(throughput(url, info.name, record, clients, seconds, engine))
                 ratio = statistics.median(r / q for r, q in zip(rates, local_rates, strict=True))
                 rows.append(
                     (
-                        f"{classifier} throughput, {clients} clients (req/s)",
+                        f"{classifier} ({engine}) throughput, {clients} clients (req/s)",
                         f"{statistics.median(rates):.0f}",
                         f"in-process {statistics.median(local_rates):.0f}",
                         f"ratio {ratio:.2f}",

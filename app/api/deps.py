@@ -22,7 +22,8 @@ from app.store.database import Store
 from app.store.models import ModelInfo, model_version
 
 if TYPE_CHECKING:  # scikit-learn loads on the first prediction, not at start-up
-    from benchmark.model import TrainedModel
+    from app.schemas.models import Engine
+    from benchmark.model import Predictor
 
 
 #: A stored model's id, artifact sha256 and name (:func:`app.store.models.model_version`).
@@ -59,7 +60,8 @@ class ModelCache:
 
     def __init__(self, size: int) -> None:
         self.size = size
-        self._models: OrderedDict[ModelKey, tuple[ModelInfo, TrainedModel]] = OrderedDict()
+        # per model version, per engine asked for: the model or its ONNX twin
+        self._models: OrderedDict[ModelKey, dict[str, tuple[ModelInfo, Predictor]]] = OrderedDict()
         self._seconds: dict[int, float] = {}  # model id -> seconds per unit of size
         self._lock = threading.Lock()
         self._in_flight = 0  # predictions under way in this process (changed on the loop only)
@@ -111,20 +113,26 @@ class ModelCache:
             known = self._seconds.get(model_id)
             self._seconds[model_id] = per_unit if known is None else 0.8 * known + 0.2 * per_unit
 
-    def get(self, store: Store, ref: str | int) -> tuple[ModelInfo, TrainedModel]:
+    def get(
+        self, store: Store, ref: str | int, engine: Engine = "auto"
+    ) -> tuple[ModelInfo, Predictor]:
+        """A stored model run by ``engine`` (the model, or its ONNX twin: see
+        :func:`app.services.export.load_predictor`)."""
         key = model_version(store, ref)
         with self._lock:
-            cached = self._models.get(key)
+            cached = self._models.get(key, {}).get(engine)
             if cached is not None:
                 self._models.move_to_end(key)
                 return cached
         # loaded with the first model: start-up time (scikit-learn loads in the service's
         # warm-up thread, not before it answers its first request)
-        from app.services.models import load_model
+        from app.services.export import load_predictor
 
-        info, model = load_model(store, key[0])
+        info, model = load_predictor(store, key[0], engine)
         with self._lock:
-            self._models[(info.id, info.sha256, info.name)] = (info, model)
+            loaded = self._models.setdefault((info.id, info.sha256, info.name), {})
+            loaded[engine] = (info, model)
+            self._models.move_to_end((info.id, info.sha256, info.name))
             while len(self._models) > self.size:
                 self._models.popitem(last=False)
         return info, model

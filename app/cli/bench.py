@@ -74,6 +74,7 @@ def classifiers_command(
     same ids name regressors (--regressors lists them).
     """
     from benchmark.catalogue import CATALOGUE, get_spec, suite
+    from benchmark.export.onnx import exports_onnx
 
     if multi_target and regressors:
         raise typer.BadParameter("give --multi-target or --regressors, not both")
@@ -110,6 +111,7 @@ def classifiers_command(
                         "suites": sorted(s.suites),
                         "limits": s.limits,
                         "search_space": s.to_json()["search_space"],
+                        "onnx": exports_onnx(s),
                     }
                     for s in specs
                 ]
@@ -128,6 +130,7 @@ def classifiers_command(
             "missing",
             "nominal",
             "sequence",
+            "onnx",
             "cost",
             "suites",
         ],
@@ -141,6 +144,7 @@ def classifiers_command(
                 yes if s.handles_missing else "",
                 yes if s.handles_nominal else "",
                 yes if s.needs_sequence else "",
+                yes if exports_onnx(s) else "",
                 s.cost,
                 ",".join(sorted(s.suites)),
             )

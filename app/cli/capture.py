@@ -209,6 +209,17 @@ def live_command(
     as_json: Annotated[
         bool, typer.Option("--json", help="One JSON object per touch on stdout (JSON lines).")
     ] = False,
+    engine: Annotated[
+        str | None,
+        typer.Option(
+            "--engine",
+            metavar="ENGINE",
+            help="What runs the predictions: onnx (the model's ONNX twin, written by "
+            "`touchbench export-model`), native (the model itself), auto (the twin where the "
+            "model has one).",
+            show_default="auto",
+        ),
+    ] = None,
 ) -> None:
     """Predict every touch of a live stream with a model: its own event detection and
     extractor run on the stream, and each touch is printed as soon as it ends."""
@@ -219,7 +230,11 @@ def live_command(
 
     if (device is None) == (replay is None):
         raise AppError("give exactly one of --device DEV or --replay FILE")
-    model_info, trained = load_live_model(get_state(ctx).store, model)
+    from app.cli.requests import build_request
+    from app.schemas.models import EngineChoice
+
+    choice = build_request(EngineChoice, engine=engine)
+    model_info, trained = load_live_model(get_state(ctx).store, model, choice.engine)
     extraction = model_info.extraction
     source: Source
     if replay is not None:

@@ -109,6 +109,12 @@ COMMANDS = (
     ),
     Subcommand("delete-model", "app.cli.models", "Delete a trained model."),
     Subcommand(
+        "export-model",
+        "app.cli.models",
+        "Write a model as one ONNX graph (preprocessing and classifier), checked against the "
+        "model on its training instances; predictions then run it in ONNX Runtime.",
+    ),
+    Subcommand(
         "extract",
         "app.cli.extract",
         "Detect touch events in recordings, extract features, and store them as a data set.",

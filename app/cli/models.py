@@ -19,6 +19,20 @@ def register(app: typer.Typer) -> None:
     app.command("models")(models_command)
     app.command("predict")(predict_command)
     app.command("delete-model")(delete_model_command)
+    app.command("export-model")(export_model_command)
+
+
+EngineOption = Annotated[
+    str | None,
+    typer.Option(
+        "--engine",
+        metavar="ENGINE",
+        help="What runs the predictions: onnx (the model's ONNX twin, written by "
+        "`touchbench export-model`), native (the model itself), auto (the twin where the "
+        "model has one).",
+        show_default="auto",
+    ),
+]
 
 
 def train_command(
@@ -118,12 +132,16 @@ def predict_command(
             show_default=False,
         ),
     ],
+    engine: EngineOption = None,
     as_json: JsonOption = False,
 ) -> None:
     """Predict every instance of a file; attributes are matched to the model's by name."""
+    from app.cli.requests import build_request
+    from app.schemas.models import EngineChoice
     from app.services.models import predict_file
 
-    report = predict_file(get_state(ctx).store, model_ref, file)
+    choice = build_request(EngineChoice, engine=engine)
+    report = predict_file(get_state(ctx).store, model_ref, file, engine=choice.engine)
     if as_json:
         print_json(report.to_json())
         return
@@ -172,3 +190,50 @@ def delete_model_command(
 
     gone = delete_model(get_state(ctx).store, model_ref)
     info(f"deleted model {gone.id} '{gone.name}'")
+
+
+def export_model_command(
+    ctx: typer.Context,
+    model_ref: Annotated[
+        str, typer.Argument(metavar="MODEL", help="Model name or id.", show_default=False)
+    ],
+    output: Annotated[
+        Path,
+        typer.Option(
+            "--output", "-o", metavar="FILE", help="The file to write.", show_default=False
+        ),
+    ],
+    format: Annotated[
+        str, typer.Option("--format", metavar="FORMAT", help="onnx: one ONNX graph.")
+    ] = "onnx",
+    force: Annotated[bool, typer.Option("--force", help="Overwrite FILE if it exists.")] = False,
+    as_json: JsonOption = False,
+) -> None:
+    """Write a model as one ONNX graph (preprocessing and classifier), checked against the
+    model on its training instances; predictions then run it in ONNX Runtime.
+
+    The graph's input is `features` (float32, one column per attribute in the order the
+    metadata key touchbench.features lists them; a nominal attribute as the index of its
+    label), its outputs `label` (an index into touchbench.labels) and `probabilities`. It
+    is kept in the store: `predict` and `live` run it (--engine).
+    """
+    from app.cli.requests import build_request
+    from app.errors import FieldError
+    from app.schemas.models import ExportRequest
+    from app.services.export import export_model
+
+    request = build_request(
+        ExportRequest, {"model": "MODEL", "format": "--format"}, model=model_ref, format=format
+    )
+    if output.exists() and not force:
+        raise FieldError("output", f"{output.name} exists; give --force to overwrite it")
+    exported, graph = export_model(get_state(ctx).store, request)
+    output.write_bytes(graph)
+    if as_json:
+        print_json({**exported.to_json(), "path": str(output)})
+        return
+    info(
+        f"wrote {output} ({exported.size_bytes:,} bytes, sha256 {exported.sha256[:12]}): model "
+        f"'{exported.model}' as ONNX, same labels and probabilities within 1e-5 on its "
+        f"{exported.checked_instances} training instances"
+    )

@@ -83,6 +83,49 @@ class PredictionReport(Schema):
 MissingPolicy = Literal["refuse", "allow"]
 
 
+#: What runs a model's predictions: ``native`` its own estimator (scikit-learn, XGBoost...),
+#: ``onnx`` its ONNX twin in ONNX Runtime (``touchbench export-model`` writes it), ``auto``
+#: the twin where the model has one (measured faster: ``perf/serve.py``,
+#: ``perf/live_latency.py``), else the estimator.
+Engine = Literal["auto", "onnx", "native"]
+
+
+class EngineChoice(Request):
+    """The engine of a command that predicts (``predict``, ``live``)."""
+
+    engine: Engine = Field(
+        default="auto",
+        description="auto: the model's ONNX twin where it has one, else the model itself; "
+        "onnx: the twin (refused without one); native: the model itself.",
+    )
+
+
+#: Formats ``export-model`` writes.
+ExportFormat = Literal["onnx"]
+
+
+class ExportRequest(Request):
+    """``GET /api/models/{id}/onnx`` and the CLI's ``export-model``: a model's twin in a
+    format other programs run, checked against the model on its training instances."""
+
+    model: str | int = Field(description="Model name or id.")
+    format: ExportFormat = Field(default="onnx", description="onnx: one ONNX graph.")
+
+
+class ExportSchema(Schema):
+    """A model's stored twin."""
+
+    model: str
+    model_id: int
+    format: str
+    sha256: str = Field(description="Digest of the twin's bytes, checked before each load.")
+    size_bytes: int
+    checked_instances: int = Field(
+        description="Training instances on which the twin's labels and probabilities were "
+        "checked against the model's."
+    )
+
+
 class PredictRequest(Request):
     """``POST /api/models/{id}/predict``: instances as attribute -> value, matched by name.
 
@@ -96,6 +139,11 @@ class PredictRequest(Request):
         default="refuse",
         description="refuse: an instance that leaves out an attribute the model needs is "
         "refused; allow: it is a missing value (the answer counts them per attribute).",
+    )
+    engine: Engine = Field(
+        default="auto",
+        description="auto: the model's ONNX twin where it has one, else the model itself; "
+        "onnx: the twin (refused without one); native: the model itself.",
     )
 
 

@@ -17,10 +17,11 @@ from typing import Any
 import numpy as np
 
 from app.errors import AppError
-from app.services.models import load_model
+from app.schemas.models import Engine
+from app.services.export import load_predictor
 from app.store.database import Store
 from app.store.models import ModelInfo
-from benchmark.model import TrainedModel
+from benchmark.model import Predictor
 from features.errors import FeatureError
 from features.extractors import Instances
 from features.recipe import Recipe
@@ -68,8 +69,8 @@ class LiveSession:
     model_info : ModelInfo
         The stored model's description: its ``name`` for messages, its ``extraction``
         for the recipe.
-    model : TrainedModel
-        The fitted model.
+    model : Predictor
+        The fitted model, or its ONNX twin.
     samplerate : float
         Of the stream, Hz; must be the training recordings'.
     n_channels : int
@@ -87,7 +88,7 @@ class LiveSession:
     def __init__(
         self,
         model_info: ModelInfo,
-        model: TrainedModel,
+        model: Predictor,
         *,
         samplerate: float,
         n_channels: int,
@@ -209,13 +210,18 @@ class LiveSession:
         return out
 
 
-def load_live_model(store: Store, ref: str | int) -> tuple[ModelInfo, TrainedModel]:
-    """A stored model (name or id) with its artifact checked; ``info.extraction`` is the
-    recipe of the data set it was trained on (None for an imported one)."""
-    return load_model(store, ref)
+def load_live_model(
+    store: Store, ref: str | int, engine: Engine = "auto"
+) -> tuple[ModelInfo, Predictor]:
+    """A stored model (name or id) with its artifact checked, run by ``engine``;
+    ``info.extraction`` is the recipe of the data set it was trained on (None for an
+    imported one)."""
+    return load_predictor(store, ref, engine)
 
 
-def open_live(store: Store, ref: str | int, *, samplerate: float, n_channels: int) -> LiveSession:
+def open_live(
+    store: Store, ref: str | int, *, samplerate: float, n_channels: int, engine: Engine = "auto"
+) -> LiveSession:
     """A :class:`LiveSession` of the stored model ``ref`` (name or id)."""
-    info, model = load_live_model(store, ref)
+    info, model = load_live_model(store, ref, engine)
     return LiveSession(info, model, samplerate=samplerate, n_channels=n_channels)

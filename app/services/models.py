@@ -20,6 +20,7 @@ import numpy as np
 
 from app.errors import ConflictError, FieldError
 from app.schemas.models import (
+    Engine,
     MissingPolicy,
     PredictionReport,
     PredictionRow,
@@ -39,7 +40,7 @@ from app.store.naming import shorten
 from app.store.runs import RunInfo, get_run, load_results
 from benchmark.dataset import Attribute, Dataset, Schema
 from benchmark.errors import ConfigurationError, DataFormatError
-from benchmark.model import TrainedModel, dumps_model, fit_model, loads_model
+from benchmark.model import Predictor, TrainedModel, dumps_model, fit_model, loads_model
 from benchmark.problem import Problem, problem_from_dataset, restrict_targets
 
 #: Labels quoted in one warning at most.
@@ -226,7 +227,7 @@ class Predictions:
         return rows
 
 
-def predict(model: TrainedModel, data: Dataset, *, source: str = "input") -> Predictions:
+def predict(model: Predictor, data: Dataset, *, source: str = "input") -> Predictions:
     """Predict every instance of ``data`` whose attributes match the model's by name."""
     warnings: list[str] = []
     X = align_features(model.schema, data, source=source, warnings=warnings)
@@ -264,7 +265,7 @@ def predict(model: TrainedModel, data: Dataset, *, source: str = "input") -> Pre
 
 
 def _predict_values(
-    model: TrainedModel, X: np.ndarray, data: Dataset, warnings: list[str]
+    model: Predictor, X: np.ndarray, data: Dataset, warnings: list[str]
 ) -> Predictions:
     """A regression model's predicted numbers, and its error where ``data`` has the truth."""
     values = model.predict_values(X)
@@ -290,14 +291,18 @@ def _predict_values(
     )
 
 
-def predict_file(store: Store, model_ref: str | int, path: Path) -> PredictionReport:
-    """:func:`predict_path` with a stored model."""
-    info, model = load_model(store, model_ref)
+def predict_file(
+    store: Store, model_ref: str | int, path: Path, *, engine: Engine = "auto"
+) -> PredictionReport:
+    """:func:`predict_path` with a stored model, run by ``engine``."""
+    from app.services.export import load_predictor  # it builds on this module
+
+    info, model = load_predictor(store, model_ref, engine)
     return predict_path(info, model, path)
 
 
 def predict_path(
-    info: ModelInfo, model: TrainedModel, path: Path, *, source: str | None = None
+    info: ModelInfo, model: Predictor, path: Path, *, source: str | None = None
 ) -> PredictionReport:
     """Predict every instance of an ARFF or CSV file (attributes matched by name), or of
     a raw recording, when the model was trained on extracted features: the recording's
@@ -360,7 +365,7 @@ def predict_records(
 
 def records_report(
     info: ModelInfo,
-    model: TrainedModel,
+    model: Predictor,
     records: Sequence[Mapping[str, Any]],
     *,
     missing: MissingPolicy = "refuse",

@@ -187,6 +187,22 @@ class ModelArtifactRow(Base):
     artifact: Mapped[bytes] = mapped_column(LargeBinary)
 
 
+class ModelExportRow(Base):
+    """A model's twin in another format (``onnx``), written after it was checked against
+    the model; its bytes are verified against ``sha256`` before each load."""
+
+    __tablename__ = "model_exports"
+
+    model_id: Mapped[int] = mapped_column(
+        ForeignKey("models.id", ondelete="CASCADE"), primary_key=True
+    )
+    format: Mapped[str] = mapped_column(String(20), primary_key=True)
+    sha256: Mapped[str] = mapped_column(String(64))
+    size_bytes: Mapped[int] = mapped_column(Integer)
+    created_at: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=utcnow)
+    data: Mapped[bytes] = mapped_column(LargeBinary)
+
+
 class JobRow(Base):
     """Long work other than runs (extraction, training), queued for worker processes."""
 

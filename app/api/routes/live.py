@@ -1,8 +1,9 @@
 """``WS /api/models/{model}/live``: live predictions on a stream of samples.
 
 The client sends a JSON header ``{"samplerate": 44100, "channels": 3, "format": "S16LE"}``
-(``format``: S16LE, S32LE or F32LE; ``api_key`` here when the handshake could not carry
-the ``X-API-Key`` header), then binary messages of interleaved samples, and
+(``format``: S16LE, S32LE or F32LE; ``engine``: auto, onnx or native, as for a
+prediction; ``api_key`` here when the handshake could not carry the ``X-API-Key``
+header), then binary messages of interleaved samples, and
 ``{"end": true}`` when its stream ends.  The server sends one JSON message per detected touch,
 as ``touchbench live --json`` prints it, and closes with a reason on bad input: 1008 for a
 missing or wrong key or a model that cannot run live, 1007 for a malformed header or block,
@@ -13,7 +14,7 @@ from __future__ import annotations
 
 import asyncio
 import json
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from fastapi import APIRouter, WebSocket, WebSocketDisconnect
@@ -21,6 +22,7 @@ from starlette.concurrency import run_in_threadpool
 
 from app.api.deps import KeyRefused, Service, key_name
 from app.errors import USER_ERRORS
+from app.schemas.models import Engine
 from drivers.errors import DriverError
 from drivers.pcm import SAMPLE_FORMATS, decode_pcm
 
@@ -49,7 +51,8 @@ async def live(websocket: WebSocket, model_ref: str) -> None:
         header = await _header(websocket)
         _check_key(service, websocket, header)
         samplerate, channels, sample_format = _stream_format(header)
-        info, model = await run_in_threadpool(service.models.get, service.store, model_ref)
+        engine = _engine(header)
+        info, model = await run_in_threadpool(service.models.get, service.store, model_ref, engine)
         from app.services.live import LiveSession  # start-up time: the feature stack
 
         try:
@@ -119,6 +122,13 @@ def _check_key(service: Service, websocket: WebSocket, header: dict[str, Any]) -
     except KeyRefused as refused:
         reason = "this service needs an API key (X-API-Key or api_key)"
         raise _Closed(POLICY, reason if refused.status == 401 else str(refused)) from None
+
+
+def _engine(header: dict[str, Any]) -> Engine:
+    engine = header.get("engine", "auto")
+    if engine not in ("auto", "onnx", "native"):
+        raise _Closed(INVALID, "header: 'engine' must be auto, onnx or native")
+    return cast(Engine, engine)
 
 
 def _stream_format(header: dict[str, Any]) -> tuple[float, int, str]:

@@ -55,6 +55,27 @@ def model(model_ref: str, store: StoreDep) -> ModelSchema:
     return get_model(store, model_ref).to_schema()
 
 
+@router.get(
+    "/{model_ref}/onnx",
+    response_class=Response,
+    responses={200: {"content": {"application/octet-stream": {}}}},
+)
+def onnx_graph(model_ref: str, service: ServiceDep) -> Response:
+    """The model as one ONNX graph (input ``features``, outputs ``label`` and
+    ``probabilities``; attribute and label names in its metadata), exported and checked on
+    the training instances the first time it is asked for, then kept in the store."""
+    from app.services.export import stored_export
+
+    info, graph, exported = stored_export(service.store, model_ref)
+    if exported:
+        service.models.forget(info.id)  # predictions with engine auto take the twin now
+    return Response(
+        graph,
+        media_type="application/octet-stream",
+        headers={"Content-Disposition": f'attachment; filename="model-{info.id}.onnx"'},
+    )
+
+
 @router.delete("/{model_ref}", response_model=ModelSchema)
 def remove(model_ref: str, service: ServiceDep) -> ModelSchema:
     gone = delete_model(service.store, model_ref)
@@ -80,7 +101,7 @@ def _predict_records(service: Service, model_ref: str, body: PredictRequest, siz
     response model it was built from); its CPU time is recorded for ``size``."""
     from app.services.models import records_report
 
-    info, trained = service.models.get(service.store, model_ref)
+    info, trained = service.models.get(service.store, model_ref, body.engine)
     start = time.thread_time()
     report = records_report(info, trained, body.instances, missing=body.missing)
     service.models.record(info.id, time.thread_time() - start, size)

@@ -1,0 +1,1 @@
+"""Trained models in formats other programs run (ONNX)."""

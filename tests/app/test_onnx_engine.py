@@ -1,0 +1,196 @@
+"""`export-model`, the example program, and the engine of `predict`, `live` and the
+service: a model's ONNX twin answers what the model answers."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import onnxruntime
+import pytest
+
+from app.schemas.extraction import ExtractRequest
+from app.schemas.models import TrainRequest
+from app.services.datasets import read_data_file
+from app.services.extraction import extract_and_store
+from app.services.models import train
+from app.services.simulation import write_labels, write_session
+from app.store.database import Store
+from tests.app.api.conftest import Server, _servers
+from tests.app.api.test_api_live import _pcm_blocks, _stream, _ws_url
+from tests.app.cli_runner import run_cli
+
+ROOT = Path(__file__).resolve().parents[2]
+EXAMPLE = ROOT / "examples" / "predict_onnx.py"
+
+
+@pytest.fixture(scope="module")
+def trained(tmp_path_factory: pytest.TempPathFactory) -> tuple[str, Path, Path]:
+    """A store with `touch-rf` (live-capable, one target) and `touch-j48`, the session
+    recordings, and an unseen session."""
+    folder = tmp_path_factory.mktemp("onnx")
+    url = f"sqlite:///{folder / 'touchbench.db'}"
+    store = Store(url)
+    recordings, rows = [], []
+    for seed in range(2):
+        wav, touches = write_session(folder, f"s{seed}", n_touches=8, seed=seed)
+        recordings.append(wav)
+        rows += [(wav.name, *touch) for touch in touches]
+    labels = write_labels(folder / "labels.csv", rows)
+    extract_and_store(store, ExtractRequest(recordings=recordings, labels=labels, name="touch"))
+    for classifier in ("rf", "j48"):
+        train(store, TrainRequest(dataset="touch", classifier=classifier, target="gesture"))
+    store.dispose()
+    unseen, _ = write_session(folder, "unseen", n_touches=4, seed=99)
+    return url, folder, unseen
+
+
+def test_export_the_example_program_and_predict_agree(
+    capsys: pytest.CaptureFixture[str], trained: tuple[str, Path, Path], tmp_path: Path
+) -> None:
+    url, _, _ = trained
+    graph = tmp_path / "model.onnx"
+    done = run_cli(capsys, url, "export-model", "touch-rf", "-o", str(graph), "--json")
+    assert done.code == 0, done.err
+    exported = done.json()
+    assert exported["checked_instances"] == 16 and len(exported["sha256"]) == 64
+    assert onnxruntime.InferenceSession(str(graph)).get_inputs()[0].name == "features"
+    again = run_cli(capsys, url, "export-model", "touch-rf", "-o", str(graph))
+    assert again.code == 2 and "--force" in again.err
+
+    arff = tmp_path / "touch.arff"
+    assert run_cli(capsys, url, "export", "touch", "-o", str(arff)).code == 0
+    native = run_cli(capsys, url, "predict", "touch-rf", str(arff), "--engine", "native", "--json")
+    onnx = run_cli(capsys, url, "predict", "touch-rf", str(arff), "--engine", "onnx", "--json")
+    assert native.code == onnx.code == 0, onnx.err
+    rows, twin_rows = native.json()["predictions"], onnx.json()["predictions"]
+    assert [r["gesture"] for r in twin_rows] == [r["gesture"] for r in rows]
+    for row, twin_row in zip(rows, twin_rows, strict=True):
+        assert twin_row["probabilities"]["gesture"] == pytest.approx(
+            row["probabilities"]["gesture"], abs=1e-5
+        )
+
+    # one instance, as a robot's program has it: attribute -> number or label
+    data = read_data_file(arff)
+    instance = {
+        attribute.name: attribute.label(data.values[0, i])
+        if attribute.kind == "nominal"
+        else float(data.values[0, i])
+        for i, attribute in enumerate(data.schema.attributes)
+    }
+    (tmp_path / "instance.json").write_text(json.dumps(instance))
+    answer = subprocess.run(
+        [sys.executable, str(EXAMPLE), str(graph), str(tmp_path / "instance.json")],
+        capture_output=True,
+        text=True,
+        check=True,
+        cwd=tmp_path,
+        env={"PATH": "/usr/bin:/bin"},  # no PYTHONPATH: touchbench is not importable there
+    )
+    assert json.loads(answer.stdout)["label"] == rows[0]["gesture"]
+    imports = [line for line in EXAMPLE.read_text().splitlines() if "import " in line]
+    assert not [line for line in imports if "app" in line or "benchmark" in line]
+
+
+def test_what_has_no_converter_is_refused_in_one_line(
+    capsys: pytest.CaptureFixture[str], trained: tuple[str, Path, Path], tmp_path: Path
+) -> None:
+    url, _, _ = trained
+    refused = run_cli(capsys, url, "export-model", "touch-j48", "-o", str(tmp_path / "j.onnx"))
+    assert refused.code == 2 and refused.err.count("\n") == 1
+    assert "'j48' (C45Classifier) has no ONNX converter; exportable:" in refused.err
+    assert not (tmp_path / "j.onnx").exists()
+    no_twin = run_cli(
+        capsys, url, "predict", "touch-j48", str(tmp_path / "x.arff"), "--engine", "onnx"
+    )
+    assert no_twin.code == 2 and "has no ONNX twin yet" in no_twin.err
+    listing = run_cli(capsys, url, "classifiers", "--json").json()["classifiers"]
+    marks = {entry["id"]: entry["onnx"] for entry in listing}
+    assert marks["rf"] and marks["xgb"] and not marks["j48"] and not marks["minirocket"]
+
+
+def test_live_answers_the_same_with_either_engine(
+    capsys: pytest.CaptureFixture[str], trained: tuple[str, Path, Path], tmp_path: Path
+) -> None:
+    url, _, unseen = trained
+    assert (
+        run_cli(capsys, url, "export-model", "touch-rf", "-o", str(tmp_path / "m.onnx")).code == 0
+    )
+    lines = {}
+    for engine in ("native", "onnx"):
+        result = run_cli(
+            capsys,
+            url,
+            "live",
+            "--model",
+            "touch-rf",
+            "--replay",
+            str(unseen),
+            "--json",
+            "--engine",
+            engine,
+        )
+        assert result.code == 0, result.err
+        lines[engine] = [json.loads(line) for line in result.out.splitlines()]
+    assert len(lines["onnx"]) == 4
+    assert [t["predictions"]["gesture"]["value"] for t in lines["onnx"]] == [
+        t["predictions"]["gesture"]["value"] for t in lines["native"]
+    ]
+
+
+def test_the_service_serves_the_graph_and_predicts_with_the_engine_asked(
+    trained: tuple[str, Path, Path], make_server_on: Callable[[str], Server]
+) -> None:
+    url, _, unseen = trained
+    server = make_server_on(url)
+    graph = server.client.get("/api/models/touch-rf/onnx")
+    assert graph.status_code == 200, graph.text
+    assert graph.headers["content-type"] == "application/octet-stream"
+    session = onnxruntime.InferenceSession(graph.content)
+    features = json.loads(session.get_modelmeta().custom_metadata_map["touchbench.features"])
+    instance = {column["name"]: 0.5 for column in features}
+    answers = {}
+    for engine in ("native", "onnx", "auto"):
+        response = server.client.post(
+            "/api/models/touch-rf/predict", json={"instances": [instance], "engine": engine}
+        )
+        assert response.status_code == 200, response.text
+        answers[engine] = response.json()["predictions"][0]["gesture"]
+    assert answers["onnx"] == answers["native"] == answers["auto"]
+    refused = server.client.get("/api/models/touch-j48/onnx")
+    assert refused.status_code in (400, 422) and "has no ONNX converter" in refused.text
+    no_twin = server.client.post(
+        "/api/models/touch-j48/predict", json={"instances": [instance], "engine": "onnx"}
+    )
+    assert no_twin.status_code in (400, 422) and "engine" in no_twin.text
+
+    # the live WebSocket, with each engine, on the same samples
+    rate, channels, blocks = _pcm_blocks(unseen)
+    labels = {}
+    for engine in ("native", "onnx"):
+        header = {"samplerate": rate, "channels": channels, "format": "S16LE", "engine": engine}
+        messages, code, reason = _stream(_ws_url(server, "touch-rf"), header, blocks)
+        assert (code, reason) == (1000, "stream ended")
+        labels[engine] = [m["predictions"]["gesture"]["value"] for m in messages]
+    assert len(labels["onnx"]) == 4 and labels["onnx"] == labels["native"]
+    header = {"samplerate": rate, "channels": channels, "engine": "fast"}
+    _, code, reason = _stream(_ws_url(server, "touch-rf"), header, [])
+    assert (code, reason) == (1007, "header: 'engine' must be auto, onnx or native")
+
+
+@pytest.fixture
+def make_server_on(tmp_path: Path) -> Iterator[Callable[[str], Server]]:
+    """Starts (and at the end stops) services on a given store."""
+    generators: list[Iterator[Callable[..., Server]]] = []
+
+    def make(url: str) -> Server:
+        generator = _servers(url, tmp_path)
+        generators.append(generator)
+        return next(generator)()
+
+    yield make
+    for generator in generators:
+        next(generator, None)
