@@ -198,7 +198,7 @@ def importance_command(
     feature and per group of features (channel, feature family), with the t-test of each
     group's drop."""
     from app.cli.requests import build_request
-    from app.schemas.importance import ImportanceRequest
+    from app.schemas.importance import ImportanceRequest, ImportanceResult
     from app.services.importance import run_importance
 
     request = build_request(
@@ -209,11 +209,11 @@ def importance_command(
         repeats=repeats,
     )
 
-    def progress(done: int, total: int) -> None:
+    def progress(partial: ImportanceResult) -> None:
         if not as_json:
-            info(f"fold {done} of {total} done")
+            info(f"fold {partial.done} of {partial.total} done")
 
-    found = run_importance(get_state(ctx).store, request, on_fold=progress)
+    found = run_importance(get_state(ctx).store, request, on_progress=progress)
     if as_json:
         print_json(found.to_json())
         return
