@@ -1,7 +1,8 @@
 """Commands that answer questions after the leaderboard: the paper's published results
 imported beside ours (``import-results``); where and how sure the classifiers are
 (``classes``: per-class scores, confusion matrices and calibration; ``calibration``: the
-expected calibration error and the reliability diagram)."""
+expected calibration error and the reliability diagram); which features (``importance``)
+and how many touches (``learning-curve``)."""
 
 from __future__ import annotations
 
@@ -25,6 +26,7 @@ def register(app: typer.Typer) -> None:
     app.command("classes")(classes_command)
     app.command("calibration")(calibration_command)
     app.command("importance")(importance_command)
+    app.command("learning-curve")(learning_curve_command)
 
 
 RunArgument = Annotated[
@@ -244,3 +246,94 @@ def _importance_row(item: FeatureImportance) -> tuple[object, ...]:
         p,
         "*" if item.significant else "",
     )
+
+
+def learning_curve_command(
+    ctx: typer.Context,
+    dataset: Annotated[
+        str, typer.Argument(metavar="DATA", help="Data set name or id.", show_default=False)
+    ],
+    classifiers: Annotated[
+        str,
+        typer.Option(
+            "--classifiers", "-c", metavar="ID,ID,...", help="Classifier ids (a curve each)."
+        ),
+    ],
+    target: Annotated[
+        str | None, typer.Option("--target", metavar="NAME", help="This one target.")
+    ] = None,
+    fractions: Annotated[
+        str | None,
+        typer.Option(
+            "--fractions",
+            metavar="F,F,...",
+            help="Shares of each training fold (default 0.1,0.2,0.3,0.5,0.7,1).",
+        ),
+    ] = None,
+    folds: Annotated[int | None, typer.Option("--folds", metavar="K", help="k (5).")] = None,
+    seed: Annotated[int | None, typer.Option("--seed", metavar="N", help="Seed (0).")] = None,
+    timeout: Annotated[
+        float | None,
+        typer.Option("--timeout", metavar="SECONDS", help="Per task (600; 0: no limit)."),
+    ] = None,
+    metric: Annotated[
+        str | None, typer.Option("--metric", metavar="NAME", help="Score (as a run's).")
+    ] = None,
+    jobs: Annotated[int, typer.Option("--jobs", "-j", min=1, help="Local worker processes.")] = 1,
+    output: Annotated[
+        Path | None,
+        typer.Option("--output", "-o", metavar="FILE.svg|png", help="Draw the curves here."),
+    ] = None,
+    as_json: JsonOption = False,
+) -> None:
+    """Cross-validate classifiers on growing shares of each training fold (stratified,
+    group-aware; the test folds stay whole): the share at which each comes within a point
+    of its full score answers "do I need to record more?". Kept as a job with its progress."""
+    from app.cli.requests import build_request
+    from app.reports.plots import figure_format, save_figure
+    from app.schemas.learning import LearningCurveRequest, LearningCurveResult
+    from app.services.jobs import carry_out_here
+
+    if output is not None:
+        figure_format(output)
+    request = build_request(
+        LearningCurveRequest,
+        {"dataset": "DATA", "fractions": "--fractions", "classifiers": "--classifiers"},
+        dataset=dataset,
+        classifiers=_items(classifiers),
+        target=target,
+        fractions=_items(fractions),
+        folds=folds,
+        seed=seed,
+        timeout=timeout,
+        metric=metric,
+    )
+    shown = [0]
+
+    def progress(partial: object) -> None:
+        assert isinstance(partial, LearningCurveResult)
+        step = max(partial.total // 10, 1)
+        if not as_json and (partial.done // step > shown[0] or partial.complete):
+            shown[0] = partial.done // step
+            info(f"learning curve: {partial.done} of {partial.total} tasks done")
+
+    job_id, found = carry_out_here(get_state(ctx).store, request, jobs=jobs, on_progress=progress)
+    result = LearningCurveResult.model_validate(found)
+    if output is not None:
+        from app.reports.figures import learning_figure
+
+        save_figure(learning_figure(result), output)
+    if as_json:
+        print_json(result.to_json())
+        return
+    from app.reports.answer_tables import learning_table
+
+    run_table(learning_table(result))
+    info(f"kept as job {job_id}" + (f"; wrote {output}" if output is not None else ""))
+
+
+def _items(text: str | None) -> list[str] | None:
+    """``a,b`` as ``["a", "b"]`` (``None`` stays ``None``, so the request's default holds)."""
+    if text is None:
+        return None
+    return [item.strip() for item in text.split(",") if item.strip()]

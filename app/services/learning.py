@@ -61,23 +61,31 @@ def learning_curve(
     """
     plan = _Plan(store, request)
     from benchmark.run.engine import run_tasks
+    from benchmark.run.folds import Fold
 
+    # one call to the engine for every fraction (its workers start once): a fraction's
+    # folds are told apart by their ``repeat``, the fraction's place in the list
+    fractions = list(plan.folds)
+    folds = [
+        Fold(place, fold.fold, fold.train, fold.test)
+        for place, fraction in enumerate(fractions)
+        for fold in plan.folds[fraction]
+    ]
     results: dict[float, list[TaskResult]] = {}
-    for fraction, folds in plan.folds.items():
 
-        def heard(result: TaskResult, fraction: float = fraction) -> None:
-            results.setdefault(fraction, []).append(result)
-            on_progress(plan.summary(results))
+    def heard(result: TaskResult) -> None:
+        results.setdefault(fractions[result.key.repeat], []).append(result)
+        on_progress(plan.summary(results))
 
-        run_tasks(
-            plan.problem,
-            request.classifiers,
-            folds,
-            jobs=jobs,
-            timeout=request.timeout,
-            random_state=request.seed,
-            on_result=heard,
-        )
+    run_tasks(
+        plan.problem,
+        request.classifiers,
+        folds,
+        jobs=jobs,
+        timeout=request.timeout,
+        random_state=request.seed,
+        on_result=heard,
+    )
     return plan.summary(results)
 
 
