@@ -18,7 +18,6 @@ from app.cli.state import get_state
 
 if TYPE_CHECKING:
     from app.schemas.certainty import RunCertainty
-    from app.schemas.importance import FeatureImportance
 
 
 def register(app: typer.Typer) -> None:
@@ -219,33 +218,10 @@ def importance_command(
     if as_json:
         print_json(found.to_json())
         return
-    header = ["feature", "features", "drop", "std", "p", ""]
-    for grouping, items in found.groups.items():
-        table(
-            f"run {found.run_id}, {found.classifier} on {found.target}: each {grouping} "
-            f"shuffled ({found.metric} drop over {found.n_folds} folds, baseline "
-            f"{found.baseline:.4f})",
-            header,
-            [_importance_row(item) for item in items],
-        )
-    table(
-        f"the {min(top, len(found.features))} most important of {len(found.features)} features",
-        header,
-        [_importance_row(item) for item in found.features[:top]],
-    )
-    info("p: corrected resampled t-test of the drop against none; * significant at 0.05")
+    from app.reports.answer_tables import importance_tables
 
-
-def _importance_row(item: FeatureImportance) -> tuple[object, ...]:
-    p = "-" if item.p is None else f"{item.p:.3g}"
-    return (
-        item.name,
-        item.n_features,
-        f"{item.mean:+.4f}",
-        f"{item.std:.4f}",
-        p,
-        "*" if item.significant else "",
-    )
+    for shown in importance_tables(found, top):
+        run_table(shown)
 
 
 def learning_curve_command(

@@ -6,7 +6,23 @@ from __future__ import annotations
 
 from app.reports.run_tables import RunTable
 from app.schemas.ablation import AblationResult
+from app.schemas.importance import FeatureImportance, ImportanceResult
 from app.schemas.learning import LearningCurveResult
+from app.services.answers import RunAnswers
+
+#: Features listed per classifier where a run is shown (the CLI's --top lists more).
+TOP_FEATURES = 10
+
+_IMPORTANCE_HEADER = ("feature", "features", "drop", "std", "p", "")
+_IMPORTANCE_NUMERIC = (False, True, True, True, True, False)
+
+
+def run_answer_tables(answers: RunAnswers) -> list[RunTable]:
+    """The tables of a run's kept answers: its ablation, then each classifier's importance."""
+    tables = [] if answers.ablation is None else [ablation_table(answers.ablation)]
+    for found in answers.importance:
+        tables.extend(importance_tables(found, TOP_FEATURES))
+    return tables
 
 
 def ablation_table(result: AblationResult) -> RunTable:
@@ -35,6 +51,48 @@ def ablation_table(result: AblationResult) -> RunTable:
             for entry in result.entries
         ],
         numeric=(False, False, True, True, True, True, True, False),
+    )
+
+
+def importance_tables(result: ImportanceResult, top: int | None = None) -> list[RunTable]:
+    """One table per grouping (each group shuffled together), then the ``top`` most
+    important features (all without ``top``)."""
+    so_far = "" if result.complete else f"; {result.done} of {result.total} folds so far"
+    tables = [
+        RunTable(
+            key="importance",
+            title=f"run {result.run_id}, {result.classifier} on {result.target}: each "
+            f"{grouping} shuffled ({result.metric} drop over {result.n_folds} folds, baseline "
+            f"{result.baseline:.4f}{so_far}; p: corrected resampled t-test of the drop "
+            "against none, * significant at 0.05)",
+            header=(grouping, *_IMPORTANCE_HEADER[1:]),
+            rows=[_importance_row(item) for item in items],
+            numeric=_IMPORTANCE_NUMERIC,
+        )
+        for grouping, items in result.groups.items()
+    ]
+    shown = result.features if top is None else result.features[:top]
+    tables.append(
+        RunTable(
+            key="importance",
+            title=f"{result.classifier}: the {len(shown)} most important of "
+            f"{len(result.features)} features",
+            header=_IMPORTANCE_HEADER,
+            rows=[_importance_row(item) for item in shown],
+            numeric=_IMPORTANCE_NUMERIC,
+        )
+    )
+    return tables
+
+
+def _importance_row(item: FeatureImportance) -> tuple[str, ...]:
+    return (
+        item.name,
+        str(item.n_features),
+        f"{item.mean:+.4f}",
+        f"{item.std:.4f}",
+        "-" if item.p is None else f"{item.p:.3g}",
+        "*" if item.significant else "",
     )
 
 

@@ -9,7 +9,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from app.errors import ConflictError, FieldError, NotFoundError
+from app.errors import ConflictError, FieldError
 from app.schemas.ablation import (
     AblationEntry,
     AblationGroup,
@@ -24,7 +24,6 @@ from app.services.runs import RunOptions, fold_plan, megabytes_to_bytes, prepare
 from app.services.tuning import run_specs
 from app.store.database import Store
 from app.store.datasets import load_dataset, load_schema
-from app.store.jobs import latest_job_of_run
 from app.store.runs import get_run
 from benchmark.dataset import Dataset
 from benchmark.evaluation.metrics import LOWER_IS_BETTER
@@ -33,24 +32,6 @@ from benchmark.results import TaskResult
 
 #: Level of the t-test that decides a verdict.
 ALPHA = 0.05
-
-
-def latest_ablation(store: Store, run_id: int) -> AblationResult:
-    """The newest finished ablation of a run.
-
-    Raises
-    ------
-    NotFoundError
-        No such run, or none of its ablations finished.
-    """
-    run = get_run(store, run_id)
-    job = latest_job_of_run(store, "ablation", run.id)
-    if job is None or job.result is None:
-        raise NotFoundError(
-            f"run {run.id} has no finished ablation (`bench --ablate-groups`, or "
-            "POST /api/jobs/ablation)"
-        )
-    return AblationResult.model_validate(job.result)
 
 
 def check_grouping(

@@ -77,18 +77,16 @@ def record_job_progress(store: Store, job_id: int, result: dict[str, Any]) -> No
         )
 
 
-def latest_job_of_run(store: Store, kind: str, run_id: int) -> JobSchema | None:
-    """The newest finished (``done``) job of ``kind`` whose request names run ``run_id``."""
+def done_jobs_of_run(store: Store, kind: str, run_id: int) -> list[JobSchema]:
+    """The finished (``done``) jobs of ``kind`` whose request names run ``run_id``, newest
+    first."""
     with store.session() as session:
         rows = session.scalars(
             select(JobRow)
             .where(JobRow.kind == kind, JobRow.status == "done")
             .order_by(JobRow.id.desc())
         )
-        for row in rows:
-            if row.params.get("run") == run_id:
-                return _schema(row)
-    return None
+        return [_schema(row) for row in rows if row.params.get("run") == run_id]
 
 
 def get_job(store: Store, job_id: int | str) -> JobSchema:

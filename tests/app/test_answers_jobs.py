@@ -10,14 +10,14 @@ import numpy as np
 import pytest
 
 from app.schemas.importance import ImportanceRequest
-from app.services.ablation import latest_ablation
+from app.services.answers import latest_ablation
 from app.services.jobs import execute_job, submit_answer
 from app.store.database import Store
 from app.store.jobs import list_jobs
 from tests.app.cli_runner import run_cli
 
 
-def _mics_arff(path: Path, *, n: int = 90, seed: int = 0) -> Path:
+def mics_arff(path: Path, *, n: int = 90, seed: int = 0) -> Path:
     """Microphone 1 hears the gesture (level_1), microphone 2 only noise."""
     rng = np.random.default_rng(seed)
     y = np.arange(n) % 3
@@ -35,12 +35,12 @@ def _mics_arff(path: Path, *, n: int = 90, seed: int = 0) -> Path:
 @pytest.fixture
 def db(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> str:
     url = f"sqlite:///{tmp_path / 'touchbench.db'}"
-    assert run_cli(capsys, url, "import", str(_mics_arff(tmp_path / "mics.arff"))).code == 0
+    assert run_cli(capsys, url, "import", str(mics_arff(tmp_path / "mics.arff"))).code == 0
     return url
 
 
 def test_ablating_the_deciding_microphone_is_significant_and_the_noise_not(
-    capsys: pytest.CaptureFixture[str], db: str
+    capsys: pytest.CaptureFixture[str], db: str, tmp_path: Path
 ) -> None:
     result = run_cli(
         capsys, db, "bench", "mics", "-c", "nb", "--folds", "5", "--ablate-groups", "channel",
@@ -71,6 +71,13 @@ def test_ablating_the_deciding_microphone_is_significant_and_the_noise_not(
     assert done.result is not None and done.result["complete"]
     assert done.result["done"] == done.result["total"] == 5
     assert done.result["groups"]["channel"][0]["name"] == "channel 1"
+    # the HTML report shows both
+    page = tmp_path / "report.html"
+    report = run_cli(capsys, db, "report", str(found["run_id"]), "-o", str(page))
+    assert report.code == 0, report.err
+    html = page.read_text()
+    assert "Which sensor and which features" in html
+    assert 'data-table="ablation"' in html and 'data-table="importance"' in html
 
 
 def test_bad_ablations_are_one_line_exit_2(

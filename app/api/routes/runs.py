@@ -19,7 +19,7 @@ from app.schemas.ablation import AblationResult
 from app.schemas.certainty import RunCertainty
 from app.schemas.imported import ImportResultsRequest
 from app.schemas.runs import BenchRequest, LeaderboardSchema, RunCreated, RunList, RunSchema
-from app.services.ablation import latest_ablation
+from app.services.answers import latest_ablation
 from app.services.certainty import run_certainty
 from app.services.imported import import_results
 from app.services.runs import create_run, run_leaderboard

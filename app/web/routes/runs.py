@@ -13,8 +13,10 @@ from fastapi import APIRouter, Query
 from fastapi.responses import HTMLResponse
 
 from app.errors import NotFoundError
+from app.reports.answer_tables import run_answer_tables
 from app.reports.run_tables import run_tables
 from app.schemas.runs import FINAL_STATUSES
+from app.services.answers import run_answers
 from app.services.listing import list_datasets
 from app.services.runs import NoResultsError, run_leaderboard
 from app.store.listing import count_datasets
@@ -99,6 +101,7 @@ def leaderboard(
         board=ranked.board,
         table=_table(ranked, chosen_baseline=baseline or None),
         tables=run_tables(ranked.report()),
+        answers=run_answer_tables(run_answers(store, run_id)),
         notes=ranked.notes(),
     )
 
