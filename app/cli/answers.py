@@ -50,7 +50,7 @@ def classes_command(
 ) -> None:
     """Show per-class precision, recall and F1, the confusion matrix (summed over folds)
     and the expected calibration error of a run's classifiers, per target."""
-    from app.reports.certainty_tables import class_tables, score
+    from app.reports.certainty_tables import calibrations, class_tables, score
 
     certainty = _certainty(ctx, run, classifier)
     if as_json:
@@ -58,15 +58,15 @@ def classes_command(
         return
     for shown in class_tables(certainty):
         run_table(shown)
-    for entry in certainty.classifiers:
-        calibration = entry.calibration
+    for entry, target, calibration in calibrations(certainty):
+        name = entry.classifier if target is None else f"{entry.classifier} on {target}"
         if calibration is not None:
             info(
-                f"{entry.classifier}: expected calibration error {score(calibration.ece)} "
+                f"{name}: expected calibration error {score(calibration.ece)} "
                 f"over {calibration.n_instances} out-of-fold predictions"
             )
         else:
-            info(f"{entry.classifier}: no calibration ({entry.calibration_note})")
+            info(f"{name}: no calibration ({entry.calibration_note})")
     info("rows: true class; the columns after support: predicted class (counts)")
 
 

@@ -96,13 +96,15 @@ def classes_figure(view: RunView) -> Figure:
 def reliability_figure(certainty: RunCertainty, classifiers: int | None = None) -> Figure:
     """The reliability diagram of a run's classifiers that kept calibration bins (the
     first ``classifiers`` of them, best first)."""
+    from app.reports.certainty_tables import calibrations
+
     curves = {}
-    for entry in certainty.classifiers:
-        calibration = entry.calibration
+    for entry, target, calibration in calibrations(certainty):
         if calibration is None or calibration.ece is None:
             continue
         bins = calibration.bins
-        curves[entry.classifier] = (
+        name = entry.classifier if target is None else f"{entry.classifier} on {target}"
+        curves[name] = (
             np.array([np.nan if b.confidence is None else b.confidence for b in bins]),
             np.array([np.nan if b.accuracy is None else b.accuracy for b in bins]),
             np.array([b.count for b in bins], dtype=np.float64),

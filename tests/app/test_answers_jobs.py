@@ -15,6 +15,7 @@ from app.services.jobs import execute_job, submit_answer
 from app.store.database import Store
 from app.store.jobs import list_jobs
 from tests.app.cli_runner import run_cli
+from tests.app.synthetic import touch_arff
 
 
 def mics_arff(path: Path, *, n: int = 90, seed: int = 0) -> Path:
@@ -118,3 +119,24 @@ def test_learning_curve_finds_where_a_classifier_has_enough(
     assert bad.code == 2 and bad.err.startswith("touchbench: error: --fractions")
     unknown = run_cli(capsys, db, "learning-curve", "mics", "-c", "nope")
     assert unknown.code == 2 and "--classifiers" in unknown.err
+
+
+def test_a_multi_target_run_is_calibrated_per_target(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    db = f"sqlite:///{tmp_path / 'touchbench.db'}"
+    data = touch_arff(tmp_path / "touch.arff", n=60)
+    assert run_cli(capsys, db, "import", str(data)).code == 0
+    run = run_cli(capsys, db, "bench", "touch", "-c", "cc:nb", "--folds", "3", "--json")
+    assert run.code == 0, run.err
+    found = run_cli(capsys, db, "classes", str(run.json()["run_id"]), "--json").json()
+    (entry,) = found["classifiers"]
+    assert entry["calibration"] is None and entry["calibration_note"] == "per target"
+    for target in entry["targets"]:
+        assert target["calibration"]["n_instances"] == 60, target["target"]
+        assert 0 <= target["calibration"]["ece"] <= 1
+    plot = tmp_path / "reliability.svg"
+    drawn = run_cli(capsys, db, "calibration", str(run.json()["run_id"]), "-o", str(plot))
+    assert drawn.code == 0, drawn.err
+    assert "cc:nb on gesture" in plot.read_text() and "cc:nb on place" in plot.read_text()
+    assert "per target" in drawn.out

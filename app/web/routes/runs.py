@@ -159,21 +159,28 @@ def classifier(
 def _how_sure(view: RunView, classifier: str) -> dict[str, Any] | None:
     """The classifier's per-class tables and its calibration (none for a regression)."""
     from app.reports import figures
-    from app.reports.certainty_tables import class_tables
+    from app.reports.certainty_tables import calibrations, class_tables
     from app.services.certainty import certainty_of
 
     if view.run.kind == "regression" or not view.board.row(classifier).n_ok:
         return None
     certainty = certainty_of(view, [classifier])
     [entry] = certainty.classifiers
+    # (target or None, calibration) of each target that has one: one for a multi-class run
+    kept = [(target, found) for _, target, found in calibrations(certainty) if found]
     diagram = None
-    if entry.calibration is not None:
+    if kept:
         diagram = draw(
             f"Reliability of {classifier}: accuracy of the top label against its "
             "confidence, out of fold",
             partial(figures.reliability_figure, certainty),
         )
-    return {"tables": class_tables(certainty), "entry": entry, "diagram": diagram}
+    return {
+        "tables": class_tables(certainty),
+        "entry": entry,
+        "calibrations": kept,
+        "diagram": diagram,
+    }
 
 
 def _folds(view: RunView, shown: list[str]) -> dict[str, Any]:
