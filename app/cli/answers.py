@@ -265,6 +265,7 @@ def learning_curve_command(
     """Cross-validate classifiers on growing shares of each training fold (stratified,
     group-aware; the test folds stay whole): the share at which each comes within a point
     of its full score answers "do I need to record more?". Kept as a job with its progress."""
+    from app.cli.progress import TenthsProgress
     from app.cli.requests import build_request
     from app.reports.plots import figure_format, save_figure
     from app.schemas.learning import LearningCurveRequest, LearningCurveResult
@@ -284,15 +285,7 @@ def learning_curve_command(
         timeout=timeout,
         metric=metric,
     )
-    shown = [0]
-
-    def progress(partial: object) -> None:
-        assert isinstance(partial, LearningCurveResult)
-        step = max(partial.total // 10, 1)
-        if not as_json and (partial.done // step > shown[0] or partial.complete):
-            shown[0] = partial.done // step
-            info(f"learning curve: {partial.done} of {partial.total} tasks done")
-
+    progress = TenthsProgress("learning curve", quiet=as_json)
     job_id, found = carry_out_here(get_state(ctx).store, request, jobs=jobs, on_progress=progress)
     result = LearningCurveResult.model_validate(found)
     if output is not None:

@@ -639,21 +639,14 @@ def _check_ablation(
 
 def _ablate(store: Store, run_id: int, grouping: str, jobs: int, as_json: bool) -> AblationResult:
     """Carry out the ablation of a finished run, as a job the store keeps."""
+    from app.cli.progress import TenthsProgress
     from app.cli.requests import build_request
     from app.schemas.ablation import AblationRequest, AblationResult
     from app.services.jobs import carry_out_here
 
     request = build_request(AblationRequest, _ABLATION_OPTIONS, run=run_id, grouping=grouping)
-    shown = [0]
-
-    def progress(partial: object) -> None:
-        assert isinstance(partial, AblationResult)
-        # a line per tenth of the work: an ablation reruns every classifier per group
-        step = max(partial.total // 10, 1)
-        if not as_json and (partial.done // step > shown[0] or partial.complete):
-            shown[0] = partial.done // step
-            info(f"ablation: {partial.done} of {partial.total} tasks done")
-
+    # a line per tenth of the work: an ablation reruns every classifier per group
+    progress = TenthsProgress("ablation", quiet=as_json)
     job_id, result = carry_out_here(store, request, jobs=jobs, on_progress=progress)
     if not as_json:
         info(f"ablation kept as job {job_id}")

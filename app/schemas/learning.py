@@ -3,12 +3,10 @@ learning-curve --json``, the API's job)."""
 
 from __future__ import annotations
 
-from typing import Any
-
 from pydantic import Field, field_validator
 
 from app.schemas.base import Request, Schema
-from app.schemas.runs import MAX_TIMEOUT
+from app.schemas.runs import MAX_TIMEOUT, id_as_text, zero_is_no_limit
 
 #: Fractions of each training fold when none are given (benchmark.run.learning's).
 DEFAULT_FRACTIONS = [0.1, 0.2, 0.3, 0.5, 0.7, 1.0]
@@ -45,17 +43,8 @@ class LearningCurveRequest(Request):
         default=0.01, gt=0, le=1, description="'Within 1 point': the gap to the full score."
     )
 
-    @field_validator("dataset", mode="before")
-    @classmethod
-    def _id_as_text(cls, value: Any) -> Any:
-        if isinstance(value, int) and not isinstance(value, bool):
-            return str(value)
-        return value
-
-    @field_validator("timeout", mode="after")
-    @classmethod
-    def _zero_is_no_limit(cls, value: float | None) -> float | None:
-        return value or None
+    _id_as_text = field_validator("dataset", mode="before")(id_as_text)
+    _zero_is_no_limit = field_validator("timeout", mode="after")(zero_is_no_limit)
 
     @field_validator("fractions", mode="after")
     @classmethod
