@@ -220,8 +220,8 @@ class _Plan:
             )
         a, b = without[both], full[both]
         t, p, sign = corrected_resampled_ttest(a, b, test_train_ratio=self.ratio, alpha=ALPHA)
-        worse = -sign if self.lower_is_better else sign
-        verdict = "can go" if sign == 0 else ("better without" if worse > 0 else "needed")
+        gain = -sign if self.lower_is_better else sign  # +1: significantly better without
+        verdict = "can go" if sign == 0 else ("better without" if gain > 0 else "needed")
         return AblationEntry(
             classifier=classifier,
             group=group,
