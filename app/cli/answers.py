@@ -197,10 +197,10 @@ def importance_command(
 ) -> None:
     """Permutation importance of a run's classifier on each of its outer test folds, per
     feature and per group of features (channel, feature family), with the t-test of each
-    group's drop."""
+    group's drop. Kept as a job: the run's web page and report show it."""
     from app.cli.requests import build_request
     from app.schemas.importance import ImportanceRequest, ImportanceResult
-    from app.services.importance import run_importance
+    from app.services.jobs import carry_out_here
 
     request = build_request(
         ImportanceRequest,
@@ -210,11 +210,13 @@ def importance_command(
         repeats=repeats,
     )
 
-    def progress(partial: ImportanceResult) -> None:
-        if not as_json:
+    def progress(partial: object) -> None:
+        if not as_json and isinstance(partial, ImportanceResult):
             info(f"fold {partial.done} of {partial.total} done")
 
-    found = run_importance(get_state(ctx).store, request, on_progress=progress)
+    # kept as a job, so that the run's web page and report show it
+    _, kept = carry_out_here(get_state(ctx).store, request, on_progress=progress)
+    found = ImportanceResult.model_validate(kept)
     if as_json:
         print_json(found.to_json())
         return
