@@ -1,7 +1,7 @@
 """The answers after a run over HTTP: an ablation kept by `bench --ablate-groups` read back by
-the API and the web page; a learning curve as a job of the service's workers, drawn as SVG;
-bad requests refused before a job exists.  One SQLite service: the jobs start the engine's
-worker processes (the CLI's tests cover the answers on their own)."""
+the API and the web page; bad requests for the three jobs refused before a job exists.  One
+SQLite service; the answers' work (and a job carried out as the service's workers do) is
+tested through the CLI (tests/app/test_answers_jobs.py), where it costs no service."""
 
 from __future__ import annotations
 
@@ -10,12 +10,12 @@ from pathlib import Path
 
 import pytest
 
-from tests.app.api.conftest import Server, finished
+from tests.app.api.conftest import Server
 from tests.app.cli_runner import run_cli
 from tests.app.test_answers_jobs import mics_arff
 
 
-def test_ablation_and_learning_curve_over_http(
+def test_a_kept_ablation_over_http_and_refused_jobs(
     capsys: pytest.CaptureFixture[str],
     make_sqlite_server: Callable[..., Server],
     tmp_path: Path,
@@ -39,17 +39,11 @@ def test_ablation_and_learning_curve_over_http(
     assert refused.status_code == 422
     unknown = api.post("/api/jobs/importance", json={"run": ablated, "classifier": "rf"})
     assert unknown.status_code in (400, 422) and "classifier" in unknown.text
-    assert api.get("/api/jobs").json()["jobs"][-1]["kind"] == "ablation"  # none queued
 
-    curve = api.post(
-        "/api/jobs/learning-curve",
-        json={"dataset": "mics", "classifiers": ["nb"], "fractions": [0.5], "folds": 2},
-    )
-    assert curve.status_code == 202, curve.text
-    job = curve.json()["job"]
-    found = server.wait_for(f"/api/jobs/{job}", finished, timeout=300)
-    assert found["status"] == "done", found
-    assert found["result"]["fractions"] == [0.5, 1.0] and found["result"]["complete"]
-    svg = api.get(f"/api/jobs/{job}/learning-curve.svg")
-    assert svg.status_code == 200 and "learning curves" in svg.text
-    assert api.get(f"/api/jobs/{job - 1}/learning-curve.svg").status_code == 404  # an ablation
+    nope = {"dataset": "mics", "classifiers": ["nope"], "fractions": [0.5]}
+    refused_curve = api.post("/api/jobs/learning-curve", json=nope)
+    assert refused_curve.status_code in (400, 422) and "classifiers" in refused_curve.text
+    jobs = api.get("/api/jobs").json()["jobs"]
+    assert [job["kind"] for job in jobs] == ["ablation"]  # nothing refused was queued
+    not_a_curve = api.get(f"/api/jobs/{jobs[0]['id']}/learning-curve.svg")
+    assert not_a_curve.status_code == 404 and "not a learning curve" in not_a_curve.text
