@@ -62,7 +62,8 @@ class TaskResult:
     calibration : dict or None
         Multi-class with probabilities: the fold's reliability bins of the top-label
         confidence (``count``, ``confidence``, ``correct``, lists of equal length; see
-        :mod:`benchmark.evaluation.calibration`); ``None`` otherwise.
+        :mod:`benchmark.evaluation.calibration`); multi-target with probabilities:
+        ``{"targets": {name: bins}}``, the same per target; ``None`` otherwise.
     """
 
     key: TaskKey
@@ -75,7 +76,7 @@ class TaskResult:
     warnings: list[str] = field(default_factory=list)
     per_target: dict[str, dict[str, float]] | None = None
     params: dict[str, Any] | None = None
-    calibration: dict[str, list[float]] | None = None
+    calibration: dict[str, Any] | None = None
 
     @property
     def ok(self) -> bool:

@@ -1,7 +1,8 @@
 """Commands that answer questions after the leaderboard: the paper's published results
 imported beside ours (``import-results``); where and how sure the classifiers are
 (``classes``: per-class scores, confusion matrices and calibration; ``calibration``: the
-expected calibration error and the reliability diagram)."""
+expected calibration error and the reliability diagram); which features (``importance``)
+and how many touches (``learning-curve``)."""
 
 from __future__ import annotations
 
@@ -17,7 +18,6 @@ from app.cli.state import get_state
 
 if TYPE_CHECKING:
     from app.schemas.certainty import RunCertainty
-    from app.schemas.importance import FeatureImportance
 
 
 def register(app: typer.Typer) -> None:
@@ -25,6 +25,7 @@ def register(app: typer.Typer) -> None:
     app.command("classes")(classes_command)
     app.command("calibration")(calibration_command)
     app.command("importance")(importance_command)
+    app.command("learning-curve")(learning_curve_command)
 
 
 RunArgument = Annotated[
@@ -49,7 +50,7 @@ def classes_command(
 ) -> None:
     """Show per-class precision, recall and F1, the confusion matrix (summed over folds)
     and the expected calibration error of a run's classifiers, per target."""
-    from app.reports.certainty_tables import class_tables, score
+    from app.reports.certainty_tables import calibrations, class_tables, score
 
     certainty = _certainty(ctx, run, classifier)
     if as_json:
@@ -57,15 +58,15 @@ def classes_command(
         return
     for shown in class_tables(certainty):
         run_table(shown)
-    for entry in certainty.classifiers:
-        calibration = entry.calibration
+    for entry, target, calibration in calibrations(certainty):
+        name = entry.classifier if target is None else f"{entry.classifier} on {target}"
         if calibration is not None:
             info(
-                f"{entry.classifier}: expected calibration error {score(calibration.ece)} "
+                f"{name}: expected calibration error {score(calibration.ece)} "
                 f"over {calibration.n_instances} out-of-fold predictions"
             )
         else:
-            info(f"{entry.classifier}: no calibration ({entry.calibration_note})")
+            info(f"{name}: no calibration ({entry.calibration_note})")
     info("rows: true class; the columns after support: predicted class (counts)")
 
 
@@ -196,10 +197,10 @@ def importance_command(
 ) -> None:
     """Permutation importance of a run's classifier on each of its outer test folds, per
     feature and per group of features (channel, feature family), with the t-test of each
-    group's drop."""
+    group's drop. Kept as a job: the run's web page and report show it."""
     from app.cli.requests import build_request
-    from app.schemas.importance import ImportanceRequest
-    from app.services.importance import run_importance
+    from app.schemas.importance import ImportanceRequest, ImportanceResult
+    from app.services.jobs import carry_out_here
 
     request = build_request(
         ImportanceRequest,
@@ -209,38 +210,101 @@ def importance_command(
         repeats=repeats,
     )
 
-    def progress(done: int, total: int) -> None:
-        if not as_json:
-            info(f"fold {done} of {total} done")
+    def progress(partial: object) -> None:
+        if not as_json and isinstance(partial, ImportanceResult):
+            info(f"fold {partial.done} of {partial.total} done")
 
-    found = run_importance(get_state(ctx).store, request, on_fold=progress)
+    # kept as a job, so that the run's web page and report show it
+    _, kept = carry_out_here(get_state(ctx).store, request, on_progress=progress)
+    found = ImportanceResult.model_validate(kept)
     if as_json:
         print_json(found.to_json())
         return
-    header = ["feature", "features", "drop", "std", "p", ""]
-    for grouping, items in found.groups.items():
-        table(
-            f"run {found.run_id}, {found.classifier} on {found.target}: each {grouping} "
-            f"shuffled ({found.metric} drop over {found.n_folds} folds, baseline "
-            f"{found.baseline:.4f})",
-            header,
-            [_importance_row(item) for item in items],
-        )
-    table(
-        f"the {min(top, len(found.features))} most important of {len(found.features)} features",
-        header,
-        [_importance_row(item) for item in found.features[:top]],
-    )
-    info("p: corrected resampled t-test of the drop against none; * significant at 0.05")
+    from app.reports.answer_tables import importance_tables
+
+    for shown in importance_tables(found, top):
+        run_table(shown)
 
 
-def _importance_row(item: FeatureImportance) -> tuple[object, ...]:
-    p = "-" if item.p is None else f"{item.p:.3g}"
-    return (
-        item.name,
-        item.n_features,
-        f"{item.mean:+.4f}",
-        f"{item.std:.4f}",
-        p,
-        "*" if item.significant else "",
+def learning_curve_command(
+    ctx: typer.Context,
+    dataset: Annotated[
+        str, typer.Argument(metavar="DATA", help="Data set name or id.", show_default=False)
+    ],
+    classifiers: Annotated[
+        str,
+        typer.Option(
+            "--classifiers", "-c", metavar="ID,ID,...", help="Classifier ids (a curve each)."
+        ),
+    ],
+    target: Annotated[
+        str | None, typer.Option("--target", metavar="NAME", help="This one target.")
+    ] = None,
+    fractions: Annotated[
+        str | None,
+        typer.Option(
+            "--fractions",
+            metavar="F,F,...",
+            help="Shares of each training fold (default 0.1,0.2,0.3,0.5,0.7,1).",
+        ),
+    ] = None,
+    folds: Annotated[int | None, typer.Option("--folds", metavar="K", help="k (5).")] = None,
+    seed: Annotated[int | None, typer.Option("--seed", metavar="N", help="Seed (0).")] = None,
+    timeout: Annotated[
+        float | None,
+        typer.Option("--timeout", metavar="SECONDS", help="Per task (600; 0: no limit)."),
+    ] = None,
+    metric: Annotated[
+        str | None, typer.Option("--metric", metavar="NAME", help="Score (as a run's).")
+    ] = None,
+    jobs: Annotated[int, typer.Option("--jobs", "-j", min=1, help="Local worker processes.")] = 1,
+    output: Annotated[
+        Path | None,
+        typer.Option("--output", "-o", metavar="FILE.svg|png", help="Draw the curves here."),
+    ] = None,
+    as_json: JsonOption = False,
+) -> None:
+    """Cross-validate classifiers on growing shares of each training fold (stratified,
+    group-aware; the test folds stay whole): the share at which each comes within a point
+    of its full score answers "do I need to record more?". Kept as a job with its progress."""
+    from app.cli.progress import TenthsProgress
+    from app.cli.requests import build_request
+    from app.reports.plots import figure_format, save_figure
+    from app.schemas.learning import LearningCurveRequest, LearningCurveResult
+    from app.services.jobs import carry_out_here
+
+    if output is not None:
+        figure_format(output)
+    request = build_request(
+        LearningCurveRequest,
+        {"dataset": "DATA", "fractions": "--fractions", "classifiers": "--classifiers"},
+        dataset=dataset,
+        classifiers=_items(classifiers),
+        target=target,
+        fractions=_items(fractions),
+        folds=folds,
+        seed=seed,
+        timeout=timeout,
+        metric=metric,
     )
+    progress = TenthsProgress("learning curve", quiet=as_json)
+    job_id, found = carry_out_here(get_state(ctx).store, request, jobs=jobs, on_progress=progress)
+    result = LearningCurveResult.model_validate(found)
+    if output is not None:
+        from app.reports.figures import learning_figure
+
+        save_figure(learning_figure(result), output)
+    if as_json:
+        print_json(result.to_json())
+        return
+    from app.reports.answer_tables import learning_table
+
+    run_table(learning_table(result))
+    info(f"kept as job {job_id}" + (f"; wrote {output}" if output is not None else ""))
+
+
+def _items(text: str | None) -> list[str] | None:
+    """``a,b`` as ``["a", "b"]`` (``None`` stays ``None``, so the request's default holds)."""
+    if text is None:
+        return None
+    return [item.strip() for item in text.split(",") if item.strip()]

@@ -25,6 +25,7 @@ from app.cli.state import get_state
 from app.schemas.runs import BenchRequest
 
 if TYPE_CHECKING:
+    from app.schemas.ablation import AblationResult
     from app.schemas.runs import LeaderboardSchema
     from app.services.runs import IndependentResult, RunLeaderboard
     from app.store.database import Store
@@ -420,6 +421,20 @@ def bench_command(
             show_default=False,
         ),
     ] = None,
+    ablate_groups: Annotated[
+        str | None,
+        typer.Option(
+            "--ablate-groups",
+            metavar="channel|family",
+            help=(
+                "Then rerun the classifiers on the same folds with each group of features "
+                "removed (channel: the _1, _2... suffixes or CHANNEL[T] windows; family: a "
+                "statistic across channels), each against the full set with the corrected "
+                "t-test."
+            ),
+            show_default=False,
+        ),
+    ] = None,
     as_json: JsonOption = False,
 ) -> None:
     """Cross-validate classifiers on a data set; every finished fold is stored at once.
@@ -465,6 +480,8 @@ def bench_command(
     elif dataset is None:
         raise typer.BadParameter("missing DATASET (or --resume RUN)")
     request = None if resume is not None else build_request(BenchRequest, BENCH_OPTIONS, **values)
+    if ablate_groups is not None:
+        _check_ablation(store, request, resume, ablate_groups)
     jobs = _check_jobs(jobs, oversubscribe)
     if scheduler is not None:
         from benchmark.run.dask_backend import connect
@@ -496,12 +513,16 @@ def bench_command(
         raise ExitWith(_kept_message(store, run_id, "interrupted"), code) from None
     except RunCancelled as cancelled:
         raise ExitWith(_kept_message(store, cancelled.run.id, "cancelled"), EXIT_FAILED) from None
-    _print_run_report(store, run.id, metric, baseline, as_json)
     if run.status == "failed":
+        _print_run_report(store, run.id, metric, baseline, as_json)
         raise ExitWith(
             f"run {run.id} failed: {run.error} (`touchbench leaderboard {run.id}` lists why)",
             EXIT_FAILED,
         )
+    ablation = None
+    if ablate_groups is not None:
+        ablation = _ablate(store, run.id, ablate_groups, jobs, as_json)
+    _print_run_report(store, run.id, metric, baseline, as_json, ablation)
 
 
 #: The option of each field of :class:`app.schemas.runs.BenchRequest`.
@@ -592,15 +613,64 @@ def _kept_message(store: Store, run_id: int, what: str) -> str:
 
 
 def _print_run_report(
-    store: Store, run_id: int, metric: str | None, baseline: str | None, as_json: bool
+    store: Store,
+    run_id: int,
+    metric: str | None,
+    baseline: str | None,
+    as_json: bool,
+    ablation: AblationResult | None = None,
 ) -> None:
     ranked = _ranked(store, run_id, metric, baseline)
     report = ranked.report()
     if as_json:
-        print_json(report.to_json())
+        extra = {} if ablation is None else {"ablation": ablation.to_json()}
+        print_json({**report.to_json(), **extra})
         return
     _print_leaderboard(ranked)
     _print_run_tables(report)
+    if ablation is not None:
+        from app.reports.answer_tables import ablation_table
+
+        run_table(ablation_table(ablation))
+        info(
+            "change: mean of (without - full) over the folds; can go: no significant change; "
+            "needed: significantly worse without"
+        )
+
+
+#: The option of each field of :class:`app.schemas.ablation.AblationRequest`.
+_ABLATION_OPTIONS = {"grouping": "--ablate-groups", "classifiers": "--classifiers"}
+
+
+def _check_ablation(
+    store: Store, request: BenchRequest | None, resume: int | None, grouping: str
+) -> None:
+    """Refuse ``--ablate-groups`` before the run: a grouping that does not exist, or that
+    the data set's feature names do not give."""
+    from app.cli.requests import build_request
+    from app.schemas.ablation import AblationRequest
+    from app.services.ablation import check_grouping
+
+    if request is not None and request.independent:
+        raise typer.BadParameter("is not used with --independent", param_hint="--ablate-groups")
+    checked = build_request(AblationRequest, _ABLATION_OPTIONS, run=resume or 1, grouping=grouping)
+    check_grouping(store, checked.grouping, bench=request, run=resume)
+
+
+def _ablate(store: Store, run_id: int, grouping: str, jobs: int, as_json: bool) -> AblationResult:
+    """Carry out the ablation of a finished run, as a job the store keeps."""
+    from app.cli.progress import TenthsProgress
+    from app.cli.requests import build_request
+    from app.schemas.ablation import AblationRequest, AblationResult
+    from app.services.jobs import carry_out_here
+
+    request = build_request(AblationRequest, _ABLATION_OPTIONS, run=run_id, grouping=grouping)
+    # a line per tenth of the work: an ablation reruns every classifier per group
+    progress = TenthsProgress("ablation", quiet=as_json)
+    job_id, result = carry_out_here(store, request, jobs=jobs, on_progress=progress)
+    if not as_json:
+        info(f"ablation kept as job {job_id}")
+    return AblationResult.model_validate(result)
 
 
 def _ranked(

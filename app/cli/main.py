@@ -92,6 +92,12 @@ COMMANDS = (
         "group's drop.",
     ),
     Subcommand(
+        "learning-curve",
+        "app.cli.answers",
+        "Cross-validate classifiers on growing shares of each training fold (stratified, "
+        "group-aware): the share at which each comes within a point of its full score.",
+    ),
+    Subcommand(
         "cancel",
         "app.cli.bench",
         "Cancel a run: a queued run at once, a running one as soon as its process hears of it.",

@@ -21,6 +21,7 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
+from app.cli.output import info
 from app.services.runs import Callbacks
 from benchmark.results import TaskKey, TaskResult
 
@@ -111,3 +112,22 @@ class TaskProgress:
     def note(self, message: str) -> None:
         """A routine adjustment worth knowing (fewer folds, how folds are stratified...)."""
         self._progress.console.print(f"note: {escape(message)}", highlight=False, soft_wrap=True)
+
+
+class TenthsProgress:
+    """One line on stderr per tenth of a job's tasks (an ablation, a learning curve), from
+    the partial answers it reports (``done``, ``total``, ``complete``); silent with
+    ``--json``, whose stdout is the answer alone anyway."""
+
+    def __init__(self, what: str, *, quiet: bool) -> None:
+        self._what = what
+        self._quiet = quiet
+        self._shown = 0
+
+    def __call__(self, partial: object) -> None:
+        done, total = getattr(partial, "done", 0), getattr(partial, "total", 0)
+        tenth = done // max(total // 10, 1)
+        if self._quiet or (tenth <= self._shown and not getattr(partial, "complete", False)):
+            return
+        self._shown = tenth
+        info(f"{self._what}: {done} of {total} tasks done")

@@ -5,7 +5,7 @@ CLI's ``classes`` and ``calibration``, the HTML report and the web page."""
 from __future__ import annotations
 
 from app.reports.run_tables import RunTable
-from app.schemas.certainty import RunCertainty
+from app.schemas.certainty import Calibration, ClassifierCertainty, RunCertainty
 
 
 def class_tables(certainty: RunCertainty) -> list[RunTable]:
@@ -38,24 +38,51 @@ def class_tables(certainty: RunCertainty) -> list[RunTable]:
 
 
 def calibration_table(certainty: RunCertainty) -> RunTable:
-    """Every classifier's expected calibration error, or why it has none."""
+    """Every classifier's expected calibration error (per target in a multi-target run), or
+    why it has none."""
+    rows = []
+    for e, target, calibration in calibrations(certainty):
+        rows.append(
+            (
+                e.classifier,
+                *((target or "-",) if certainty.kind == "multitarget" else ()),
+                score(calibration.ece) if calibration else "-",
+                str(calibration.n_instances) if calibration else "-",
+                str(calibration.n_folds) if calibration else "-",
+                "" if calibration else e.calibration_note or "",
+            )
+        )
+    per_target = certainty.kind == "multitarget"
     return RunTable(
         key="calibration",
         title=f"run {certainty.run_id}: calibration of the top label, out of fold "
-        "(expected calibration error, 10 bins)",
-        header=("classifier", "ECE", "instances", "folds", "note"),
-        rows=[
-            (
-                e.classifier,
-                score(e.calibration.ece) if e.calibration else "-",
-                str(e.calibration.n_instances) if e.calibration else "-",
-                str(e.calibration.n_folds) if e.calibration else "-",
-                e.calibration_note or "",
-            )
-            for e in certainty.classifiers
-        ],
-        numeric=(False, True, True, True, False),
+        "(expected calibration error, 10 bins" + (", per target)" if per_target else ")"),
+        header=(
+            "classifier",
+            *(("target",) if per_target else ()),
+            "ECE",
+            "instances",
+            "folds",
+            "note",
+        ),
+        rows=rows,
+        numeric=(False, *((False,) if per_target else ()), True, True, True, False),
     )
+
+
+def calibrations(
+    certainty: RunCertainty,
+) -> list[tuple[ClassifierCertainty, str | None, Calibration | None]]:
+    """(classifier, target, calibration) of each classifier, per target in a multi-target
+    run (target ``None`` otherwise)."""
+    out: list[tuple[ClassifierCertainty, str | None, Calibration | None]] = []
+    for entry in certainty.classifiers:
+        if certainty.kind != "multitarget":
+            out.append((entry, None, entry.calibration))
+            continue
+        for target in entry.targets:
+            out.append((entry, target.target, target.calibration))
+    return out
 
 
 def score(value: float | None) -> str:

@@ -12,6 +12,7 @@ from matplotlib.figure import Figure
 from app.reports import plots
 from app.schemas.certainty import RunCertainty
 from app.schemas.datasets import DatasetDescription
+from app.schemas.learning import LearningCurveResult
 from app.services.compare import Comparison
 from app.services.report import RunView
 from benchmark.errors import ConfigurationError
@@ -95,13 +96,15 @@ def classes_figure(view: RunView) -> Figure:
 def reliability_figure(certainty: RunCertainty, classifiers: int | None = None) -> Figure:
     """The reliability diagram of a run's classifiers that kept calibration bins (the
     first ``classifiers`` of them, best first)."""
+    from app.reports.certainty_tables import calibrations
+
     curves = {}
-    for entry in certainty.classifiers:
-        calibration = entry.calibration
+    for entry, target, calibration in calibrations(certainty):
         if calibration is None or calibration.ece is None:
             continue
         bins = calibration.bins
-        curves[entry.classifier] = (
+        name = entry.classifier if target is None else f"{entry.classifier} on {target}"
+        curves[name] = (
             np.array([np.nan if b.confidence is None else b.confidence for b in bins]),
             np.array([np.nan if b.accuracy is None else b.accuracy for b in bins]),
             np.array([b.count for b in bins], dtype=np.float64),
@@ -118,6 +121,26 @@ def reliability_figure(certainty: RunCertainty, classifiers: int | None = None) 
         curves,
         title=f"run {certainty.run_id} ({certainty.dataset}, {', '.join(certainty.targets)}): "
         "out-of-fold reliability",
+    )
+
+
+def learning_figure(result: LearningCurveResult) -> Figure:
+    """The learning curves of a learning-curve answer (those scored so far)."""
+    curves = {
+        curve.classifier: (
+            np.array([p.fraction for p in curve.points]),
+            np.array([np.nan if p.mean is None else p.mean for p in curve.points]),
+            np.array([np.nan if p.std is None else p.std for p in curve.points]),
+            curve.enough,
+        )
+        for curve in result.curves
+    }
+    return plots.learning_curve_figure(
+        curves,
+        metric=result.metric,
+        lower_is_better=result.lower_is_better,
+        title=f"{result.dataset} ({', '.join(result.targets)}): learning curves over "
+        f"{result.n_folds} folds",
     )
 
 

@@ -19,6 +19,7 @@ from markupsafe import Markup
 from matplotlib.figure import Figure
 
 from app.reports import bounds, figures
+from app.reports.answer_tables import run_answer_tables
 from app.reports.certainty_tables import calibration_table, class_tables
 from app.reports.leaderboard import (
     beside_notes,
@@ -28,6 +29,7 @@ from app.reports.leaderboard import (
 )
 from app.reports.plots import svg_text
 from app.reports.run_tables import run_tables
+from app.services.answers import RunAnswers
 from app.services.certainty import certainty_of
 from app.services.compare import Comparison
 from app.services.imported import is_imported
@@ -217,6 +219,7 @@ def _run(report: Report, view: RunView, plots: list[_Plot]) -> dict[str, Any]:
         "beside_notes": beside_notes(view.besides),
         "mark_column": 4 if view.besides else 3,
         "sure": sure,
+        "answers": run_answer_tables(report.answers.get(run.id, RunAnswers())),
         "metric": board.metric,
         "baseline": board.baseline,
         "alpha": board.alpha,

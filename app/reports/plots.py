@@ -401,6 +401,61 @@ def class_distribution_figure(counts: Mapping[str, Mapping[str, int]], *, title:
     return figure
 
 
+@_styled
+def learning_curve_figure(
+    curves: Mapping[str, tuple[np.ndarray, np.ndarray, np.ndarray, float | None]],
+    *,
+    metric: str,
+    lower_is_better: bool = False,
+    title: str,
+) -> Figure:
+    """Learning curves: a classifier's mean score (band: one standard deviation over the
+    folds) against the share of each training fold, and a mark where it comes within the
+    tolerance of its full score.
+
+    Parameters
+    ----------
+    curves : mapping of str to (fractions, mean, std, enough)
+        Per classifier: ndarrays of shape (n_fractions,) (NaN where nothing scored) and the
+        fraction that is enough (``None``: not known yet).
+    metric : str
+        The axis label.
+    lower_is_better : bool
+    title : str
+    """
+    if not curves:
+        raise AppError("no learning curve to plot")
+    figure = Figure(figsize=(6.4, 4.4), layout="constrained")
+    ax = figure.add_subplot()
+    for name, (fractions, mean, std, enough) in curves.items():
+        shown = ~np.isnan(mean)
+        (line,) = ax.plot(fractions[shown], mean[shown], marker="o", label=name)
+        spread = shown & ~np.isnan(std)
+        ax.fill_between(
+            fractions[spread],
+            (mean - std)[spread],
+            (mean + std)[spread],
+            color=line.get_color(),
+            alpha=0.15,
+            linewidth=0,
+        )
+        if enough is not None:
+            at = np.flatnonzero(np.isclose(fractions, enough))
+            if at.size and shown[at[0]]:
+                ax.scatter(
+                    [enough], [mean[at[0]]], s=90, facecolors="none", edgecolors=line.get_color()
+                )
+    ax.set_xlim(0, 1.02)
+    ax.set_xlabel("share of each training fold (circled: within tolerance of the full score)")
+    direction = "lower is better" if lower_is_better else "higher is better"
+    ax.set_ylabel(f"{metric} ({direction})")
+    ax.grid(color="#dddddd", linewidth=0.6)
+    ax.set_axisbelow(True)
+    ax.legend(loc="lower right" if not lower_is_better else "upper right", fontsize=8)
+    _suptitle(figure, title)
+    return figure
+
+
 def _suptitle(figure: Figure, title: str, shown: str = "") -> None:
     """A figure title wrapped to the figure's width (about 13 characters an inch at 9 pt),
     saying what is ``shown`` of all there is ("first 6 of 800 targets") when not empty."""

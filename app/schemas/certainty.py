@@ -19,16 +19,6 @@ class ClassScores(Schema):
     support: int = Field(description="Test instances of the class, over every fold.")
 
 
-class TargetClasses(Schema):
-    """A classifier on one target: the confusion matrix summed over its successful folds
-    (rows true, columns predicted) and the scores of each class."""
-
-    target: str
-    labels: list[str]
-    confusion: list[list[int]]
-    classes: list[ClassScores]
-
-
 class ReliabilityBin(Schema):
     """One bin of the top-label confidence."""
 
@@ -46,6 +36,21 @@ class Calibration(Schema):
     n_instances: int
     n_folds: int
     bins: list[ReliabilityBin]
+
+
+class TargetClasses(Schema):
+    """A classifier on one target: the confusion matrix summed over its successful folds
+    (rows true, columns predicted) and the scores of each class."""
+
+    target: str
+    labels: list[str]
+    confusion: list[list[int]]
+    classes: list[ClassScores]
+    calibration: Calibration | None = Field(
+        default=None,
+        description="Multi-target runs: this target's calibration (multi-class runs: the "
+        "classifier's).",
+    )
 
 
 class ClassifierCertainty(Schema):

@@ -44,3 +44,6 @@ class ImportanceResult(Schema):
     groups: dict[str, list[FeatureImportance]] = Field(
         description="Per grouping (channel, family): each group shuffled together."
     )
+    done: int = Field(default=0, description="Folds finished (n_folds of them so far).")
+    total: int = Field(default=0, description="Folds in all.")
+    complete: bool = True

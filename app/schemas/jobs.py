@@ -1,5 +1,6 @@
-"""Jobs other than runs (extraction of an uploaded recording session, training a model), as
-the API answers them."""
+"""Jobs other than runs (extraction of an uploaded recording session, training a model, the
+answers after a run: ablation, permutation importance, a learning curve), as the API answers
+them."""
 
 from __future__ import annotations
 
@@ -8,13 +9,22 @@ from typing import Any, Literal
 
 from pydantic import Field
 
+from app.schemas.ablation import AblationRequest
 from app.schemas.base import Request, Schema
 from app.schemas.extraction import ExtractRequest
+from app.schemas.importance import ImportanceRequest
+from app.schemas.learning import LearningCurveRequest
 from app.schemas.models import TrainRequest
 
-JobKind = Literal["extract", "train"]
+JobKind = Literal["extract", "train", "ablation", "importance", "learning-curve"]
 #: The request each kind of job carries out (its JSON is the job's ``params``).
-JOB_REQUESTS: dict[JobKind, type[Request]] = {"extract": ExtractRequest, "train": TrainRequest}
+JOB_REQUESTS: dict[JobKind, type[Request]] = {
+    "extract": ExtractRequest,
+    "train": TrainRequest,
+    "ablation": AblationRequest,
+    "importance": ImportanceRequest,
+    "learning-curve": LearningCurveRequest,
+}
 #: Same life as a run's (app/store/states.py), without resume: queued -> running -> done |
 #: failed | cancelling -> cancelled (| interrupted after a crash).
 JobStatus = Literal["queued", "running", "cancelling", "done", "failed", "cancelled", "interrupted"]
@@ -33,7 +43,10 @@ class JobSchema(Schema):
         description="What the job was asked to do: its request (TrainRequest, ExtractRequest)."
     )
     result: dict[str, Any] | None = Field(
-        default=None, description="extract: the new data set; train: the new model."
+        default=None,
+        description="extract: the new data set; train: the new model; ablation, importance, "
+        "learning-curve: the answer (while running, what is finished so far, `complete` "
+        "false).",
     )
     error: str | None = None
     created_at: datetime

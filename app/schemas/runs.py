@@ -271,6 +271,18 @@ _NOT_INDEPENDENT = {
 }
 
 
+def id_as_text(value: Any) -> Any:
+    """A data set's numeric id is one of its names (a request's ``dataset`` validator)."""
+    if isinstance(value, int) and not isinstance(value, bool):
+        return str(value)
+    return value
+
+
+def zero_is_no_limit(value: float | None) -> float | None:
+    """A ``timeout`` of 0 means none (a request's ``timeout`` validator)."""
+    return value or None
+
+
 class BenchRequest(Request):
     """A benchmark run: what to cross-validate, how, and what to add to the classifiers.
 
@@ -390,18 +402,8 @@ class BenchRequest(Request):
         "label per recording; its folds already keep each recording whole.",
     )
 
-    @field_validator("dataset", mode="before")
-    @classmethod
-    def _id_as_text(cls, value: Any) -> Any:
-        """A data set's numeric id is one of its names."""
-        if isinstance(value, int) and not isinstance(value, bool):
-            return str(value)
-        return value
-
-    @field_validator("timeout", mode="after")
-    @classmethod
-    def _zero_is_no_limit(cls, value: float | None) -> float | None:
-        return value or None
+    _id_as_text = field_validator("dataset", mode="before")(id_as_text)
+    _zero_is_no_limit = field_validator("timeout", mode="after")(zero_is_no_limit)
 
     @model_validator(mode="after")
     def _rules_across_fields(self) -> BenchRequest:

@@ -3,8 +3,8 @@ classifier and target, and the calibration of its classifiers' probabilities.
 
 Everything comes from what the store keeps of each fold: its confusion matrix (per target)
 and, for multi-class folds of classifiers with probabilities, its reliability bins
-(:mod:`benchmark.evaluation.calibration`; runs carried out before the bins were kept, and
-multi-target runs, have none, and say so).
+(:mod:`benchmark.evaluation.calibration`), per target for multi-target folds (runs carried
+out before the bins were kept have none, and say so).
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from app.services.imported import is_imported
 from app.services.report import RunView, run_view
 from app.store.database import Store
 from benchmark.errors import ConfigurationError
-from benchmark.evaluation.calibration import Reliability, merge
+from benchmark.evaluation.calibration import PER_TARGET, Reliability, merge
 from benchmark.results import TaskResult
 
 
@@ -107,10 +107,16 @@ def class_scores(confusion: np.ndarray, labels: Sequence[str]) -> list[ClassScor
     return out
 
 
-def calibration_of(results: Sequence[TaskResult]) -> Calibration | None:
-    """The summed reliability bins of the results that have them (``None`` if none has)."""
-    kept = [r for r in results if r.ok and r.calibration is not None]
-    merged = merge(Reliability.from_json(r.calibration) for r in kept if r.calibration)
+def calibration_of(results: Sequence[TaskResult], target: str | None = None) -> Calibration | None:
+    """The summed reliability bins of the results that have them (``None`` if none has):
+    a multi-class fold's, or of a multi-target fold the bins of ``target``."""
+    bins = [
+        r.calibration if target is None else r.calibration.get(PER_TARGET, {}).get(target)
+        for r in results
+        if r.ok and r.calibration is not None
+    ]
+    kept = [b for b in bins if b]
+    merged = merge(Reliability.from_json(b) for b in kept)
     if merged is None:
         return None
     edges = merged.edges
@@ -135,13 +141,20 @@ def calibration_of(results: Sequence[TaskResult]) -> Calibration | None:
 def _classifier(view: RunView, name: str) -> ClassifierCertainty:
     confusion = view.confusion(name)
     mine = [r for r in view.results if r.key.classifier == name and r.ok]
-    calibration = calibration_of(mine)
+    multitarget = view.run.kind == "multitarget"
+    calibration = None if multitarget else calibration_of(mine)
+    per_target = {t: calibration_of(mine, t) for t in confusion.matrices} if multitarget else {}
     note = None
-    if calibration is None:
+    if multitarget and not any(per_target.values()):
         note = (
-            "multi-target folds keep no probabilities"
-            if view.run.kind == "multitarget"
-            else "no fold kept its probabilities' bins (a classifier without probabilities, "
+            "no fold kept its targets' probability bins (a configuration without "
+            "probabilities, or a run carried out before they were kept)"
+        )
+    elif multitarget:
+        note = "per target"
+    elif calibration is None:
+        note = (
+            "no fold kept its probabilities' bins (a classifier without probabilities, "
             "or a run carried out before they were kept)"
         )
     return ClassifierCertainty(
@@ -153,6 +166,7 @@ def _classifier(view: RunView, name: str) -> ClassifierCertainty:
                 labels=view.labels[target],
                 confusion=matrix.astype(int).tolist(),
                 classes=class_scores(matrix, view.labels[target]),
+                calibration=per_target.get(target),
             )
             for target, matrix in confusion.matrices.items()
         ],

@@ -1,5 +1,7 @@
 """Long work the service queues instead of doing in a request: benchmark runs (the runs table
-is their queue), extraction of an uploaded recording session, training a model.
+is their queue), extraction of an uploaded recording session, training a model, and the
+answers after a run (an ablation, permutation importance, a learning curve), which keep what
+they finished as the job's result while they run.
 
 The request stores what is asked (``queued``) and answers at once; a dispatcher
 (:mod:`app.jobs.dispatcher`) hands each queued item to a worker process, which claims it
@@ -15,18 +17,37 @@ import os
 import shutil
 import socket
 import threading
+from collections.abc import Callable
 from typing import Any
 
 from pydantic import ValidationError
 
 from app.errors import USER_ERRORS, AppError, client_words
-from app.schemas.base import Request
+from app.schemas.ablation import AblationRequest
+from app.schemas.base import Request, Schema
 from app.schemas.extraction import ExtractRequest
+from app.schemas.importance import ImportanceRequest
 from app.schemas.jobs import JOB_REQUESTS, JobKind, JobSchema
+from app.schemas.learning import LearningCurveRequest
 from app.schemas.models import TrainRequest
 from app.store.database import Store
-from app.store.jobs import claim_job, create_job, finish_job, get_job, job_heartbeat
+from app.store.jobs import (
+    claim_job,
+    create_job,
+    finish_job,
+    get_job,
+    job_heartbeat,
+    record_job_progress,
+    start_job,
+)
 from app.store.ownership import process_owner
+
+#: The kind of job of each request that answers a question after a run.
+ANSWER_KINDS: dict[type[Request], JobKind] = {
+    AblationRequest: "ablation",
+    ImportanceRequest: "importance",
+    LearningCurveRequest: "learning-curve",
+}
 
 #: Seconds a job's work has, once asked to stop, to end by itself (the interrupt reaches
 #: Python code at once, native code only when it returns) before its process ends it.
@@ -58,6 +79,88 @@ def submit_training(store: Store, request: TrainRequest) -> JobSchema:
 
     check_training(store, request)
     return _submit(store, "train", request)
+
+
+def submit_answer(
+    store: Store, request: AblationRequest | ImportanceRequest | LearningCurveRequest
+) -> JobSchema:
+    """Queue an ablation, permutation importance or a learning curve, once its request was
+    checked against the store (the run, its classifiers, the data set...)."""
+    _check_answer(store, request)
+    return _submit(store, ANSWER_KINDS[type(request)], request)
+
+
+def carry_out_here(
+    store: Store,
+    request: AblationRequest | ImportanceRequest | LearningCurveRequest,
+    *,
+    jobs: int = 1,
+    on_progress: Callable[[Schema], None] = lambda partial: None,
+) -> tuple[int, dict[str, Any]]:
+    """Carry out an answer's work in this process (the command line), as a job of its own
+    that the store keeps, with its progress, for the API and the web page to show.
+
+    Returns
+    -------
+    tuple of (int, dict)
+        The job's id and its result.
+
+    Raises
+    ------
+    AppError, ConfigurationError
+        As the work raises them (the job ends ``failed`` with the same message).
+    KeyboardInterrupt
+        The job ends ``interrupted`` (``cancelled`` when the API cancelled it).
+    """
+    _check_answer(store, request)
+    owner = process_owner()
+    job = start_job(
+        store,
+        ANSWER_KINDS[type(request)],
+        {**request.model_dump(mode="json"), "host": socket.gethostname()},
+        owner=owner,
+    )
+    stopper = _Stopper(store, job.id, None)
+    beat = job_heartbeat(store, job.id, owner, stopper.stop)
+    beat.start()
+
+    def progress(partial: Schema) -> None:
+        record_job_progress(store, job.id, partial.to_json())
+        on_progress(partial)
+
+    try:
+        result = _carry_out(store, request, jobs=jobs, on_progress=progress)
+    except KeyboardInterrupt:
+        stopper.finish("cancelled" if stopper.asked else "interrupted", error="interrupted")
+        raise
+    except USER_ERRORS as error:
+        stopper.finish("failed", error=str(error))
+        raise
+    except Exception as error:
+        stopper.finish("failed", error=f"unexpected {type(error).__name__}: {error}")
+        raise
+    else:
+        stopper.finish("done", result=result)
+    finally:
+        beat.stop()
+    return job.id, result
+
+
+def _check_answer(
+    store: Store, request: AblationRequest | ImportanceRequest | LearningCurveRequest
+) -> None:
+    if isinstance(request, AblationRequest):
+        from app.services.ablation import check_ablation
+
+        check_ablation(store, request)
+    elif isinstance(request, ImportanceRequest):
+        from app.services.importance import check_importance
+
+        check_importance(store, request)
+    else:
+        from app.services.learning import check_learning_curve
+
+        check_learning_curve(store, request)
 
 
 def _submit(store: Store, kind: JobKind, request: Request) -> JobSchema:
@@ -105,7 +208,11 @@ def execute_job(store: Store, job_id: int) -> JobSchema | None:
     beat.start()
     try:
         try:
-            result = _carry_out(store, job_request(job))
+            result = _carry_out(
+                store,
+                job_request(job),
+                on_progress=lambda partial: record_job_progress(store, job.id, partial.to_json()),
+            )
         finally:  # before the job ends, so that whoever sees it ended finds no upload left
             if folder:
                 shutil.rmtree(folder, ignore_errors=True)
@@ -170,8 +277,26 @@ class _Stopper:
         os._exit(1)
 
 
-def _carry_out(store: Store, request: Request) -> dict[str, Any]:
-    """The result of a job's request: the new data set, or the new model."""
+def _carry_out(
+    store: Store,
+    request: Request,
+    *,
+    jobs: int = 1,
+    on_progress: Callable[[Schema], None] = lambda partial: None,
+) -> dict[str, Any]:
+    """The result of a job's request: the new data set, the new model, or the answer."""
+    if isinstance(request, AblationRequest):
+        from app.services.ablation import run_ablation
+
+        return run_ablation(store, request, jobs=jobs, on_progress=on_progress).to_json()
+    if isinstance(request, ImportanceRequest):
+        from app.services.importance import run_importance
+
+        return run_importance(store, request, on_progress=on_progress).to_json()
+    if isinstance(request, LearningCurveRequest):
+        from app.services.learning import learning_curve
+
+        return learning_curve(store, request, jobs=jobs, on_progress=on_progress).to_json()
     if isinstance(request, ExtractRequest):
         from app.services.extraction import extract_and_store
 

@@ -12,6 +12,7 @@ from importlib import metadata
 
 import numpy as np
 
+from app.services.answers import RunAnswers, run_answers
 from app.services.compare import Comparison, compare_runs, with_besides
 from app.services.runs import (
     PerTargetSummary,
@@ -161,6 +162,8 @@ class Report:
         How many of each run's best classifiers get a confusion matrix.
     versions : dict of str to str
     created_at : datetime
+    answers : dict of int to RunAnswers
+        Per run id: its kept ablation and importance.
     """
 
     views: list[RunView]
@@ -170,6 +173,7 @@ class Report:
     confusions: int
     versions: dict[str, str]
     created_at: datetime = field(default_factory=lambda: datetime.now(UTC))
+    answers: dict[int, RunAnswers] = field(default_factory=dict)
 
 
 def run_view(
@@ -254,7 +258,15 @@ def build_report(
             comparison = compare_runs(store, run_refs, metric=metric, alpha=alpha, missing=missing)
         except BenchmarkError as error:  # the report stands without it; it says why
             note = str(error)
-    return Report(views, comparison, note, fold_ranks, confusions, library_versions())
+    return Report(
+        views,
+        comparison,
+        note,
+        fold_ranks,
+        confusions,
+        library_versions(),
+        answers={view.run.id: run_answers(store, view.run.id) for view in views},
+    )
 
 
 def library_versions() -> dict[str, str]:

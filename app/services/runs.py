@@ -500,7 +500,7 @@ def execute_run(
                 skip=done,
                 on_start=callbacks.on_start,
                 on_result=persist,
-                max_memory=_bytes(options.max_memory_mb),
+                max_memory=megabytes_to_bytes(options.max_memory_mb),
                 stop=stop.is_set,
                 extra_specs=run_specs(run.config, run.classifiers),
                 race=race,
@@ -932,7 +932,8 @@ def _tuning_config(
     }
 
 
-def _bytes(megabytes: float | None) -> int | None:
+def megabytes_to_bytes(megabytes: float | None) -> int | None:
+    """A limit in megabytes as the engine takes it (``None``: no limit)."""
     return None if megabytes is None else int(megabytes * 2**20)
 
 

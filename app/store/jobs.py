@@ -47,6 +47,48 @@ def create_job(store: Store, kind: str, params: dict[str, Any]) -> JobSchema:
         return _schema(row)
 
 
+def start_job(store: Store, kind: str, params: dict[str, Any], *, owner: str) -> JobSchema:
+    """A job carried out at once by ``owner`` (the command line's own process): created
+    ``running``, so that no dispatcher takes it."""
+    now = utcnow()
+    with store.session() as session:
+        row = JobRow(
+            kind=kind,
+            status="running",
+            params=params,
+            owner=owner,
+            started_at=now,
+            heartbeat_at=now,
+        )
+        session.add(row)
+        session.flush()
+        return _schema(row)
+
+
+def record_job_progress(store: Store, job_id: int, result: dict[str, Any]) -> None:
+    """Keep what a running job has finished so far as its ``result`` (shown while it runs;
+    the final result replaces it)."""
+    with store.session() as session:
+        session.execute(
+            update(JobRow)
+            .where(JobRow.id == job_id, JobRow.status.in_(("running", "cancelling")))
+            .values(result=result)
+            .execution_options(synchronize_session=False)
+        )
+
+
+def done_jobs_of_run(store: Store, kind: str, run_id: int) -> list[JobSchema]:
+    """The finished (``done``) jobs of ``kind`` whose request names run ``run_id``, newest
+    first."""
+    with store.session() as session:
+        rows = session.scalars(
+            select(JobRow)
+            .where(JobRow.kind == kind, JobRow.status == "done")
+            .order_by(JobRow.id.desc())
+        )
+        return [_schema(row) for row in rows if row.params.get("run") == run_id]
+
+
 def get_job(store: Store, job_id: int | str) -> JobSchema:
     with store.session() as session:
         return _schema(_row(session, job_id))

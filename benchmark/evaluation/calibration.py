@@ -23,6 +23,8 @@ import numpy as np
 
 #: Equal-width confidence bins of a fold.
 N_BINS = 10
+#: A multi-target fold keeps ``{PER_TARGET: {target name: bins}}``: each target's own.
+PER_TARGET = "targets"
 
 
 @dataclass(frozen=True)

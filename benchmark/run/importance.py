@@ -87,7 +87,7 @@ def permutation_importance(
     n_repeats: int = 3,
     random_state: int = 0,
     extra_specs: Mapping[str, ClassifierSpec] | None = None,
-    on_fold: Callable[[int, int], None] = lambda done, total: None,
+    on_fold: Callable[[int, int, Importance], None] = lambda done, total, so_far: None,
 ) -> Importance:
     """Permutation importance of every feature and feature group on each test fold.
 
@@ -106,7 +106,7 @@ def permutation_importance(
     random_state : int
         Seed of the classifier (as the run's) and of the shuffles.
     on_fold : callable
-        Called with (folds done, folds in all) after each fold.
+        Called with (folds done, folds in all, the drops of the folds done) after each fold.
 
     Raises
     ------
@@ -142,8 +142,17 @@ def permutation_importance(
         for grouping, members in groupings.items():
             for name, columns in members.items():
                 groups[grouping][name][k] = test.drop(columns, n_repeats, rng)
-        on_fold(k + 1, len(folds))
+        on_fold(k + 1, len(folds), _first(Importance(baseline, features, groups), k + 1))
     return Importance(baseline, features, groups)
+
+
+def _first(found: Importance, n: int) -> Importance:
+    """The drops of the first ``n`` folds."""
+    return Importance(
+        found.baseline[:n].copy(),
+        {name: drops[:n].copy() for name, drops in found.features.items()},
+        {g: {name: d[:n].copy() for name, d in m.items()} for g, m in found.groups.items()},
+    )
 
 
 class _TestFold:

@@ -19,7 +19,7 @@ import numpy as np
 
 from benchmark.catalogue import ClassifierSpec
 from benchmark.estimators import build_estimator
-from benchmark.evaluation.calibration import reliability
+from benchmark.evaluation.calibration import PER_TARGET, reliability
 from benchmark.evaluation.metrics import confusion_matrix, expand_proba, multiclass_scores
 from benchmark.evaluation.recordings import Recordings
 from benchmark.problem import Problem
@@ -230,6 +230,15 @@ def _run_multitarget(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResu
         int(fold.test.size),
         per_target=per_target,
         params=chosen_params(model, problem.target_names),
+        # per target, the bins of its top label's confidence (as a multi-class fold keeps)
+        calibration=None
+        if probas is None
+        else {
+            PER_TARGET: {
+                name: reliability(Y_test[:, t], probas[t]).to_json()
+                for t, name in enumerate(problem.target_names)
+            }
+        },
     )
 
 

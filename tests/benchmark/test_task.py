@@ -111,6 +111,9 @@ def test_multitarget_task_uses_the_multitarget_configurations() -> None:
     assert set(result.per_target or {}) == {"gesture", "place"}
     assert [len(m) for m in result.confusion or []] == [3, 2]
     assert result.metrics["fit_time"] >= 0 and result.metrics["model_size"] > 0
+    bins = (result.calibration or {})["targets"]  # each target's own reliability bins
+    assert set(bins) == {"gesture", "place"}
+    assert all(sum(b["count"]) == result.n_test for b in bins.values())
 
 
 def test_json_round_trip_keeps_nan_as_null() -> None:

@@ -15,9 +15,11 @@ from fastapi.responses import PlainTextResponse
 
 from app.api.deps import PageDep, ServiceDep, StoreDep, paginate
 from app.api.uploads import form_request, save_upload
+from app.schemas.ablation import AblationResult
 from app.schemas.certainty import RunCertainty
 from app.schemas.imported import ImportResultsRequest
 from app.schemas.runs import BenchRequest, LeaderboardSchema, RunCreated, RunList, RunSchema
+from app.services.answers import latest_ablation
 from app.services.certainty import run_certainty
 from app.services.imported import import_results
 from app.services.runs import create_run, run_leaderboard
@@ -143,6 +145,13 @@ def classes(run_id: int, store: StoreDep, classifier: ClassifiersQuery = None) -
     """Per-class precision, recall and F1, confusion matrices (summed over folds) per
     target, and out-of-fold calibration of each classifier (``touchbench classes --json``)."""
     return run_certainty(store, run_id, classifiers=_classifiers(classifier))
+
+
+@router.get("/{run_id}/ablation", response_model=AblationResult)
+def ablation(run_id: int, store: StoreDep) -> AblationResult:
+    """The run's latest finished ablation (``bench --ablate-groups``, or a job of
+    ``POST /api/jobs/ablation``)."""
+    return latest_ablation(store, run_id)
 
 
 @router.get(

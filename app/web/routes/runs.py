@@ -13,8 +13,10 @@ from fastapi import APIRouter, Query
 from fastapi.responses import HTMLResponse
 
 from app.errors import NotFoundError
+from app.reports.answer_tables import run_answer_tables
 from app.reports.run_tables import run_tables
 from app.schemas.runs import FINAL_STATUSES
+from app.services.answers import run_answers
 from app.services.listing import list_datasets
 from app.services.runs import NoResultsError, run_leaderboard
 from app.store.listing import count_datasets
@@ -99,6 +101,7 @@ def leaderboard(
         board=ranked.board,
         table=_table(ranked, chosen_baseline=baseline or None),
         tables=run_tables(ranked.report()),
+        answers=run_answer_tables(run_answers(store, run_id)),
         notes=ranked.notes(),
     )
 
@@ -156,21 +159,28 @@ def classifier(
 def _how_sure(view: RunView, classifier: str) -> dict[str, Any] | None:
     """The classifier's per-class tables and its calibration (none for a regression)."""
     from app.reports import figures
-    from app.reports.certainty_tables import class_tables
+    from app.reports.certainty_tables import calibrations, class_tables
     from app.services.certainty import certainty_of
 
     if view.run.kind == "regression" or not view.board.row(classifier).n_ok:
         return None
     certainty = certainty_of(view, [classifier])
     [entry] = certainty.classifiers
+    # (target or None, calibration) of each target that has one: one for a multi-class run
+    kept = [(target, found) for _, target, found in calibrations(certainty) if found]
     diagram = None
-    if entry.calibration is not None:
+    if kept:
         diagram = draw(
             f"Reliability of {classifier}: accuracy of the top label against its "
             "confidence, out of fold",
             partial(figures.reliability_figure, certainty),
         )
-    return {"tables": class_tables(certainty), "entry": entry, "diagram": diagram}
+    return {
+        "tables": class_tables(certainty),
+        "entry": entry,
+        "calibrations": kept,
+        "diagram": diagram,
+    }
 
 
 def _folds(view: RunView, shown: list[str]) -> dict[str, Any]:
