@@ -154,15 +154,21 @@ class Ros1Transport:
         self._taxel_type = Float32MultiArray
         self._publisher: Any = None
         self._subscribers: list[Any] = []
-        self._closed = threading.Event()
+        self._stopped = threading.Event()
+        self._closed = False
 
     def audio_info(self, topic: str, *, timeout: float) -> AudioFormat | None:
         got: queue.Queue[Any] = queue.Queue()
         subscriber = self._rospy.Subscriber(topic, self._audio_info, got.put)
+        deadline = time.monotonic() + timeout
         try:
-            info = got.get(timeout=timeout)
-        except queue.Empty:
-            return None
+            while True:
+                try:
+                    info = got.get(timeout=min(POLL, max(0.0, deadline - time.monotonic())))
+                    break
+                except queue.Empty:
+                    if self._stopped.is_set() or time.monotonic() >= deadline:
+                        return None
         finally:
             subscriber.unregister()
         return AudioFormat(
@@ -192,11 +198,18 @@ class Ros1Transport:
         return self._messages(received)
 
     def _messages(self, received: queue.Queue[Message]) -> Iterator[Message]:
-        while not self._closed.is_set() and not self._rospy.is_shutdown():
+        while not self._stopped.is_set() and not self._rospy.is_shutdown():
             try:
                 yield received.get(timeout=POLL)
             except queue.Empty:
                 continue
+        # What came before the stop is still processed; what comes after (a microphone
+        # never stops) is not waited for.
+        for _ in range(received.qsize()):
+            yield received.get_nowait()
+
+    def stop(self) -> None:
+        self._stopped.set()
 
     def advertise(self, topic: str) -> None:
         with warnings.catch_warnings():
@@ -221,9 +234,10 @@ class Ros1Transport:
         return True
 
     def close(self) -> None:
-        if self._closed.is_set():
+        if self._closed:
             return
-        self._closed.set()
+        self._closed = True
+        self._stopped.set()
         for subscriber in self._subscribers:
             subscriber.unregister()
         if self._publisher is not None:

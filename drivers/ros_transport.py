@@ -77,7 +77,7 @@ class RosTransport(Protocol):
     """A connection of one node to a ROS graph.
 
     Methods block (the node has nothing else to do) and are called from one thread;
-    ``close`` may come from another (a signal's handler) and ends a blocked iteration.
+    ``stop`` may come from a signal's handler and ends the iterations and waits.
     """
 
     def audio_info(self, topic: str, *, timeout: float) -> AudioFormat | None:
@@ -86,7 +86,13 @@ class RosTransport(Protocol):
 
     def subscribe(self, topic: str, kind: Kind) -> Iterator[Message]:
         """Every message of ``topic`` from now on, in order, none dropped; each ``next``
-        waits for the next message.  Ends when the transport is closed."""
+        waits for the next message.  Ends after :meth:`stop`, once the messages received
+        before it are taken."""
+        ...
+
+    def stop(self) -> None:
+        """End the subscriptions (see :meth:`subscribe`) and the wait for ``AudioInfo``.
+        Only sets a flag, so a signal's handler may call it."""
         ...
 
     def advertise(self, topic: str) -> None:

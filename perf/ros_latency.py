@@ -70,6 +70,8 @@ def main() -> None:
     args = parser.parse_args()
     if shutil.which("rosmaster") is None:
         sys.exit("ROS 1 is not installed: bash scripts/install.sh")
+    load = ", ".join(f"{value:.1f}" for value in os.getloadavg())
+    print(f"Machine load average (1, 5, 15 min): {load} on {os.cpu_count()} cores")
     with tempfile.TemporaryDirectory() as folder_name:
         folder = Path(folder_name)
         url = f"sqlite:///{folder / 'touchbench.db'}"
@@ -124,6 +126,8 @@ def main() -> None:
         heard = peer.touches[: len(trigger)]
         ros = [1000 * (t["received"] - peer.sent[i]) for t, i in zip(heard, trigger, strict=True)]
         reported = [t["touch"]["latency_ms"] for t in heard]
+    load = ", ".join(f"{value:.1f}" for value in os.getloadavg())
+    print(f"Machine load average at the end: {load}")
     print(
         f"touchbench ros, cc:rf on uc3m-audio, {len(trigger)} touches, messages of "
         f"{args.block} samples ({1000 * args.block / rate:.1f} ms), node on core {args.core}"

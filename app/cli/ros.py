@@ -8,6 +8,7 @@ import typer
 
 from app.cli.output import info
 from app.cli.requests import build_request
+from app.cli.signals import deferred_interrupts
 from app.cli.state import get_state
 from app.schemas.ros import RosNodeRequest, SampleFormat
 
@@ -109,12 +110,15 @@ def ros_command(
         )
 
     try:
-        run_ros_node(
-            store,
-            request,
-            transport,
-            on_ready=ready,
-            on_touch=lambda touch: _show(touch.to_json(), True) if as_json else None,
-        )
+        # Ctrl-C stops the node between two messages, never inside the processing of one:
+        # what was received is processed and the touches still open are published.
+        with deferred_interrupts(transport.stop):
+            run_ros_node(
+                store,
+                request,
+                transport,
+                on_ready=ready,
+                on_touch=lambda touch: _show(touch.to_json(), True) if as_json else None,
+            )
     finally:
         transport.close()

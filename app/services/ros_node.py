@@ -28,8 +28,9 @@ def run_ros_node(
     on_ready: Callable[[Source], None] | None = None,
     on_touch: Callable[[TouchPrediction], None] | None = None,
 ) -> int:
-    """Publish every touch of the request's topic until interrupted; the touches still
-    open when Ctrl-C comes are published before the interrupt goes on.
+    """Publish every touch of the request's topic until the transport is stopped
+    (:meth:`~drivers.ros_transport.RosTransport.stop`, on Ctrl-C): the messages received
+    before the stop are processed, then the touches still open are published.
 
     Parameters
     ----------
@@ -41,7 +42,7 @@ def run_ros_node(
     Returns
     -------
     int
-        Touches published, when the transport ends the stream (its node was shut down).
+        Touches published.
     """
     info, model = load_live_model(store, request.model)
     recipe = info.extraction or {}
@@ -84,12 +85,9 @@ def run_ros_node(
         )
         if on_ready is not None:
             on_ready(source)
-        try:
-            for block in source.blocks():
-                for touch in session.feed(block.samples, block.time, arrived=block.arrived):
-                    publish(touch)
-        except KeyboardInterrupt:
-            for touch in session.finish():
+        for block in source.blocks():
+            for touch in session.feed(block.samples, block.time, arrived=block.arrived):
                 publish(touch)
-            raise
+        for touch in session.finish():
+            publish(touch)
     return published

@@ -79,34 +79,44 @@ def stop(process: subprocess.Popen[str]) -> tuple[int, str, str]:
     return process.returncode, out, err
 
 
+@pytest.mark.parametrize("kind", ["audio", "taxels"])
 def test_the_node_publishes_the_touches_live_replay_prints(
+    kind: str,
     ros_env: dict[str, str],
     trained: tuple[str, str, Path],
     tmp_path: Path,
     capsys: pytest.CaptureFixture[str],
 ) -> None:
+    """The session cut short in the middle of its last touch, so that touch is still open
+    when the stream stops: ``live`` prints it at the end of the file, the node when
+    interrupted.  As taxels, the same samples as Float32MultiArray blocks."""
     url, model, unseen = trained
-    replay = run_cli(capsys, url, "live", "--model", model, "--replay", str(unseen), "--json")
-    assert replay.code == 0, replay.err
-    expected = [json.loads(line) for line in replay.out.splitlines()]
-    assert len(expected) == 5
     samples, rate = soundfile.read(unseen, dtype="float32", always_2d=True)
-    # The touches the stream gives before its end, and those only its end closes (the node
-    # publishes those when interrupted, as `live` prints them at the end of the file).
+    whole = run_cli(capsys, url, "live", "--model", model, "--replay", str(unseen), "--json")
+    assert whole.code == 0, whole.err
+    last = json.loads(whole.out.splitlines()[-1])
+    samples = samples[: int((last["start"] + last["end"]) / 2 * rate)]
+    cut = tmp_path / "cut.wav"
+    soundfile.write(cut, samples, int(rate), subtype="FLOAT")
+    replay = run_cli(capsys, url, "live", "--model", model, "--replay", str(cut), "--json")
+    expected = [json.loads(line) for line in replay.out.splitlines()]
     store = Store(url)
-    try:
+    try:  # the touches that come out while the stream flows: all but the last
         session = open_live(store, model, samplerate=rate, n_channels=3)
         blocks = [samples[i : i + 512].T.astype(np.float64) for i in range(0, len(samples), 512)]
         while_streaming = sum(len(session.feed(block)) for block in blocks)
     finally:
         store.dispose()
+    assert len(expected) == 5 and while_streaming == 4, (len(expected), while_streaming)
     np.save(tmp_path / "audio.npy", samples.T)
 
-    node = start_node(ros_env, url, "--model", model, "--audio-topic", "/mic/audio")
+    topic = ("--audio-topic" if kind == "audio" else "--taxel-topic", "/mic/signal")
+    node = start_node(ros_env, url, "--model", model, *topic)
+    peer_options = ("--info", "/mic/audio_info") if kind == "audio" else ("--taxels",)
     peer = Peer(
         ros_env,
         str(tmp_path / "audio.npy"),
-        *("--topic", "/mic/audio", "--info", "/mic/audio_info"),
+        *("--topic", "/mic/signal", *peer_options),
         patience=PATIENCE,
     )
     try:
@@ -122,5 +132,5 @@ def test_the_node_publishes_the_touches_live_replay_prints(
     assert "Traceback" not in err
     got = [line["touch"] for line in peer.touches]
     assert [t["predictions"] for t in got] == [t["predictions"] for t in expected]
-    assert [t["start"] for t in got] == [t["start"] for t in expected]
+    assert [(t["start"], t["end"]) for t in got] == [(t["start"], t["end"]) for t in expected]
     assert all(t["latency_ms"] >= 0 for t in got)

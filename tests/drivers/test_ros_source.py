@@ -38,6 +38,9 @@ class ListTransport:
     def publish(self, text: str) -> None:
         self.published.append(text)
 
+    def stop(self) -> None:
+        pass
+
     def close(self) -> None:
         pass
 
