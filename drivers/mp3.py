@@ -26,6 +26,8 @@ from drivers.errors import DriverError
 
 #: Bytes of the stream kept behind the read position, for libsndfile's short seeks back.
 WINDOW = 1 << 20
+#: The length an unbounded (live) stream reports: beyond any stream's end.
+UNBOUNDED = 1 << 50
 
 #: Kilobits per second by (MPEG-1?, layer) and bitrate index (0: free format, unused here).
 _BITRATES = {
@@ -50,17 +52,30 @@ class ChunkStream:
         start) each time it is called.
     window : int
         Bytes kept behind the read position; a seek further back starts the chunks over.
+    unbounded : bool
+        A live stream (ROS messages as they come), which has no end to count the frames
+        up to and cannot be read again: see Notes.
 
     Notes
     -----
     ``seek(0, SEEK_END)`` then ``tell()`` gives 0: the length is not known without
     reading everything, and libsndfile, for a length of 0, counts the frames exactly
-    (see the module docstring).
+    (see the module docstring).  That count would wait for the end of a live stream, so
+    an unbounded stream reports :data:`UNBOUNDED` bytes instead (mpg123 then estimates
+    more frames than any stream has and reads on as they come), and reads near that
+    far end (mpg123 looking for an ID3v1 tag) give zeros (no tag).
     """
 
-    def __init__(self, open_chunks: Callable[[], Iterator[bytes]], *, window: int = WINDOW):
+    def __init__(
+        self,
+        open_chunks: Callable[[], Iterator[bytes]],
+        *,
+        window: int = WINDOW,
+        unbounded: bool = False,
+    ):
         self._open = open_chunks
         self._window = window
+        self._unbounded = unbounded
         self._restart()
         self.restarts = 0  # how often the chunks were read from the start again
 
@@ -74,7 +89,13 @@ class ChunkStream:
     def read(self, size: int = -1) -> bytes:
         if self._at_end:
             return b""
+        if self._unbounded and self._position >= UNBOUNDED // 2:
+            size = max(0, min(size, UNBOUNDED - self._position))
+            self._position += size
+            return bytes(size)
         if self._position < self._buffer_start:
+            if self._unbounded:
+                raise DriverError("cannot read a live MP3 stream again from its start")
             position = self._position
             self._restart()
             self.restarts += 1
@@ -101,6 +122,9 @@ class ChunkStream:
             self._buffer_start += excess
 
     def seek(self, offset: int, whence: int = os.SEEK_SET) -> int:
+        if whence == os.SEEK_END and self._unbounded:
+            self._position = max(0, UNBOUNDED + offset)
+            return self._position
         if whence == os.SEEK_END:
             self._at_end = True
             return 0
@@ -134,6 +158,8 @@ class Mp3Decoder:
         As for :class:`ChunkStream`.
     name : str
         What the stream is, for messages.
+    unbounded : bool
+        A live stream, decoded as its chunks come (see :class:`ChunkStream`).
 
     Attributes
     ----------
@@ -146,9 +172,11 @@ class Mp3Decoder:
         libsndfile cannot read the bytes as MPEG audio.
     """
 
-    def __init__(self, open_chunks: Callable[[], Iterator[bytes]], *, name: str) -> None:
+    def __init__(
+        self, open_chunks: Callable[[], Iterator[bytes]], *, name: str, unbounded: bool = False
+    ) -> None:
         self.name = name
-        self.stream = ChunkStream(open_chunks)
+        self.stream = ChunkStream(open_chunks, unbounded=unbounded)
         try:
             self._file = _ForwardFile(self.stream)
         except (soundfile.LibsndfileError, RuntimeError, TypeError) as error:

@@ -2,7 +2,9 @@
 # Sets touchbench up on a fresh Debian machine with Python >= 3.11: the system libraries it
 # needs (PortAudio for sound-card capture, libsndfile for audio files; WEKA and a Java
 # runtime, which the tests run to check the WEKA-named classifiers; Chromium, which the
-# web-page tests drive through Playwright; wrk, the HTTP load generator of perf/serve.py),
+# web-page tests drive through Playwright; wrk, the HTTP load generator of perf/serve.py;
+# ROS 1 (rosmaster, rospy, genpy) for `touchbench ros` and its tests, which reach these
+# system packages from the venv through drivers/ros1.py only),
 # a .venv/ at the repository root, and touchbench
 # with its test tools installed (editable) inside it.
 # Safe to run again: it only does what is missing.
@@ -30,7 +32,8 @@ if ! "$PYTHON" -c 'import sys; sys.exit(sys.version_info < (3, 11))' 2>/dev/null
   exit 2
 fi
 
-apt_install libportaudio2 libsndfile1 weka default-jre-headless chromium wrk
+apt_install libportaudio2 libsndfile1 weka default-jre-headless chromium wrk \
+  ros-core python3-rospy python3-genpy python3-rosgraph
 "$PYTHON" -c 'import ensurepip, venv' 2>/dev/null || apt_install python3-venv
 
 [ -x .venv/bin/python ] || "$PYTHON" -m venv .venv

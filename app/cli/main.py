@@ -178,6 +178,12 @@ COMMANDS = (
         "Predict every touch of a live stream with a model: its own event detection and "
         "extractor run on the stream, and each touch is printed as soon as it ends.",
     ),
+    Subcommand(
+        "ros",
+        "app.cli.ros",
+        "Run a ROS node that predicts every touch of an audio or taxel topic with a model and "
+        "publishes each as a std_msgs/String JSON message (what `live --json` prints).",
+    ),
 )
 
 

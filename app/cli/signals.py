@@ -70,6 +70,44 @@ def _interrupt(signum: int, frame: FrameType | None) -> None:
     raise Interrupted(signum)
 
 
+@contextmanager
+def deferred_interrupts(on_interrupt: Callable[[], object]) -> Iterator[None]:
+    """Within the block, the first SIGINT or SIGTERM only calls ``on_interrupt`` (which
+    must not block: set a flag) and the block ends its work in its own time; at the end
+    of the block it raises :class:`Interrupted` as :func:`interrupts` would have.  A
+    second signal raises at once (a stuck command still stops on a second Ctrl-C).
+
+    For a loop that must not be cut in the middle of an item (a ROS node between two
+    messages: the audio already received is still processed and published).  In another
+    thread than the main one nothing is installed.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    heard: list[int] = []
+
+    def handler(signum: int, frame: FrameType | None) -> None:
+        if heard:
+            raise Interrupted(signum)
+        heard.append(signum)
+        on_interrupt()
+
+    previous = {signum: signal.getsignal(signum) for signum in INTERRUPTS}
+    for signum in INTERRUPTS:
+        signal.signal(signum, handler)
+    try:
+        yield
+    except Exception:
+        if heard:  # what the interrupt cut short (a wait given up) is not the news
+            raise Interrupted(heard[0]) from None
+        raise
+    finally:
+        for signum, before in previous.items():
+            signal.signal(signum, before if before is not None else signal.SIG_DFL)
+    if heard:
+        raise Interrupted(heard[0])
+
+
 def redeliver_lost_interrupts() -> None:
     """Install a ``sys.unraisablehook`` that re-sends an interrupt a finaliser swallowed.
 

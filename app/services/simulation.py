@@ -77,15 +77,15 @@ def write_labels(path: Path, rows: list[tuple[str, float, float, str, str]]) -> 
 
 
 def write_contact_mic_sessions(
-    folder: Path, *, trials: int, seed: int = 0
+    folder: Path, *, trials: int, seed: int = 0, n_touches: int = 16
 ) -> tuple[list[Path], Path]:
-    """``trials`` simulated contact-microphone sessions of 16 touches and their labels CSV
-    (``file,start,end,gesture,place``)."""
+    """``trials`` simulated contact-microphone sessions of ``n_touches`` touches and their
+    labels CSV (``file,start,end,gesture,place``)."""
     folder.mkdir(parents=True, exist_ok=True)
     paths, rows = [], []
     for trial in range(trials):
         path, touches = write_session(
-            folder, f"session{trial + 1}", n_touches=16, seed=seed + trial
+            folder, f"session{trial + 1}", n_touches=n_touches, seed=seed + trial
         )
         paths.append(path)
         rows += [(path.name, *touch) for touch in touches]
