@@ -13,9 +13,10 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 
 from app.cli.extract import key_values
-from app.cli.output import JsonOption, info, print_json, table
+from app.cli.output import JsonOption, info, print_json, table, warn
 from app.cli.state import get_state
 from app.errors import AppError
 from drivers.source import LIVE_BLOCK
@@ -160,7 +161,16 @@ def simulate_command(
 
 def live_command(
     ctx: typer.Context,
-    model: Annotated[str, typer.Option("--model", "-m", metavar="MODEL", help="Model name or id.")],
+    model: Annotated[
+        str,
+        typer.Option(
+            "--model",
+            "-m",
+            metavar="MODEL",
+            help="Model id, NAME (its newest version), NAME@VERSION or NAME@ALIAS; NAME and "
+            "NAME@ALIAS are followed: a new version they name answers the next touches.",
+        ),
+    ],
     device: Annotated[
         str | None,
         typer.Option("--device", "-d", metavar="DEV", help="Capture device index or name."),
@@ -212,14 +222,15 @@ def live_command(
 ) -> None:
     """Predict every touch of a live stream with a model: its own event detection and
     extractor run on the stream, and each touch is printed as soon as it ends."""
-    from app.services.live import LiveSession, load_live_model
+    from app.services.live import LiveSession, follower, load_live_model
     from drivers.replay import FileReplaySource
     from drivers.sound import SoundDeviceSource
     from drivers.source import Source
 
     if (device is None) == (replay is None):
         raise AppError("give exactly one of --device DEV or --replay FILE")
-    model_info, trained = load_live_model(get_state(ctx).store, model)
+    store = get_state(ctx).store
+    model_info, trained = load_live_model(store, model)
     extraction = model_info.extraction
     source: Source
     if replay is not None:
@@ -247,6 +258,7 @@ def live_command(
             samplerate=source.samplerate,
             n_channels=source.n_channels,
             extraction=extraction,
+            follow=follower(store, model, model_info),
         )
         shown = 0
         try:
@@ -254,6 +266,7 @@ def live_command(
                 for touch in session.feed(block.samples, block.time, arrived=block.arrived):
                     _show(touch.to_json(), as_json)
                     shown += 1
+                _tell(session.take_events())
                 if seconds is not None and block.time >= seconds:
                     break
         except KeyboardInterrupt:
@@ -267,6 +280,15 @@ def live_command(
         info(f"[yellow]warning:[/yellow] {source.overflows} block(s) were lost (overflow)")
     if not as_json:
         info(f"{shown} touch(es) recognised")
+
+
+def _tell(events: list[dict[str, str]]) -> None:
+    """What happened to a followed model (``NAME@champion`` moved), on stderr."""
+    for event in events:
+        if "switched" in event:
+            info(f"now predicting with {escape(event['switched'])} (was {escape(event['from'])})")
+        else:
+            warn(event["warning"])
 
 
 def _show(touch: dict, as_json: bool) -> None:

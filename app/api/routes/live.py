@@ -4,14 +4,22 @@ The client sends a JSON header ``{"samplerate": 44100, "channels": 3, "format": 
 (``format``: S16LE, S32LE or F32LE; ``api_key`` here when the handshake could not carry
 the ``X-API-Key`` header), then binary messages of interleaved samples, and
 ``{"end": true}`` when its stream ends.  The server sends one JSON message per detected touch,
-as ``touchbench live --json`` prints it, and closes with a reason on bad input: 1008 for a
+as ``touchbench live --json`` prints it (its ``model`` says which version answered), and
+closes with a reason on bad input: 1008 for a
 missing or wrong key or a model that cannot run live, 1007 for a malformed header or block,
 1009 for a block over the size limit, 1000 when the stream ended.
+
+A session on ``NAME@ALIAS`` (or ``NAME``, the newest version) follows it: when the alias
+moves, the next touches are answered by the new version without the stream being
+dropped, and the server sends ``{"switched": "NAME@3", "from": "NAME@2"}`` first; a new
+version that extracts its features otherwise is not taken, and ``{"warning": "..."}`` says
+so once.
 """
 
 from __future__ import annotations
 
 import asyncio
+import functools
 import json
 from typing import Any
 
@@ -49,11 +57,20 @@ async def live(websocket: WebSocket, model_ref: str) -> None:
         header = await _header(websocket)
         _check_key(service, websocket, header)
         samplerate, channels, sample_format = _stream_format(header)
-        info, model = await run_in_threadpool(service.models.get, service.store, model_ref)
-        from app.services.live import LiveSession  # start-up time: the feature stack
+        from app.services.live import open_live  # start-up time: the feature stack
 
         try:
-            session = LiveSession(info, model, samplerate=samplerate, n_channels=channels)
+            session = await run_in_threadpool(
+                functools.partial(
+                    open_live,
+                    service.store,
+                    model_ref,
+                    samplerate=samplerate,
+                    n_channels=channels,
+                    load=service.models.get,
+                    follow_seconds=service.settings.live_follow_seconds,
+                )
+            )
         except USER_ERRORS as error:
             raise _Closed(POLICY, str(error)) from None
         frame = channels * np.dtype(SAMPLE_FORMATS[sample_format][0]).itemsize
@@ -71,6 +88,8 @@ async def live(websocket: WebSocket, model_ref: str) -> None:
                 except DriverError as error:
                     raise _Closed(INVALID, str(error)) from None
                 touches = await run_in_threadpool(session.feed, block)
+                for event in session.take_events():
+                    await websocket.send_json(event)
             else:
                 if _json(message.get("text")).get("end") is not True:
                     raise _Closed(INVALID, 'text messages after the header must be {"end": true}')
