@@ -100,7 +100,12 @@ class ModelCache:
         known to be quick: the model is loaded and its recent predictions took under
         :data:`INLINE_SECONDS` of CPU time for that size."""
         with self._lock:
-            model_id = self._refs.get(ref)
+            model_id = self._refs.get(ref)  # what ``ref`` named last (NAME@champion...)
+            if model_id is None:
+                for loaded, _, label in self._models:
+                    if ref in (label, label.rpartition("@")[0], str(loaded)):
+                        model_id = loaded
+                        break
             seconds = None if model_id is None else self._seconds.get(model_id)
         return seconds is not None and seconds * size <= INLINE_SECONDS
 
@@ -139,6 +144,8 @@ class ModelCache:
             for key in [key for key in self._models if key[0] == model_id]:
                 del self._models[key]
             self._seconds.pop(model_id, None)
+            for ref in [ref for ref, known in self._refs.items() if known == model_id]:
+                del self._refs[ref]
 
 
 @dataclass
