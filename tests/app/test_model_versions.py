@@ -25,6 +25,7 @@ from app.store.models import (
     set_alias,
 )
 from app.store.tables import DatasetRow, ModelRow
+from tests.app.cli_runner import run_cli
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 
@@ -188,3 +189,33 @@ def test_two_processes_storing_one_name_get_distinct_versions(store_url: str) ->
     finally:
         store.dispose()
     assert versions == list(range(1, 2 * each + 1))
+
+
+def test_the_cli_promotes_aliases_and_rolls_back(
+    capsys: pytest.CaptureFixture[str], store: Store, store_url: str
+) -> None:
+    for _ in range(3):
+        _save(store)
+    assert run_cli(capsys, store_url, "promote", "mic@1").code == 0
+    promoted = run_cli(capsys, store_url, "promote", "mic@3", "--json")
+    assert promoted.json() == {"alias": "champion", "model": "mic@3", "version": 3, "previous": 1}
+    aliased = run_cli(capsys, store_url, "alias", "mic@2", "staging")
+    assert aliased.code == 0 and "mic@staging is now version 2" in aliased.err
+    listing = run_cli(capsys, store_url, "models", "--json").json()["models"]
+    assert [(m["version"], m["aliases"]) for m in listing] == [
+        (1, []),
+        (2, ["staging"]),
+        (3, ["champion"]),
+    ]
+    back = run_cli(capsys, store_url, "rollback", "mic")
+    assert back.code == 0 and "mic@champion is now version 1 (was version 3)" in back.err
+    refused = [
+        (("alias", "mic@2", "2"), "ALIAS: an alias starts with a letter"),
+        (("promote", "mic@9"), "model 'mic' has no version 9"),
+        (("rollback", "mic"), "nothing to roll back to"),
+        (("rollback", "mic", "--alias", "beta"), "no alias 'beta' to roll back"),
+    ]
+    for args, words in refused:
+        result = run_cli(capsys, store_url, *args)
+        assert result.code == 2 and words in result.err, (args, result.err)
+        assert len(result.err.strip().splitlines()) == 1
