@@ -229,8 +229,7 @@ def model_version(store: Store, ref: str | int) -> tuple[int, str, str]:
     text = str(ref)
     found = None
     if may_be_name(text):
-        found = store.first_row(_VERSION_BY_NAME, ref=text)
-        if found is None and "@" in text:
+        if "@" in text:  # one query for NAME@champion; a name stored with '@' next
             name, _, suffix = text.rpartition("@")
             if is_row_id(suffix):
                 found = store.first_row(_VERSION_BY_NUMBER, ref=name, number=int(suffix))
@@ -238,6 +237,8 @@ def model_version(store: Store, ref: str | int) -> tuple[int, str, str]:
                 found = store.first_row(_VERSION_BY_NAME, ref=name)
             else:
                 found = store.first_row(_VERSION_BY_ALIAS, ref=name, alias=suffix)
+        if found is None:
+            found = store.first_row(_VERSION_BY_NAME, ref=text)
     if found is None and is_row_id(text):
         found = store.first_row(_VERSION_BY_ID, ref=int(text))
     if found is None:
@@ -440,8 +441,8 @@ def _row(session: Session, ref: str | int) -> ModelRow:
     """The model version ``ref`` names: a name (its newest version), an id, or
     ``NAME@VERSION``, ``NAME@latest``, ``NAME@ALIAS``.
 
-    A name is looked up whole first, so that a model stored with ``@`` in its name before
-    names refused it is still found.
+    A name with ``@`` in it that names no version is looked up whole, so that a model
+    stored with ``@`` in its name before names refused it is still found.
 
     Raises
     ------
@@ -450,14 +451,24 @@ def _row(session: Session, ref: str | int) -> ModelRow:
     """
     text = str(ref)
     if may_be_name(text):
-        row = session.scalars(
-            select(ModelRow).where(ModelRow.name == text).order_by(ModelRow.version.desc())
-        ).first()
+        if "@" in text:
+            try:
+                return _version_of(session, *text.rpartition("@")[::2])
+            except NotFoundError:
+                row = _newest(session, text)
+                if row is None:
+                    raise
+                return row
+        row = _newest(session, text)
         if row is not None:
             return row
-        if "@" in text and not is_row_id(text):
-            return _version_of(session, *text.rpartition("@")[::2])
     return find_row(session, ModelRow, ref, kind="model", hint="none yet; training makes one")
+
+
+def _newest(session: Session, name: str) -> ModelRow | None:
+    return session.scalars(
+        select(ModelRow).where(ModelRow.name == name).order_by(ModelRow.version.desc())
+    ).first()
 
 
 def _version_of(session: Session, name: str, suffix: str) -> ModelRow:
