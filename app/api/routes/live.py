@@ -19,9 +19,8 @@ so once.
 from __future__ import annotations
 
 import asyncio
-import functools
 import json
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from fastapi import APIRouter, WebSocket, WebSocketDisconnect
@@ -31,6 +30,9 @@ from app.api.deps import KeyRefused, Service, key_name
 from app.errors import USER_ERRORS
 from drivers.errors import DriverError
 from drivers.pcm import SAMPLE_FORMATS, decode_pcm
+
+if TYPE_CHECKING:  # start-up time: the feature stack loads with the first session
+    from app.services.live import LiveSession
 
 router = APIRouter(tags=["models"])
 
@@ -57,20 +59,8 @@ async def live(websocket: WebSocket, model_ref: str) -> None:
         header = await _header(websocket)
         _check_key(service, websocket, header)
         samplerate, channels, sample_format = _stream_format(header)
-        from app.services.live import open_live  # start-up time: the feature stack
-
         try:
-            session = await run_in_threadpool(
-                functools.partial(
-                    open_live,
-                    service.store,
-                    model_ref,
-                    samplerate=samplerate,
-                    n_channels=channels,
-                    load=service.models.get,
-                    follow_seconds=service.settings.live_follow_seconds,
-                )
-            )
+            session = await run_in_threadpool(_open, service, model_ref, samplerate, channels)
         except USER_ERRORS as error:
             raise _Closed(POLICY, str(error)) from None
         frame = channels * np.dtype(SAMPLE_FORMATS[sample_format][0]).itemsize
@@ -107,6 +97,21 @@ async def live(websocket: WebSocket, model_ref: str) -> None:
         return
     except Exception as error:  # never crash the server: say what happened, close
         await websocket.close(code=INTERNAL, reason=f"unexpected {type(error).__name__}")
+
+
+def _open(service: Service, model_ref: str, samplerate: float, channels: int) -> LiveSession:
+    """The session, opened in a worker thread: the first one imports the feature stack and
+    scikit-learn, which must not hold the event loop (and its other sockets' pings) up."""
+    from app.services.live import open_live
+
+    return open_live(
+        service.store,
+        model_ref,
+        samplerate=samplerate,
+        n_channels=channels,
+        load=service.models.get,
+        follow_seconds=service.settings.live_follow_seconds,
+    )
 
 
 async def _header(websocket: WebSocket) -> dict[str, Any]:
