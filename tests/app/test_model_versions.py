@@ -88,12 +88,12 @@ def test_alias_moves_and_rollback_steps_back_through_its_history(store: Store) -
         get_model(store, "mic@champion")
 
 
-@pytest.mark.parametrize("alias", ["3", "latest", "", "with space", "x" * 101])
-def test_aliases_that_would_read_otherwise_are_refused(store: Store, alias: str) -> None:
+def test_aliases_that_would_read_otherwise_are_refused(store: Store) -> None:
     _save(store)
-    with pytest.raises(FieldError) as refused:
-        set_alias(store, "mic@1", alias)
-    assert refused.value.field == "alias"
+    for alias in ["3", "latest", "", "with space", "x" * 101]:
+        with pytest.raises(FieldError) as refused:
+            set_alias(store, "mic@1", alias)
+        assert refused.value.field == "alias", alias
 
 
 def test_names_with_at_are_refused_where_they_would_be_ambiguous(store: Store) -> None:
