@@ -99,6 +99,9 @@ class Settings(BaseSettings):
         Where uploaded recording sessions wait for their extraction job.
     model_cache : int
         Loaded models kept in memory per service process for predictions.
+    live_follow_seconds : float
+        How often a live WebSocket session on ``NAME@ALIAS`` (or ``NAME``) asks the store
+        which version its reference names now (one indexed query); 0: before every block.
     """
 
     model_config = SettingsConfigDict(env_prefix=ENV_PREFIX, extra="ignore")
@@ -117,6 +120,7 @@ class Settings(BaseSettings):
     resume_on_start: bool = False
     work_dir: Path = Field(default_factory=lambda: Path(tempfile.gettempdir()) / "touchbench")
     model_cache: int = Field(default=8, ge=1)
+    live_follow_seconds: float = Field(default=1.0, ge=0, le=3600)
 
     @property
     def max_upload_bytes(self) -> int:

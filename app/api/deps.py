@@ -26,7 +26,8 @@ if TYPE_CHECKING:  # scikit-learn loads on the first prediction, not at start-up
     from benchmark.model import Predictor
 
 
-#: A stored model's id, artifact sha256 and name (:func:`app.store.models.model_version`).
+#: A stored model's id, artifact sha256 and ``NAME@VERSION``
+#: (:func:`app.store.models.model_version`).
 ModelKey = tuple[int, str, str]
 
 log = logging.getLogger("touchbench.api")
@@ -49,12 +50,14 @@ def request_size(instances: Sequence[Mapping[str, object]]) -> int:
 
 
 class ModelCache:
-    """Loaded models by (id, sha256, name), least recently used dropped first; thread-safe.
+    """Loaded models by (id, sha256, ``NAME@VERSION``), least recently used dropped first;
+    thread-safe.
 
     Loading a model checks and rebuilds its artifact (tens to hundreds of milliseconds);
-    a prediction on a cached model costs one indexed query for the model's id, sha256 and
-    name, so a model deleted, renamed or retrained under the same name by another process
-    is never served stale. The cache also keeps how long each model's predictions take
+    a prediction on a cached model costs one indexed query for the id, sha256 and version
+    its reference names now, so a model deleted or renamed by another process, a new
+    version trained under its name, or an alias moved (``NAME@champion``) is never served
+    stale. The cache also keeps how long each model's predictions take
     (:meth:`record`), which decides where the next one runs (:meth:`runs_inline`).
     """
 
@@ -63,6 +66,7 @@ class ModelCache:
         # per model version, per engine asked for: the model or its ONNX twin
         self._models: OrderedDict[ModelKey, dict[str, tuple[ModelInfo, Predictor]]] = OrderedDict()
         self._seconds: dict[int, float] = {}  # model id -> seconds per unit of size
+        self._refs: dict[str, int] = {}  # reference -> the model id it named last
         self._lock = threading.Lock()
         self._in_flight = 0  # predictions under way in this process (changed on the loop only)
         self._thread = ThreadPoolExecutor(1, thread_name_prefix="predict")
@@ -98,11 +102,14 @@ class ModelCache:
         known to be quick: the model is loaded and its recent predictions took under
         :data:`INLINE_SECONDS` of CPU time for that size."""
         with self._lock:
-            for model_id, _, name in self._models:
-                if ref in (name, str(model_id)):
-                    seconds = self._seconds.get(model_id)
-                    return seconds is not None and seconds * size <= INLINE_SECONDS
-        return False
+            model_id = self._refs.get(ref)  # what ``ref`` named last (NAME@champion...)
+            if model_id is None:
+                for loaded, _, label in self._models:
+                    if ref in (label, label.rpartition("@")[0], str(loaded)):
+                        model_id = loaded
+                        break
+            seconds = None if model_id is None else self._seconds.get(model_id)
+        return seconds is not None and seconds * size <= INLINE_SECONDS
 
     def record(self, model_id: int, seconds: float, size: int) -> None:
         """Note that a prediction of ``size`` (:func:`request_size`) took ``seconds`` of its
@@ -120,6 +127,9 @@ class ModelCache:
         :func:`app.services.export.load_predictor`)."""
         key = model_version(store, ref)
         with self._lock:
+            if len(self._refs) >= 64 * self.size and str(ref) not in self._refs:
+                self._refs.clear()  # bounded: clients choose the references
+            self._refs[str(ref)] = key[0]
             cached = self._models.get(key, {}).get(engine)
             if cached is not None:
                 self._models.move_to_end(key)
@@ -130,9 +140,9 @@ class ModelCache:
 
         info, model = load_predictor(store, key[0], engine)
         with self._lock:
-            loaded = self._models.setdefault((info.id, info.sha256, info.name), {})
+            loaded = self._models.setdefault((info.id, info.sha256, info.label), {})
             loaded[engine] = (info, model)
-            self._models.move_to_end((info.id, info.sha256, info.name))
+            self._models.move_to_end((info.id, info.sha256, info.label))
             while len(self._models) > self.size:
                 self._models.popitem(last=False)
         return info, model
@@ -142,6 +152,8 @@ class ModelCache:
             for key in [key for key in self._models if key[0] == model_id]:
                 del self._models[key]
             self._seconds.pop(model_id, None)
+            for ref in [ref for ref, known in self._refs.items() if known == model_id]:
+                del self._refs[ref]
 
 
 @dataclass

@@ -9,13 +9,15 @@ import json
 # is chosen).
 import sys
 from enum import StrEnum
+from functools import partial
 from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 
 from app.cli.extract import key_values
-from app.cli.output import JsonOption, info, print_json, table
+from app.cli.output import JsonOption, info, print_json, table, warn
 from app.cli.state import get_state
 from app.errors import AppError
 from drivers.source import LIVE_BLOCK
@@ -160,7 +162,16 @@ def simulate_command(
 
 def live_command(
     ctx: typer.Context,
-    model: Annotated[str, typer.Option("--model", "-m", metavar="MODEL", help="Model name or id.")],
+    model: Annotated[
+        str,
+        typer.Option(
+            "--model",
+            "-m",
+            metavar="MODEL",
+            help="Model id, NAME (its newest version), NAME@VERSION or NAME@ALIAS; NAME and "
+            "NAME@ALIAS are followed: a new version they name answers the next touches.",
+        ),
+    ],
     device: Annotated[
         str | None,
         typer.Option("--device", "-d", metavar="DEV", help="Capture device index or name."),
@@ -223,7 +234,7 @@ def live_command(
 ) -> None:
     """Predict every touch of a live stream with a model: its own event detection and
     extractor run on the stream, and each touch is printed as soon as it ends."""
-    from app.services.live import LiveSession, load_live_model
+    from app.services.live import LiveSession, follower, load_live_model
     from drivers.replay import FileReplaySource
     from drivers.sound import SoundDeviceSource
     from drivers.source import Source
@@ -234,7 +245,8 @@ def live_command(
     from app.schemas.models import EngineChoice
 
     choice = build_request(EngineChoice, engine=engine)
-    model_info, trained = load_live_model(get_state(ctx).store, model, choice.engine)
+    store = get_state(ctx).store
+    model_info, trained = load_live_model(store, model, choice.engine)
     extraction = model_info.extraction
     source: Source
     if replay is not None:
@@ -262,6 +274,9 @@ def live_command(
             samplerate=source.samplerate,
             n_channels=source.n_channels,
             extraction=extraction,
+            follow=follower(
+                store, model, model_info, load=partial(load_live_model, engine=choice.engine)
+            ),
         )
         shown = 0
         try:
@@ -269,6 +284,7 @@ def live_command(
                 for touch in session.feed(block.samples, block.time, arrived=block.arrived):
                     _show(touch.to_json(), as_json)
                     shown += 1
+                _tell(session.take_events())
                 if seconds is not None and block.time >= seconds:
                     break
         except KeyboardInterrupt:
@@ -282,6 +298,15 @@ def live_command(
         info(f"[yellow]warning:[/yellow] {source.overflows} block(s) were lost (overflow)")
     if not as_json:
         info(f"{shown} touch(es) recognised")
+
+
+def _tell(events: list[dict[str, str]]) -> None:
+    """What happened to a followed model (``NAME@champion`` moved), on stderr."""
+    for event in events:
+        if "switched" in event:
+            info(f"now predicting with {escape(event['switched'])} (was {escape(event['from'])})")
+        else:
+            warn(event["warning"])
 
 
 def _show(touch: dict, as_json: bool) -> None:

@@ -107,13 +107,35 @@ COMMANDS = (
         "app.cli.models",
         "Fit a classifier on every instance of a data set and store the model.",
     ),
-    Subcommand("models", "app.cli.models", "List trained models (artifacts are not read)."),
+    Subcommand(
+        "models",
+        "app.cli.models",
+        "List trained models, a row per version, with their aliases (artifacts are not read).",
+    ),
     Subcommand(
         "predict",
         "app.cli.models",
         "Predict every instance of a file; attributes are matched to the model's by name.",
     ),
-    Subcommand("delete-model", "app.cli.models", "Delete a trained model."),
+    Subcommand(
+        "delete-model",
+        "app.cli.models",
+        "Delete a trained model (one version: NAME alone is its newest).",
+    ),
+    Subcommand(
+        "alias", "app.cli.models", "Point an alias of a model (NAME@ALIAS) at one of its versions."
+    ),
+    Subcommand(
+        "promote",
+        "app.cli.models",
+        "Make a version the model's champion: NAME@champion, which `live`, `serve` and live "
+        "WebSocket sessions on it follow, answers with it from now on (`rollback` undoes).",
+    ),
+    Subcommand(
+        "rollback",
+        "app.cli.models",
+        "Point the champion (or --alias) back at the version it pointed at before its last move.",
+    ),
     Subcommand(
         "export-model",
         "app.cli.models",

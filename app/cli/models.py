@@ -1,4 +1,5 @@
-"""Commands for models: train, models, predict."""
+"""Commands for models: train, models, predict, and the aliases of their versions: alias,
+promote, rollback."""
 
 from __future__ import annotations
 
@@ -6,12 +7,16 @@ from __future__ import annotations
 # one chosen loads only what it uses (the CLI imports the module when a command of it
 # is chosen).
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
 from app.cli.output import JsonOption, info, print_json, table, warn
 from app.cli.state import get_state
+
+if TYPE_CHECKING:
+    from app.schemas.models import AliasRequest
+    from app.store.models import AliasMove
 
 
 def register(app: typer.Typer) -> None:
@@ -20,6 +25,9 @@ def register(app: typer.Typer) -> None:
     app.command("predict")(predict_command)
     app.command("delete-model")(delete_model_command)
     app.command("export-model")(export_model_command)
+    app.command("alias")(alias_command)
+    app.command("promote")(promote_command)
+    app.command("rollback")(rollback_command)
 
 
 EngineOption = Annotated[
@@ -56,7 +64,12 @@ def train_command(
     ] = None,
     name: Annotated[
         str | None,
-        typer.Option("--name", metavar="NAME", help="Model name (default: DATASET-CLASSIFIER)."),
+        typer.Option(
+            "--name",
+            metavar="NAME",
+            help="Model name (default: DATASET-CLASSIFIER); a name already taken gets its "
+            "next version.",
+        ),
     ] = None,
     seed: Annotated[
         int | None,
@@ -83,13 +96,13 @@ def train_command(
         print_json(model.to_json())
         return
     info(
-        f"trained model {model.id} '{model.name}': {model.classifier} on {model.dataset_name} "
+        f"trained model {model.id} '{model.label}': {model.classifier} on {model.dataset_name} "
         f"for {', '.join(model.targets)} ({model.size_bytes:,} bytes, sha256 {model.sha256[:12]})"
     )
 
 
 def models_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
-    """List trained models (artifacts are not read)."""
+    """List trained models, a row per version, with their aliases (artifacts are not read)."""
     from app.schemas.models import ModelList
     from app.store.models import list_models
 
@@ -102,11 +115,24 @@ def models_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
         return
     table(
         None,
-        ["id", "name", "classifier", "dataset", "targets", "bytes", "live", "trained"],
+        [
+            "id",
+            "name",
+            "version",
+            "aliases",
+            "classifier",
+            "dataset",
+            "targets",
+            "bytes",
+            "live",
+            "trained",
+        ],
         [
             (
                 m.id,
                 m.name,
+                m.version,
+                ", ".join(m.aliases),
                 m.classifier,
                 m.dataset_name,
                 ", ".join(m.targets),
@@ -122,7 +148,12 @@ def models_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
 def predict_command(
     ctx: typer.Context,
     model_ref: Annotated[
-        str, typer.Argument(metavar="MODEL", help="Model name or id.", show_default=False)
+        str,
+        typer.Argument(
+            metavar="MODEL",
+            help="Model id, NAME (its newest version), NAME@VERSION or NAME@ALIAS.",
+            show_default=False,
+        ),
     ],
     file: Annotated[
         Path,
@@ -185,11 +216,11 @@ def delete_model_command(
         str, typer.Argument(metavar="MODEL", help="Model name or id.", show_default=False)
     ],
 ) -> None:
-    """Delete a trained model."""
+    """Delete a trained model (one version: NAME alone is its newest)."""
     from app.store.models import delete_model
 
     gone = delete_model(get_state(ctx).store, model_ref)
-    info(f"deleted model {gone.id} '{gone.name}'")
+    info(f"deleted model {gone.id} '{gone.label}'")
 
 
 def export_model_command(
@@ -237,3 +268,76 @@ def export_model_command(
         f"'{exported.model}' as ONNX, same labels and probabilities within 1e-5 on its "
         f"{exported.checked_instances} training instances"
     )
+
+
+_VERSION_ARGUMENT = typer.Argument(
+    metavar="MODEL@VERSION",
+    help="The version: NAME@VERSION (or an id, NAME for the newest, NAME@ALIAS).",
+    show_default=False,
+)
+
+
+def alias_command(
+    ctx: typer.Context,
+    model_ref: Annotated[str, _VERSION_ARGUMENT],
+    alias: Annotated[
+        str,
+        typer.Argument(metavar="ALIAS", help="The alias, e.g. champion.", show_default=False),
+    ],
+    as_json: JsonOption = False,
+) -> None:
+    """Point an alias of a model (NAME@ALIAS) at one of its versions."""
+    from app.services.models import move_alias
+
+    _moved(move_alias(get_state(ctx).store, _alias_request(model_ref, alias)), as_json)
+
+
+def promote_command(
+    ctx: typer.Context,
+    model_ref: Annotated[str, _VERSION_ARGUMENT],
+    as_json: JsonOption = False,
+) -> None:
+    """Make a version the model's champion: NAME@champion, which `live`, `serve` and live
+    WebSocket sessions on it follow, answers with it from now on (`rollback` undoes)."""
+    from app.services.models import move_alias
+
+    _moved(move_alias(get_state(ctx).store, _alias_request(model_ref, None)), as_json)
+
+
+def rollback_command(
+    ctx: typer.Context,
+    model_ref: Annotated[
+        str,
+        typer.Argument(
+            metavar="MODEL", help="Model name (or any of its versions).", show_default=False
+        ),
+    ],
+    alias: Annotated[
+        str | None,
+        typer.Option(
+            "--alias", metavar="ALIAS", help="The alias to step back.", show_default="champion"
+        ),
+    ] = None,
+    as_json: JsonOption = False,
+) -> None:
+    """Point the champion (or --alias) back at the version it pointed at before its last move."""
+    from app.services.models import roll_back
+
+    _moved(roll_back(get_state(ctx).store, _alias_request(model_ref, alias)), as_json)
+
+
+def _alias_request(model_ref: str, alias: str | None) -> AliasRequest:
+    from app.cli.requests import build_request
+    from app.schemas.models import AliasRequest
+
+    return build_request(
+        AliasRequest, {"model": "MODEL", "alias": "ALIAS"}, model=model_ref, alias=alias
+    )
+
+
+def _moved(move: AliasMove, as_json: bool) -> None:
+    if as_json:
+        print_json(move.to_json())
+        return
+    before = "" if move.previous is None else f" (was version {move.previous})"
+    info(f"{move.model.name}@{move.alias} is now version {move.model.version}{before}")

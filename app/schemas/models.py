@@ -10,7 +10,7 @@ from pydantic import ConfigDict, Field, model_validator
 
 from app.errors import FieldError
 from app.schemas.base import Request, Schema
-from app.schemas.names import ModelName
+from app.schemas.names import AliasName, ModelName
 
 #: The largest id or seed (the store's integer columns are 32-bit on PostgreSQL).
 MAX_ID = 2**31 - 1
@@ -21,6 +21,10 @@ class ModelSchema(Schema):
 
     id: int
     name: str
+    version: int = Field(description="1, 2, ...: training again under a name adds a version.")
+    aliases: list[str] = Field(
+        default_factory=list, description="Aliases pointing at this version (champion)."
+    )
     classifier: str
     targets: list[str]
     dataset: str | None = Field(description="Name of the training data set (null if deleted).")
@@ -55,7 +59,7 @@ class PredictionRow(Schema):
 class PredictionReport(Schema):
     """Predictions of a model for a file or a list of instances."""
 
-    model: str
+    model: str = Field(description="NAME@VERSION: the version that answered.")
     targets: list[str]
     predictions: list[PredictionRow]
     accuracy: dict[str, float] = Field(
@@ -185,3 +189,29 @@ class TrainRequest(Request):
         if self.classifier is None:
             raise FieldError("classifier", "is required with `dataset`")
         return self
+
+
+class AliasRequest(Request):
+    """``alias``, ``promote`` and ``rollback`` (``POST /api/models/{model}/aliases``,
+    ``.../promote``, ``.../rollback``): point an alias of a model at one of its versions, or
+    step it back to the version it pointed at before."""
+
+    model: str = Field(
+        min_length=1, max_length=400, description="MODEL@VERSION (any reference to a version)."
+    )
+    alias: AliasName = Field(default="champion", description="The alias (champion).")
+
+
+class AliasBody(Request):
+    """``POST /api/models/{model}/aliases`` (and ``.../rollback``): the alias to move."""
+
+    alias: AliasName = Field(default="champion", description="The alias (champion).")
+
+
+class AliasMoved(Schema):
+    """An alias set or stepped back: the version it points at now, and before."""
+
+    alias: str
+    model: str = Field(description="NAME@VERSION it points at now.")
+    version: int
+    previous: int | None = Field(description="The version it pointed at before (null: none).")

@@ -5,7 +5,10 @@ A name is how a user finds a row again, on the command line and in a URL path
 (``/api/datasets/{name}``), so it must survive both: not empty, at most :data:`MAX_NAME`
 characters, no control characters, no spaces at its ends, no ``/`` (a path segment
 cannot hold one: ``a/b`` would be stored and never reached by name again), and not a
-number (a number is read as an id).
+number (a number is read as an id).  A model's name holds no ``@`` either: ``NAME@VERSION``
+and ``NAME@ALIAS`` name one of its versions.
+
+An alias (``champion``) starts with a letter, so that it is never read as a version number.
 """
 
 from __future__ import annotations
@@ -61,7 +64,39 @@ def check_name(name: str, *, kind: str) -> str:
         )
     if name.isascii() and name.isdigit():
         raise AppError(f"a {kind} name cannot be a number ('{name}' would read as an id)")
+    if kind == "model" and "@" in name:
+        raise AppError(
+            f"a model name cannot hold '@' (NAME@VERSION and NAME@ALIAS name a version of "
+            f"model NAME): '{shown(name)}'"
+        )
     return name
+
+
+#: The longest alias the store keeps (``model_aliases.alias`` is ``String(100)``).
+MAX_ALIAS = 100
+_ALIAS = re.compile(r"[A-Za-z][A-Za-z0-9_.-]*")
+#: ``NAME@latest`` is the newest version, whatever the aliases say.
+LATEST = "latest"
+
+
+def check_alias(alias: str) -> str:
+    """``alias`` if it can name a version of a model (``champion``, ``staging``).
+
+    Raises
+    ------
+    AppError
+        Saying which rule the alias breaks.
+    """
+    if len(alias) > MAX_ALIAS:
+        raise AppError(f"an alias has at most {MAX_ALIAS} characters, got {len(alias)}")
+    if not _ALIAS.fullmatch(alias):
+        raise AppError(
+            f"an alias starts with a letter and holds only letters, digits, '_', '.' and '-' "
+            f"(a number would read as a version): '{shown(alias)}'"
+        )
+    if alias == LATEST:
+        raise AppError(f"'{LATEST}' is not an alias: NAME@{LATEST} is always the newest version")
+    return alias
 
 
 def shown(text: str, limit: int = _SHOWN) -> str:
@@ -84,3 +119,14 @@ def _field_rule(kind: str) -> Callable[[str, ValidationInfo], str]:
 DatasetName = Annotated[str, AfterValidator(_field_rule("dataset"))]
 #: A request's field that names a new model.
 ModelName = Annotated[str, AfterValidator(_field_rule("model"))]
+
+
+def _alias_rule(alias: str, info: ValidationInfo) -> str:
+    try:
+        return check_alias(alias)
+    except AppError as error:
+        raise FieldError(info.field_name or "alias", str(error)) from None
+
+
+#: A request's field that names an alias of a model's version.
+AliasName = Annotated[str, AfterValidator(_alias_rule)]

@@ -5,13 +5,21 @@ options and the event detector that made its training data) through the streamin
 engine, so live features are computed exactly as the training features were, and
 predicts every instance as soon as its event ends.  Its methods are plain synchronous
 calls, so that a CLI loop and an async WebSocket handler (in a worker thread) share it.
+
+A session opened on a reference that can name another version later (``NAME``: the
+newest version; ``NAME@champion``) follows it (:class:`ModelFollower`): between two blocks
+it asks the store, at most once per second, which version the reference names, and
+switches to a new one without dropping the stream when that version extracts its features
+the same way (same recipe, sample rate and channels); otherwise it keeps the model it has
+and says why once.  Each prediction names the version that made it.
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -20,7 +28,7 @@ from app.errors import AppError
 from app.schemas.models import Engine
 from app.services.export import load_predictor
 from app.store.database import Store
-from app.store.models import ModelInfo
+from app.store.models import ModelInfo, is_pinned, model_version
 from benchmark.model import Predictor
 from features.errors import FeatureError
 from features.extractors import Instances
@@ -41,12 +49,15 @@ class TouchPrediction:
     latency_ms : float
         From the end of the event to the prediction: how long after its last sample
         the block holding it arrived, plus the time to extract and predict.
+    model : str
+        ``NAME@VERSION`` of the model version that made the prediction.
     """
 
     start: float
     end: float
     predictions: dict[str, tuple[str | float, float | None]]
     latency_ms: float
+    model: str = ""
 
     def to_json(self) -> dict[str, Any]:
         """One line of ``live --json`` (and one WebSocket message)."""
@@ -58,7 +69,84 @@ class TouchPrediction:
                 for target, (value, probability) in self.predictions.items()
             },
             "latency_ms": round(self.latency_ms, 3),
+            "model": self.model,
         }
+
+
+#: The model a reference names now, loaded: ``load(store, ref)``.
+Loader = Callable[[Store, "str | int"], "tuple[ModelInfo, Predictor]"]
+#: Seconds between two checks of which version a followed reference names.
+FOLLOW_SECONDS = 1.0
+
+
+class ModelFollower:
+    """Which version a model reference (``NAME@champion``) names now.
+
+    Parameters
+    ----------
+    store : Store
+    ref : str or int
+        The reference the session was opened with.
+    current : ModelInfo
+        The version the session holds.
+    load : callable, optional
+        ``load(store, model_id)``, the loaded model (the service passes its model cache).
+    interval : float
+        Seconds between two checks: a check is one indexed query, a change a model load.
+    """
+
+    def __init__(
+        self,
+        store: Store,
+        ref: str | int,
+        current: ModelInfo,
+        *,
+        load: Loader | None = None,
+        interval: float = FOLLOW_SECONDS,
+    ) -> None:
+        self.store = store
+        self.ref = ref
+        self.load: Loader = load or load_live_model
+        self.interval = interval
+        self.held = (current.id, current.sha256)
+        self.refused: tuple[int, str] | None = None  # a version already found unfit
+        self.checked = time.monotonic()
+
+    def check(self) -> tuple[ModelInfo, Predictor] | str | None:
+        """A version to switch to, a message when the reference names nothing now, or None
+        (no change, or not time to ask yet, or a version refused before)."""
+        now = time.monotonic()
+        if now - self.checked < self.interval:
+            return None
+        self.checked = now
+        try:
+            model_id, sha256, _ = model_version(self.store, self.ref)
+        except AppError as error:  # the version deleted, the alias removed: keep ours
+            return self._once(("gone", str(self.ref)), f"{error}; the session keeps its model")
+        if (model_id, sha256) in (self.held, self.refused):
+            return None
+        return self.load(self.store, model_id)
+
+    def _once(self, key: tuple[Any, str], message: str) -> str | None:
+        if self.refused == key:
+            return None
+        self.refused = key
+        return message
+
+
+def follower(
+    store: Store,
+    ref: str | int,
+    current: ModelInfo,
+    *,
+    load: Loader | None = None,
+    interval: float = FOLLOW_SECONDS,
+) -> ModelFollower | None:
+    """A :class:`ModelFollower` of ``ref``, or None when it names one version for good (an
+    id, ``NAME@VERSION``)."""
+    if is_pinned(ref):
+        return None
+    return ModelFollower(store, ref, current, load=load, interval=interval)
 
 
 class LiveSession:
@@ -77,6 +165,15 @@ class LiveSession:
         Of the stream; must be the training recordings'.
     extraction : mapping, optional
         The recipe, when ``model_info`` does not carry it.
+    follow : ModelFollower, optional
+        Switch to the version it names when that changes (see the module's description).
+
+    Attributes
+    ----------
+    events : list of dict
+        What happened to the session's model since the adapter last took them
+        (:meth:`take_events`): ``{"switched": "NAME@3", "from": "NAME@2"}`` or
+        ``{"warning": "..."}``.
 
     Raises
     ------
@@ -93,8 +190,9 @@ class LiveSession:
         samplerate: float,
         n_channels: int,
         extraction: Mapping[str, Any] | None = None,
+        follow: ModelFollower | None = None,
     ) -> None:
-        name = model_info.name
+        name = model_info.label
         recipe_json = extraction if extraction is not None else model_info.extraction
         if not recipe_json:
             raise AppError(
@@ -125,20 +223,74 @@ class LiveSession:
             )
         except FeatureError as error:
             raise AppError(f"model '{name}': {error}") from None
+        self.recipe = recipe
+        self.recipe_json = dict(recipe_json)
+        self.samplerate = float(samplerate)
+        self.n_channels = n_channels
+        self.columns = self._columns(name, model)
+        self.model = model
+        self.label = name
+        self.origin: float | None = None
+        self.warnings: list[str] = []
+        self.follow = follow
+        self.events: list[dict[str, str]] = []
+
+    def _columns(self, name: str, model: Predictor) -> np.ndarray:
+        """Where each feature ``model`` needs is among the stream's, shape (n_features,)."""
         position = {feature: i for i, feature in enumerate(self.stream.feature_names)}
         missing = [a.name for a in model.schema.features if a.name not in position]
         if missing:
             raise AppError(
-                f"model '{name}' needs features its extractor '{recipe.extractor}' does not "
-                f"make on {n_channels} channel(s): {', '.join(missing[:5])}"
+                f"model '{name}' needs features its extractor '{self.recipe.extractor}' does "
+                f"not make on {self.n_channels} channel(s): {', '.join(missing[:5])}"
             )
-        self.columns = np.array([position[a.name] for a in model.schema.features], dtype=np.int64)
+        return np.array([position[a.name] for a in model.schema.features], dtype=np.int64)
+
+    def switch(self, model_info: ModelInfo, model: Predictor) -> None:
+        """Predict with another model from the next touch on, keeping the stream (its
+        extraction state, its time origin).
+
+        Raises
+        ------
+        AppError
+            The model extracts its features otherwise (recipe, sample rate, channels) or
+            needs features the stream does not make.
+        """
+        if model_info.extraction != self.recipe_json:
+            raise AppError(
+                f"model '{model_info.label}' extracts its features otherwise than "
+                f"'{self.label}' (recipe, sample rate or channels): the session keeps "
+                f"'{self.label}'"
+            )
+        self.columns = self._columns(model_info.label, model)
         self.model = model
-        self.recipe = recipe
-        self.samplerate = float(samplerate)
-        self.n_channels = n_channels
-        self.origin: float | None = None
-        self.warnings: list[str] = []
+        self.label = model_info.label
+
+    def take_events(self) -> list[dict[str, str]]:
+        """The events since the last call (see the class's ``events``), oldest first."""
+        events, self.events = self.events, []
+        return events
+
+    def _follow(self) -> None:
+        """Switch to the version the followed reference names now, if it changed."""
+        if self.follow is None:
+            return
+        found = self.follow.check()
+        if found is None:
+            return
+        if isinstance(found, str):
+            self.events.append({"warning": found})
+            return
+        info, model = found
+        before = self.label
+        try:
+            self.switch(info, model)
+        except AppError as error:
+            self.follow.refused = (info.id, info.sha256)
+            self.events.append({"warning": str(error)})
+            return
+        self.follow.held, self.follow.refused = (info.id, info.sha256), None
+        self.events.append({"switched": info.label, "from": before})
 
     def feed(
         self, block: np.ndarray, t0: float | None = None, *, arrived: float | None = None
@@ -158,6 +310,7 @@ class LiveSession:
         arrived = time.perf_counter() if arrived is None else arrived
         if self.origin is None:
             self.origin = t0 or 0.0
+        self._follow()
         try:
             instances = self.stream.feed(block)
         except FeatureError as error:
@@ -205,6 +358,7 @@ class LiveSession:
                     end=origin + last / self.samplerate,
                     predictions=predictions,
                     latency_ms=1000.0 * (behind + done - arrived),
+                    model=self.label,
                 )
             )
         return out
@@ -213,15 +367,42 @@ class LiveSession:
 def load_live_model(
     store: Store, ref: str | int, engine: Engine = "auto"
 ) -> tuple[ModelInfo, Predictor]:
-    """A stored model (name or id) with its artifact checked, run by ``engine``;
-    ``info.extraction`` is the recipe of the data set it was trained on (None for an
-    imported one)."""
+    """A stored model (any reference: id, ``NAME``, ``NAME@VERSION``, ``NAME@ALIAS``) with
+    its artifact checked, run by ``engine``; ``info.extraction`` is the recipe of the data
+    set it was trained on (None for an imported one)."""
     return load_predictor(store, ref, engine)
 
 
 def open_live(
-    store: Store, ref: str | int, *, samplerate: float, n_channels: int, engine: Engine = "auto"
+    store: Store,
+    ref: str | int,
+    *,
+    samplerate: float,
+    n_channels: int,
+    engine: Engine = "auto",
+    load: Loader | None = None,
+    follow_seconds: float = FOLLOW_SECONDS,
 ) -> LiveSession:
-    """A :class:`LiveSession` of the stored model ``ref`` (name or id)."""
-    info, model = load_live_model(store, ref, engine)
-    return LiveSession(info, model, samplerate=samplerate, n_channels=n_channels)
+    """A :class:`LiveSession` of the stored model ``ref`` (id, ``NAME``, ``NAME@VERSION``,
+    ``NAME@ALIAS``), following ``ref`` when it can name another version later.
+
+    Parameters
+    ----------
+    engine : {"auto", "onnx", "native"}
+        What runs the predictions (see :func:`app.services.export.load_predictor`), of
+        this version and of those the session switches to.
+    load : callable, optional
+        ``load(store, ref)``: the loaded model (default :func:`load_live_model` with
+        ``engine``; the service passes its model cache).
+    follow_seconds : float
+        Seconds between two checks of the version ``ref`` names.
+    """
+    loader: Loader = load or partial(load_live_model, engine=engine)
+    info, model = loader(store, ref)
+    return LiveSession(
+        info,
+        model,
+        samplerate=samplerate,
+        n_channels=n_channels,
+        follow=follower(store, ref, info, load=loader, interval=follow_seconds),
+    )

@@ -20,6 +20,7 @@ import numpy as np
 
 from app.errors import ConflictError, FieldError
 from app.schemas.models import (
+    AliasRequest,
     Engine,
     MissingPolicy,
     PredictionReport,
@@ -30,11 +31,13 @@ from app.services.datasets import read_data_file
 from app.store.database import Store
 from app.store.datasets import find_dataset, load_dataset
 from app.store.models import (
+    AliasMove,
     ModelInfo,
     check_model_name,
-    check_name_free,
     load_artifact,
+    rollback_alias,
     save_model,
+    set_alias,
 )
 from app.store.naming import shorten
 from app.store.runs import RunInfo, get_run, load_results
@@ -61,7 +64,8 @@ class Training:
 
 def train(store: Store, request: TrainRequest) -> ModelInfo:
     """Fit a classifier on every instance of a data set (or a finished run's best classifier
-    on the run's data set and targets) and store the model.
+    on the run's data set and targets) and store the model as the next version of its name
+    (``request.name``, else ``DATASET-CLASSIFIER``).
 
     Raises as :func:`check_training` does.
     """
@@ -88,7 +92,7 @@ def check_training(store: Store, request: TrainRequest) -> Training:
     NotFoundError
         No such data set or run.
     ConflictError
-        The model name is taken; the run has no successful classifier.
+        The run has no successful classifier.
     FieldError
         An invalid name; an unknown target or one without any known value; an unknown
         classifier or one that cannot learn the targets (a multi-class classifier for
@@ -97,8 +101,7 @@ def check_training(store: Store, request: TrainRequest) -> Training:
     from benchmark.estimators import check_classifier  # start-up time: the catalogue is big
 
     if request.name is not None:
-        check_model_name(request.name)
-        check_name_free(store, request.name)
+        check_model_name(request.name)  # a name taken is not refused: it gets a new version
     targets: list[str] | None
     if request.run is not None:
         run, classifier = _best_of_run(store, request.run)
@@ -163,10 +166,23 @@ def _best_of_run(store: Store, run_ref: int) -> tuple[RunInfo, str]:
 
 
 def load_model(store: Store, ref: str | int) -> tuple[ModelInfo, TrainedModel]:
-    """A stored model; its bytes are checked against their sha256 and loaded only as an
-    artifact that cannot run code (:mod:`benchmark.artifacts`)."""
+    """A stored model (an id, ``NAME``: its newest version, ``NAME@VERSION``, ``NAME@ALIAS``);
+    its bytes are checked against their sha256 and loaded only as an artifact that cannot
+    run code (:mod:`benchmark.artifacts`)."""
     info, artifact = load_artifact(store, ref)
     return info, loads_model(artifact, sha256=info.sha256)
+
+
+def move_alias(store: Store, request: AliasRequest) -> AliasMove:
+    """Point ``NAME@alias`` at the version ``request.model`` names (``promote``: the alias
+    ``champion``, which live sessions and services on ``NAME@champion`` follow); the
+    version it pointed at before is kept in the alias's history for :func:`roll_back`."""
+    return set_alias(store, request.model, request.alias)
+
+
+def roll_back(store: Store, request: AliasRequest) -> AliasMove:
+    """Point ``NAME@alias`` back at the version it pointed at before its last move."""
+    return rollback_alias(store, request.model, request.alias)
 
 
 @dataclass
@@ -200,7 +216,7 @@ class Predictions:
     def report(self, model: ModelInfo) -> PredictionReport:
         """The report ``predict --json`` prints and the API answers."""
         return PredictionReport(
-            model=model.name,
+            model=model.label,
             targets=model.targets,
             predictions=[PredictionRow(**row) for row in self.to_json()],
             accuracy=self.accuracy,

@@ -152,15 +152,25 @@ class EntryDropRow(Base):
     mean: Mapped[float | None] = mapped_column(Float)
 
 
+#: The constraint that keeps two models of one name from taking the same version.
+MODEL_VERSION_KEY = "uq_models_name_version"
+
+
 class ModelRow(Base):
     """A trained model: the estimator's artifact (``format`` says how it is serialised;
     only formats that cannot run code are loaded), its schema, and how its features were
-    extracted."""
+    extracted.
+
+    Models trained under one name are its versions 1, 2, ...; ``id`` stays the row's own
+    number, unique across names.
+    """
 
     __tablename__ = "models"
+    __table_args__ = (UniqueConstraint("name", "version", name=MODEL_VERSION_KEY),)
 
     id: Mapped[int] = mapped_column(Integer, primary_key=True)
-    name: Mapped[str] = mapped_column(String(200), unique=True)
+    name: Mapped[str] = mapped_column(String(200))
+    version: Mapped[int] = mapped_column(Integer, default=1)
     dataset_id: Mapped[int | None] = mapped_column(ForeignKey("datasets.id", ondelete="SET NULL"))
     run_id: Mapped[int | None] = mapped_column(ForeignKey("runs.id", ondelete="SET NULL"))
     classifier: Mapped[str] = mapped_column(String(100))
@@ -172,6 +182,32 @@ class ModelRow(Base):
     created_at: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=utcnow)
     format: Mapped[str] = mapped_column(String(20), default="skops")
     extraction: Mapped[dict[str, Any] | None] = mapped_column(JSON(none_as_null=True))
+
+
+class ModelAliasRow(Base):
+    """A name for one version of a model (``champion``), moved by ``alias``, ``promote``
+    and ``rollback``: ``NAME@ALIAS`` is that version."""
+
+    __tablename__ = "model_aliases"
+
+    name: Mapped[str] = mapped_column(String(200), primary_key=True)
+    alias: Mapped[str] = mapped_column(String(100), primary_key=True)
+    version: Mapped[int] = mapped_column(Integer)
+    set_at: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=utcnow)
+
+
+class ModelAliasEventRow(Base):
+    """Each version an alias was set to, in order: ``rollback`` steps back through them
+    (a step undone is marked, so that a second rollback goes one further back)."""
+
+    __tablename__ = "model_alias_history"
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    name: Mapped[str] = mapped_column(String(200), index=True)
+    alias: Mapped[str] = mapped_column(String(100))
+    version: Mapped[int] = mapped_column(Integer)
+    set_at: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=utcnow)
+    undone: Mapped[bool] = mapped_column(default=False)
 
 
 class ModelArtifactRow(Base):

@@ -120,8 +120,8 @@ def test_training_is_refused_naming_the_option(
     assert run_cli(capsys, store_url, "import", str(half)).code == 0
     cases = [
         (
-            ["touch", "-c", "nb", "--name", "touch-nb"],
-            "a model named 'touch-nb' already exists; choose another name",
+            ["touch", "-c", "nb", "--name", "touch-nb@2"],
+            "--name: a model name cannot hold '@' (NAME@VERSION and NAME@ALIAS name a version",
         ),
         (
             ["half", "-c", "nb", "--target", "place"],

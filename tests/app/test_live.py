@@ -54,7 +54,8 @@ def test_live_predicts_what_predict_says_of_the_extracted_instances(
         assert [t.predictions[target][0] for t in touches] == expected.labels[target]
     assert all(0 < t.predictions["gesture"][1] <= 1 for t in touches)  # type: ignore[operator]
     line = touches[0].to_json()
-    assert set(line) == {"start", "end", "predictions", "latency_ms"}
+    assert set(line) == {"start", "end", "predictions", "latency_ms", "model"}
+    assert line["model"] == f"{name}@1"
     assert set(line["predictions"]["place"]) == {"value", "probability"}
     assert line["latency_ms"] >= 0 and json.dumps(line)
 

@@ -44,11 +44,11 @@ def test_the_version_follows_renames_and_deletes_by_name_and_by_id(store: Store)
     artifact = os.urandom(3_000_000)  # far beyond a page: an artifact in overflow pages
     model_id = _add(store, "big", artifact)
     digest = hashlib.sha256(artifact).hexdigest()
-    assert model_version(store, "big") == (model_id, digest, "big")
-    assert model_version(store, str(model_id)) == (model_id, digest, "big")
-    assert model_version(store, model_id) == (model_id, digest, "big")
+    assert model_version(store, "big") == (model_id, digest, "big@1")
+    assert model_version(store, str(model_id)) == (model_id, digest, "big@1")
+    assert model_version(store, model_id) == (model_id, digest, "big@1")
     rename_model(store, "big", "large")
-    assert model_version(store, model_id) == (model_id, digest, "large")
+    assert model_version(store, model_id) == (model_id, digest, "large@1")
     with pytest.raises(NotFoundError, match="no model 'big'"):
         model_version(store, "big")
     assert load_artifact(store, "large")[1] == artifact

@@ -5,16 +5,24 @@ The client sends a JSON header ``{"samplerate": 44100, "channels": 3, "format": 
 prediction; ``api_key`` here when the handshake could not carry the ``X-API-Key``
 header), then binary messages of interleaved samples, and
 ``{"end": true}`` when its stream ends.  The server sends one JSON message per detected touch,
-as ``touchbench live --json`` prints it, and closes with a reason on bad input: 1008 for a
+as ``touchbench live --json`` prints it (its ``model`` says which version answered), and
+closes with a reason on bad input: 1008 for a
 missing or wrong key or a model that cannot run live, 1007 for a malformed header or block,
 1009 for a block over the size limit, 1000 when the stream ended.
+
+A session on ``NAME@ALIAS`` (or ``NAME``, the newest version) follows it: when the alias
+moves, the next touches are answered by the new version without the stream being
+dropped, and the server sends ``{"switched": "NAME@3", "from": "NAME@2"}`` first; a new
+version that extracts its features otherwise is not taken, and ``{"warning": "..."}`` says
+so once.
 """
 
 from __future__ import annotations
 
 import asyncio
 import json
-from typing import Any, cast
+from functools import partial
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 from fastapi import APIRouter, WebSocket, WebSocketDisconnect
@@ -25,6 +33,9 @@ from app.errors import USER_ERRORS
 from app.schemas.models import Engine
 from drivers.errors import DriverError
 from drivers.pcm import SAMPLE_FORMATS, decode_pcm
+
+if TYPE_CHECKING:  # start-up time: the feature stack loads with the first session
+    from app.services.live import LiveSession
 
 router = APIRouter(tags=["models"])
 
@@ -52,11 +63,10 @@ async def live(websocket: WebSocket, model_ref: str) -> None:
         _check_key(service, websocket, header)
         samplerate, channels, sample_format = _stream_format(header)
         engine = _engine(header)
-        info, model = await run_in_threadpool(service.models.get, service.store, model_ref, engine)
-        from app.services.live import LiveSession  # start-up time: the feature stack
-
         try:
-            session = LiveSession(info, model, samplerate=samplerate, n_channels=channels)
+            session = await run_in_threadpool(
+                _open, service, model_ref, samplerate, channels, engine
+            )
         except USER_ERRORS as error:
             raise _Closed(POLICY, str(error)) from None
         frame = channels * np.dtype(SAMPLE_FORMATS[sample_format][0]).itemsize
@@ -74,6 +84,8 @@ async def live(websocket: WebSocket, model_ref: str) -> None:
                 except DriverError as error:
                     raise _Closed(INVALID, str(error)) from None
                 touches = await run_in_threadpool(session.feed, block)
+                for event in session.take_events():
+                    await websocket.send_json(event)
             else:
                 if _json(message.get("text")).get("end") is not True:
                     raise _Closed(INVALID, 'text messages after the header must be {"end": true}')
@@ -91,6 +103,23 @@ async def live(websocket: WebSocket, model_ref: str) -> None:
         return
     except Exception as error:  # never crash the server: say what happened, close
         await websocket.close(code=INTERNAL, reason=f"unexpected {type(error).__name__}")
+
+
+def _open(
+    service: Service, model_ref: str, samplerate: float, channels: int, engine: Engine
+) -> LiveSession:
+    """The session, opened in a worker thread: the first one imports the feature stack and
+    scikit-learn, which must not hold the event loop (and its other sockets' pings) up."""
+    from app.services.live import open_live
+
+    return open_live(
+        service.store,
+        model_ref,
+        samplerate=samplerate,
+        n_channels=channels,
+        load=partial(service.models.get, engine=engine),
+        follow_seconds=service.settings.live_follow_seconds,
+    )
 
 
 async def _header(websocket: WebSocket) -> dict[str, Any]:

@@ -1,4 +1,8 @@
-"""Models: train (a job, 202), list, describe, delete, predict (JSON instances or a file)."""
+"""Models: train (a job, 202), list, describe, delete, predict (JSON instances or a file), and
+the aliases of their versions (alias, promote, rollback).
+
+``{model_ref}`` is an id, ``NAME`` (its newest version), ``NAME@VERSION`` or ``NAME@ALIAS``.
+"""
 
 from __future__ import annotations
 
@@ -17,6 +21,9 @@ from app.api.direct import DirectRoute
 from app.api.uploads import in_client_words, save_upload
 from app.schemas.jobs import JobCreated
 from app.schemas.models import (
+    AliasBody,
+    AliasMoved,
+    AliasRequest,
     ModelList,
     ModelSchema,
     PredictionReport,
@@ -81,6 +88,33 @@ def remove(model_ref: str, service: ServiceDep) -> ModelSchema:
     gone = delete_model(service.store, model_ref)
     service.models.forget(gone.id)
     return gone.to_schema()
+
+
+@router.post("/{model_ref}/aliases", response_model=AliasMoved)
+def alias(model_ref: str, body: AliasBody, store: StoreDep) -> AliasMoved:
+    """Point ``NAME@alias`` at the version ``model_ref`` names (``touchbench alias``)."""
+    from app.services.models import move_alias
+
+    return move_alias(store, AliasRequest(model=model_ref, alias=body.alias)).to_schema()
+
+
+@router.post("/{model_ref}/promote", response_model=AliasMoved)
+def promote(model_ref: str, store: StoreDep) -> AliasMoved:
+    """Make the version ``model_ref`` names the champion: predictions and live sessions on
+    ``NAME@champion`` answer with it from now on (``touchbench promote``)."""
+    from app.services.models import move_alias
+
+    return move_alias(store, AliasRequest(model=model_ref)).to_schema()
+
+
+@router.post("/{model_ref}/rollback", response_model=AliasMoved)
+def rollback(model_ref: str, store: StoreDep, body: AliasBody | None = None) -> AliasMoved:
+    """Point the champion (or ``alias``) of the model back at the version it pointed at
+    before its last move (``touchbench rollback``)."""
+    from app.services.models import roll_back
+
+    alias = "champion" if body is None else body.alias
+    return roll_back(store, AliasRequest(model=model_ref, alias=alias)).to_schema()
 
 
 @predictions.post("/{model_ref}/predict", response_model=PredictionReport)

@@ -80,7 +80,7 @@ def test_run_leaderboard_model_and_predictions_over_http(
     )
     assert predicted.status_code == 200, predicted.text
     report = predicted.json()
-    assert report["model"] == "best" and len(report["predictions"]) == 2
+    assert report["model"] == "best@1" and len(report["predictions"]) == 2
     first = report["predictions"][0]
     assert first["gesture"] in {"tap", "slap", "stroke"}
     assert sum(first["probabilities"]["gesture"].values()) == pytest.approx(1.0)
@@ -105,7 +105,7 @@ def test_run_leaderboard_model_and_predictions_over_http(
         store.dispose()
     assert api.post("/api/models/best/predict", json=one).status_code == 404
     renamed = api.post("/api/models/renamed/predict", json=one)
-    assert renamed.status_code == 200 and renamed.json()["model"] == "renamed"
+    assert renamed.status_code == 200 and renamed.json()["model"] == "renamed@1"
     assert run_cli(capsys, server.database_url, "delete-model", "renamed").code == 0
     gone = api.post(f"/api/models/{model_id}/predict", json=one)
     assert gone.status_code == 404 and gone.json()["error"]["type"] == "NotFoundError"

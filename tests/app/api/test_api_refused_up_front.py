@@ -87,8 +87,8 @@ def test_training_is_refused_before_any_job(server: Server, tmp_path: Path) -> N
     assert job["status"] == "done", job
     assert job["params"]["name"] == "mine" and job["params"]["target"] == "gesture"
 
-    taken = api.post("/api/models", json={"dataset": "touch", "classifier": "nb", "name": "mine"})
-    assert _error(taken, 409) == "a model named 'mine' already exists; choose another name"
+    at = api.post("/api/models", json={"dataset": "touch", "classifier": "nb", "name": "mine@2"})
+    assert _error(at, 422, "body.name").startswith("a model name cannot hold '@'")
 
     store = Store(server.database_url)
     try:  # a run that failed before any result (written as failed: no worker takes it)

@@ -1,0 +1,137 @@
+"""Versions and aliases on a real service: a live WebSocket session on ``NAME@champion``
+switches to the version promoted mid-stream without dropping the stream, refuses one that
+extracts its features otherwise, and each answer names its version; the alias routes need a
+write key."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import httpx
+from websockets.sync.client import ClientConnection, connect
+
+from app.schemas.datasets import ImportRequest
+from app.schemas.extraction import ExtractRequest
+from app.schemas.models import TrainRequest
+from app.services.datasets import import_file
+from app.services.extraction import extract_and_store
+from app.services.models import train
+from app.services.simulation import SAMPLERATE, write_labels, write_session
+from app.store.database import Store
+from tests.app.api.conftest import Server
+from tests.app.api.test_api_live import _as_int16
+from tests.app.synthetic import touch_arff
+
+WRITE = "lab-write-key-0123456789"
+PREDICT = "robot-predict-key-0123456789"
+
+
+def _versions(store_url: str, tmp_path: Path) -> list[tuple[float, float, str, str]]:
+    """``mic`` versions 1 and 2 on extracted sessions, 3 on an imported file (no recipe);
+    the touches of ``unseen.wav``, a session none of them saw."""
+    store = Store(store_url)
+    try:
+        recordings, rows = [], []
+        for seed in range(2):
+            wav, touches = write_session(tmp_path, f"s{seed}", n_touches=6, seed=seed)
+            recordings.append(wav)
+            rows += [(wav.name, *touch) for touch in touches]
+        labels = write_labels(tmp_path / "labels.csv", rows)
+        extract_and_store(store, ExtractRequest(recordings=recordings, labels=labels, name="touch"))
+        for classifier in ("cc:j48", "cc:nb"):
+            train(store, TrainRequest(dataset="touch", classifier=classifier, name="mic"))
+        flat = touch_arff(tmp_path / "flat.arff", n=40)
+        import_file(store, ImportRequest(file=flat, name="flat"))
+        train(store, TrainRequest(dataset="flat", classifier="nb", target="gesture", name="mic"))
+    finally:
+        store.dispose()
+    _, touches = write_session(tmp_path, "unseen", n_touches=5, seed=99)
+    return touches
+
+
+def _until(socket: ClientConnection, seen: list[dict[str, Any]], key: str) -> None:
+    """Receive messages into ``seen`` until one holds ``key``."""
+    while True:
+        seen.append(json.loads(socket.recv(timeout=120)))
+        if key in seen[-1]:
+            return
+
+
+def test_a_live_session_follows_the_champion_mid_stream(
+    make_sqlite_server: Callable[..., Server], tmp_path: Path
+) -> None:
+    server = make_sqlite_server(
+        api_keys=f"lab:write:{WRITE},robot:predict:{PREDICT}", live_follow_seconds="0"
+    )
+    touches = _versions(server.database_url, tmp_path)
+    lab = httpx.Client(base_url=server.url, headers={"X-API-Key": WRITE}, timeout=60)
+    robot = httpx.Client(base_url=server.url, headers={"X-API-Key": PREDICT}, timeout=60)
+    refused = robot.post("/api/models/mic@1/promote")
+    assert refused.status_code == 403 and "needs a write key" in refused.text
+    assert lab.post("/api/models/mic@1/promote").json()["model"] == "mic@1"
+
+    samples, rate = _as_int16(tmp_path / "unseen.wav")
+    assert rate == SAMPLERATE
+    frames = 2048
+    # each part ends as a touch begins: the one before it is over and answered
+    cuts = [int(touches[1][0] * rate), int(touches[3][0] * rate), len(samples)]
+    parts, start = [], 0
+    for cut in cuts:
+        part = samples[start:cut]
+        parts.append([part[i : i + frames].tobytes() for i in range(0, len(part), frames)])
+        start = cut
+    seen: list[dict[str, Any]] = []
+    url = server.url.replace("http://", "ws://") + "/api/models/mic@champion/live"
+    # no keepalive pings: a loaded machine may leave them unanswered for a while
+    with connect(
+        url, additional_headers={"X-API-Key": PREDICT}, open_timeout=60, ping_interval=None
+    ) as socket:
+        socket.send(json.dumps({"samplerate": rate, "channels": samples.shape[1]}))
+        for block in parts[0]:
+            socket.send(block)
+        _until(socket, seen, "predictions")  # the first touch, by version 1
+        moved = lab.post("/api/models/mic@2/promote")
+        assert moved.json() == {"alias": "champion", "model": "mic@2", "version": 2, "previous": 1}
+        for block in parts[1]:
+            socket.send(block)
+        _until(socket, seen, "switched")
+        lab.post("/api/models/mic@3/promote").raise_for_status()  # no recipe: not taken
+        for block in parts[2]:
+            socket.send(block)
+        socket.send(json.dumps({"end": True}))
+        _until(socket, seen, "warning")
+        try:
+            while True:
+                seen.append(json.loads(socket.recv(timeout=120)))
+        except Exception:  # closed: the stream ended
+            pass
+        assert (socket.close_code, socket.close_reason) == (1000, "stream ended")
+
+    answers = [m["model"] for m in seen if "predictions" in m]
+    assert len(answers) == 5  # every touch of the stream, none dropped by the switch
+    first = answers.count("mic@1")
+    assert first >= 1 and answers == ["mic@1"] * first + ["mic@2"] * (5 - first)
+    assert 5 - first >= 1
+    switched = [m for m in seen if "switched" in m]
+    assert switched == [{"switched": "mic@2", "from": "mic@1"}]
+    assert seen.index(switched[0]) == first  # said before the first answer of version 2
+    warnings = [m["warning"] for m in seen if "warning" in m]
+    assert len(warnings) == 1 and "'mic@3' extracts its features otherwise" in warnings[0]
+
+    back = lab.post("/api/models/mic/rollback")
+    assert back.json() == {"alias": "champion", "model": "mic@2", "version": 2, "previous": 3}
+    listed = {m["version"]: m["aliases"] for m in lab.get("/api/models").json()["models"]}
+    assert listed == {1: [], 2: ["champion"], 3: []}
+    again = lab.post("/api/models/mic/rollback")
+    assert again.json()["model"] == "mic@1"
+    bad = lab.post("/api/models/mic@1/aliases", json={"alias": "2"})
+    assert bad.status_code == 422 and bad.json()["error"]["where"] == "body.alias"
+    features = robot.get("/api/models/mic@champion").json()["features"]
+    instance = dict.fromkeys(features, 0.0)
+    predicted = robot.post("/api/models/mic@champion/predict", json={"instances": [instance]})
+    assert predicted.status_code == 200 and predicted.json()["model"] == "mic@1"
+    lab.close()
+    robot.close()

@@ -1,0 +1,221 @@
+"""Versions of a model and their aliases, in the store (SQLite and PostgreSQL): references
+(``NAME``, ``NAME@VERSION``, ``NAME@ALIAS``, ids), alias moves and rollbacks, names with
+``@`` refused, and versions stored by two processes at once."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from sqlalchemy import select
+
+from app.errors import ConflictError, FieldError, NotFoundError
+from app.schemas.models import TrainRequest
+from app.store import models as store_models
+from app.store.database import Store
+from app.store.models import (
+    delete_model,
+    get_model,
+    list_models,
+    model_version,
+    rollback_alias,
+    save_model,
+    set_alias,
+)
+from app.store.tables import DatasetRow, ModelRow
+from tests.app.cli_runner import run_cli
+
+REPOSITORY = Path(__file__).resolve().parents[2]
+
+
+def _save(store: Store, name: str | None = "mic", dataset_id: int | None = None) -> int:
+    info = save_model(
+        store,
+        classifier="nb",
+        params={},
+        schema={"relation": "r", "attributes": []},
+        targets=["gesture"],
+        artifact=b"artifact",
+        name=name,
+        dataset_id=dataset_id,
+    )
+    return info.version
+
+
+def test_references_name_versions_and_aliases(store: Store) -> None:
+    assert [_save(store) for _ in range(3)] == [1, 2, 3]
+    ids = [model.id for model in list_models(store)]
+    assert model_version(store, "mic")[2] == "mic@3"  # a name alone: the newest version
+    assert model_version(store, "mic@latest")[2] == "mic@3"
+    assert model_version(store, "mic@2") == (ids[1], model_version(store, ids[1])[1], "mic@2")
+    assert get_model(store, "mic@1").id == ids[0] and get_model(store, ids[2]).version == 3
+    with pytest.raises(NotFoundError, match=r"model 'mic' has no version 7 \(versions: 1, 2, 3\)"):
+        get_model(store, "mic@7")
+    with pytest.raises(NotFoundError, match="model 'mic' has no alias 'champion'"):
+        model_version(store, "mic@champion")
+    with pytest.raises(NotFoundError, match="no model 'other'"):
+        get_model(store, "other@1")
+
+
+def test_alias_moves_and_rollback_steps_back_through_its_history(store: Store) -> None:
+    for _ in range(4):
+        _save(store)
+    moves = [set_alias(store, f"mic@{version}", "champion") for version in (1, 2, 3)]
+    assert [(m.model.version, m.previous) for m in moves] == [(1, None), (2, 1), (3, 2)]
+    set_alias(store, "mic@4", "staging")
+    assert model_version(store, "mic@champion")[2] == "mic@3"
+    listed = {m.version: m.aliases for m in list_models(store)}
+    assert listed == {1: (), 2: (), 3: ("champion",), 4: ("staging",)}
+
+    back = rollback_alias(store, "mic")
+    assert (back.model.label, back.previous) == ("mic@2", 3)
+    assert model_version(store, "mic@champion")[2] == "mic@2"
+    delete_model(store, "mic@1")  # rollback skips a version deleted since
+    with pytest.raises(ConflictError, match="nothing to roll back to"):
+        rollback_alias(store, "mic@champion")
+    assert model_version(store, "mic@champion")[2] == "mic@2"  # a refused rollback moves nothing
+    assert set_alias(store, "mic@4", "champion").previous == 2
+    assert rollback_alias(store, "mic").model.label == "mic@2"  # 3 was undone before
+
+    with pytest.raises(ConflictError, match="nothing to roll back to"):
+        rollback_alias(store, "mic", "staging")  # it only ever pointed at version 4
+    with pytest.raises(ConflictError, match="no alias 'beta' to roll back"):
+        rollback_alias(store, "mic", "beta")
+    delete_model(store, "mic@2")  # its alias goes with it
+    with pytest.raises(NotFoundError, match="has no alias 'champion'"):
+        get_model(store, "mic@champion")
+
+
+def test_aliases_that_would_read_otherwise_are_refused(store: Store) -> None:
+    _save(store)
+    for alias in ["3", "latest", "", "with space", "x" * 101]:
+        with pytest.raises(FieldError) as refused:
+            set_alias(store, "mic@1", alias)
+        assert refused.value.field == "alias", alias
+
+
+def test_names_with_at_are_refused_where_they_would_be_ambiguous(store: Store) -> None:
+    with pytest.raises(FieldError, match="a model name cannot hold '@'"):
+        TrainRequest(dataset="touch", classifier="nb", name="mic@2")
+    with pytest.raises(FieldError, match="a model name cannot hold '@'"):
+        _save(store, "mic@champion")
+    with store.session() as session:  # a data set's name may hold '@': the default folds it
+        session.add(
+            DatasetRow(
+                name="lab@home",
+                relation="r",
+                schema={},
+                target_names=[],
+                n_instances=0,
+                n_attributes=0,
+                sha256="0" * 64,
+            )
+        )
+    assert [_save(store, None, dataset_id=1) for _ in range(2)] == [1, 2]
+    assert model_version(store, "lab_home-nb@2")[2] == "lab_home-nb@2"
+    # a model stored with '@' before the rule is still found by its whole name
+    with store.session() as session:
+        session.add(
+            ModelRow(
+                name="old@name",
+                version=1,
+                classifier="nb",
+                params={},
+                schema={},
+                targets=[],
+                sha256="0" * 64,
+                size_bytes=0,
+            )
+        )
+    assert get_model(store, "old@name").name == "old@name"
+
+
+def test_a_version_taken_meanwhile_is_retried(
+    store: Store, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Another process stores version 2 between this one's choice and its insert."""
+    _save(store)
+    chosen = store_models._next_version
+    stale = iter([1])
+    monkeypatch.setattr(
+        store_models,
+        "_next_version",
+        lambda session, name: next(stale, None) or chosen(session, name),
+    )
+    assert _save(store) == 2
+    with store.session() as session:
+        versions = session.scalars(select(ModelRow.version).order_by(ModelRow.id)).all()
+    assert versions == [1, 2]
+
+
+SAVER = """
+import sys
+from app.store.database import Store
+from app.store.models import save_model
+store = Store(sys.argv[1])
+print(sys.argv[2], flush=True)
+sys.stdin.readline()  # both processes start saving together
+for _ in range(int(sys.argv[3])):
+    save_model(store, classifier="nb", params={}, schema={}, targets=["g"],
+               artifact=sys.argv[2].encode(), name="mic")
+"""
+
+
+def test_two_processes_storing_one_name_get_distinct_versions(store_url: str) -> None:
+    Store(store_url).dispose()  # migrated before the race
+    each = 6
+    savers = [
+        subprocess.Popen(
+            [sys.executable, "-c", SAVER, store_url, tag, str(each)],
+            cwd=REPOSITORY,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+        )
+        for tag in ("a", "b")
+    ]
+    for saver in savers:  # both have opened the store
+        assert saver.stdout is not None and saver.stdout.readline().strip()
+    for saver in savers:
+        assert saver.stdin is not None
+        saver.stdin.write("go\n")
+        saver.stdin.close()
+    assert [saver.wait(timeout=120) for saver in savers] == [0, 0]
+    store = Store(store_url)
+    try:
+        versions = sorted(m.version for m in list_models(store))
+    finally:
+        store.dispose()
+    assert versions == list(range(1, 2 * each + 1))
+
+
+def test_the_cli_promotes_aliases_and_rolls_back(
+    capsys: pytest.CaptureFixture[str], store: Store, store_url: str
+) -> None:
+    for _ in range(3):
+        _save(store)
+    assert run_cli(capsys, store_url, "promote", "mic@1").code == 0
+    promoted = run_cli(capsys, store_url, "promote", "mic@3", "--json")
+    assert promoted.json() == {"alias": "champion", "model": "mic@3", "version": 3, "previous": 1}
+    aliased = run_cli(capsys, store_url, "alias", "mic@2", "staging")
+    assert aliased.code == 0 and "mic@staging is now version 2" in aliased.err
+    listing = run_cli(capsys, store_url, "models", "--json").json()["models"]
+    assert [(m["version"], m["aliases"]) for m in listing] == [
+        (1, []),
+        (2, ["staging"]),
+        (3, ["champion"]),
+    ]
+    back = run_cli(capsys, store_url, "rollback", "mic")
+    assert back.code == 0 and "mic@champion is now version 1 (was version 3)" in back.err
+    refused = [
+        (("alias", "mic@2", "2"), "ALIAS: an alias starts with a letter"),
+        (("promote", "mic@9"), "model 'mic' has no version 9"),
+        (("rollback", "mic"), "nothing to roll back to"),
+        (("rollback", "mic", "--alias", "beta"), "no alias 'beta' to roll back"),
+    ]
+    for args, words in refused:
+        result = run_cli(capsys, store_url, *args)
+        assert result.code == 2 and words in result.err, (args, result.err)
+        assert len(result.err.strip().splitlines()) == 1
