@@ -83,6 +83,9 @@ class RoundSchedule:
         Predicted seconds of one fold per entry, before it has been timed.
     previous : sequence of TaskResult
         Results of a resumed run (not run again, not delivered again).
+    done : collection of TaskKey
+        Tasks of a resumed run done without their results at hand (not run again; a
+        race needs ``previous`` instead, for its scores).
     race : RaceRule, optional
     test_train_ratio : float
         ``n_test / n_train`` of the folds, for the race's t-test.
@@ -103,6 +106,7 @@ class RoundSchedule:
         *,
         hints: Mapping[str, float],
         previous: Sequence[TaskResult] = (),
+        done: Collection[TaskKey] = (),
         race: RaceRule | None = None,
         test_train_ratio: float = 0.0,
         budget: float | None = None,
@@ -134,6 +138,9 @@ class RoundSchedule:
         self.dropped: dict[str, Drop] = {}
         for result in previous:
             self._note(result)
+        for key in done:
+            if key.classifier in self._arrived and (key.repeat, key.fold) in self._rounds:
+                self._arrived[key.classifier].add(self._rounds[(key.repeat, key.fold)])
         for entry in self._entries:
             self._started[entry] = set(self._arrived[entry])
         self._make_decisions()
