@@ -26,6 +26,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import pickle
 import sys
 import time
 from collections import Counter
@@ -187,6 +188,12 @@ def main() -> int:
     parser.add_argument(
         "--dask", action="store_true", help="on a local Dask cluster of --jobs workers"
     )
+    parser.add_argument(
+        "--save",
+        metavar="FILE",
+        default=None,
+        help="pickle the (last) full run for perf/racing_replay.py",
+    )
     args = parser.parse_args()
     if not args.regression and not DATASETS.is_dir():
         print(f"skipped: {DATASETS} is absent (the shared reference data sets)")
@@ -223,6 +230,9 @@ def main() -> int:
         ratio = float(np.mean([f.test.size / f.train.size for f in folds]))
         print(f"\n{robot} {task}: {len(ids)} entries ({args.suite}), {len(folds)} folds")
         full, _, full_wall = timed(problem, ids, folds, args.jobs, random_state=args.seed)
+        if args.save:
+            with open(args.save, "wb") as file:
+                pickle.dump({"ids": ids, "results": full, "wall": full_wall}, file)
         race = RaceRule(metric, args.alpha)
         raced, drops, raced_wall = timed(
             problem, ids, folds, args.jobs, random_state=args.seed, race=race
