@@ -26,6 +26,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import pickle
 import sys
 import time
 from collections import Counter
@@ -70,7 +71,21 @@ def load(robot: str, task: str) -> Problem:
     )
 
 
+def regression(n: int) -> Problem:
+    """``perf/regression_catalogue.py``'s contact-localisation data: (x, y) of ``n`` touches."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from regression_catalogue import contact_problem
+
+    return contact_problem(n, 30, 0)
+
+
 def suite_ids(problem: Problem, name: str) -> list[str]:
+    if problem.kind == "regression":
+        from benchmark.catalogue.regressors import regression_suite
+
+        return regression_suite(
+            name, n_targets=problem.n_targets, n_instances=int(problem.X.shape[0])
+        )
     if problem.n_targets > 1:
         from benchmark.multitarget.suites import multitarget_suite
 
@@ -81,11 +96,22 @@ def suite_ids(problem: Problem, name: str) -> list[str]:
     return [i for i in suite(name) if not reads_sequences(i)]
 
 
+#: ``--dask``: the address of the local Dask cluster the runs go to.
+SCHEDULER: list[str] = []
+
+
 def timed(problem: Problem, ids: list[str], folds: list, jobs: int, **options: Any):
     drops: list[Drop] = []
     start = time.perf_counter()
     results = run_tasks(
-        problem, ids, folds, jobs=jobs, timeout=TIMEOUT, on_drop=drops.append, **options
+        problem,
+        ids,
+        folds,
+        jobs=jobs,
+        timeout=TIMEOUT,
+        on_drop=drops.append,
+        scheduler=SCHEDULER[0] if SCHEDULER else None,
+        **options,
     )
     return results, {d.classifier: d for d in drops}, time.perf_counter() - start
 
@@ -99,6 +125,11 @@ def per_fold(results: list[TaskResult], metric: str) -> dict[str, dict[int, floa
         entry: {fold: score for (_, fold), score in scores_by_fold(rs, metric).items()}
         for entry, rs in by_entry.items()
     }
+
+
+def full_top(results: list[TaskResult], metric: str, n: int = 5) -> set[str]:
+    """The first ``n`` entries of the full run's leaderboard."""
+    return {row.classifier for row in build_leaderboard(results, metric=metric).rows[:n]}
 
 
 def replay_ttest(scores, metric: str, alpha: float, ratio: float, n_rounds: int):
@@ -146,90 +177,159 @@ def main() -> int:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--alpha", type=float, default=0.01)
     parser.add_argument("--budget-fraction", type=float, default=None)
+    parser.add_argument(
+        "--regression",
+        type=int,
+        default=0,
+        metavar="N",
+        help="race the regression suite on perf/regression_catalogue.py's data of N touches "
+        "instead of the robots",
+    )
+    parser.add_argument(
+        "--dask", action="store_true", help="on a local Dask cluster of --jobs workers"
+    )
+    parser.add_argument(
+        "--save",
+        metavar="FILE",
+        default=None,
+        help="pickle the (last) full run for perf/racing_replay.py",
+    )
     args = parser.parse_args()
-    if not DATASETS.is_dir():
+    if not args.regression and not DATASETS.is_dir():
         print(f"skipped: {DATASETS} is absent (the shared reference data sets)")
         return 0
-    for robot in args.robots.split(","):
-        for task in args.tasks.split(","):
-            problem = load(robot, task)
-            ids = suite_ids(problem, args.suite)
-            metric = "hamming_score" if problem.n_targets > 1 else "f1_weighted"
-            folds = make_folds(
-                problem.Y, n_folds=args.folds, seed=args.seed, target_names=problem.target_names
-            )[0]
-            ratio = float(np.mean([f.test.size / f.train.size for f in folds]))
-            print(f"\n{robot} {task}: {len(ids)} entries ({args.suite}), {len(folds)} folds")
-            full, _, full_wall = timed(problem, ids, folds, args.jobs, random_state=args.seed)
-            race = RaceRule(metric, args.alpha)
-            raced, drops, raced_wall = timed(
-                problem, ids, folds, args.jobs, random_state=args.seed, race=race
+    if args.dask:
+        from distributed import LocalCluster
+
+        cluster = LocalCluster(
+            n_workers=args.jobs, threads_per_worker=1, processes=True, dashboard_address=None
+        )
+        SCHEDULER.append(cluster.scheduler_address)
+    pairs = (
+        [("contact", "x+y")]
+        if args.regression
+        else [(r, t) for r in args.robots.split(",") for t in args.tasks.split(",")]
+    )
+    for robot, task in pairs:
+        problem = regression(args.regression) if args.regression else load(robot, task)
+        ids = suite_ids(problem, args.suite)
+        metric = (
+            "mae"
+            if problem.kind == "regression"
+            else "hamming_score"
+            if problem.n_targets > 1
+            else "f1_weighted"
+        )
+        folds = make_folds(
+            problem.Y,
+            n_folds=args.folds,
+            seed=args.seed,
+            target_names=problem.target_names,
+            regression=problem.kind == "regression",
+        )[0]
+        ratio = float(np.mean([f.test.size / f.train.size for f in folds]))
+        print(f"\n{robot} {task}: {len(ids)} entries ({args.suite}), {len(folds)} folds")
+        full, _, full_wall = timed(problem, ids, folds, args.jobs, random_state=args.seed)
+        if args.save:
+            with open(args.save, "wb") as file:
+                pickle.dump({"ids": ids, "results": full, "wall": full_wall}, file)
+        race = RaceRule(metric, args.alpha)
+        raced, drops, raced_wall = timed(
+            problem, ids, folds, args.jobs, random_state=args.seed, race=race
+        )
+        full_board = build_leaderboard(full, metric=metric)
+        raced_board = build_leaderboard(raced, metric=metric, drops=drops)
+        top = [row.classifier for row in full_board.rows[:5]]
+        top_live = [entry for entry in top if entry not in drops]
+        full_best = full_board.rows[0]
+        raced_best = next(row for row in raced_board.rows if row.dropped is None)
+        difference = abs(full_best.metrics[metric][0] - raced_best.metrics[metric][0])
+        print(f"  full : {full_wall:7.1f} s, {len(full)} tasks")
+        when = dict(sorted(Counter(d.after_fold for d in drops.values()).items()))
+        print(
+            f"  raced: {raced_wall:7.1f} s, {len(raced)} tasks, {len(drops)} dropped "
+            f"(after fold: {when})"
+        )
+        print(f"  wall ratio raced/full: {raced_wall / full_wall:.3f} (goal <= 0.5)")
+        # the floor of that ratio: the share of the full run's fit and predict seconds
+        # spent on what the race still runs
+        seconds = {r.key: r.metrics.get("fit_time", 0.0) + r.metrics.get("predict_time", 0.0)
+                   for r in full if r.ok}  # fmt: skip
+        kept = {r.key for r in raced}
+        share = sum(v for k, v in seconds.items() if k in kept) / max(sum(seconds.values()), 1e-9)
+        print(f"  share of the full run's fit+predict seconds the race still spends: {share:.3f}")
+        # where the raced run's time went: its workers' seconds not spent fitting or
+        # predicting (start-up, waiting for a decision, the pool's own work)
+        busy = sum(
+            r.metrics.get("fit_time", 0.0) + r.metrics.get("predict_time", 0.0)
+            for r in raced
+            if r.ok
+        )
+        print(
+            f"  raced run's worker seconds not in fit+predict: "
+            f"{1 - busy / (args.jobs * raced_wall):.3f} of {args.jobs} x {raced_wall:.0f} s"
+        )
+        spent: Counter[str] = Counter()
+        for r in raced:
+            spent[r.key.classifier] += r.metrics.get("fit_time", 0.0) + r.metrics.get(
+                "predict_time", 0.0
             )
-            full_board = build_leaderboard(full, metric=metric)
-            raced_board = build_leaderboard(raced, metric=metric, drops=drops)
-            top = [row.classifier for row in full_board.rows[:5]]
-            top_live = [entry for entry in top if entry not in drops]
-            full_best = full_board.rows[0]
-            raced_best = next(row for row in raced_board.rows if row.dropped is None)
-            difference = abs(full_best.metrics[metric][0] - raced_best.metrics[metric][0])
-            print(f"  full : {full_wall:7.1f} s, {len(full)} tasks")
-            when = dict(sorted(Counter(d.after_fold for d in drops.values()).items()))
+        print(
+            f"  {len(ids) - len(drops)} live at the end; dearest in the race: "
+            + ", ".join(f"{e} {v / max(busy, 1e-9):.0%}" for e, v in spent.most_common(5))
+        )
+        # the floor of any race that keeps the full top 5 to the end: every entry's
+        # first folds before the first decision, and every fold of the top 5
+        first = {(0, f) for f in range(FIRST_ROUND)}
+        floor = sum(
+            v
+            for k, v in seconds.items()
+            if k.classifier in full_top(full, metric) or (k.repeat, k.fold) in first
+        ) / max(sum(seconds.values()), 1e-9)
+        print(
+            f"  floor of a race keeping the full top 5 (their folds and {FIRST_ROUND} "
+            f"folds of the rest): {floor:.3f} of the full run's seconds"
+        )
+        print(f"  full top 5 live at the end of the race: {len(top_live)}/5 ({', '.join(top)})")
+        print(
+            f"  winner: full {full_best.classifier} {full_best.metrics[metric][0]:.4f}, "
+            f"raced {raced_best.classifier} {raced_best.metrics[metric][0]:.4f}; "
+            f"difference {difference:.4f} (goal <= 0.005)"
+        )
+        scores = per_fold(full, metric)
+        lower = race.lower_is_better
+        for name, dropped in (
+            ("t-test vs leader", replay_ttest(scores, metric, args.alpha, ratio, len(folds))),
+            ("Friedman/Nemenyi", replay_nemenyi(scores, lower, args.alpha, len(folds))),
+        ):
+            saved = sum(len(folds) - k for k in dropped.values())
+            lost = [entry for entry in top if entry in dropped]
             print(
-                f"  raced: {raced_wall:7.1f} s, {len(raced)} tasks, {len(drops)} dropped "
-                f"(after fold: {when})"
+                f"  replay {name}: {len(dropped)} dropped, {saved}/{len(full)} tasks "
+                f"saved, top 5 dropped: {', '.join(lost) or 'none'}"
             )
-            print(f"  wall ratio raced/full: {raced_wall / full_wall:.3f} (goal <= 0.5)")
-            # the floor of that ratio: the share of the full run's fit and predict seconds
-            # spent on what the race still runs
-            seconds = {r.key: r.metrics.get("fit_time", 0.0) + r.metrics.get("predict_time", 0.0)
-                       for r in full if r.ok}  # fmt: skip
-            kept = {r.key for r in raced}
-            share = sum(v for k, v in seconds.items() if k in kept) / max(
-                sum(seconds.values()), 1e-9
+        live = len(ids)
+        print(
+            "  Nemenyi critical difference at alpha "
+            f"{args.alpha:g} with {live} entries: "
+            + ", ".join(
+                f"{nemenyi_cd(live, n, args.alpha):.1f} after {n} folds"
+                for n in sorted({FIRST_ROUND, len(folds)})
             )
+            + f" (mean ranks differ by {live - 1} at most)"
+        )
+        if args.budget_fraction:
+            budget = full_wall * args.budget_fraction
+            cut, cuts, cut_wall = timed(
+                problem, ids, folds, args.jobs, random_state=args.seed, budget=budget
+            )
+            complete = Counter(r.key.classifier for r in cut)
+            whole = [e for e in top if complete[e] == len(folds)]
             print(
-                f"  share of the full run's fit+predict seconds the race still spends: {share:.3f}"
+                f"  budget {budget:.1f} s ({args.budget_fraction:g} x full): ended after "
+                f"{cut_wall:.1f} s, {len(cut)}/{len(full)} tasks, {len(cuts)} entries cut, "
+                f"full top 5 with every fold: {len(whole)}/5"
             )
-            print(f"  full top 5 live at the end of the race: {len(top_live)}/5 ({', '.join(top)})")
-            print(
-                f"  winner: full {full_best.classifier} {full_best.metrics[metric][0]:.4f}, "
-                f"raced {raced_best.classifier} {raced_best.metrics[metric][0]:.4f}; "
-                f"difference {difference:.4f} (goal <= 0.005)"
-            )
-            scores = per_fold(full, metric)
-            lower = race.lower_is_better
-            for name, dropped in (
-                ("t-test vs leader", replay_ttest(scores, metric, args.alpha, ratio, len(folds))),
-                ("Friedman/Nemenyi", replay_nemenyi(scores, lower, args.alpha, len(folds))),
-            ):
-                saved = sum(len(folds) - k for k in dropped.values())
-                lost = [entry for entry in top if entry in dropped]
-                print(
-                    f"  replay {name}: {len(dropped)} dropped, {saved}/{len(full)} tasks "
-                    f"saved, top 5 dropped: {', '.join(lost) or 'none'}"
-                )
-            live = len(ids)
-            print(
-                "  Nemenyi critical difference at alpha "
-                f"{args.alpha:g} with {live} entries: "
-                + ", ".join(
-                    f"{nemenyi_cd(live, n, args.alpha):.1f} after {n} folds"
-                    for n in sorted({FIRST_ROUND, len(folds)})
-                )
-                + f" (mean ranks differ by {live - 1} at most)"
-            )
-            if args.budget_fraction:
-                budget = full_wall * args.budget_fraction
-                cut, cuts, cut_wall = timed(
-                    problem, ids, folds, args.jobs, random_state=args.seed, budget=budget
-                )
-                complete = Counter(r.key.classifier for r in cut)
-                whole = [e for e in top if complete[e] == len(folds)]
-                print(
-                    f"  budget {budget:.1f} s ({args.budget_fraction:g} x full): ended after "
-                    f"{cut_wall:.1f} s, {len(cut)}/{len(full)} tasks, {len(cuts)} entries cut, "
-                    f"full top 5 with every fold: {len(whole)}/5"
-                )
     return 0
 
 

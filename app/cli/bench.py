@@ -50,6 +50,7 @@ def register(app: typer.Typer) -> None:
 
 
 def classifiers_command(
+    ctx: typer.Context,
     as_json: JsonOption = False,
     suite_name: Annotated[
         str | None, typer.Option("--suite", help="Only this suite: fast, default or all.")
@@ -67,6 +68,15 @@ def classifiers_command(
             help="List what the ids mean on numeric targets (regression) instead.",
         ),
     ] = False,
+    dataset: Annotated[
+        str | None,
+        typer.Option(
+            "--dataset",
+            metavar="NAME",
+            help="Say each entry's cost on this stored data set's shape (instances, "
+            "features, classes) rather than the catalogue's hint at its reference shape.",
+        ),
+    ] = None,
 ) -> None:
     """List the classifier catalogue (id, WEKA name, family, capabilities).
 
@@ -94,6 +104,7 @@ def classifiers_command(
     else:
         ids = suite(suite_name) if suite_name else list(CATALOGUE)
         specs = [get_spec(i) for i in ids]
+    costs, cost_note = _costs(ctx, specs, dataset)
     if as_json:
         print_json(
             {
@@ -108,20 +119,21 @@ def classifiers_command(
                         "handles_missing": s.handles_missing,
                         "handles_nominal": s.handles_nominal,
                         "sequence": s.needs_sequence,
-                        "cost": s.cost,
+                        "cost": costs[s.id],
                         "suites": sorted(s.suites),
                         "limits": s.limits,
                         "search_space": s.to_json()["search_space"],
                         "onnx": exports_onnx(s),
                     }
                     for s in specs
-                ]
+                ],
+                "cost": cost_note,
             }
         )
         return
     yes = "✓"
     table(
-        f"{len(specs)} {'regressors' if regressors else 'classifiers'}",
+        f"{len(specs)} {'regressors' if regressors else 'classifiers'} (cost: {cost_note})",
         [
             "id",
             "WEKA",
@@ -146,12 +158,44 @@ def classifiers_command(
                 yes if s.handles_nominal else "",
                 yes if s.needs_sequence else "",
                 yes if exports_onnx(s) else "",
-                s.cost,
+                costs[s.id],
                 ",".join(sorted(s.suites)),
             )
             for s in specs
         ],
     )
+
+
+def _costs(
+    ctx: typer.Context, specs: Sequence[Any], dataset: str | None
+) -> tuple[dict[str, str], str]:
+    """Each entry's cost label and what the labels mean: the catalogue's hint at its
+    reference shape, or (with a data set) the shape-aware estimate the engine orders a
+    race and predicts a budget by."""
+    from benchmark.catalogue.costs import (
+        REFERENCE_CLASSES,
+        REFERENCE_FEATURES,
+        REFERENCE_INSTANCES,
+        Shape,
+        cost_label,
+    )
+
+    if dataset is None:
+        return {s.id: s.cost for s in specs}, (
+            f"the catalogue's hint at {REFERENCE_INSTANCES:,} instances x "
+            f"{REFERENCE_FEATURES} features x {REFERENCE_CLASSES} classes; --dataset "
+            "NAME scales it to a data set"
+        )
+    from app.store.datasets import load_schema
+
+    info, schema, _ = load_schema(get_state(ctx).store, dataset)
+    classes = max((len(t.values) for t in schema.targets), default=1)
+    shape = Shape(info.n_instances, info.n_features, max(classes, 1))
+    note = (
+        f"estimated for {info.name}: {info.n_instances:,} instances x "
+        f"{info.n_features:,} features x {classes} classes"
+    )
+    return {s.id: cost_label(s, shape) for s in specs}, note
 
 
 def _print_multitarget(suite_name: str | None, as_json: bool) -> None:
@@ -717,8 +761,7 @@ def runs_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
                 run.dataset_name,
                 ", ".join(run.targets),
                 len(run.classifiers),
-                f"{run.n_results}/{run.n_tasks}"
-                + (f" ({run.n_failed} failed)" if run.n_failed else ""),
+                run.tasks_text(),
                 run.status,
                 run.created_at.strftime("%Y-%m-%d %H:%M"),
             )

@@ -213,7 +213,7 @@ def _run(report: Report, view: RunView, plots: list[_Plot]) -> dict[str, Any]:
         "finished_at": run.finished_at.strftime("%Y-%m-%d %H:%M") if run.finished_at else "-",
         "config": {key: config[key] for key in sorted(config)},
         "n_classifiers": len(run.classifiers),
-        "tasks": f"{run.n_results} of {run.n_tasks}",
+        "tasks": run.tasks_text(),
         "header": leaderboard_header(board, columns, view.besides),
         "rows": leaderboard_rows(board, columns, view.besides),
         "beside_notes": beside_notes(view.besides),

@@ -47,6 +47,11 @@ class RunSchema(Schema):
     tasks_done: int = Field(description="Tasks with a result (failed ones included).")
     tasks: int = Field(description="Tasks in all: classifiers x folds x repeats.")
     tasks_failed: int = 0
+    tasks_dropped: int = Field(
+        default=0,
+        description="Tasks that will not run: later folds of entries a race dropped or a "
+        "total budget cut (tasks_done + tasks_dropped = tasks once such a run is done).",
+    )
     error: str | None = Field(default=None, description="Why the run failed, if it did.")
     owner: str | None = Field(default=None, description="host:pid of the executing process.")
 
@@ -129,6 +134,10 @@ class BudgetSchema(Schema):
     minutes: float
     cut: list[str] = Field(description="Classifiers whose later folds were not started.")
     tasks_not_run: int = Field(description="Tasks of the run without a result.")
+    minutes_spent: float = Field(
+        default=0.0,
+        description="Wall minutes the run's executions took (a resume gets what is left).",
+    )
     note: str
 
 

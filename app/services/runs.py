@@ -13,6 +13,7 @@ from __future__ import annotations
 # job process import this module; the catalogue, the engine and the statistics load
 # scikit-learn and scipy, which only the functions that need them import.
 import threading
+import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -41,6 +42,7 @@ from app.store.drops import forget_budget_cuts, load_drops, record_drop
 from app.store.ownership import process_owner
 from app.store.runs import (
     RunInfo,
+    add_spent,
     claim_run,
     finish_run,
     finished_keys,
@@ -472,7 +474,7 @@ def execute_run(
         counts = [len(run.classifiers) * len(folds), len(done)]
         callbacks.on_plan(*counts)
         forget_budget_cuts(store, run.id)
-        budget = run.config.get("budget_total")
+        budget = _budget_left(run)
 
         def persist(result: TaskResult) -> None:
             record_result(store, run.id, result)
@@ -488,6 +490,7 @@ def execute_run(
         from benchmark.run.engine import RunStopped, run_tasks
 
         beat.start()
+        began = time.monotonic()
         try:
             run_tasks(
                 prepared.problem,
@@ -504,7 +507,7 @@ def execute_run(
                 stop=stop.is_set,
                 extra_specs=run_specs(run.config, run.classifiers),
                 race=race,
-                budget=None if budget is None else float(budget) * 60.0,
+                budget=budget,
                 previous=previous,
                 on_drop=dropped,
                 by_recording=run.config.get("aggregate") == "recording",
@@ -512,6 +515,8 @@ def execute_run(
         except RunStopped:
             finish_run(store, run.id, "cancelled")
             raise RunCancelled(get_run(store, run.id)) from None
+        finally:
+            add_spent(store, run.id, time.monotonic() - began)
     except (KeyboardInterrupt, SystemExit):
         finish_run(store, run.id, "interrupted")
         raise
@@ -528,6 +533,19 @@ def execute_run(
     status, error_text = _outcome(load_results(store, run.id))
     finish_run(store, run.id, status, error=error_text)
     return get_run(store, run.id)
+
+
+#: Seconds a resumed run whose total budget is spent gets: positive for the engine, too
+#: short for any task to fit, so that every entry left is cut and the leaderboard says so.
+NO_BUDGET_LEFT = 1e-6
+
+
+def _budget_left(run: RunInfo) -> float | None:
+    """Seconds of the run's total budget its earlier executions left; ``None`` without one."""
+    minutes = run.config.get("budget_total")
+    if minutes is None:
+        return None
+    return max(float(minutes) * 60.0 - run.seconds_spent, NO_BUDGET_LEFT)
 
 
 def race_rule(run: RunInfo) -> RaceRule | None:
@@ -644,6 +662,7 @@ class RunLeaderboard:
             minutes=float(minutes),
             cut=cut,
             tasks_not_run=missing,
+            minutes_spent=self.run.seconds_spent / 60.0,
             note=f"total budget {float(minutes):g} min: {missing} task(s) not run{cut_text}",
         )
 

@@ -31,7 +31,7 @@ from app.store.naming import is_row_id
 from app.store.ownership import aware, mark_lost, owner_alive, process_owner
 from app.store.paging import count_rows, paged
 from app.store.states import ACTIVE, LOST_AS, check_claim, check_resume
-from app.store.tables import DatasetRow, FoldResultRow, RunRow, utcnow
+from app.store.tables import DatasetRow, EntryDropRow, FoldResultRow, RunRow, utcnow
 from benchmark.results import TaskKey, TaskResult
 
 #: Multi-target folds keep their per-target scores in the metrics column under this key.
@@ -63,10 +63,23 @@ class RunInfo:
     heartbeat_at: datetime | None = None
     error: str | None = None
     cancel_requested: bool = False
+    #: Tasks that will not run: the later folds of entries a race dropped or a total
+    #: budget cut (not counted in ``n_results``).
+    n_dropped: int = 0
+    #: Wall seconds the engine has run for this run, over all its executions.
+    seconds_spent: float = 0.0
 
     @property
     def n_tasks(self) -> int:
         return int(self.config.get("n_tasks", 0))
+
+    def tasks_text(self) -> str:
+        """Progress as listings say it: ``done/total``, and with drops ``done done,
+        dropped dropped / total`` (a raced run ends with fewer results than tasks)."""
+        failed = f" ({self.n_failed} failed)" if self.n_failed else ""
+        if not self.n_dropped:
+            return f"{self.n_results}/{self.n_tasks}{failed}"
+        return f"{self.n_results} done{failed}, {self.n_dropped} dropped / {self.n_tasks}"
 
     @property
     def fold_scheme(self) -> str:
@@ -108,6 +121,7 @@ class RunInfo:
             tasks_done=self.n_results,
             tasks=self.n_tasks,
             tasks_failed=self.n_failed,
+            tasks_dropped=self.n_dropped,
             error=self.error,
             owner=self.owner,
         )
@@ -304,6 +318,16 @@ def finish_run(store: Store, run_id: int, status: RunStatus, *, error: str | Non
         )
 
 
+def add_spent(store: Store, run_id: int, seconds: float) -> None:
+    """Add ``seconds`` of an execution to the run's spent time."""
+    with store.session() as session:
+        session.execute(
+            update(RunRow)
+            .where(RunRow.id == run_id)
+            .values(seconds_spent=RunRow.seconds_spent + max(seconds, 0.0))
+        )
+
+
 def request_cancel(store: Store, run_id: int | str) -> RunInfo:
     """Cancel a run: at once if nobody executes it, else by asking its process to stop
     (status ``cancelling`` until it has; see :mod:`app.store.states`).
@@ -467,7 +491,7 @@ def _row(session: Session, run_id: int | str) -> RunRow:
 
 
 def _infos(session: Session, rows: Sequence[RunRow]) -> list[RunInfo]:
-    """Descriptions of ``rows`` with two queries in all (names, result counts)."""
+    """Descriptions of ``rows`` with three queries in all (names, result counts, drops)."""
     if not rows:
         return []
     ids = [row.id for row in rows]
@@ -490,6 +514,11 @@ def _infos(session: Session, rows: Sequence[RunRow]) -> list[RunInfo]:
             .group_by(FoldResultRow.run_id)
         ).all()
     }
+    stopped: dict[int, list[int]] = {}  # run -> folds run by each of its dropped entries
+    for run_id, after_fold in session.execute(
+        select(EntryDropRow.run_id, EntryDropRow.after_fold).where(EntryDropRow.run_id.in_(ids))
+    ).all():
+        stopped.setdefault(run_id, []).append(int(after_fold))
     return [
         RunInfo(
             id=row.id,
@@ -509,6 +538,14 @@ def _infos(session: Session, rows: Sequence[RunRow]) -> list[RunInfo]:
             heartbeat_at=row.heartbeat_at,
             error=row.error,
             cancel_requested=bool(row.cancel_requested),
+            n_dropped=_skipped(row, stopped.get(row.id, [])),
+            seconds_spent=float(row.seconds_spent or 0.0),
         )
         for row in rows
     ]
+
+
+def _skipped(row: RunRow, folds_run: Sequence[int]) -> int:
+    """Tasks a run's dropped entries will not run: each entry's folds after its last."""
+    per_entry = int(row.config.get("n_tasks", 0)) // max(len(row.classifiers), 1)
+    return sum(max(per_entry - folds, 0) for folds in folds_run)

@@ -113,6 +113,9 @@ class RunRow(Base):
     heartbeat_at: Mapped[datetime | None] = mapped_column(DateTime(timezone=True))
     error: Mapped[str | None] = mapped_column(Text)
     cancel_requested: Mapped[bool] = mapped_column(default=False)
+    #: Wall seconds the engine ran for this run, summed over its executions (a resumed run
+    #: with a total budget gets the rest).
+    seconds_spent: Mapped[float] = mapped_column(Float, default=0.0, server_default="0")
 
 
 class FoldResultRow(Base):

@@ -192,6 +192,7 @@ def run_tasks(
             hand_on,
             hints=cost_hints(problem, classifiers, specs, folds),
             previous=previous,
+            done=skip,
             race=race,
             test_train_ratio=test_train_ratio(sizes.values()),
             budget=budget,

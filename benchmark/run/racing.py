@@ -73,6 +73,26 @@ def leader(scores: Mapping[str, Mapping[int, float]], *, lower_is_better: bool) 
     return min(sorted(means), key=lambda entry: sign * means[entry])
 
 
+@dataclass(frozen=True)
+class RoundOutcome:
+    """What one decision of a race found.
+
+    Attributes
+    ----------
+    drops : list of Drop
+        The entries dropped, in the order of the live entries.
+    p_values : dict of str to float
+        Each compared entry's p-value against the leader (the survivors' included; NaN for
+        an undefined test): how close each is to a drop, which the schedule uses to decide
+        which entries may run ahead of the next decision.
+    leader : str or None
+    """
+
+    drops: list[Drop]
+    p_values: dict[str, float]
+    leader: str | None
+
+
 def decide(
     rule: RaceRule,
     scores: Mapping[str, Mapping[int, float]],
@@ -81,7 +101,19 @@ def decide(
     *,
     test_train_ratio: float,
 ) -> list[Drop]:
-    """The entries to drop after round ``round_index`` (0-based).
+    """The entries to drop after round ``round_index`` (0-based); see :func:`race_round`."""
+    return race_round(rule, scores, live, round_index, test_train_ratio=test_train_ratio).drops
+
+
+def race_round(
+    rule: RaceRule,
+    scores: Mapping[str, Mapping[int, float]],
+    live: Collection[str],
+    round_index: int,
+    *,
+    test_train_ratio: float,
+) -> RoundOutcome:
+    """The decision after round ``round_index`` (0-based).
 
     Parameters
     ----------
@@ -97,19 +129,17 @@ def decide(
 
     Returns
     -------
-    list of Drop
-        In the order of ``live``; empty before ``rule.first_round`` rounds.
+    RoundOutcome
+        No drops before ``rule.first_round`` rounds.
     """
-    if round_index + 1 < rule.first_round:
-        return []
     lower = rule.lower_is_better
     racing = {entry: scores.get(entry, {}) for entry in live}
     best = leader(racing, lower_is_better=lower)
+    outcome = RoundOutcome([], {}, best)
     if best is None:
-        return []
-    drops = []
+        return outcome
     for entry, own in racing.items():
-        if entry == best or entry in rule.protected:
+        if entry == best:
             continue
         paired = sorted(set(own) & set(racing[best]))
         if len(paired) < 2:
@@ -121,9 +151,10 @@ def decide(
             alpha=rule.alpha,
             lower_is_better=lower,
         )
-        if mark == "*":
+        outcome.p_values[entry] = p
+        if mark == "*" and entry not in rule.protected and round_index + 1 >= rule.first_round:
             mean = float(np.mean(list(own.values())))
-            drops.append(
+            outcome.drops.append(
                 Drop(
                     entry,
                     "race",
@@ -133,4 +164,4 @@ def decide(
                     mean=mean,
                 )
             )
-    return drops
+    return outcome

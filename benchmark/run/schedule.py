@@ -4,10 +4,13 @@ A backend asks its :class:`TaskSource` for a task whenever a worker is free, and
 result back through the engine, so that what starts next may depend on what has finished.
 
 - :class:`TaskList`: a fixed order (classifier-major, what a plain run does).
-- :class:`RoundSchedule`: fold-major rounds (every live entry on fold 1, then fold 2, ...),
-  cheap entries first within a round; with a :class:`~benchmark.run.racing.RaceRule` the
-  entries significantly worse than the leader are dropped after each round from the third;
-  with a budget, tasks whose predicted cost does not fit the time left are not started.
+- :class:`RoundSchedule`: fold-major rounds (every live entry on fold 1, then fold 2, ...);
+  with a :class:`~benchmark.run.racing.RaceRule` the entries significantly worse than the
+  leader are dropped after each round from the third, and the entries the last decision
+  found far from a drop run ahead of the next one instead of leaving workers idle while a
+  round's dearest task finishes (a race starts the dear entries of a round first); with a
+  budget, tasks whose predicted cost does not fit the time left are not started (cheap
+  entries first).
 
 A race's decisions depend on the scores alone: a result of round ``r + 1`` of an entry is
 held back until the decision after round ``r`` is made, and dropped with its entry, so that
@@ -24,13 +27,16 @@ from collections.abc import Callable, Collection, Mapping, Sequence
 from typing import Protocol, runtime_checkable
 
 from benchmark.results import Drop, TaskKey, TaskResult
-from benchmark.run.racing import RaceRule, decide
+from benchmark.run.racing import RaceRule, race_round
 
 __all__ = ["RoundSchedule", "TaskList", "TaskSource"]
 
 #: A task's predicted cost is its entry's timed folds' mean, or the entry's hint times how
 #: much slower the timed entries ran than their hints: this machine's speed, at least this.
 MIN_CALIBRATION = 0.05
+#: An entry whose p-value against the leader at the race's last decision is above this
+#: (the leaderboard's own level) may start folds beyond the next decision's round.
+SAFE_P = 0.05
 
 
 @runtime_checkable
@@ -69,7 +75,7 @@ class TaskList:
 
 
 class RoundSchedule:
-    """Fold-major rounds, cheap entries first, with an optional race and budget.
+    """Fold-major rounds with an optional race and budget.
 
     Parameters
     ----------
@@ -83,6 +89,9 @@ class RoundSchedule:
         Predicted seconds of one fold per entry, before it has been timed.
     previous : sequence of TaskResult
         Results of a resumed run (not run again, not delivered again).
+    done : collection of TaskKey
+        Tasks of a resumed run done without their results at hand (not run again; a
+        race needs ``previous`` instead, for its scores).
     race : RaceRule, optional
     test_train_ratio : float
         ``n_test / n_train`` of the folds, for the race's t-test.
@@ -103,6 +112,7 @@ class RoundSchedule:
         *,
         hints: Mapping[str, float],
         previous: Sequence[TaskResult] = (),
+        done: Collection[TaskKey] = (),
         race: RaceRule | None = None,
         test_train_ratio: float = 0.0,
         budget: float | None = None,
@@ -128,12 +138,18 @@ class RoundSchedule:
         self._began: dict[TaskKey, float] = {}
         self._seconds: dict[str, list[float]] = {}
         self._cut: set[str] = set()
+        #: the last decision's leader and each survivor's p-value against it
+        self._leader: str | None = None
+        self._p_values: dict[str, float] = {}
         #: rounds up to this index are decided; the next one is certain, the one after
         #: may start ahead of the decision (its results are held back)
         self._decided = race.first_round - 2 if race is not None else self._n_rounds
         self.dropped: dict[str, Drop] = {}
         for result in previous:
             self._note(result)
+        for key in done:
+            if key.classifier in self._arrived and (key.repeat, key.fold) in self._rounds:
+                self._arrived[key.classifier].add(self._rounds[(key.repeat, key.fold)])
         for entry in self._entries:
             self._started[entry] = set(self._arrived[entry])
         self._make_decisions()
@@ -141,30 +157,66 @@ class RoundSchedule:
     # the backend's side -------------------------------------------------------------
 
     def next_task(self) -> TaskKey | None:
-        """The cheapest unstarted task of the earliest round that may start, if any."""
+        """The next fold of the live entry that is furthest behind and may start, if any.
+
+        Ties within a round: a race without a budget starts the dear entries first (the
+        round's decision waits for its last task: a long one started last leaves the other
+        workers idle at the end of the round); a budget starts the cheap ones first (more
+        entries complete before it runs out).
+        """
         now = self._clock()
-        horizon = min(self._decided + 2, self._n_rounds - 1)
         calibration = self._calibration()  # once per call: it reads every timed entry
-        for index in range(self._n_rounds):
-            if index > horizon:
-                break
-            waiting = [e for e in self._live if index not in self._started[e]]
-            costs = {e: self._cost(e, calibration) for e in waiting}
-            for entry in sorted(waiting, key=costs.__getitem__):
-                if self._deadline is not None and now + costs[entry] > self._deadline:
-                    self._cut_entry(entry)
-                    continue
-                self._started[entry].add(index)
-                key = TaskKey(entry, *self._round_keys[index])
-                self._began[key] = now
-                return key
+        order = -1.0 if self._race is not None and self._deadline is None else 1.0
+        waiting = []
+        for position, entry in enumerate(self._live):
+            index = next(
+                (i for i in range(self._horizon(entry) + 1) if i not in self._started[entry]),
+                None,
+            )
+            if index is not None:
+                cost = self._cost(entry, calibration)
+                waiting.append((index, order * cost, position, entry, cost))
+        for index, _, _, entry, cost in sorted(waiting):  # ties: the run's order
+            if entry not in self._live:
+                continue  # a budget's cut below let the race decide and drop it
+            if self._deadline is not None and now + cost > self._deadline:
+                self._cut_entry(entry)
+                continue
+            self._started[entry].add(index)
+            key = TaskKey(entry, *self._round_keys[index])
+            self._began[key] = now
+            return key
         return None
+
+    def _horizon(self, entry: str) -> int:
+        """The last round ``entry`` may start now.
+
+        A race's next decision waits for every live entry's round after the last decision;
+        the round after that may start too (its results are held back until the decision).
+        An entry the last decision found far from a drop (the leader, the protected ones,
+        p-value against the leader above :data:`SAFE_P`) may run further ahead: a worker
+        that would wait for the slowest entry of the round works on a fold the race will
+        most probably keep.  Only the timing depends on it, not what is stored.
+        """
+        last = self._n_rounds - 1
+        if self._race is None or self._deadline is not None:
+            return last if self._race is None else min(self._decided + 2, last)
+        if entry == self._leader or entry in self._race.protected:
+            return last
+        p = self._p_values.get(entry)
+        if p is not None and p > SAFE_P:
+            return last
+        return min(self._decided + 2, last)
 
     @property
     def exhausted(self) -> bool:
         return self.remaining() == 0
 
     def remaining(self) -> int:
+        if self._deadline is not None and self._clock() >= self._deadline:
+            for entry in list(self._live):  # nothing fits any more: no worker need start
+                if entry in self._live and len(self._started[entry]) < self._n_rounds:
+                    self._cut_entry(entry)
         return sum(self._n_rounds - len(self._started[e]) for e in self._live)
 
     def arrived(self, result: TaskResult) -> None:
@@ -205,8 +257,11 @@ class RoundSchedule:
             scores = {
                 e: {r: s for r, s in self._scores[e].items() if r <= index} for e in self._live
             }
-            drops = decide(self._race, scores, self._live, index, test_train_ratio=self._ratio)
-            for drop in drops:
+            outcome = race_round(
+                self._race, scores, self._live, index, test_train_ratio=self._ratio
+            )
+            self._leader, self._p_values = outcome.leader, outcome.p_values
+            for drop in outcome.drops:
                 self.dropped[drop.classifier] = drop
                 self._live.remove(drop.classifier)
                 self._on_drop(drop)

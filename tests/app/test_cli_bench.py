@@ -257,3 +257,23 @@ def test_an_empty_dataset_cannot_be_benchmarked(
     result = run_cli(capsys, store_url, "bench", "e", "-c", "zeror")
     assert result.code == 2 and "dataset 'e' has no instances" in result.err
     assert run_cli(capsys, store_url, "runs", "--json").json() == {"runs": []}
+
+
+def test_classifiers_say_the_cost_on_a_data_sets_shape(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    url = f"sqlite:///{tmp_path}/t.db"
+    hinted = run_cli(capsys, url, "classifiers", "--json").json()
+    assert hinted["cost"].startswith("the catalogue's hint at 2,000 instances")
+    run_cli(capsys, url, "import", str(touch_arff(tmp_path / "t.arff", n=60)), "--name", "small")
+    shaped = run_cli(capsys, url, "classifiers", "--json", "--dataset", "small").json()
+    assert shaped["cost"].startswith("estimated for small: 60 instances x ")
+    before = {e["id"]: e["cost"] for e in hinted["classifiers"]}
+    after = {e["id"]: e["cost"] for e in shaped["classifiers"]}
+    # slow at the reference shape, fast on 60 instances: the estimate, not the label
+    assert before["gp"] == "slow" and after["gp"] == "fast"
+    assert set(after.values()) <= {"fast", "slow"}
+    listing = run_cli(capsys, url, "classifiers", "--dataset", "small").out
+    assert "(cost: estimated for small: 60 instances" in listing
+    missing = run_cli(capsys, url, "classifiers", "--dataset", "nope")
+    assert missing.code == 2 and len(missing.err.strip().splitlines()) == 1

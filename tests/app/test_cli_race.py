@@ -4,6 +4,7 @@ Ctrl-C that resumes to the leaderboard of an uninterrupted one."""
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
@@ -12,13 +13,29 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from sqlalchemy import text
 
 from tests.app.cli_runner import run_cli
 from tests.app.synthetic import touch_arff
-from tests.app.test_cli_runs_hardening import ROOT, _bench_process, _scalar, _wait_for_results
+from tests.app.test_cli_runs_hardening import (
+    ROOT,
+    _bench_process,
+    _engine,
+    _scalar,
+    _wait_for_results,
+)
 from tests.gate import Gate
 
 RACE = ["--target", "gesture", "--folds", "5", "--race", "--seed", "3"]
+#: Runs each command line of the JSON list in argv[1] with touchbench's main, in order.
+BENCH_TWICE = (
+    "import json, sys\n"
+    "from app.cli.main import main\n"
+    "for command in json.loads(sys.argv[1]):\n"
+    "    code = main(command)\n"
+    "    if code:\n"
+    "        sys.exit(code)\n"
+)
 
 
 @pytest.mark.parametrize(
@@ -91,7 +108,16 @@ def test_a_raced_run_says_what_it_dropped_in_every_view(
     assert "dropped after fold 3" in html and "raced at alpha 0.01" in html
 
 
-def test_a_budget_that_fits_cuts_nothing_and_says_so(
+def _execute(url: str, statement: str) -> None:
+    engine = _engine(url)
+    try:
+        with engine.begin() as connection:
+            connection.execute(text(statement))
+    finally:
+        engine.dispose()
+
+
+def test_a_budget_that_fits_cuts_nothing_and_a_resume_gets_what_is_left(
     capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
 ) -> None:
     run_cli(capsys, store_url, "import", str(touch_arff(tmp_path / "t.arff")), "--name", "touch")
@@ -101,6 +127,7 @@ def test_a_budget_that_fits_cuts_nothing_and_says_so(
     )  # fmt: skip
     assert bench.code == 0, bench.err
     board = bench.json()
+    assert 0 < board["budget"].pop("minutes_spent") < 60
     assert board["budget"] == {
         "minutes": 60.0,
         "cut": [],
@@ -108,6 +135,19 @@ def test_a_budget_that_fits_cuts_nothing_and_says_so(
         "note": "total budget 60 min: 0 task(s) not run",
     }
     assert board["race"] is None
+    # the run, interrupted once its budget was spent with nb's folds still to run: the
+    # resume gets what is left of the budget (nothing), not the whole budget again
+    _execute(store_url, "DELETE FROM fold_results WHERE classifier = 'nb'")
+    _execute(store_url, "UPDATE runs SET status = 'interrupted', seconds_spent = 3600")
+    resumed = run_cli(capsys, store_url, "bench", "--resume", "1", "--json")
+    assert resumed.code == 0, resumed.err
+    budget = resumed.json()["budget"]
+    assert budget["cut"] == ["nb"] and budget["tasks_not_run"] == 3
+    assert budget["minutes_spent"] >= 60
+    assert _scalar(store_url, "SELECT count(*) FROM fold_results") == 3
+    listed = run_cli(capsys, store_url, "runs", "--json").json()["runs"][0]
+    assert (listed["tasks_done"], listed["tasks_dropped"], listed["tasks"]) == (3, 3, 6)
+    assert "3 done, 3 dropped / 6" in run_cli(capsys, store_url, "runs").out
 
 
 def test_a_race_interrupted_by_ctrl_c_resumes_to_the_uninterrupted_leaderboard(
@@ -132,15 +172,17 @@ def test_a_race_interrupted_by_ctrl_c_resumes_to_the_uninterrupted_leaderboard(
     assert 6 <= stored < 9
     gate.open()
     environment = {**os.environ, **gate.environment()}
-    for command in (["--resume", "1"], args):  # the resumed run, then an uninterrupted one
-        done = subprocess.run(
-            [sys.executable, "-m", "app.cli.main", "--db", store_url, "bench", *command],
-            cwd=ROOT,
-            env=environment,
-            capture_output=True,
-            timeout=300,
-        )
-        assert done.returncode == 0, done.stderr.decode()
+    # the resumed run, then an uninterrupted one, in one process (the gate is a plugin, read
+    # when the catalogue is imported: not in this one)
+    commands = [["--db", store_url, "bench", *c] for c in (["--resume", "1"], args)]
+    done = subprocess.run(
+        [sys.executable, "-c", BENCH_TWICE, json.dumps(commands)],
+        cwd=ROOT,
+        env=environment,
+        capture_output=True,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr.decode()
     resumed, uninterrupted = (
         _rows(run_cli(capsys, store_url, "leaderboard", run_id, "--json").json())
         for run_id in ("1", "2")

@@ -2,7 +2,7 @@
 before it was written, with its bytes' sha256.
 
 Revision ID: 0009
-Revises: 0007 (re-chained after 0008 at merge)
+Revises: 0008
 """
 
 from __future__ import annotations
