@@ -48,7 +48,7 @@ from sklearn.utils.validation import check_is_fitted, validate_data
 from benchmark.sequence import panel
 
 #: The networks an architecture may name.
-KINDS = ("bilstm", "cnn1d", "resnet1d")
+KINDS = ("bilstm", "cnn1d", "resnet1d", "inception-time")
 
 #: Every key of an architecture and its allowed range (inclusive); nothing else is built.
 ARCHITECTURE_BOUNDS: Mapping[str, tuple[float, float]] = {
