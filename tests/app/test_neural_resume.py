@@ -55,9 +55,11 @@ def test_a_network_run_killed_mid_training_resumes_to_the_same_scores(tmp_path: 
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
     )
+    deadline = time.monotonic() + 300
     try:
         while gate.started() < 2:  # the first fold is trained: the second is training now
             assert child.poll() is None, child.stderr.read().decode() if child.stderr else ""
+            assert time.monotonic() < deadline, "the first fold did not train in 5 minutes"
             time.sleep(0.02)
     finally:
         os.kill(child.pid, signal.SIGKILL)
