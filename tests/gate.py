@@ -60,8 +60,8 @@ class GateClassifier(ClassifierMixin, BaseEstimator):
 
 
 class GatedNetworkClassifier(NeuralSequenceClassifier):
-    """The ``cnn1d`` entry's network, whose every fit first passes the gate: with the gate
-    open, its ``started-*`` files tell the test which fold's training has begun."""
+    """A narrow ``cnn1d`` network (:data:`SMALL`), whose every fit first passes the gate:
+    with the gate open, its ``started-*`` files tell the test which fold's training began."""
 
     def fit(self, X: Any, y: Any, groups: np.ndarray | None = None) -> GatedNetworkClassifier:
         Gate(Path(os.environ[GATE_VARIABLE])).wait()
@@ -70,8 +70,10 @@ class GatedNetworkClassifier(NeuralSequenceClassifier):
 
 
 #: The ``cnn1d`` entry's parameters (a test keeps them equal; the catalogue itself cannot
-#: be read here: plugins load while it is being built).
+#: be read here: plugins load while it is being built), with :data:`SMALL` on top.
 CNN1D_PARAMS = {"network": "cnn1d", "filters": 32, "kernel": 5, "hidden": 64}
+#: A narrow network and few epochs: a quick test.
+SMALL = {"filters": 8, "max_epochs": 10}
 
 CLASSIFIERS = (
     *(
@@ -97,7 +99,7 @@ CLASSIFIERS = (
         family="test",
         description="Test only: cnn1d, each fit once the test lets it through",
         factory=GatedNetworkClassifier,
-        params=CNN1D_PARAMS,
+        params={**CNN1D_PARAMS, **SMALL},
         probabilities=True,
         needs_scaling=False,
         handles_missing=False,

@@ -20,7 +20,7 @@ from benchmark.estimators import build_estimator
 from benchmark.problem import problem_from_dataset
 from benchmark.run.folds import make_fold_plan
 from tests.benchmark.test_sequences import sequence_dataset, shapes
-from tests.gate import CNN1D_PARAMS, Gate
+from tests.gate import CNN1D_PARAMS, SMALL, Gate
 
 FOLDS = 3
 
@@ -80,6 +80,7 @@ def test_a_network_run_killed_mid_training_resumes_to_the_same_scores(tmp_path: 
     plan = make_fold_plan(problem.Y, n_folds=FOLDS, seed=0, target_names=problem.target_names)
     for fold in plan.folds:
         model = build_estimator("cnn1d", problem, random_state=0)
+        model.set_params(**{f"classifier__{key}": value for key, value in SMALL.items()})
         y = problem.Y[:, 0]
         model.fit(problem.X[fold.train], y[fold.train])
         accuracy = float(np.mean(model.predict(problem.X[fold.test]) == y[fold.test]))
