@@ -9,8 +9,11 @@ its tasks, model training and the app's checks all ask here, so the rule lives o
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Mapping
 from typing import Any
+
+import numpy as np
 
 from benchmark.catalogue import (
     CATALOGUE,
@@ -173,3 +176,26 @@ def build_estimator(
         sequence=problem.sequence,
         extra_specs=extra_specs,
     )
+
+
+def group_fit_params(estimator: Any, groups: np.ndarray | None) -> dict[str, np.ndarray]:
+    """Fit parameters that hand ``groups`` to a pipeline's last step if its ``fit`` takes
+    them, else none.
+
+    The neural networks hold out part of the training fold for early stopping; with the
+    groups (a window's recording) they hold out whole recordings, so that a recording's
+    sister windows on both sides cannot hide overfitting from the validation loss.
+
+    Parameters
+    ----------
+    estimator : Any
+        What :func:`build_estimator` returned.
+    groups : ndarray of shape (n_instances,) or None
+        The group of each training instance, rows as the ``X`` given to ``fit``.
+    """
+    if groups is None or not hasattr(estimator, "steps"):
+        return {}
+    name, last = estimator.steps[-1]
+    if "groups" not in inspect.signature(last.fit).parameters:
+        return {}
+    return {f"{name}__groups": np.asarray(groups)}

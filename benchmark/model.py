@@ -21,7 +21,7 @@ from benchmark.artifacts import dumps_artifact, loads_artifact
 from benchmark.catalogue import get_spec
 from benchmark.dataset import Dataset, Schema
 from benchmark.errors import ConfigurationError
-from benchmark.estimators import build_estimator, check_classifier
+from benchmark.estimators import build_estimator, check_classifier, group_fit_params
 from benchmark.evaluation.metrics import expand_proba
 from benchmark.forest_inference import forest_proba
 from benchmark.problem import feature_matrix, problem_from_dataset
@@ -216,7 +216,8 @@ def fit_model(dataset: Dataset, classifier_id: str, *, random_state: int = 0) ->
         spec = check_classifier(classifier_id, problem)
         assert spec is not None
         estimator = build_estimator(classifier_id, problem, random_state=random_state)
-        estimator.fit(problem.X, problem.Y if problem.n_targets > 1 else problem.Y[:, 0])
+        targets = problem.Y if problem.n_targets > 1 else problem.Y[:, 0]
+        estimator.fit(problem.X, targets, **group_fit_params(estimator, problem.groups))
         return TrainedModel(
             classifier_id,
             {**spec.params, "random_state": random_state},
@@ -231,7 +232,7 @@ def fit_model(dataset: Dataset, classifier_id: str, *, random_state: int = 0) ->
             )
     estimator = build_estimator(classifier_id, problem, random_state=random_state)
     if problem.kind == "multiclass":
-        estimator.fit(problem.X, problem.Y[:, 0])
+        estimator.fit(problem.X, problem.Y[:, 0], **group_fit_params(estimator, problem.groups))
         params: dict[str, Any] = dict(get_spec(classifier_id).params)
     else:
         estimator.fit(problem.X, problem.Y)

@@ -7,8 +7,9 @@ FFT band peaks (95.6 %).  This script measures the same comparison on the simula
 per second of a trial), contact points p1 to p5 only (the trials without contact are
 left out), folds grouped by trial and stratified as ``touchbench bench`` makes them:
 
-* ``bilstm`` and ``minirocket`` (and ``cnn1d``, ``resnet1d`` with ``--all``) on MFCC
-  frames (``mfcc`` with ``frames=N``: 13 coefficients x N frames a channel);
+* ``bilstm`` and ``minirocket`` (and ``cnn1d``, ``resnet1d``, ``inception-time`` with
+  ``--all``) on MFCC frames (``mfcc`` with ``frames=N``: 14 coefficients x N frames a
+  channel);
 * ``rf`` and ``mlp`` on FFT band peaks (``band-peaks``).
 
 Printed per entry: accuracy (mean ± std over folds) and fit seconds per fold (the
@@ -141,12 +142,14 @@ def main() -> None:
     parser.add_argument("--folds", type=int, default=5)
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--frames", type=int, default=32, help="MFCC frames per 1-s window")
-    parser.add_argument("--all", action="store_true", help="also cnn1d and resnet1d")
+    parser.add_argument(
+        "--all", action="store_true", help="also cnn1d, resnet1d and inception-time"
+    )
     parser.add_argument("--install", action="store_true", help="time a fresh install")
     arguments = parser.parse_args()
     load = ", ".join(f"{value:.1f}" for value in os.getloadavg())
     print(f"Machine load average (1, 5, 15 min): {load} on {os.cpu_count()} cores")
-    networks = ("bilstm", "cnn1d", "resnet1d") if arguments.all else ("bilstm",)
+    networks = ("bilstm", "cnn1d", "resnet1d", "inception-time") if arguments.all else ("bilstm",)
     with tempfile.TemporaryDirectory() as name:
         folder = Path(name)
         print(

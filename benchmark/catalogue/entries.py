@@ -268,6 +268,12 @@ NEURAL_ENTRIES: tuple[tuple[str, dict[str, Any], str, int], ...] = (
         "Time-series ResNet: 3 residual blocks of 1-D convolutions, global pooling (PyTorch)",
         8,
     ),
+    (
+        "inception-time",
+        {"network": "inception-time", "filters": 32, "kernel": 39, "layers": 6},
+        "InceptionTime: 6 inception modules (kernels 39, 19, 9), shortcuts, pooling (PyTorch)",
+        8,
+    ),
 )
 NEURAL_LIMITS = (
     "sequence data sets only; missing values imputed by the training mean; early stopping "

@@ -12,9 +12,14 @@ Training, all of it inside the training fold:
 
 * standardisation per channel (sequences) and per column (other columns, and a
   regression's targets), fitted on the training fold;
-* an inner validation split of the training fold (``validation_fraction``, stratified
-  for classes) for early stopping: training stops after ``patience`` epochs without a
-  lower validation loss and keeps the weights of the best epoch;
+* an inner validation split of the training fold (``validation_fraction``) for early
+  stopping: training stops after ``patience`` epochs without a lower validation loss and
+  keeps the weights of the best epoch.  Given the instances' ``groups`` (the engine gives
+  a data set's recordings), whole groups are held out: windows of one recording share its
+  contact force and resonances, and with sister windows on both sides the validation loss
+  keeps falling while the network learns recordings rather than contacts (on the
+  oscillating link it stopped later and scored lower on the test fold).  Without groups,
+  the split is of instances, stratified for classes;
 * Adam, mini-batches, cross-entropy for classes and squared error for numbers;
 * one seed (``random_state``) for the initial weights, the split and the batch order,
   with PyTorch's deterministic algorithms: two fits give equal predictions;
@@ -42,13 +47,13 @@ from typing import Any
 
 import numpy as np
 from sklearn.base import BaseEstimator, ClassifierMixin, RegressorMixin
-from sklearn.model_selection import train_test_split
+from sklearn.model_selection import GroupShuffleSplit, train_test_split
 from sklearn.utils.validation import check_is_fitted, validate_data
 
 from benchmark.sequence import panel
 
 #: The networks an architecture may name.
-KINDS = ("bilstm", "cnn1d", "resnet1d")
+KINDS = ("bilstm", "cnn1d", "resnet1d", "inception-time")
 
 #: Every key of an architecture and its allowed range (inclusive); nothing else is built.
 ARCHITECTURE_BOUNDS: Mapping[str, tuple[float, float]] = {
@@ -176,7 +181,7 @@ class _NeuralSequenceModel(BaseEstimator):
 
     # -- fitting -------------------------------------------------------------------------
 
-    def _fit(self, X: np.ndarray, y: np.ndarray) -> None:
+    def _fit(self, X: np.ndarray, y: np.ndarray, groups: np.ndarray | None) -> None:
         sequences, others = self._split(X)
         self.sequence_mean_, self.sequence_scale_ = _moments(sequences, axis=(0, 2))
         self.others_mean_, self.others_scale_ = _moments(others, axis=0)
@@ -197,7 +202,9 @@ class _NeuralSequenceModel(BaseEstimator):
         )
         inputs = self._scaled(sequences, others)
         with _torch_settings() as torch:
-            self.weights_, self.n_epochs_, self.best_epoch_ = _train(torch, self, inputs, targets)
+            self.weights_, self.n_epochs_, self.best_epoch_ = _train(
+                torch, self, inputs, targets, groups
+            )
         self._network: Any = None  # the built network, kept for the next predictions
 
     def _outputs(self, X: np.ndarray) -> np.ndarray:
@@ -272,10 +279,14 @@ class NeuralSequenceClassifier(ClassifierMixin, _NeuralSequenceModel):
         Epochs run, and the epoch whose weights were kept (1-based).
     """
 
-    def fit(self, X: np.ndarray, y: np.ndarray) -> NeuralSequenceClassifier:
-        """Fit on ``X`` of shape (n_samples, n_columns) and labels ``y`` (n_samples,)."""
+    def fit(
+        self, X: np.ndarray, y: np.ndarray, groups: np.ndarray | None = None
+    ) -> NeuralSequenceClassifier:
+        """Fit on ``X`` of shape (n_samples, n_columns) and labels ``y`` (n_samples,);
+        ``groups`` (n_samples,), optional, keep a group on one side of the inner
+        validation split."""
         X, y = validate_data(self, X, y)
-        self._fit(X, y)
+        self._fit(X, y, _checked_groups(groups, len(y)))
         return self
 
     def _targets(self, y: np.ndarray) -> np.ndarray:
@@ -310,11 +321,13 @@ class NeuralSequenceRegressor(RegressorMixin, _NeuralSequenceModel):
         As the classifier's.
     """
 
-    def fit(self, X: np.ndarray, y: np.ndarray) -> NeuralSequenceRegressor:
+    def fit(
+        self, X: np.ndarray, y: np.ndarray, groups: np.ndarray | None = None
+    ) -> NeuralSequenceRegressor:
         """Fit on ``X`` (n_samples, n_columns) and ``y`` (n_samples,) or (n_samples,
-        n_targets)."""
+        n_targets); ``groups`` as the classifier's."""
         X, y = validate_data(self, X, y, multi_output=True, y_numeric=True)
-        self._fit(X, y)
+        self._fit(X, y, _checked_groups(groups, len(y)))
         return self
 
     def _targets(self, y: np.ndarray) -> np.ndarray:
@@ -330,6 +343,16 @@ class NeuralSequenceRegressor(RegressorMixin, _NeuralSequenceModel):
         """Values of shape (n_samples,) or (n_samples, n_targets), as ``y`` was."""
         values = self._outputs(X) * self.target_scale_ + self.target_mean_
         return values.reshape(len(values), *self.target_shape_)
+
+
+def _checked_groups(groups: np.ndarray | None, n: int) -> np.ndarray | None:
+    """``groups`` as an array of ``n`` entries, or ``ValueError``."""
+    if groups is None:
+        return None
+    groups = np.asarray(groups)
+    if groups.shape != (n,):
+        raise ValueError(f"groups must have one entry per instance ({n}), got {groups.shape}")
+    return groups
 
 
 def _moments(values: np.ndarray, axis: int | tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
@@ -382,7 +405,11 @@ def _torch_settings() -> Iterator[Any]:
 
 
 def _train(
-    torch: Any, model: _NeuralSequenceModel, inputs: tuple[np.ndarray, np.ndarray], y: np.ndarray
+    torch: Any,
+    model: _NeuralSequenceModel,
+    inputs: tuple[np.ndarray, np.ndarray],
+    y: np.ndarray,
+    groups: np.ndarray | None,
 ) -> tuple[bytes, int, int]:
     """Train ``model``'s network; the best epoch's weights, epochs run, best epoch."""
     from benchmark.catalogue.networks import build_network, network_bytes  # PyTorch: on use
@@ -390,7 +417,7 @@ def _train(
     seed = 0 if model.random_state is None else int(model.random_state)
     torch.manual_seed(seed)
     rng = np.random.default_rng(seed)
-    train, valid = _validation_split(y, model.validation_fraction, seed)
+    train, valid = _validation_split(y, model.validation_fraction, seed, groups)
     network = build_network(model.architecture_)
     optimiser = torch.optim.Adam(network.parameters(), lr=model.learning_rate)
     loss_of = torch.nn.CrossEntropyLoss() if y.dtype == np.int64 else torch.nn.MSELoss()
@@ -427,12 +454,23 @@ def _train(
     return network_bytes(network), epoch, best_epoch
 
 
-def _validation_split(y: np.ndarray, fraction: float, seed: int) -> tuple[np.ndarray, np.ndarray]:
-    """Training and validation indices of the training fold (stratified for classes)."""
+#: Fewest groups a validation split holds out whole groups of (else it splits instances).
+MIN_GROUPS = 5
+
+
+def _validation_split(
+    y: np.ndarray, fraction: float, seed: int, groups: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Training and validation indices of the training fold: whole groups when there are
+    at least :data:`MIN_GROUPS` of them, else instances (stratified for classes)."""
     index = np.arange(len(y))
     n_valid = round(fraction * len(y))
     if fraction <= 0 or len(y) < 10 or n_valid < 1:
         return index, index[:0]
+    if groups is not None and np.unique(groups).size >= MIN_GROUPS:
+        splitter = GroupShuffleSplit(n_splits=1, test_size=fraction, random_state=seed)
+        train, valid = next(splitter.split(index, groups=groups))
+        return np.sort(train), np.sort(valid)
     stratify = None
     if y.dtype == np.int64:
         counts = np.bincount(y)

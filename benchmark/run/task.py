@@ -14,11 +14,12 @@ import traceback
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from benchmark.catalogue import ClassifierSpec
-from benchmark.estimators import build_estimator
+from benchmark.estimators import build_estimator, group_fit_params
 from benchmark.evaluation.calibration import PER_TARGET, reliability
 from benchmark.evaluation.metrics import confusion_matrix, expand_proba, multiclass_scores
 from benchmark.evaluation.recordings import Recordings
@@ -118,7 +119,7 @@ def _run_multiclass(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResul
     )
     y = problem.Y[:, 0]
     timer = _Timer()
-    model.fit(problem.X[fold.train], y[fold.train])
+    model.fit(problem.X[fold.train], y[fold.train], **_groups(model, problem, fold))
     fit_time, fit_cpu = timer.lap()
     X_test = problem.X[fold.test]
     y_pred = np.asarray(model.predict(X_test), dtype=np.int64)
@@ -147,6 +148,12 @@ def _run_multiclass(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResul
     )
 
 
+def _groups(model: Any, problem: Problem, fold: Fold) -> dict[str, np.ndarray]:
+    """The training fold's groups for a model whose fit takes them (:func:`group_fit_params`)."""
+    groups = None if problem.groups is None else problem.groups[fold.train]
+    return group_fit_params(model, groups)
+
+
 def _run_regression(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResult:
     from benchmark.evaluation.regression import regression_scores
 
@@ -154,7 +161,7 @@ def _run_regression(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResul
     model = build_estimator(key.classifier, problem, random_state=context.random_state)
     Y = problem.Y if problem.n_targets > 1 else problem.Y[:, 0]
     timer = _Timer()
-    model.fit(problem.X[fold.train], Y[fold.train])
+    model.fit(problem.X[fold.train], Y[fold.train], **_groups(model, problem, fold))
     fit_time, fit_cpu = timer.lap()
     Y_pred = np.asarray(model.predict(problem.X[fold.test]), dtype=np.float64)
     predict_time, predict_cpu = timer.lap()

@@ -256,8 +256,10 @@ def test_every_entry_fits_and_predicts_nominal_and_missing_inputs(classifier_id:
     model = build_pipeline(
         classifier_id, nominal_features=nominal, n_features=X.shape[1], sequence=sequence
     )
-    if "classifier__max_epochs" in model.get_params():  # networks: a few quick epochs
-        model.set_params(classifier__max_epochs=10, classifier__learning_rate=0.01)
+    if "classifier__max_epochs" in model.get_params():  # networks: a few quick epochs, narrow
+        model.set_params(
+            classifier__max_epochs=10, classifier__learning_rate=0.01, classifier__filters=8
+        )
     model.fit(X[::2], y[::2])
     predicted = model.predict(X[1::2])
     assert predicted.shape == (90,)

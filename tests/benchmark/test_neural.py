@@ -1,5 +1,6 @@
-"""The neural entries (``bilstm``, ``cnn1d``, ``resnet1d``): the estimator contract, one
-seed for equal fits, the engine's limits, safe artifacts, and regression on x, y.
+"""The neural entries (``bilstm``, ``cnn1d``, ``resnet1d``, ``inception-time``): the
+estimator contract, one seed for equal fits, early stopping on whole recordings, the
+engine's limits, safe artifacts, and regression on x, y.
 
 The catalogue's parametrised test fits every entry on tiny windows; here, a few epochs.
 """
@@ -23,12 +24,13 @@ from benchmark.catalogue import build_pipeline, get_spec
 from benchmark.catalogue.neural import (
     NeuralSequenceClassifier,
     NeuralSequenceRegressor,
+    _validation_split,
     check_architecture,
 )
 from benchmark.catalogue.regressors import REGRESSORS, regression_suite, regressor_spec
 from benchmark.dataset import Attribute, Dataset, Schema
 from benchmark.errors import ConfigurationError
-from benchmark.estimators import check_classifier
+from benchmark.estimators import check_classifier, group_fit_params
 from benchmark.model import dumps_model, fit_model, loads_model, model_digest
 from benchmark.problem import Problem, problem_from_dataset
 from benchmark.run.engine import run_tasks
@@ -60,14 +62,19 @@ def test_parameters_round_trip_through_clone_and_set_params() -> None:
     assert get_spec("bilstm").make_estimator().get_params()["network"] == "bilstm"
 
 
-@pytest.mark.parametrize("classifier_id", ["cnn1d", "bilstm"])
-def test_two_fits_with_one_seed_give_equal_predictions(classifier_id: str) -> None:
+@pytest.mark.parametrize(
+    ("classifier_id", "size"),
+    [("cnn1d", {}), ("bilstm", {}), ("inception-time", {"filters": 4, "layers": 3})],
+)
+def test_two_fits_with_one_seed_give_equal_predictions(
+    classifier_id: str, size: dict[str, int]
+) -> None:
     X, y, layout = windows()
-    first = quick(classifier_id, layout).fit(X[::2], y[::2])
-    second = quick(classifier_id, layout).fit(X[::2], y[::2])
+    first = quick(classifier_id, layout, **size).fit(X[::2], y[::2])
+    second = quick(classifier_id, layout, **size).fit(X[::2], y[::2])
     np.testing.assert_array_equal(first.predict_proba(X[1::2]), second.predict_proba(X[1::2]))
     assert first[-1].weights_ == second[-1].weights_
-    other = quick(classifier_id, layout, random_state=1).fit(X[::2], y[::2])
+    other = quick(classifier_id, layout, random_state=1, **size).fit(X[::2], y[::2])
     assert other[-1].weights_ != first[-1].weights_
 
 
@@ -76,6 +83,33 @@ def test_early_stopping_keeps_the_best_epoch_of_the_inner_validation_split() -> 
     model = quick("cnn1d", layout, max_epochs=40, patience=2).fit(X, y)[-1]
     assert model.best_epoch_ <= model.n_epochs_ <= model.best_epoch_ + 2
     assert model.n_epochs_ < 40
+
+
+def test_early_stopping_holds_out_whole_groups_when_given_them() -> None:
+    y = np.arange(60) % 3
+    groups = np.repeat(np.arange(20), 3)  # a recording's three windows, one of each class
+    train, valid = _validation_split(y, 0.15, 0, groups)
+    assert valid.size and not set(groups[train]) & set(groups[valid])
+    assert sorted(np.concatenate([train, valid])) == list(range(60))
+    few = np.arange(60) % 4
+    train, valid = _validation_split(y, 0.15, 0, few)  # too few groups: instances
+    assert valid.size == 9 and set(few[train]) & set(few[valid])
+    train, valid = _validation_split(y, 0.15, 0)  # instances, stratified
+    assert np.bincount(y[valid]).tolist() == [3, 3, 3]
+
+
+def test_the_engine_and_training_give_the_groups_to_a_network_only() -> None:
+    X, y, layout = windows()
+    groups = np.arange(len(y)) // 4
+    network = quick("cnn1d", layout)
+    assert group_fit_params(network, groups)["classifier__groups"] is not None
+    assert group_fit_params(network, None) == {}
+    assert group_fit_params(build_pipeline("rf", n_features=layout.stop), groups) == {}
+    with pytest.raises(ValueError, match="one entry per instance"):
+        network.fit(X, y, classifier__groups=groups[:-1])
+    grouped = network.fit(X, y, **group_fit_params(network, groups))[-1]
+    ungrouped = quick("cnn1d", layout).fit(X, y)[-1]
+    assert grouped.weights_ != ungrouped.weights_  # another validation split was held out
 
 
 @pytest.fixture(scope="module")
