@@ -1,5 +1,5 @@
-"""The answers kept for a run (its finished ablation and importance jobs), for the pages and
-reports that show a run."""
+"""The answers kept for a run (its finished ablation and importance jobs) and for a data set
+(its finished learning curves), for the pages and reports that show them."""
 
 from __future__ import annotations
 
@@ -8,8 +8,9 @@ from dataclasses import dataclass, field
 from app.errors import NotFoundError
 from app.schemas.ablation import AblationResult
 from app.schemas.importance import ImportanceResult
+from app.schemas.learning import LearningCurveResult
 from app.store.database import Store
-from app.store.jobs import done_jobs_of_run
+from app.store.jobs import done_jobs_naming, done_jobs_of_run
 from app.store.runs import get_run
 
 
@@ -57,3 +58,12 @@ def latest_ablation(store: Store, run_id: int) -> AblationResult:
             "POST /api/jobs/ablation)"
         )
     return found
+
+
+def latest_learning_curve(store: Store, dataset_id: int, name: str) -> LearningCurveResult | None:
+    """The newest finished learning curve of a data set (asked for by its name or its id),
+    or None."""
+    for job in done_jobs_naming(store, "learning-curve", "dataset", (name, str(dataset_id))):
+        if job.result is not None:
+            return LearningCurveResult.model_validate(job.result)
+    return None

@@ -4,7 +4,7 @@ service processes on one store) never carry out the same job twice."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from dataclasses import dataclass
 from datetime import datetime
 from typing import Any
@@ -80,13 +80,21 @@ def record_job_progress(store: Store, job_id: int, result: dict[str, Any]) -> No
 def done_jobs_of_run(store: Store, kind: str, run_id: int) -> list[JobSchema]:
     """The finished (``done``) jobs of ``kind`` whose request names run ``run_id``, newest
     first."""
+    return done_jobs_naming(store, kind, "run", (run_id,))
+
+
+def done_jobs_naming(
+    store: Store, kind: str, field: str, values: Collection[object]
+) -> list[JobSchema]:
+    """The finished (``done``) jobs of ``kind`` whose request's ``field`` is one of
+    ``values`` (a data set's name and id, say), newest first."""
     with store.session() as session:
         rows = session.scalars(
             select(JobRow)
             .where(JobRow.kind == kind, JobRow.status == "done")
             .order_by(JobRow.id.desc())
         )
-        return [_schema(row) for row in rows if row.params.get("run") == run_id]
+        return [_schema(row) for row in rows if row.params.get(field) in values]
 
 
 def get_job(store: Store, job_id: int | str) -> JobSchema:

@@ -9,6 +9,7 @@ from functools import partial
 from fastapi import APIRouter
 from fastapi.responses import HTMLResponse
 
+from app.services.answers import latest_learning_curve
 from app.services.datasets import describe_dataset
 from app.services.listing import list_datasets
 from app.store.listing import count_datasets
@@ -30,10 +31,13 @@ def datasets(store: StoreDep) -> HTMLResponse:
 
 @router.get("/{dataset}", response_class=HTMLResponse)
 def dataset(dataset: Ref, store: StoreDep) -> HTMLResponse:
-    """Attributes, class distribution per target (table and plot), the runs on it."""
-    from app.reports.figures import dataset_classes_figure
+    """Attributes, class distribution per target (table and plot), the runs on it, and its
+    newest learning curve (table and plot) when one was computed."""
+    from app.reports.answer_tables import learning_table
+    from app.reports.figures import dataset_classes_figure, learning_figure
 
     description = describe_dataset(store, dataset)
+    curve = latest_learning_curve(store, description.id, description.name)
     return render(
         "fragments/dataset.html.j2",
         dataset=description,
@@ -42,4 +46,8 @@ def dataset(dataset: Ref, store: StoreDep) -> HTMLResponse:
             count_runs(store, dataset_id=description.id),
             partial(list_runs, store, dataset_id=description.id),
         ),
+        learning=None if curve is None else learning_table(curve),
+        learning_plot=None
+        if curve is None
+        else draw("Score by share of each training fold", partial(learning_figure, curve)),
     )

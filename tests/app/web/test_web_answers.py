@@ -39,3 +39,21 @@ def test_the_page_shows_the_paper_beside_us_and_how_sure(
     assert "How sure: per class and calibration" in page
     assert 'data-table="classes"' in page and "Expected calibration error" in page
     assert page.count("<figure") >= 3  # confusion, folds, reliability
+
+
+def test_the_data_set_view_shows_its_newest_learning_curve(
+    capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path
+) -> None:
+    db, api = server.database_url, server.client
+    data = touch_arff(tmp_path / "touch.arff", n=60, with_place=False)
+    assert run_cli(capsys, db, "import", str(data)).code == 0
+    before = api.get("/fragments/datasets/touch")
+    assert before.status_code == 200 and "How many touches" not in before.text
+    curve = run_cli(
+        capsys, db, "learning-curve", "touch", "-c", "nb", "--fractions", "0.5", "--folds", "3"
+    )
+    assert curve.code == 0, curve.err
+    after = api.get("/fragments/datasets/touch").text
+    assert "How many touches" in after and 'data-table="learning"' in after
+    assert ">nb<" in after and after.count("<figure") == 2  # classes, learning curve
+    assert "Not drawn" not in after
