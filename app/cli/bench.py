@@ -41,6 +41,16 @@ def _default(field: str) -> Any:
     return BenchRequest.model_fields[field].default
 
 
+def _memory_default() -> str:
+    """The default memory cap of a task on this machine, for ``--help``."""
+    from benchmark.run.memory import MB, default_task_memory
+
+    caps = [default_task_memory(jobs) for jobs in (1, 2)]
+    if caps[0] is None or caps[1] is None:
+        return "none where the machine's memory cannot be read"
+    return f"here {caps[0].bytes / MB:,.0f} MB at --jobs 1, {caps[1].bytes / MB:,.0f} MB at 2"
+
+
 def register(app: typer.Typer) -> None:
     app.command("classifiers")(classifiers_command)
     app.command("bench")(bench_command)
@@ -322,11 +332,16 @@ def bench_command(
         ),
     ] = None,
     max_memory: Annotated[
-        float | None,
+        str | None,
         typer.Option(
             "--max-memory",
-            metavar="MB",
-            help="Megabytes one task may allocate (beyond its copy of the data) before it fails.",
+            metavar="MB|none",
+            help=(
+                "Megabytes one task may allocate (beyond its copy of the data) before it fails, "
+                "marked, while the run goes on; none (or 0): no limit. Default: the memory "
+                "available when the run starts, less a tenth of the RAM, shared by the --jobs "
+                f"workers ({_memory_default()}); stored with the run as task_memory_mb."
+            ),
             show_default=False,
         ),
     ] = None,

@@ -259,6 +259,10 @@ Suite = Literal["fast", "default", "all"]
 
 #: Largest memory cap of a task, in megabytes (1 TiB): finite, and a limit the OS can set.
 MAX_MEMORY_MB = 2**20
+#: Smallest memory cap of a task, in megabytes.
+MIN_MEMORY_MB = 1
+#: ``max_memory_mb`` that lifts the cap (``none`` on the command line, null in JSON).
+NO_MEMORY_LIMIT = 0.0
 #: Longest time limit of a task, in seconds (a week).
 MAX_TIMEOUT = 7 * 24 * 3600.0
 
@@ -340,9 +344,12 @@ class BenchRequest(Request):
     )
     max_memory_mb: float | None = Field(
         default=None,
-        ge=1,
+        ge=0,
         le=MAX_MEMORY_MB,
-        description="Megabytes one task may allocate beyond its copy of the data; null: no limit.",
+        description="Megabytes one task may allocate beyond its copy of the data before it "
+        'fails (marked, the run goes on); 0, "none" or null: no limit; absent: the '
+        "machine's available memory less a reserve, shared by the run's worker processes "
+        "(derived when the run starts, stored as `task_memory_mb`).",
     )
     metric: str | None = Field(
         default=None,
@@ -413,6 +420,28 @@ class BenchRequest(Request):
 
     _id_as_text = field_validator("dataset", mode="before")(id_as_text)
     _zero_is_no_limit = field_validator("timeout", mode="after")(zero_is_no_limit)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _no_memory_limit(cls, data: Any) -> Any:
+        """``max_memory_mb`` given as null or "none" is no limit (0); absent, the default
+        cap (None), as a timeout of null is no limit and an absent one the default."""
+        if isinstance(data, dict) and "max_memory_mb" in data:
+            value = data["max_memory_mb"]
+            if value is None or (isinstance(value, str) and value.strip().lower() == "none"):
+                data = {**data, "max_memory_mb": NO_MEMORY_LIMIT}
+        return data
+
+    @field_validator("max_memory_mb", mode="after")
+    @classmethod
+    def _a_cap_or_none(cls, value: float | None) -> float | None:
+        if value is not None and 0 < value < MIN_MEMORY_MB:
+            raise FieldError(
+                "max_memory_mb",
+                f"Input should be greater than or equal to {MIN_MEMORY_MB}, or 0 or none "
+                "for no limit",
+            )
+        return value
 
     @model_validator(mode="after")
     def _rules_across_fields(self) -> BenchRequest:

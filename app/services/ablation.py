@@ -20,7 +20,7 @@ from app.schemas.ablation import (
 from app.schemas.runs import BenchRequest
 from app.services.importance import feature_names, refittable_run
 from app.services.report import run_view
-from app.services.runs import RunOptions, fold_plan, megabytes_to_bytes, prepare_problem
+from app.services.runs import RunOptions, fold_plan, prepare_problem, task_memory
 from app.services.tuning import run_specs
 from app.store.database import Store
 from app.store.datasets import load_dataset, load_schema
@@ -119,6 +119,12 @@ def run_ablation(
         on_progress(plan.summary(results))
 
     options = plan.options
+    max_memory, _ = task_memory(
+        options.max_memory_mb,
+        jobs=jobs,
+        scheduler=None,
+        data_bytes=int(plan.problem.X.nbytes),
+    )
     ablate(
         plan.problem,
         plan.classifiers,
@@ -128,7 +134,7 @@ def run_ablation(
         jobs=jobs,
         timeout=options.timeout,
         random_state=options.seed,
-        max_memory=megabytes_to_bytes(options.max_memory_mb),
+        max_memory=max_memory,
         extra_specs=plan.specs,
     )
     return plan.summary(results)

@@ -50,6 +50,7 @@ from app.store.runs import (
     load_results,
     record_result,
     run_heartbeat,
+    update_config,
 )
 from app.store.runs import (
     create_run as store_run,
@@ -84,7 +85,8 @@ class RunOptions:
     timeout : float or None
         Seconds one task may take before its worker process is killed; ``None``: no limit.
     max_memory_mb : float or None
-        Megabytes one task may allocate beyond its worker's copy of the data.
+        Megabytes one task may allocate beyond its worker's copy of the data; 0: no limit;
+        None: derived from the machine when the run starts (:func:`task_memory`).
     """
 
     folds: int
@@ -475,6 +477,20 @@ def execute_run(
         callbacks.on_plan(*counts)
         forget_budget_cuts(store, run.id)
         budget = _budget_left(run)
+        max_memory, memory_from = task_memory(
+            options.max_memory_mb,
+            jobs=jobs,
+            scheduler=scheduler,
+            data_bytes=int(prepared.problem.X.nbytes),
+        )
+        update_config(
+            store,
+            run.id,
+            {
+                "task_memory_mb": None if max_memory is None else round(max_memory / 2**20),
+                "task_memory_from": memory_from,
+            },
+        )
 
         def persist(result: TaskResult) -> None:
             record_result(store, run.id, result)
@@ -503,7 +519,7 @@ def execute_run(
                 skip=done,
                 on_start=callbacks.on_start,
                 on_result=persist,
-                max_memory=megabytes_to_bytes(options.max_memory_mb),
+                max_memory=max_memory,
                 stop=stop.is_set,
                 extra_specs=run_specs(run.config, run.classifiers),
                 race=race,
@@ -951,9 +967,44 @@ def _tuning_config(
     }
 
 
-def megabytes_to_bytes(megabytes: float | None) -> int | None:
-    """A limit in megabytes as the engine takes it (``None``: no limit)."""
-    return None if megabytes is None else int(megabytes * 2**20)
+def task_memory(
+    max_memory_mb: float | None, *, jobs: int, scheduler: str | None, data_bytes: int
+) -> tuple[int | None, str]:
+    """The bytes one task of a run may allocate, and where that cap comes from.
+
+    Parameters
+    ----------
+    max_memory_mb : float or None
+        The run's own cap in megabytes; 0: no limit; None: derived from what this machine
+        has available, shared by ``jobs`` workers
+        (:func:`benchmark.run.memory.default_task_memory`).  A run on a Dask cluster
+        derives none: its workers' own memory limits apply.
+    jobs : int
+        Local worker processes (-1: one per core).
+    scheduler : str or None
+        The Dask scheduler the run uses, if any.
+    data_bytes : int
+        Bytes of the run's features.
+
+    Returns
+    -------
+    tuple of (int or None, str)
+        The cap (None: no limit) and a few words on its origin, stored with the run.
+    """
+    if max_memory_mb == 0:
+        return None, "no limit asked"
+    if max_memory_mb is not None:
+        return int(max_memory_mb * 2**20), "asked"
+    if scheduler is not None:
+        return None, "the Dask workers' own memory limits"
+    from benchmark.run.engine import available_cores
+    from benchmark.run.memory import default_task_memory
+
+    cap = default_task_memory(available_cores() if jobs == -1 else jobs, data_bytes=data_bytes)
+    if cap is None:
+        return None, "no limit: this machine's memory cannot be read"
+    # whole megabytes: the figure the run's config and its failures' messages show
+    return cap.bytes // 2**20 * 2**20, f"default: {cap.describe()}"
 
 
 def fold_plan(prepared: PreparedProblem, options: RunOptions) -> FoldPlan:

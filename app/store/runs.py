@@ -302,6 +302,14 @@ def should_stop(store: Store, run_id: int, owner: str) -> bool:
     return queue.should_stop(store, RunRow, run_id, owner)
 
 
+def update_config(store: Store, run_id: int, values: dict[str, Any]) -> None:
+    """Merge ``values`` into a run's stored config (what its executing process decided
+    when it started, such as the memory cap it derived)."""
+    with store.session() as session:
+        row = _row(session, run_id)
+        row.config = {**row.config, **values}
+
+
 def finish_run(store: Store, run_id: int, status: RunStatus, *, error: str | None = None) -> None:
     """Leave a run in ``status`` (``finished_at`` set for final ones), its owner released."""
     with store.session() as session:

@@ -15,6 +15,10 @@ from scipy.special import ndtri
 
 #: WEKA's tolerance in comparisons (``Utils.SMALL``).
 SMALL = 1e-6
+#: Cells (rows x columns x classes) of one array of the numeric split search: the search
+#: holds about ten such float arrays, so 2**18 cells cost some 20 MB at most, whatever the
+#: data's width and number of classes.
+CHUNK_CELLS = 2**18
 
 
 @dataclass
@@ -142,15 +146,27 @@ class SplitSelector:
     def _numeric_splits(
         self, rows: np.ndarray, weight: np.ndarray, total: float
     ) -> list[tuple[float, float, Split]]:
-        """The best cut of every numeric attribute at once (``C45Split`` on each).
+        """The best cut of every numeric attribute (``C45Split`` on each), a few columns at
+        a time: the scoring holds arrays of (n_rows, columns, n_classes), so that columns
+        are taken in chunks of at most :data:`CHUNK_CELLS` cells (memory linear in the
+        data, not times the classes; each column's arithmetic is the same)."""
+        if self.numeric.size == 0 or rows.size < 2:
+            return []
+        width = max(1, CHUNK_CELLS // (rows.size * self.n_classes))
+        found: list[tuple[float, float, Split]] = []
+        for start in range(0, self.numeric.size, width):
+            found += self._numeric_chunk(self.numeric[start : start + width], rows, weight, total)
+        return found
+
+    def _numeric_chunk(
+        self, columns: np.ndarray, rows: np.ndarray, weight: np.ndarray, total: float
+    ) -> list[tuple[float, float, Split]]:
+        """The best cut of each numeric attribute in ``columns`` at once.
 
         Each column is sorted (missing values last); cumulative class weights give the
         class distribution on each side of every candidate cut, of shape
-        (n_rows - 1, n_numeric, n_classes).
+        (n_rows - 1, n_columns, n_classes).
         """
-        columns = self.numeric
-        if columns.size == 0 or rows.size < 2:
-            return []
         values = self.X[np.ix_(rows, columns)]
         order = np.argsort(values, axis=0, kind="stable")
         v = np.take_along_axis(values, order, axis=0)

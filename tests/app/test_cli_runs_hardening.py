@@ -195,7 +195,7 @@ def test_bench_refusals_exit_2_and_leave_no_run(
         (["singles", "-c", "zeror"], "fold"),
         (["touch", "--target", "gesture", "-c", "nb", "--scheduler", "garbage"], "not a Dask"),
         (["touch", "--target", "gesture", "-c", "nb", "--jobs", "999"], "--oversubscribe"),
-        (["touch", "--target", "gesture", "-c", "nb", "--max-memory", "0"], "--max-memory"),
+        (["touch", "--target", "gesture", "-c", "nb", "--max-memory", "-1"], "--max-memory"),
     ]
     for args, message in cases:
         result = run_cli(capsys, store_url, "bench", *args)
