@@ -54,6 +54,12 @@ TIME_COLUMNS = frozenset(
 #: nanoseconds: 1e11 s is more than 3000 years, 1e3 s between two samples is no series.
 NS_MAGNITUDE = 1e11
 NS_STEP = 1e3
+#: Seconds per unit of a time column, by the unit's name (``auto``: seconds or nanoseconds,
+#: told apart by magnitude).
+TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
+#: A median step longer than this, in seconds, is said in a note: few sensors sample
+#: slower than once a second, and stamps in milliseconds read as seconds look like that.
+SLOW_STEP = 1.0
 #: Steps within this fraction of the median step count as even.
 EVEN = 0.01
 
@@ -87,6 +93,7 @@ def read_csv_series(
     *,
     samplerate: float | None = None,
     time_column: str | None = None,
+    time_unit: str = "auto",
     channels: Sequence[str] | None = None,
 ) -> CsvSeries:
     """Read a CSV time series (see the module docstring).
@@ -100,6 +107,8 @@ def read_csv_series(
         resampled onto.
     time_column : str, optional
         The time column's name, when it has none of the usual ones.
+    time_unit : {"auto", "s", "ms", "us", "ns"}
+        The time column's unit; ``auto``: seconds or nanoseconds, by magnitude.
     channels : sequence of str, optional
         The columns to keep as channels, by name or 1-based number; all by default.
     """
@@ -114,23 +123,33 @@ def read_csv_series(
     samples = values[:, picked]
     if time is None:
         return CsvSeries(np.ascontiguousarray(samples.T), samplerate, kept_names, ())
-    times, unit = stamps_in_seconds(values[:, time])
+    times, unit = stamps_in_seconds(values[:, time], time_unit)
     rate, samples, notes = _on_even_grid(path, names[time], times, lines, samples, samplerate)
     resampled = samplerate is None and bool(notes)
-    if unit != "s":
+    if time_unit == "auto" and unit != "s":
         notes.insert(0, f"column '{names[time]}' holds nanoseconds")
+    step = float(np.median(np.diff(times))) if times.size > 1 else 0.0
+    if time_unit == "auto" and unit == "s" and step > SLOW_STEP:
+        notes.insert(
+            0,
+            f"column '{names[time]}' read as seconds: {step:g} s between samples "
+            f"({1 / step:.3g} Hz); if its stamps are milliseconds, give the time unit (ms)",
+        )
     return CsvSeries(np.ascontiguousarray(samples.T), rate, kept_names, tuple(notes), resampled)
 
 
-def stamps_in_seconds(stamps: np.ndarray) -> tuple[np.ndarray, str]:
-    """Stamps of shape (n,) as seconds from the first one, and their unit (``s``, ``ns``).
+def stamps_in_seconds(stamps: np.ndarray, unit: str = "auto") -> tuple[np.ndarray, str]:
+    """Stamps of shape (n,) as seconds from the first one, and their unit.
 
-    Nanoseconds are told from seconds by magnitude: stamps beyond :data:`NS_MAGNITUDE`
-    or a median step beyond :data:`NS_STEP` (ROS stamps since 1970 in nanoseconds are
-    about 1.7e18; in seconds about 1.7e9).
+    ``unit`` is one of :data:`TIME_UNITS` or ``auto``: then nanoseconds are told from
+    seconds by magnitude, stamps beyond :data:`NS_MAGNITUDE` or a median step beyond
+    :data:`NS_STEP` (ROS stamps since 1970 in nanoseconds are about 1.7e18; in seconds
+    about 1.7e9).
     """
     stamps = np.asarray(stamps, dtype=np.float64)
     relative = stamps - stamps[0]
+    if unit != "auto":
+        return relative * TIME_UNITS[unit], unit
     step = float(np.median(np.diff(stamps))) if stamps.size > 1 else 0.0
     if np.abs(stamps).max() > NS_MAGNITUDE or step > NS_STEP:
         return relative * 1e-9, "ns"

@@ -33,6 +33,7 @@ def read_recording(
     *,
     samplerate: float | None = None,
     time_column: str | None = None,
+    time_unit: str = "auto",
     fields: Sequence[str] | None = None,
 ) -> Recording:
     """Read one recording, choosing the reader by the file's suffix.
@@ -47,6 +48,8 @@ def read_recording(
         grid their stamps are resampled onto if they differ.
     time_column : str, optional
         A CSV file's time column, when it has none of the usual names.
+    time_unit : {"auto", "s", "ms", "us", "ns"}
+        The unit of a CSV file's time column (``auto``: seconds or nanoseconds).
     fields : sequence of str, optional
         The CSV columns to keep as channels (names, or 1-based numbers); all by default.
 
@@ -77,7 +80,11 @@ def read_recording(
         samples, rate = np.asarray(open_npy(path), dtype=np.float64), samplerate
     elif suffix in _CSV_SUFFIXES:
         series = read_csv_series(
-            path, samplerate=samplerate, time_column=time_column, channels=fields
+            path,
+            samplerate=samplerate,
+            time_column=time_column,
+            time_unit=time_unit,
+            channels=fields,
         )
         samples, rate, names, notes = (
             series.samples,

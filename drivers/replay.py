@@ -70,6 +70,7 @@ class FileReplaySource(Source):
         channels: int | None = None,
         sample_format: str | None = None,
         time_column: str | None = None,
+        time_unit: str = "auto",
     ) -> None:
         self.path = Path(path)
         self.name = str(path)
@@ -117,7 +118,11 @@ class FileReplaySource(Source):
             raise DriverError(f"{path}: is a folder, not a recording (nor a ROS 2 bag)")
         elif self.path.suffix.lower() in CSV_SUFFIXES:
             recording = read_recording(
-                self.path, samplerate=samplerate, time_column=time_column, fields=fields
+                self.path,
+                samplerate=samplerate,
+                time_column=time_column,
+                time_unit=time_unit,
+                fields=fields,
             )
             inner = RecordingSource(recording, block_length=block_length)
             self._inner, self.channel_names, self.notes = inner, inner.channel_names, inner.notes

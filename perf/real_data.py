@@ -83,7 +83,7 @@ SOURCES = {
         "data/fabric/*.csv",
         label=lambda path: path.name.split("_")[0],
         order=_trial,
-        extraction={"options": {"length": "512"}},
+        extraction={"time_unit": "ms", "options": {"length": "512"}},
     ),
 }
 

@@ -114,11 +114,22 @@ def extract_command(
             "--time-column",
             metavar="NAME",
             help=(
-                "The time column of CSV files (seconds or nanoseconds), when it is not named "
-                "time, t, timestamp, stamp, header.stamp, %time, ..."
+                "The time column of CSV files, when it is not named time, t, timestamp, "
+                "stamp, header.stamp, %time, ..."
             ),
         ),
     ] = None,
+    time_unit: Annotated[
+        str,
+        typer.Option(
+            "--time-unit",
+            metavar="UNIT",
+            help=(
+                "Unit of the CSV files' time column: s, ms, us or ns; auto: seconds or "
+                "nanoseconds, told apart by magnitude."
+            ),
+        ),
+    ] = "auto",
     segment: Annotated[
         float | None,
         typer.Option("--segment", help="With --events none: cut files into segments of SECONDS."),
@@ -203,6 +214,7 @@ def extract_command(
         sample_format=sample_format,
         max_event=max_event,
         time_column=time_column,
+        time_unit=time_unit,
     )
     with _Reading() as reading:
         summary = extract_and_store(get_state(ctx).store, request, on_progress=reading.update)

@@ -86,6 +86,11 @@ class ExtractRequest(Request):
         max_length=200,
         description="The time column of CSV recordings, when it has none of the usual names.",
     )
+    time_unit: Literal["auto", "s", "ms", "us", "ns"] = Field(
+        default="auto",
+        description="Unit of the time column of CSV recordings; auto: seconds or "
+        "nanoseconds, told apart by magnitude.",
+    )
     channels: int | None = Field(
         default=None,
         ge=1,

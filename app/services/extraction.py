@@ -122,6 +122,7 @@ def extract_dataset(
     sample_format: str | None = None,
     max_event: float | None = None,
     time_column: str | None = None,
+    time_unit: str = "auto",
     on_progress: Callable[[str, float], None] | None = None,
 ) -> ExtractionResult:
     """Turn recordings into a labelled data set, each recording read block by block.
@@ -159,6 +160,8 @@ def extract_dataset(
         Longest event in seconds (default 60); longer ones are cut, with a warning.
     time_column : str, optional
         The time column of CSV recordings.
+    time_unit : {"auto", "s", "ms", "us", "ns"}
+        The unit of that column.
     on_progress : callable, optional
         Called as ``on_progress(file_name, seconds_read)`` after every block.
 
@@ -198,6 +201,7 @@ def extract_dataset(
             channels=channels,
             sample_format=sample_format,
             time_column=time_column,
+            time_unit=time_unit,
         )
 
     for index, path in enumerate(paths):
@@ -367,6 +371,7 @@ def extract_and_store(
         sample_format=request.sample_format,
         max_event=request.max_event,
         time_column=request.time_column,
+        time_unit=request.time_unit,
         on_progress=on_progress,
     )
     data = result.dataset

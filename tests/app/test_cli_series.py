@@ -130,6 +130,7 @@ def test_a_biotac_export_keeps_its_names_and_says_it_resampled(
         (["--fields", "ele1"], "slip.csv: has no channel 'ele1' (channels: tdc, tac)"),
         (["--time-column", "when"], "slip.csv: has no column 'when' to read times from"),
         (["--time-column", ""], "--time-column:"),
+        (["--time-unit", "min"], "--time-unit: Input should be 'auto', 's', 'ms', 'us' or 'ns'"),
         (["--fields", "x" * 300], "--fields: String should have at most 200 characters"),
     ],
 )

@@ -55,6 +55,22 @@ def test_nanosecond_stamps_are_told_by_magnitude(tmp_path: Path) -> None:
     assert recording.channels == ("tdc", "tac")
 
 
+def test_millisecond_stamps_are_read_with_their_unit_and_noted_without(tmp_path: Path) -> None:
+    """As the FabricSlide exports write them: milliseconds since the sensor started."""
+    path = tmp_path / "ms.csv"
+    lines = ["timestamp,c1"] + [f"{4277465 + 28 * i},{i % 7}" for i in range(200)]
+    path.write_text("\n".join(lines) + "\n")
+    given = read_recording(path, time_unit="ms")
+    assert given.samplerate == pytest.approx(1000 / 28) and given.notes == ()
+    guessed = read_recording(path)
+    assert guessed.samplerate == pytest.approx(1 / 28)
+    assert guessed.notes[0] == (
+        "column 'timestamp' read as seconds: 28 s between samples (0.0357 Hz); if its "
+        "stamps are milliseconds, give the time unit (ms)"
+    )
+    assert read_recording(path, time_unit="s").notes == ()  # said, so nothing to note
+
+
 @pytest.mark.parametrize("name", ["time", "T", "Timestamp", "stamp", "header.stamp", "%time"])
 def test_time_columns_are_found_by_name(tmp_path: Path, name: str) -> None:
     path = tmp_path / "named.csv"

@@ -42,6 +42,9 @@ def upload_session(
     time_column: Annotated[
         str | None, Form(description="The time column of CSV recordings, if not a usual name.")
     ] = None,
+    time_unit: Annotated[
+        str, Form(description="auto, s, ms, us or ns: the unit of that time column.")
+    ] = "auto",
     channels: Annotated[
         int | None, Form(description="Channels of raw PCM in bags without AudioInfo.")
     ] = None,
@@ -64,6 +67,7 @@ def upload_session(
         "topic": topic,
         "fields": fields,
         "time_column": time_column,
+        "time_unit": time_unit,
         "channels": channels,
         "sample_format": sample_format,
     }
