@@ -19,7 +19,7 @@ from markupsafe import Markup
 from matplotlib.figure import Figure
 
 from app.reports import bounds, figures
-from app.reports.answer_tables import run_answer_tables
+from app.reports.answer_tables import learning_table, run_answer_tables
 from app.reports.certainty_tables import calibration_table, class_tables
 from app.reports.leaderboard import (
     beside_notes,
@@ -220,6 +220,7 @@ def _run(report: Report, view: RunView, plots: list[_Plot]) -> dict[str, Any]:
         "mark_column": 4 if view.besides else 3,
         "sure": sure,
         "answers": run_answer_tables(report.answers.get(run.id, RunAnswers())),
+        "learning": _learning(report, run.id, plots),
         "metric": board.metric,
         "baseline": board.baseline,
         "alpha": board.alpha,
@@ -229,6 +230,21 @@ def _run(report: Report, view: RunView, plots: list[_Plot]) -> dict[str, Any]:
         "fold_note": ranked if isinstance(ranked, str) else None,
         "tables": run_tables(view.report()),
         "notes": view.notes(),
+    }
+
+
+def _learning(report: Report, run_id: int, plots: list[_Plot]) -> dict[str, Any] | None:
+    """The table and plot of the newest learning curve of the run's data set, or None."""
+    curve = report.learning.get(run_id)
+    if curve is None:
+        return None
+    return {
+        "table": learning_table(curve),
+        "plot": _plan(
+            plots,
+            "Score by share of each training fold",
+            partial(figures.learning_figure, curve),
+        ),
     }
 
 

@@ -12,7 +12,8 @@ from importlib import metadata
 
 import numpy as np
 
-from app.services.answers import RunAnswers, run_answers
+from app.schemas.learning import LearningCurveResult
+from app.services.answers import RunAnswers, latest_learning_curve, run_answers
 from app.services.compare import Comparison, compare_runs, with_besides
 from app.services.runs import (
     PerTargetSummary,
@@ -164,6 +165,8 @@ class Report:
     created_at : datetime
     answers : dict of int to RunAnswers
         Per run id: its kept ablation and importance.
+    learning : dict of int to LearningCurveResult
+        Per run id: the newest learning curve of its data set, where one was computed.
     """
 
     views: list[RunView]
@@ -174,6 +177,7 @@ class Report:
     versions: dict[str, str]
     created_at: datetime = field(default_factory=lambda: datetime.now(UTC))
     answers: dict[int, RunAnswers] = field(default_factory=dict)
+    learning: dict[int, LearningCurveResult] = field(default_factory=dict)
 
 
 def run_view(
@@ -266,7 +270,21 @@ def build_report(
         confusions,
         library_versions(),
         answers={view.run.id: run_answers(store, view.run.id) for view in views},
+        learning=_learning_curves(store, views),
     )
+
+
+def _learning_curves(store: Store, views: Sequence[RunView]) -> dict[int, LearningCurveResult]:
+    """The newest learning curve of each run's data set (runs without one left out)."""
+    found = {}
+    for view in views:
+        run = view.run
+        if run.dataset_id is None:  # an imported run's data set may be gone
+            continue
+        curve = latest_learning_curve(store, run.dataset_id, run.dataset_name or "")
+        if curve is not None:
+            found[run.id] = curve
+    return found
 
 
 def library_versions() -> dict[str, str]:

@@ -115,6 +115,13 @@ def test_learning_curve_finds_where_a_classifier_has_enough(
         assert sizes == sorted(sizes) and sizes[-1] == 60
         assert curve["enough"] in found["fractions"]
     assert "<svg" in plot.read_text() and "learning curves" in plot.read_text()
+    # the HTML report of a run on the data set shows the data set's newest curve
+    run = run_cli(capsys, db, "bench", "mics", "-c", "nb", "--folds", "3", "--json").json()
+    page = tmp_path / "report.html"
+    assert run_cli(capsys, db, "report", str(run["run_id"]), "-o", str(page)).code == 0
+    html = page.read_text()
+    assert "How many touches" in html and 'data-table="learning"' in html
+    assert html.count("Score by share of each training fold") == 1 and "Not drawn" not in html
     bad = run_cli(capsys, db, "learning-curve", "mics", "-c", "nb", "--fractions", "0,0.5")
     assert bad.code == 2 and bad.err.startswith("touchbench: error: --fractions")
     unknown = run_cli(capsys, db, "learning-curve", "mics", "-c", "nope")
