@@ -89,13 +89,14 @@ COMMANDS = (
         "app.cli.answers",
         "Permutation importance of a run's classifier on each of its outer test folds, per "
         "feature and per group of features (channel, feature family), with the t-test of each "
-        "group's drop.",
+        "group's drop. Kept as a job: the run's web page and report show it.",
     ),
     Subcommand(
         "learning-curve",
         "app.cli.answers",
         "Cross-validate classifiers on growing shares of each training fold (stratified, "
-        "group-aware): the share at which each comes within a point of its full score.",
+        "group-aware; the test folds stay whole): the share at which each comes within a point "
+        'of its full score answers "do I need to record more?". Kept as a job with its progress.',
     ),
     Subcommand(
         "cancel",

@@ -78,6 +78,7 @@ def ros_command(
     --samplerate, --channels when not the model's). Ctrl-C publishes the touches still
     open and stops the node.
     """
+    # start-up time: the feature stack, and ROS's modules only for this command
     from app.cli.capture import _show
     from app.services.ros_node import run_ros_node
     from drivers.ros1 import Ros1Transport

@@ -10,6 +10,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from app.reports import plots
+from app.reports.certainty_tables import calibrations
 from app.schemas.certainty import RunCertainty
 from app.schemas.datasets import DatasetDescription
 from app.schemas.learning import LearningCurveResult
@@ -96,7 +97,6 @@ def classes_figure(view: RunView) -> Figure:
 def reliability_figure(certainty: RunCertainty, classifiers: int | None = None) -> Figure:
     """The reliability diagram of a run's classifiers that kept calibration bins (the
     first ``classifiers`` of them, best first)."""
-    from app.reports.certainty_tables import calibrations
 
     curves = {}
     for entry, target, calibration in calibrations(certainty):

@@ -61,7 +61,7 @@ def _groups(
 ) -> tuple[list[str], dict[str, list[int]]]:
     """The feature names of a run's problem and their groups of ``grouping``."""
     names = feature_names(dataset, targets)
-    from benchmark.run.importance import feature_groups
+    from benchmark.run.importance import feature_groups  # start-up time: scikit-learn
 
     groups = feature_groups(names).get(grouping)
     if groups is None:
@@ -110,7 +110,7 @@ def run_ablation(
         No such run.
     """
     plan = _plan(store, request)
-    from benchmark.run.ablation import ablate
+    from benchmark.run.ablation import ablate  # start-up time: the engine's imports
 
     results: dict[tuple[str, str], list[TaskResult]] = {}
 

@@ -60,6 +60,7 @@ def learning_curve(
         No such data set.
     """
     plan = _Plan(store, request)
+    # start-up time: the engine's imports (scikit-learn) load with the first curve
     from benchmark.run.engine import run_tasks
     from benchmark.run.folds import Fold
 
@@ -111,7 +112,7 @@ class _Plan:
             raise FieldError("metric", str(error)) from None
         options = RunOptions(request.folds, 1, request.seed, request.timeout, None)
         plan = fold_plan(prepared, options)
-        from benchmark.run.learning import learning_folds
+        from benchmark.run.learning import learning_folds  # start-up time, as above
 
         self.request = request
         self.dataset = info.name
@@ -130,7 +131,7 @@ class _Plan:
 
     def summary(self, results: dict[float, list[TaskResult]]) -> LearningCurveResult:
         """The curves from the results so far."""
-        from benchmark.run.learning import enough_fraction
+        from benchmark.run.learning import enough_fraction  # start-up time, as above
 
         lower = self.metric in LOWER_IS_BETTER
         curves = []

@@ -26,6 +26,7 @@ graph is checked against the model it came from before it is returned
 from __future__ import annotations
 
 import contextlib
+import copy
 import json
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
@@ -228,6 +229,27 @@ def _unwrap(model: TrainedModel, final: BaseEstimator) -> Unwrapped:
     return Unwrapped(final, classes, encoded=False)
 
 
+def _listed_columns(preprocess: BaseEstimator) -> BaseEstimator:
+    """A shallow copy of a fitted column transformer whose columns are lists of ints.
+
+    The model selects its columns by int64 arrays (:func:`benchmark.preprocessing.
+    make_preprocessor`: fast on one row), which skl2onnx takes for column names.
+    """
+    fitted = getattr(preprocess, "transformers_", None)
+    if fitted is None:
+        return preprocess
+    listed = copy.copy(preprocess)
+    listed.transformers_ = [
+        (
+            name,
+            transformer,
+            [int(c) for c in columns] if isinstance(columns, np.ndarray) else columns,
+        )
+        for name, transformer, columns in fitted
+    ]
+    return listed
+
+
 def _convert_pipeline(model: TrainedModel, preprocess: BaseEstimator, unwrapped: Unwrapped) -> Any:
     """skl2onnx's graph of ``[preprocess, estimator]`` with its default output names."""
     from skl2onnx import convert_sklearn
@@ -236,7 +258,7 @@ def _convert_pipeline(model: TrainedModel, preprocess: BaseEstimator, unwrapped:
 
     _register_boosters()
     estimator = unwrapped.estimator
-    pipeline = Pipeline([("preprocess", preprocess), ("model", estimator)])
+    pipeline = Pipeline([("preprocess", _listed_columns(preprocess)), ("model", estimator)])
     n_features = len(usable_feature_columns(model.schema))
     options: dict[int, dict[str, Any]] = {}
     if not model.regression:

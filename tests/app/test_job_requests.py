@@ -9,7 +9,6 @@ from pathlib import Path
 
 import pytest
 
-from app.errors import ConflictError
 from app.schemas.datasets import ImportRequest
 from app.schemas.models import TrainRequest
 from app.services.datasets import import_file
@@ -37,9 +36,10 @@ def test_a_training_job_holds_its_request_and_carries_it_out(store: Store) -> No
     assert done.result is not None and done.result["name"] == "quick"
     assert [(m.name, m.targets) for m in list_models(store)] == [("quick", ["gesture"])]
 
-    with pytest.raises(ConflictError, match="a model named 'quick' already exists"):
-        submit_training(store, request)
-    assert len(list_jobs(store)) == 1
+    again = execute_job(store, submit_training(store, request).id)  # a taken name: a version
+    assert again is not None and again.status == "done", again
+    assert [(m.name, m.version) for m in list_models(store)] == [("quick", 1), ("quick", 2)]
+    assert len(list_jobs(store)) == 2
 
 
 def test_params_that_are_not_a_request_fail_the_job(store: Store) -> None:

@@ -19,7 +19,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 def test_a_plugin_module_gives_its_specs() -> None:
     specs = plugin_specs(["rf", "nb"], "tests.gate, ")
-    assert [spec.id for spec in specs] == ["gate", "gate-stubborn"]
+    assert [spec.id for spec in specs] == ["gate", "gate-stubborn", "gate-cnn1d"]
 
 
 @pytest.mark.parametrize(

@@ -74,6 +74,7 @@ def cancel(job_id: int, store: StoreDep) -> JobSchema:
 )
 def learning_curve_svg(job_id: int, store: StoreDep) -> Response:
     """The curves of a learning-curve job, as far as it has come."""
+    # start-up time: matplotlib loads with the first figure drawn
     from app.reports.figures import learning_figure
     from app.reports.plots import svg_text
     from app.schemas.learning import LearningCurveResult

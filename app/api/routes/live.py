@@ -110,7 +110,7 @@ def _open(
 ) -> LiveSession:
     """The session, opened in a worker thread: the first one imports the feature stack and
     scikit-learn, which must not hold the event loop (and its other sockets' pings) up."""
-    from app.services.live import open_live
+    from app.services.live import open_live  # start-up time: see above
 
     return open_live(
         service.store,

@@ -148,7 +148,11 @@ def _operations(document: dict[str, Any]) -> Iterator[tuple[str, str, str, dict[
             content = operation.get("requestBody", {}).get("content", {})
             for media, described in content.items():
                 if media in ("application/json", "multipart/form-data"):
-                    yield method, path, media, _resolve(document, described["schema"])
+                    schema = _resolve(document, described["schema"])
+                    if "anyOf" in schema:  # an optional body: its object
+                        options = [_resolve(document, option) for option in schema["anyOf"]]
+                        schema = next(o for o in options if o.get("type") != "null")
+                    yield method, path, media, schema
 
 
 def _prepare(server: Server, tmp_path: Path) -> bytes:
