@@ -17,7 +17,7 @@ import typer
 from rich.markup import escape
 
 from app.cli.extract import key_values
-from app.cli.output import JsonOption, info, print_json, table, warn
+from app.cli.output import EngineOption, JsonOption, info, print_json, table, warn
 from app.cli.state import get_state
 from app.errors import AppError
 from drivers.source import LIVE_BLOCK
@@ -220,17 +220,7 @@ def live_command(
     as_json: Annotated[
         bool, typer.Option("--json", help="One JSON object per touch on stdout (JSON lines).")
     ] = False,
-    engine: Annotated[
-        str | None,
-        typer.Option(
-            "--engine",
-            metavar="ENGINE",
-            help="What runs the predictions: onnx (the model's ONNX twin, written by "
-            "`touchbench export-model`), native (the model itself), auto (the twin where the "
-            "model has one).",
-            show_default="auto",
-        ),
-    ] = None,
+    engine: EngineOption = None,
 ) -> None:
     """Predict every touch of a live stream with a model: its own event detection and
     extractor run on the stream, and each touch is printed as soon as it ends."""

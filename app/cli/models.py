@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from app.cli.output import JsonOption, info, print_json, table, warn
+from app.cli.output import EngineOption, JsonOption, info, print_json, table, warn
 from app.cli.state import get_state
 
 if TYPE_CHECKING:
@@ -28,19 +28,6 @@ def register(app: typer.Typer) -> None:
     app.command("alias")(alias_command)
     app.command("promote")(promote_command)
     app.command("rollback")(rollback_command)
-
-
-EngineOption = Annotated[
-    str | None,
-    typer.Option(
-        "--engine",
-        metavar="ENGINE",
-        help="What runs the predictions: onnx (the model's ONNX twin, written by "
-        "`touchbench export-model`), native (the model itself), auto (the twin where the "
-        "model has one).",
-        show_default="auto",
-    ),
-]
 
 
 def train_command(

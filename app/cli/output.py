@@ -91,3 +91,17 @@ def printable(text: str, limit: int = MAX_CELL) -> str:
     """``text`` with control characters shown as ``?`` and cut to ``limit`` characters."""
     text = _CONTROL.sub("?", text)
     return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+#: ``--engine``: what runs a model's predictions (``predict``, ``live``).
+EngineOption = Annotated[
+    str | None,
+    typer.Option(
+        "--engine",
+        metavar="ENGINE",
+        help="What runs the predictions: onnx (the model's ONNX twin, written by "
+        "`touchbench export-model`), native (the model itself), auto (the twin where the "
+        "model has one).",
+        show_default="auto",
+    ),
+]
