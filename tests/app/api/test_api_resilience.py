@@ -84,7 +84,7 @@ def test_twenty_clients_at_once_lose_and_duplicate_nothing(
         capsys, server.database_url, "train", "touch", "-c", "nb", "--target", "gesture"
     )
     assert trained.code == 0, trained.err
-    stop_at = time.monotonic() + 20
+    stop_at = time.monotonic() + 10
     outcomes: dict[str, list[int]] = {"upload": [], "run": [], "predict": []}
     errors: list[str] = []
     runs: list[int] = []
@@ -93,7 +93,9 @@ def test_twenty_clients_at_once_lose_and_duplicate_nothing(
     def client(number: int) -> None:
         path = touch_arff(tmp_path / f"c{number}.arff", n=30, seed=number + 1)
         with httpx.Client(base_url=server.url, timeout=120) as api:
-            started = False
+            # a run is created among the uploads; each costs a job process, so a quarter
+            # of the clients start one, and they all race the others' writes
+            started = number % 4 != 0
             while time.monotonic() < stop_at:
                 with path.open("rb") as handle:
                     answer = api.post(
@@ -138,7 +140,7 @@ def test_twenty_clients_at_once_lose_and_duplicate_nothing(
     assert set(outcomes["predict"]) == {200}
     # the first upload of each client creates its data set; later ones are the same content
     assert outcomes["upload"].count(201) == 20 and set(outcomes["upload"]) <= {200, 201}
-    assert len(runs) == 20 and set(outcomes["run"]) == {202}
+    assert len(runs) == 5 and set(outcomes["run"]) == {202}
     for run_id in runs:
         run = server.wait_for(f"/api/runs/{run_id}", finished, timeout=900)
         assert (run["status"], run["tasks_done"], run["tasks"]) == ("done", 4, 4), run
@@ -147,4 +149,5 @@ def test_twenty_clients_at_once_lose_and_duplicate_nothing(
         ["touch", *(f"client-{n}" for n in range(20))]
     )
     all_runs = server.client.get("/api/runs").json()["runs"]
-    assert len(all_runs) == 20 and sum(r["tasks_done"] for r in all_runs) == 80
+    assert len(all_runs) == 5 and sum(r["tasks_done"] for r in all_runs) == 20
+    assert sorted(r["dataset"] for r in all_runs) == sorted(f"client-{n}" for n in range(0, 20, 4))
