@@ -20,6 +20,7 @@ from app.services.models import train
 from app.services.simulation import write_labels, write_session
 from app.store.database import Store
 from tests.app.api.conftest import Server, _servers
+from tests.app.api.test_api_bench_request import CLI_WORDS
 from tests.app.api.test_api_live import _pcm_blocks, _stream, _ws_url
 from tests.app.cli_runner import run_cli
 
@@ -192,6 +193,7 @@ def test_the_service_serves_the_graph_and_predicts_with_the_engine_asked(
             )
         assert refused.status_code == 422, refused.text
         assert refused.json()["error"]["where"] == "body.engine", refused.text
+        assert not CLI_WORDS.search(refused.json()["error"]["message"]), refused.text
 
     # the live WebSocket, with each engine, on the same samples
     rate, channels, blocks = _pcm_blocks(unseen)
