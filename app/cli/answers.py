@@ -15,6 +15,7 @@ import typer
 
 from app.cli.output import JsonOption, info, print_json, run_table, table
 from app.cli.state import get_state
+from app.schemas.runs import DEFAULT_TIMEOUT
 
 if TYPE_CHECKING:
     from app.schemas.certainty import RunCertainty
@@ -252,7 +253,9 @@ def learning_curve_command(
     seed: Annotated[int | None, typer.Option("--seed", metavar="N", help="Seed (0).")] = None,
     timeout: Annotated[
         float | None,
-        typer.Option("--timeout", metavar="SECONDS", help="Per task (600; 0: no limit)."),
+        typer.Option(
+            "--timeout", metavar="SECONDS", help=f"Per task ({DEFAULT_TIMEOUT:g}; 0: no limit)."
+        ),
     ] = None,
     metric: Annotated[
         str | None, typer.Option("--metric", metavar="NAME", help="Score (as a run's).")

@@ -20,7 +20,7 @@ def register(app: typer.Typer) -> None:
 
 def datasets_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
     """List the data sets in the store."""
-    rows = list_datasets(get_state(ctx).store)
+    rows = list_datasets(get_state(ctx).reader)
     if as_json:
         print_json(DatasetList(datasets=rows).to_json())
         return

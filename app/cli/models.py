@@ -155,11 +155,17 @@ def predict_command(
 ) -> None:
     """Predict every instance of a file; attributes are matched to the model's by name."""
     from app.cli.requests import build_request
-    from app.schemas.models import EngineChoice
+    from app.schemas.models import PredictFileRequest
     from app.services.models import predict_file
 
-    choice = build_request(EngineChoice, engine=engine)
-    report = predict_file(get_state(ctx).store, model_ref, file, engine=choice.engine)
+    request = build_request(
+        PredictFileRequest,
+        {"model": "MODEL", "file": "FILE"},
+        model=model_ref,
+        file=file,
+        engine=engine,
+    )
+    report = predict_file(get_state(ctx).store, request)
     if as_json:
         print_json(report.to_json())
         return

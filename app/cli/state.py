@@ -9,6 +9,7 @@ import typer
 
 if TYPE_CHECKING:
     from app.store.database import Store
+    from app.store.reading import Readable
 
 
 @dataclass
@@ -24,6 +25,17 @@ class CliState:
 
             self._store = Store(self.database_url)
         return self._store
+
+    @property
+    def reader(self) -> Readable:
+        """The store for a command that only reads it: a SQLite file at the newest revision
+        read without SQLAlchemy, else :attr:`store`."""
+        if self._store is not None:
+            return self._store
+        # loaded when the command runs: start-up time (sqlite3 only)
+        from app.store.reading import sqlite_file
+
+        return sqlite_file(self.database_url) or self.store
 
 
 def get_state(ctx: typer.Context) -> CliState:

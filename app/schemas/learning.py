@@ -6,7 +6,7 @@ from __future__ import annotations
 from pydantic import Field, field_validator
 
 from app.schemas.base import Request, Schema
-from app.schemas.runs import MAX_TIMEOUT, id_as_text, zero_is_no_limit
+from app.schemas.runs import DEFAULT_TIMEOUT, MAX_TIMEOUT, id_as_text, zero_is_no_limit
 
 #: Fractions of each training fold when none are given (benchmark.run.learning's).
 DEFAULT_FRACTIONS = [0.1, 0.2, 0.3, 0.5, 0.7, 1.0]
@@ -31,7 +31,7 @@ class LearningCurveRequest(Request):
     folds: int = Field(default=5, ge=2, le=100, description="k of k-fold cross-validation.")
     seed: int = Field(default=0, ge=0, le=2**31 - 1, description="Seed of folds and cuts.")
     timeout: float | None = Field(
-        default=600.0,
+        default=DEFAULT_TIMEOUT,
         ge=0,
         le=MAX_TIMEOUT,
         description="Seconds one task may take; 0 or null: no limit.",

@@ -4,6 +4,7 @@ them and the API answers them."""
 from __future__ import annotations
 
 from datetime import datetime
+from pathlib import Path
 from typing import Any, Literal
 
 from pydantic import ConfigDict, Field, model_validator
@@ -130,7 +131,25 @@ class ExportSchema(Schema):
     )
 
 
-class PredictRequest(Request):
+class PredictFileRequest(EngineChoice):
+    """The CLI's ``predict MODEL FILE`` and ``POST /api/models/{id}/predict/file``: every
+    instance of an ARFF or CSV file (attributes matched by name; one the model needs and the
+    file lacks is refused), or of a raw recording, whose instances are extracted with the
+    model's own recipe."""
+
+    model: str | int = Field(
+        description="Model id, NAME (its newest version), NAME@VERSION or NAME@ALIAS."
+    )
+    file: Path = Field(description="The file to read.")
+    source_name: str | None = Field(
+        default=None,
+        max_length=255,
+        description="The name the user knows the file by (an upload's file name): what "
+        "messages call the file.",
+    )
+
+
+class PredictRequest(EngineChoice):
     """``POST /api/models/{id}/predict``: instances as attribute -> value, matched by name.
 
     Every instance gives every attribute the model needs (``null`` for a value it does not
@@ -143,11 +162,6 @@ class PredictRequest(Request):
         default="refuse",
         description="refuse: an instance that leaves out an attribute the model needs is "
         "refused; allow: it is a missing value (the answer counts them per attribute).",
-    )
-    engine: Engine = Field(
-        default="auto",
-        description="auto: the model's ONNX twin where it has one, else the model itself; "
-        "onnx: the twin (refused without one); native: the model itself.",
     )
 
 

@@ -265,6 +265,9 @@ MIN_MEMORY_MB = 1
 NO_MEMORY_LIMIT = 0.0
 #: Longest time limit of a task, in seconds (a week).
 MAX_TIMEOUT = 7 * 24 * 3600.0
+#: Time limit of a task unless the request gives one, in seconds: every use case that runs
+#: tasks (a run, a learning curve) and every adapter's help reads it from here.
+DEFAULT_TIMEOUT = 600.0
 
 #: Folds a race runs before its first test (:data:`benchmark.run.racing.FIRST_ROUND`).
 RACE_MIN_FOLDS = 3
@@ -337,7 +340,7 @@ class BenchRequest(Request):
     repeats: int = Field(default=1, ge=1, le=100, description="Repeats of the whole k-fold.")
     seed: int = Field(default=0, ge=0, le=2**31 - 1, description="Seed of folds and classifiers.")
     timeout: float | None = Field(
-        default=600.0,
+        default=DEFAULT_TIMEOUT,
         ge=0,
         le=MAX_TIMEOUT,
         description="Seconds one task may take before its worker is stopped; 0 or null: no limit.",

@@ -102,8 +102,8 @@ def load_predictor(
         if engine == "onnx":
             raise FieldError(
                 "engine",
-                f"model '{info.name}' has no ONNX twin yet; export it first (touchbench "
-                "export-model MODEL, or GET /api/models/ID/onnx)",
+                f"model '{info.name}' has no ONNX twin yet; export it to ONNX first, or "
+                "predict with the native engine",
             )
         return load_model(store, info.id)
     from benchmark.export.onnx import OnnxModel  # start-up time: onnxruntime

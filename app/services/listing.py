@@ -9,8 +9,8 @@ from __future__ import annotations
 from app.schemas.datasets import DatasetSummary
 from app.schemas.listing import Page
 from app.store import listing as stored
-from app.store.database import Store
 from app.store.listing import DatasetInfo
+from app.store.reading import Readable
 
 
 def summary(info: DatasetInfo) -> DatasetSummary:
@@ -28,6 +28,6 @@ def summary(info: DatasetInfo) -> DatasetSummary:
     )
 
 
-def list_datasets(store: Store, *, page: Page | None = None) -> list[DatasetSummary]:
+def list_datasets(store: Readable, *, page: Page | None = None) -> list[DatasetSummary]:
     """Every stored data set (those of ``page``), oldest first."""
     return [summary(info) for info in stored.list_datasets(store, page=page)]

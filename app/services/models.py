@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import csv
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -23,6 +23,7 @@ from app.schemas.models import (
     AliasRequest,
     Engine,
     MissingPolicy,
+    PredictFileRequest,
     PredictionReport,
     PredictionRow,
     TrainRequest,
@@ -307,14 +308,27 @@ def _predict_values(
     )
 
 
-def predict_file(
-    store: Store, model_ref: str | int, path: Path, *, engine: Engine = "auto"
-) -> PredictionReport:
-    """:func:`predict_path` with a stored model, run by ``engine``."""
-    from app.services.export import load_predictor  # it builds on this module
+#: How a stored model is loaded to predict: :func:`app.services.export.load_predictor`'s
+#: signature (the service passes its cache of loaded models).
+PredictorLoader = Callable[[Store, str | int, Engine], tuple[ModelInfo, Predictor]]
 
-    info, model = load_predictor(store, model_ref, engine)
-    return predict_path(info, model, path)
+
+def predict_file(
+    store: Store, request: PredictFileRequest, *, loader: PredictorLoader | None = None
+) -> PredictionReport:
+    """:func:`predict_path` of the request's file with its model, run by its engine.
+
+    Parameters
+    ----------
+    loader : callable, optional
+        Loads the model (default: :func:`app.services.export.load_predictor`).
+    """
+    if loader is None:
+        from app.services.export import load_predictor  # it builds on this module
+
+        loader = load_predictor
+    info, model = loader(store, request.model, request.engine)
+    return predict_path(info, model, request.file, source=request.source_name)
 
 
 def predict_path(

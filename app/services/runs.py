@@ -55,7 +55,7 @@ from app.store.runs import (
 from app.store.runs import (
     create_run as store_run,
 )
-from benchmark.dataset import Dataset
+from benchmark.dataset import Dataset, Schema
 from benchmark.errors import ConfigurationError
 from benchmark.problem import Problem, position_columns, problem_from_dataset, restrict_targets
 from benchmark.results import Drop, TaskKey, TaskResult
@@ -143,6 +143,17 @@ class PreparedProblem:
     warnings: list[str] = field(default_factory=list)
 
 
+class OneValueError(ConfigurationError):
+    """A numeric target with a single value: a regression has nothing to predict."""
+
+    def __init__(self, target: str, value: float) -> None:
+        super().__init__(
+            f"numeric target '{target}' has a single value ({value:g}): nothing to predict"
+        )
+        self.target = target
+        self.value = value
+
+
 class RunCancelled(Exception):  # noqa: N818 (an outcome, not an error)
     """The run was cancelled while it executed; its finished tasks are kept."""
 
@@ -173,10 +184,7 @@ def prepare_problem(
     if problem.kind == "regression":
         for column, name in zip(problem.Y.T, problem.target_names, strict=True):
             if problem.n_instances and np.ptp(column) == 0:
-                raise ConfigurationError(
-                    f"numeric target '{name}' has a single value ({column[0]:g}): nothing to "
-                    "predict"
-                )
+                raise OneValueError(name, float(column[0]))
         return PreparedProblem(problem, list(problem.target_names), warnings)
     for column, target in zip(problem.Y.T, restricted.schema.targets, strict=True):
         present = np.unique(column)
@@ -186,6 +194,28 @@ def prepare_problem(
                 f"target '{target.name}' has a single class ('{only}'): nothing to classify"
             )
     return PreparedProblem(problem, list(problem.target_names), warnings)
+
+
+def _check_position(schema: Schema, position: Sequence[str]) -> None:
+    """Refuse a position the run's targets (``schema``'s) cannot have, naming the field.
+
+    Raises
+    ------
+    FieldError
+        Not 2 or 3 distinct numeric targets, or targets that are not all numeric (a
+        position's run is a regression).
+    """
+    try:
+        position_columns(schema, position)
+    except ConfigurationError as error:
+        raise FieldError("position", str(error)) from None
+    nominal = [t.name for t in schema.targets if t.kind != "numeric"]
+    if nominal:
+        raise FieldError(
+            "position",
+            f"coordinates make the run a regression, and the targets include nominal ones "
+            f"({', '.join(nominal)}): a position's run takes numeric targets only",
+        )
 
 
 def default_classifiers(
@@ -330,11 +360,15 @@ def _plan_run(store: Store, request: BenchRequest) -> _Plan:
             raise FieldError("target", str(error)) from None
     if position:
         run_schema = schema if targets is None else schema.with_targets([schema.index(targets[0])])
-        try:
-            position_columns(run_schema, position)
-        except ConfigurationError as error:
-            raise FieldError("position", str(error)) from None
-    prepared = prepare_problem(load_dataset(store, info.id), targets, position)
+        _check_position(run_schema, position)
+    try:
+        prepared = prepare_problem(load_dataset(store, info.id), targets, position)
+    except OneValueError as error:
+        if error.target not in position:
+            raise
+        raise FieldError(
+            "position", f"'{error.target}' has a single value ({error.value:g}): nothing to predict"
+        ) from None
     problem = prepared.problem
     if request.metric is not None:
         try:

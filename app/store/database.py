@@ -18,13 +18,12 @@ from sqlalchemy.sql.compiler import SQLCompiler
 from sqlalchemy.sql.elements import ClauseElement
 
 from app.errors import AppError, ConflictError
+from app.store.reading import HEAD_REVISION
 
 if TYPE_CHECKING:
     from sqlalchemy.orm import Session, sessionmaker
 
 MIGRATIONS = Path(__file__).with_name("migrations")
-#: The newest migration; a test checks it against Alembic's own idea of the head.
-HEAD_REVISION = "0010"
 
 
 class Store:
@@ -127,6 +126,16 @@ class Store:
         finally:
             connection.close()  # back to the pool, which ends the read's transaction
         return None if row is None else tuple(row)
+
+    @contextmanager
+    def reading(self) -> Iterator[Any]:
+        """A DB-API connection of the pool for reading (:mod:`app.store.reading`): its
+        transaction ends when it goes back to the pool, with the block."""
+        connection = self.engine.raw_connection()
+        try:
+            yield connection
+        finally:
+            connection.close()
 
     def dispose(self) -> None:
         self.engine.dispose()

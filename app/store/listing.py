@@ -1,35 +1,35 @@
-"""The data sets' listing, read without the ORM.
+"""The data sets' listing, read through the database driver alone.
 
 ``touchbench datasets`` and the pages that list data sets need one row per data set and
-nothing of its instances; reading them through SQLAlchemy Core keeps the ORM (and NumPy)
-out of the command's start-up.  :data:`DATASETS` names the columns the listing reads, with
-the types that turn them back into Python values; a test keeps it equal to the ``datasets``
-table of :mod:`app.store.tables`.
+nothing of its instances.  The listing is one SQL statement run on a DB-API connection
+(:mod:`app.store.reading`): the CLI reads a SQLite store without importing SQLAlchemy, the
+service through its :class:`~app.store.database.Store`'s pool, alike.  :data:`COLUMNS`
+names the columns it reads; a test keeps them those of the ``datasets`` table of
+:mod:`app.store.tables`.
 """
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 from datetime import UTC, datetime
+from types import SimpleNamespace
 from typing import Any
 
-from sqlalchemy import JSON, DateTime, Integer, String, Text, column, func, select, table
-
 from app.schemas.listing import Page
-from app.store.database import Store
-from app.store.paging import paged
+from app.store.reading import Readable, fetch_all
 
-DATASETS = table(
-    "datasets",
-    column("id", Integer),
-    column("name", String),
-    column("relation", Text),
-    column("target_names", JSON),
-    column("n_instances", Integer),
-    column("n_attributes", Integer),
-    column("source_name", Text),
-    column("sha256", String),
-    column("created_at", DateTime(timezone=True)),
+#: The columns of ``datasets`` the listing reads, in the order of its rows.
+COLUMNS = (
+    "id",
+    "name",
+    "relation",
+    "target_names",
+    "n_instances",
+    "n_attributes",
+    "source_name",
+    "sha256",
+    "created_at",
 )
 
 
@@ -66,14 +66,25 @@ class DatasetInfo:
         )
 
 
-def list_datasets(store: Store, *, page: Page | None = None) -> list[DatasetInfo]:
+def list_datasets(store: Readable, *, page: Page | None = None) -> list[DatasetInfo]:
     """The data sets, oldest first (those of ``page`` only, when given)."""
-    with store.engine.connect() as connection:
-        rows = connection.execute(paged(select(DATASETS).order_by(DATASETS.c.id), page))
-        return [DatasetInfo.of(row) for row in rows]
+    statement = f"SELECT {', '.join(COLUMNS)} FROM datasets ORDER BY id"
+    if page is not None:  # whole numbers (a Page's bounds): written into the statement
+        statement += f" LIMIT {int(page.limit)} OFFSET {int(page.offset)}"
+    return [_info(values) for values in fetch_all(store, statement)]
 
 
-def count_datasets(store: Store) -> int:
+def _info(values: tuple[Any, ...]) -> DatasetInfo:
+    """A row as its driver gives it: SQLite's JSON and times as text, PostgreSQL's parsed."""
+    row = dict(zip(COLUMNS, values, strict=True))
+    if isinstance(row["target_names"], str):
+        row["target_names"] = json.loads(row["target_names"])
+    if isinstance(row["created_at"], str):
+        row["created_at"] = datetime.fromisoformat(row["created_at"])
+    return DatasetInfo.of(SimpleNamespace(**row))
+
+
+def count_datasets(store: Readable) -> int:
     """How many data sets the store holds."""
-    with store.engine.connect() as connection:
-        return int(connection.scalar(select(func.count()).select_from(DATASETS)) or 0)
+    ((count,),) = fetch_all(store, "SELECT count(*) FROM datasets")
+    return int(count)

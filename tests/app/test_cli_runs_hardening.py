@@ -328,7 +328,8 @@ def test_an_old_store_migrates_and_finished_runs_become_done(tmp_path: Path) -> 
     from alembic import command
     from alembic.config import Config
 
-    from app.store.database import HEAD_REVISION, MIGRATIONS
+    from app.store.database import MIGRATIONS
+    from app.store.reading import HEAD_REVISION
 
     url = f"sqlite:///{tmp_path / 'old.db'}"
     engine = create_engine(url)

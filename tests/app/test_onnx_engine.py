@@ -20,6 +20,7 @@ from app.services.models import train
 from app.services.simulation import write_labels, write_session
 from app.store.database import Store
 from tests.app.api.conftest import Server, _servers
+from tests.app.api.test_api_bench_request import CLI_WORDS
 from tests.app.api.test_api_live import _pcm_blocks, _stream, _ws_url
 from tests.app.cli_runner import run_cli
 
@@ -107,6 +108,10 @@ def test_what_has_no_converter_is_refused_in_one_line(
         capsys, url, "predict", "touch-j48", str(tmp_path / "x.arff"), "--engine", "onnx"
     )
     assert no_twin.code == 2 and "has no ONNX twin yet" in no_twin.err
+    unknown = run_cli(
+        capsys, url, "predict", "touch-rf", str(tmp_path / "x.arff"), "--engine", "fast"
+    )
+    assert unknown.code == 2 and unknown.err.startswith("touchbench: error: --engine: "), unknown
     listing = run_cli(capsys, url, "classifiers", "--json").json()["classifiers"]
     marks = {entry["id"]: entry["onnx"] for entry in listing}
     assert marks["rf"] and marks["xgb"] and not marks["j48"] and not marks["minirocket"]
@@ -166,6 +171,29 @@ def test_the_service_serves_the_graph_and_predicts_with_the_engine_asked(
         "/api/models/touch-j48/predict", json={"instances": [instance], "engine": "onnx"}
     )
     assert no_twin.status_code in (400, 422) and "engine" in no_twin.text
+
+    # an uploaded recording, with the engine asked in the form as the CLI's --engine asks it
+    files = {}
+    for engine in ("native", "onnx"):
+        with unseen.open("rb") as upload:
+            response = server.client.post(
+                "/api/models/touch-rf/predict/file",
+                files={"file": (unseen.name, upload)},
+                data={"engine": engine},
+            )
+        assert response.status_code == 200, response.text
+        files[engine] = [row["gesture"] for row in response.json()["predictions"]]
+    assert len(files["onnx"]) == 4 and files["onnx"] == files["native"]
+    for engine, model in (("fast", "touch-rf"), ("onnx", "touch-j48")):  # unknown, no twin
+        with unseen.open("rb") as upload:
+            refused = server.client.post(
+                f"/api/models/{model}/predict/file",
+                files={"file": (unseen.name, upload)},
+                data={"engine": engine},
+            )
+        assert refused.status_code == 422, refused.text
+        assert refused.json()["error"]["where"] == "body.engine", refused.text
+        assert not CLI_WORDS.search(refused.json()["error"]["message"]), refused.text
 
     # the live WebSocket, with each engine, on the same samples
     rate, channels, blocks = _pcm_blocks(unseen)

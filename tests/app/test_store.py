@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
+import sqlite3
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -19,7 +22,8 @@ from app.store.datasets import (
     find_dataset,
     load_dataset,
 )
-from app.store.listing import DATASETS, list_datasets
+from app.store.listing import COLUMNS, count_datasets, list_datasets
+from app.store.reading import SQLiteFile, sqlite_file
 from app.store.tables import DatasetRow, InstanceBlockRow, InstanceRow
 from benchmark.dataset import Attribute, Dataset, Schema
 
@@ -137,13 +141,16 @@ def test_the_listing_reads_columns_of_the_datasets_table_with_their_types(
     store: Store,
 ) -> None:
     orm_columns = DatasetRow.__table__.columns
-    for name, listed in DATASETS.columns.items():
-        assert name in orm_columns, name
-        assert type(listed.type) is type(orm_columns[name].type), name
-    add_dataset(store, small_dataset(), sha256="1" * 64, name="mini")
+    assert set(COLUMNS) <= set(orm_columns.keys())
+    added, _ = add_dataset(store, small_dataset(), sha256="1" * 64, name="mini")
     (listed,) = list_datasets(store)
+    assert listed == added  # as the ORM reads the row
     assert (listed.name, listed.n_instances, listed.targets) == ("mini", 7, ["gesture"])
     assert listed.created_at.tzinfo is not None
+    assert count_datasets(store) == 1
+    if store.url.startswith("sqlite:///"):  # the CLI's read without SQLAlchemy
+        assert sqlite_file(store.url) is not None
+        assert list_datasets(sqlite_file(store.url)) == [listed]
 
 
 def test_reopening_a_store_keeps_its_data(store_url: str) -> None:
@@ -166,7 +173,8 @@ def test_head_revision_constant_matches_the_migrations() -> None:
     from alembic.config import Config
     from alembic.script import ScriptDirectory
 
-    from app.store.database import HEAD_REVISION, MIGRATIONS
+    from app.store.database import MIGRATIONS
+    from app.store.reading import HEAD_REVISION
 
     config = Config()
     config.set_main_option("script_location", str(MIGRATIONS))
@@ -174,7 +182,7 @@ def test_head_revision_constant_matches_the_migrations() -> None:
 
 
 def test_a_fresh_store_is_migrated_to_head(store: Store) -> None:
-    from app.store.database import HEAD_REVISION
+    from app.store.reading import HEAD_REVISION
 
     assert store.revision() == HEAD_REVISION
 
@@ -278,3 +286,20 @@ def test_a_block_changed_outside_touchbench_is_refused_saying_so(store: Store) -
         )
     with pytest.raises(AppError, match=r"holds 12 bytes where 5 attributes need 280"):
         load_dataset(store, "touch")
+
+
+def test_only_a_store_at_the_newest_revision_is_read_without_sqlalchemy(tmp_path: Path) -> None:
+    """Whatever is not a plain SQLite store at the head revision is left to Store, which
+    creates, migrates or refuses it."""
+    path = tmp_path / "s.db"
+    url = f"sqlite:///{path}"
+    assert sqlite_file(url) is None  # not there yet
+    Store(url).dispose()
+    assert sqlite_file(url) == SQLiteFile(path)
+    for other in (f"{url}?timeout=5", "sqlite://", "sqlite:///:memory:", f"sqlite:///{tmp_path}"):
+        assert sqlite_file(other) is None, other
+    with contextlib.closing(sqlite3.connect(path)) as connection, connection:
+        connection.execute("UPDATE alembic_version SET version_num = '0001'")
+    assert sqlite_file(url) is None  # a migration is due
+    (tmp_path / "other.db").write_bytes(b"not a database, but not empty either")
+    assert sqlite_file(f"sqlite:///{tmp_path / 'other.db'}") is None

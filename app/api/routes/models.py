@@ -14,11 +14,11 @@ import time
 from pathlib import Path
 from typing import Annotated
 
-from fastapi import APIRouter, File, Request, Response, UploadFile, status
+from fastapi import APIRouter, File, Form, Request, Response, UploadFile, status
 
 from app.api.deps import PageDep, Service, ServiceDep, StoreDep, paginate, request_size
 from app.api.direct import DirectRoute
-from app.api.uploads import in_client_words, save_upload
+from app.api.uploads import form_request, in_client_words, save_upload
 from app.schemas.jobs import JobCreated
 from app.schemas.models import (
     AliasBody,
@@ -26,6 +26,7 @@ from app.schemas.models import (
     AliasRequest,
     ModelList,
     ModelSchema,
+    PredictFileRequest,
     PredictionReport,
     PredictRequest,
     TrainRequest,
@@ -153,18 +154,27 @@ def predict_upload(
             "FLAC, a CSV time series, a bag) of a model trained on extracted features."
         ),
     ],
+    engine: Annotated[
+        str | None,
+        Form(description="auto (default), onnx or native: what runs the predictions."),
+    ] = None,
 ) -> PredictionReport:
     """Predict every instance of an uploaded ARFF or CSV file (accuracy when it carries the
     targets), or of a raw recording, whose instances are extracted with the model's own
     recipe (as ``touchbench predict MODEL take.wav``).  The upload is bounded by the
     service's upload limit (``max_upload_mb``), and so is the extraction's work."""
-    from app.services.models import predict_path
+    from app.services.models import predict_file
 
-    info, trained = service.models.get(service.store, model_ref)
     with tempfile.TemporaryDirectory(dir=_work_dir(service)) as folder:
+        fields = {"model": model_ref, "engine": engine}
+        asked = form_request(PredictFileRequest, file=Path(folder) / "upload", **fields)
+        # The model before the upload is read: an unknown one is answered at once (loaded
+        # here, it is in the cache that predict_file's loader reads).
+        service.models.get(service.store, asked.model, asked.engine)
         path = save_upload(file, Path(folder), "upload.arff")
+        request = form_request(PredictFileRequest, file=path, source_name=path.name, **fields)
         with in_client_words(Path(folder)):  # the client's names, not our folder
-            return predict_path(info, trained, path, source=path.name)
+            return predict_file(service.store, request, loader=service.models.get)
 
 
 def _work_dir(service: ServiceDep) -> Path:

@@ -59,6 +59,8 @@ REFUSALS: list[tuple[dict[str, Any], str, str]] = [
         "'mic' is not a target",
     ),
     ({"dataset": "contact", "classifiers": ["ridge"], "position": ["x"]}, "position", "at least 2"),
+    ({"dataset": "mixed", "position": ["x", "y"]}, "position", "include nominal ones (mic)"),
+    ({"dataset": "flat", "position": ["x", "y"]}, "position", "'x' has a single value (1)"),
     # racing and the total budget
     ({"race": True, "folds": 2}, "race", "needs at least 3 folds"),
     ({"race": True, "race_alpha": 0}, "race_alpha", "greater than 0"),
@@ -72,9 +74,15 @@ REFUSALS: list[tuple[dict[str, Any], str, str]] = [
 def test_every_refusal_names_its_field_and_leaves_no_run(
     capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path
 ) -> None:
+    contact = position_arff(tmp_path / "contact.arff").read_text(encoding="utf-8")
+    (tmp_path / "mixed.arff").write_text(contact.replace("-C -2", "-C -3"), encoding="utf-8")
+    flat = [re.sub(r",[^,]+,([^,]+)$", r",1.0,\1", line) for line in contact.splitlines()]
+    (tmp_path / "flat.arff").write_text("\n".join(flat) + "\n", encoding="utf-8")  # x is 1.0
     for path, name in (
         (touch_arff(tmp_path / "touch.arff", n=60), "touch"),
         (position_arff(tmp_path / "contact.arff"), "contact"),
+        (tmp_path / "mixed.arff", "mixed"),
+        (tmp_path / "flat.arff", "flat"),
     ):
         assert run_cli(capsys, server.database_url, "import", str(path), "--name", name).code == 0
     api = server.client
