@@ -15,6 +15,7 @@ from fastapi import Depends, FastAPI
 
 from app.api import main as api
 from app.api.deps import ModelCache, Service, require_api_key
+from app.api.stopping import CutByStop
 from app.api.trust import Cors, Trust
 from app.jobs.dispatcher import Dispatcher
 from app.settings import Settings, get_settings
@@ -82,6 +83,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
             allow_methods=["GET", "POST", "PUT", "PATCH", "DELETE"],
             allow_headers=["X-API-Key", "Content-Type"],
         )
-    # outermost: a request for another host name or from a foreign page goes no further
+    # a request for another host name or from a foreign page goes no further
     app.add_middleware(Trust, hosts=settings.hosts, origins=settings.origins)
+    app.add_middleware(CutByStop)  # outermost: whatever a stop cuts short is answered 503
     return app

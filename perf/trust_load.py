@@ -4,7 +4,7 @@ and the one-instance prediction latency while another client asks for the heavie
 (the data set fragment of the widest data set the default limits accept), side by side
 with the same latency on an idle service.
 
-    .venv/bin/python perf/trust_load.py [--predictions 300] [--targets 1000]
+    .venv/bin/python perf/trust_load.py [--predictions 300] [--targets 1000] [--rounds 3]
 
 Prints a table of figures and ratios; nothing here is asserted.  The issue measured,
 before: the fragment of a 50/200/800-target data set 2.6 s / 27.5 s / no answer in 120 s,
@@ -157,6 +157,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--predictions", type=int, default=300)
     parser.add_argument("--targets", type=int, default=1000, help="of the widest data set")
+    parser.add_argument("--rounds", type=int, default=3, help="idle and loaded, alternating")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as temporary:
         folder = Path(temporary)
@@ -173,8 +174,17 @@ def main() -> None:
                 after = peak_rss_mb(process.pid)
                 record = {"f0": 0.1, "f1": 0.2, "f2": -0.3, "f3": 1.0, "mic": "left"}
                 many_status, many_in = refuse_many_instances(client, record)
-            idle = latencies(url, model, record, args.predictions)
-            loaded, pages = under_load(url, model, record, args.predictions, page)
+            # the sides alternate, so that a change of the machine's load meets both
+            idle: list[float] = []
+            loaded: list[float] = []
+            pages: list[float] = []
+            share = max(1, args.predictions // args.rounds)
+            for _ in range(args.rounds):
+                idle += latencies(url, model, record, share)
+                times, drawn = under_load(url, model, record, share, page)
+                loaded += times
+                pages += drawn
+            peak = peak_rss_mb(process.pid)  # the fragments drawn again and again included
         finally:
             process.terminate()
             process.wait(timeout=60)
@@ -188,6 +198,7 @@ def main() -> None:
             f"data set fragment, {args.targets} targets",
             f"median {statistics.median(pages):.2f} s over {len(pages)} (max {max(pages):.2f})",
         ),
+        ("service peak RSS at the end", f"{peak:.0f} MB"),
         ("1-instance prediction, idle", f"p50 {p50_idle:.1f} ms  p99 {p99_idle:.1f} ms"),
         ("... while the fragment is asked", f"p50 {p50_loaded:.1f} ms  p99 {p99_loaded:.1f} ms"),
         ("p99 loaded / idle", f"{p99_loaded / p99_idle:.1f}x (p50 {p50_loaded / p50_idle:.1f}x)"),

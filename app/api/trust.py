@@ -59,7 +59,7 @@ class Trust:
         status, kind, message, where = refusal
         body = json.dumps(error_body(kind, message, where)).encode()
         if scope["type"] == "http":
-            await _answer(send, "http.response", status, body)
+            await send_json(send, "http.response", status, body)
         else:
             await _deny_websocket(scope, receive, send, status, body)
 
@@ -145,7 +145,9 @@ def _headers(scope: Scope) -> dict[str, str]:
     return found
 
 
-async def _answer(send: Send, prefix: str, status: int, body: bytes) -> None:
+async def send_json(send: Send, prefix: str, status: int, body: bytes) -> None:
+    """Send a whole JSON answer (``prefix``: ``http.response`` or, for a refused WebSocket
+    handshake, ``websocket.http.response``)."""
     await send(
         {
             "type": f"{prefix}.start",
@@ -166,6 +168,6 @@ async def _deny_websocket(
     can send one, else with a close before the handshake (an HTTP 403)."""
     await receive()  # websocket.connect
     if "websocket.http.response" in scope.get("extensions", {}):
-        await _answer(send, "websocket.http.response", status, body)
+        await send_json(send, "websocket.http.response", status, body)
     else:
         await send({"type": "websocket.close", "code": 1008})

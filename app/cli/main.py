@@ -17,7 +17,7 @@ import typer
 from app.cli import help as help_pages
 from app.cli.exits import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_USAGE, ExitWith
 from app.cli.lazy import LazyGroup, Subcommand
-from app.cli.signals import interrupts
+from app.cli.signals import interrupted_status, interrupts
 from app.cli.state import CliState
 from app.environment import database_url
 
@@ -341,8 +341,9 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     except Exception as error:
         return _failed(error)
-    if returned == EXIT_INTERRUPTED:  # typer turned a Ctrl-C into this status, silently
+    if returned == EXIT_INTERRUPTED:  # typer turned an interrupt into this status, silently
         print("touchbench: interrupted", file=sys.stderr)
+        return interrupted_status()  # 143 for SIGTERM, as the README promises
     return returned if isinstance(returned, int) else 0
 
 

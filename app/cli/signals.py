@@ -56,6 +56,7 @@ def interrupts() -> Iterator[None]:
     if threading.current_thread() is not threading.main_thread():
         yield
         return
+    _HEARD.clear()  # a command of its own (tests run many in one process)
     previous = {signum: signal.getsignal(signum) for signum in INTERRUPTS}
     for signum in INTERRUPTS:
         signal.signal(signum, _interrupt)
@@ -66,8 +67,20 @@ def interrupts() -> Iterator[None]:
             signal.signal(signum, handler if handler is not None else signal.SIG_DFL)
 
 
+#: The signals that interrupted a command of this process, first first: typer turns any
+#: interrupt into the status 130, and :func:`interrupted_status` tells SIGTERM's apart.
+_HEARD: list[int] = []
+
+
 def _interrupt(signum: int, frame: FrameType | None) -> None:
+    _HEARD.append(signum)
     raise Interrupted(signum)
+
+
+def interrupted_status() -> int:
+    """128 + the number of the first signal that interrupted a command of this process
+    (130 when none is known: an interrupt Python raised itself is a Ctrl-C)."""
+    return 128 + (_HEARD[0] if _HEARD else signal.SIGINT)
 
 
 @contextmanager
@@ -88,8 +101,9 @@ def deferred_interrupts(on_interrupt: Callable[[], object]) -> Iterator[None]:
 
     def handler(signum: int, frame: FrameType | None) -> None:
         if heard:
-            raise Interrupted(signum)
+            _interrupt(signum, frame)
         heard.append(signum)
+        _HEARD.append(signum)
         on_interrupt()
 
     previous = {signum: signal.getsignal(signum) for signum in INTERRUPTS}

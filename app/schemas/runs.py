@@ -53,7 +53,9 @@ class RunSchema(Schema):
         "total budget cut (tasks_done + tasks_dropped = tasks once such a run is done).",
     )
     error: str | None = Field(default=None, description="Why the run failed, if it did.")
-    owner: str | None = Field(default=None, description="host:pid of the executing process.")
+    # Not the process executing it (host:pid, app/store/runs.py): the service's machine is
+    # none of a client's business, with a write key or not (a cancel needs the run's id only;
+    # a job's host is left out for the same reason, app/schemas/jobs.py).
 
 
 class RunList(Schema):

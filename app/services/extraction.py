@@ -316,8 +316,8 @@ def extract_with_recipe(path: Path, recipe: Mapping[str, Any]) -> ExtractionResu
 
 def check_extraction(store: Store, request: ExtractRequest) -> None:
     """Refuse what can be refused before any recording is read: the request checked its
-    extractor, event detection and options when it was made; here, the data set's name
-    and the number of targets the labels file declares.
+    extractor, event detection and options when it was made; here, the data set's name,
+    the number of targets the labels file declares, and then the labels file itself.
 
     Raises
     ------
@@ -326,7 +326,8 @@ def check_extraction(store: Store, request: ExtractRequest) -> None:
     ConflictError
         The name is taken.
     DataFormatError
-        The labels file declares more targets than :mod:`app.services.limits` allows.
+        The labels file declares more targets than :mod:`app.services.limits` allows, or
+        :func:`read_labels` refuses it.
     """
     if request.name is not None:
         check_dataset_name(store, request.name)
@@ -335,6 +336,9 @@ def check_extraction(store: Store, request: ExtractRequest) -> None:
         # the header alone says how many targets: a file declaring thousands is refused
         # before a job reads any recording
         check_dataset_size(n_targets=count_label_targets(labels), source=str(request.labels))
+        # the rest is read too (a labels file is small; its time is linear in its size), so
+        # that a bad one is refused when uploaded, not by a job that failed meanwhile
+        read_labels(labels)
 
 
 def extract_and_store(

@@ -123,7 +123,6 @@ class RunInfo:
             tasks_failed=self.n_failed,
             tasks_dropped=self.n_dropped,
             error=self.error,
-            owner=self.owner,
         )
 
     def to_json(self) -> dict[str, Any]:

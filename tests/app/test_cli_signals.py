@@ -1,13 +1,18 @@
 """Interrupts a loop hears between two items (the ROS node's): the first only asks it to
-stop, the end of the block raises; a second one raises at once."""
+stop, the end of the block raises; a second one raises at once.  A command interrupted
+exits with its signal's status."""
 
 from __future__ import annotations
 
 import signal
+from pathlib import Path
 
 import pytest
 
 from app.cli.signals import Interrupted, deferred_interrupts
+from app.services import datasets
+from tests.app.cli_runner import run_cli
+from tests.app.synthetic import touch_arff
 
 
 def test_the_first_interrupt_asks_and_the_end_of_the_block_raises() -> None:
@@ -30,3 +35,24 @@ def test_a_second_interrupt_raises_at_once_and_a_cut_wait_is_not_the_news() -> N
     with pytest.raises(Interrupted), deferred_interrupts(lambda: None):
         signal.raise_signal(signal.SIGINT)
         raise ValueError("the wait the stop cut short failed")
+
+
+@pytest.mark.parametrize(("sig", "code"), [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
+def test_a_command_that_leaves_the_interrupt_to_typer_exits_with_its_signal(
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+    tmp_path: Path,
+    sig: signal.Signals,
+    code: int,
+) -> None:
+    """typer answers any interrupt a command does not catch with the status 130: a SIGTERM
+    in the middle of ``import`` (or while a command loads its modules) still exits 143."""
+
+    def interrupted(*args: object, **kwargs: object) -> None:
+        signal.raise_signal(sig)
+
+    monkeypatch.setattr(datasets, "import_file", interrupted)
+    url = f"sqlite:///{tmp_path / 'touchbench.db'}"
+    done = run_cli(capsys, url, "import", str(touch_arff(tmp_path / "touch.arff", n=30)))
+    assert (done.code, done.err) == (code, "touchbench: interrupted\n")
+    assert run_cli(capsys, url, "datasets", "--json").out.count('"name"') == 0

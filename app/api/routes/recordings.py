@@ -10,7 +10,7 @@ from typing import Annotated
 from fastapi import APIRouter, File, Form, UploadFile, status
 
 from app.api.deps import ServiceDep
-from app.api.uploads import form_request, save_upload
+from app.api.uploads import form_request, in_client_words, save_upload
 from app.schemas.extraction import DEFAULT_EXTRACTOR, ExtractRequest
 from app.schemas.jobs import JobCreated
 from app.services.jobs import submit_extraction
@@ -56,7 +56,8 @@ def upload_session(
 
     Everything that can be refused without reading the recordings is refused before the job
     exists: the extractor, event detection and bounds before anything is saved, the data
-    set's name before the job is queued (the saved files are then removed).
+    set's name and the labels file before the job is queued (the saved files are then
+    removed).
     """
     values = {
         "extractor": extractor,
@@ -85,7 +86,8 @@ def upload_session(
         request = form_request(
             ExtractRequest, recordings=names, labels=labels_name, folder=folder, **values
         )
-        job = submit_extraction(service.store, request)
+        with in_client_words(folder):  # the labels file by the client's name, not our folder
+            job = submit_extraction(service.store, request)
     except BaseException:
         shutil.rmtree(folder, ignore_errors=True)
         raise

@@ -1,8 +1,9 @@
 """Ctrl-C and SIGTERM stop ``touchbench serve`` within a few seconds whatever it computes
 (issue 21, case 3 and 11): exit 130 or 143, ``touchbench: interrupted`` once, no
-traceback, also after a second Ctrl-C.  A real service in a subprocess, made busy by
-importing a CSV upload (parsed in Python: seconds of computing in a worker thread, which
-nothing can interrupt).  The time it takes is bounded by the wait's time-out only."""
+traceback, also after a second Ctrl-C; the upload the stop cuts short is answered 503 in
+JSON.  A real service in a subprocess, made busy by importing a CSV upload (parsed in
+Python: seconds of computing in a worker thread, which nothing can interrupt).  The time
+it takes is bounded by the wait's time-out only."""
 
 from __future__ import annotations
 
@@ -23,13 +24,16 @@ from tests.app.api.conftest import Server
 STOP_TIMEOUT = 60.0
 
 
-def _busy(server: Server, tmp_path: Path) -> threading.Thread:
-    """Upload a CSV whose import computes for seconds; returns once the service is at it."""
+def _busy(
+    server: Server, tmp_path: Path, answers: list[httpx.Response], rows: int
+) -> threading.Thread:
+    """Upload a CSV of ``rows`` whose import computes for seconds; returns once the service
+    is at it.  The answer, if the upload gets one, goes into ``answers``."""
     columns = 20
     csv = tmp_path / "heavy.csv"
     header = ",".join(f"f{i}" for i in range(columns)) + ",c\n"
     row = ",".join(f"{i}.25" for i in range(columns)) + ",a\n"
-    csv.write_bytes((header + row * 150_000).encode())
+    csv.write_bytes((header + row * rows).encode())
     sent = threading.Event()
 
     def body() -> Iterator[bytes]:
@@ -44,11 +48,13 @@ def _busy(server: Server, tmp_path: Path) -> threading.Thread:
 
     def upload() -> None:
         with contextlib.suppress(httpx.HTTPError):  # the service stops under it
-            httpx.post(
-                f"{server.url}/api/datasets",
-                content=body(),
-                headers={"Content-Type": "multipart/form-data; boundary=touchbench-boundary"},
-                timeout=STOP_TIMEOUT,
+            answers.append(
+                httpx.post(
+                    f"{server.url}/api/datasets",
+                    content=body(),
+                    headers={"Content-Type": "multipart/form-data; boundary=touchbench-boundary"},
+                    timeout=STOP_TIMEOUT,
+                )
             )
 
     thread = threading.Thread(target=upload, daemon=True)
@@ -66,12 +72,13 @@ def _stopped(server: Server) -> tuple[int, str]:
 
 
 @pytest.mark.parametrize(
-    ("signals", "status", "workers"),
+    ("signals", "status", "workers", "answered"),
     [
-        ((signal.SIGINT,), 130, 1),
-        ((signal.SIGTERM,), 143, 1),
-        ((signal.SIGINT, signal.SIGINT), 130, 1),
-        ((signal.SIGTERM,), 143, 2),
+        ((signal.SIGINT,), 130, 1, True),
+        ((signal.SIGTERM,), 143, 1, True),
+        # a second Ctrl-C ends the process at once; the supervisor of 2 kills its workers
+        ((signal.SIGINT, signal.SIGINT), 130, 1, False),
+        ((signal.SIGTERM,), 143, 2, False),
     ],
     ids=["ctrl-c", "sigterm", "ctrl-c-twice", "sigterm-2-workers"],
 )
@@ -81,10 +88,13 @@ def test_a_busy_service_stops_on_a_signal(
     signals: tuple[signal.Signals, ...],
     status: int,
     workers: int,
+    answered: bool,
 ) -> None:
     server = make_sqlite_server(arguments=("--workers", str(workers)))
     assert server.process is not None
-    uploading = _busy(server, tmp_path)
+    answers: list[httpx.Response] = []
+    # an answer is awaited: an import far longer than the stop's grace of 2 s on any machine
+    uploading = _busy(server, tmp_path, answers, 400_000 if answered else 150_000)
     for signum in signals:
         if signum == signal.SIGINT:  # Ctrl-C: the terminal signals the whole group
             os.killpg(server.process.pid, signum)
@@ -97,6 +107,12 @@ def test_a_busy_service_stops_on_a_signal(
     assert "CancelledError" not in log, log[-3000:]
     assert log.count("touchbench: interrupted") == 1, log[-3000:]
     uploading.join(STOP_TIMEOUT)
+    # the request the stop cut short: a JSON 503 (uvicorn's would be a plain-text 500)
+    assert [answer.status_code for answer in answers] == (
+        [503] if answered else [503] * len(answers)
+    )
+    for answer in answers:
+        assert answer.json()["error"]["type"] == "ServiceUnavailable", answer.text
 
 
 def test_an_idle_service_stops_on_ctrl_c(make_sqlite_server: Callable[..., Server]) -> None:

@@ -109,23 +109,25 @@ def test_a_csv_field_over_the_limit_is_refused_at_upload_and_prediction(
     _refusal(answer, 400, "long-field.csv:3", "131,072 characters")
 
 
-def test_a_labels_field_over_the_limit_fails_the_recordings_job_in_one_line(
+def test_a_labels_field_over_the_limit_is_refused_before_any_job(
     served: Server, tmp_path: Path
 ) -> None:
     labels = tmp_path / "long-labels.csv"
     labels.write_text(f"file,gesture\ntake.wav,{LONG_FIELD}\n", encoding="utf-8")
+    jobs = served.client.get("/api/jobs").json()["jobs"]
+    uploads = set((served.work_dir / "uploads").glob("*"))
     with labels.open("rb") as handle:
-        queued = served.client.post(
+        refused = served.client.post(
             "/api/datasets/recordings",
             files=[
                 ("recordings", ("take.wav", b"RIFF not really")),
                 ("labels", (labels.name, handle)),
             ],
         )
-    assert queued.status_code == 202, queued.text
-    job = served.wait_for(f"/api/jobs/{queued.json()['job']}", finished)
-    assert job["status"] == "failed", job
-    assert job["error"] == "long-labels.csv:2: a field is longer than 131,072 characters"
+    error = _refusal(refused, 400, "long-labels.csv:2: a field is longer than 131,072 characters")
+    assert error["type"] == "DataFormatError"
+    assert served.client.get("/api/jobs").json()["jobs"] == jobs
+    assert set((served.work_dir / "uploads").glob("*")) == uploads, "an upload was kept"
 
 
 # -- 5. a data set name beyond Latin-1, a quote in a file name --------------------------
@@ -248,6 +250,23 @@ def test_job_listings_and_errors_speak_of_the_clients_own_files(
     ]
     assert leaks == []
     assert len(listing["jobs"]) >= 2
+
+
+def test_a_running_run_shows_no_host_to_any_client(served: Server) -> None:
+    """The process executing a run (host:pid) stays the service's business: the run and the
+    listing show its status, never the machine's name."""
+    gate = served.gate
+    assert gate is not None
+    request = {"dataset": "wide", "classifiers": ["gate"], "folds": 2}
+    run_id = served.client.post("/api/runs", json=request).json()["id"]
+    gate.wait_started(1)  # a worker holds the run: its owner is set in the store
+    seen = [served.client.get(f"/api/runs/{run_id}").json(), served.client.get("/api/runs").json()]
+    assert seen[0]["status"] == "running", seen[0]
+    host = socket.gethostname()
+    leaks = [text for text in _strings(seen) if text in (host, "owner") or f"{host}:" in text]
+    gate.open()
+    assert served.wait_for(f"/api/runs/{run_id}", finished)["status"] == "done"
+    assert leaks == []
 
 
 # -- 8. names are checked once, wherever one is given ---------------------------------------
