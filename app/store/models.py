@@ -427,6 +427,54 @@ def rollback_alias(store: Store, ref: str | int, alias: str = CHAMPION) -> Alias
         )
 
 
+def delete_alias(store: Store, ref: str | int, alias: str) -> AliasMove:
+    """Remove ``NAME@alias``; returns the version it pointed at (``model``, and
+    ``previous``).  Its history is marked undone, so that the alias set again later starts
+    afresh (``rollback`` does not step back past its deletion).
+
+    A ``ref`` that names one version (an id, ``NAME@VERSION``) deletes the alias only while
+    it points at that version: an alias another client moved since is not removed unseen.
+
+    Raises
+    ------
+    FieldError
+        An invalid alias (``alias``).
+    NotFoundError
+        No such model, or the model has no such alias.
+    ConflictError
+        ``ref`` names a version the alias does not point at.
+    """
+    try:
+        check_alias(alias)
+    except AppError as error:
+        raise FieldError("alias", str(error)) from None
+    with store.session() as session:
+        row = _row(session, ref)
+        current = _alias_row(session, row.name, alias)
+        if current is None:
+            known = _aliases(session, {row.name})
+            names = sorted(a for aliases in known.values() for a in aliases)
+            raise NotFoundError(
+                f"model '{shorten(row.name)}' has no alias '{alias}' (aliases: "
+                f"{', '.join(names) or 'none'})"
+            )
+        if is_pinned(ref) and current.version != row.version:
+            raise ConflictError(
+                f"'{shorten(row.name)}@{alias}' points at version {current.version}, not "
+                f"{row.version}: not deleted (name the model without a version to delete it "
+                "whatever it points at)"
+            )
+        target = _version_row(session, row.name, current.version)
+        assert target is not None  # deleting a version deletes the aliases on it
+        session.execute(
+            update(ModelAliasEventRow)
+            .where(ModelAliasEventRow.name == row.name, ModelAliasEventRow.alias == alias)
+            .values(undone=True)
+        )
+        session.delete(current)
+        return AliasMove(alias, _info(session, target), current.version)
+
+
 def _alias_row(session: Session, name: str, alias: str) -> ModelAliasRow | None:
     return session.get(ModelAliasRow, (name, alias))
 

@@ -639,9 +639,9 @@ def _check_twin(model: TrainedModel, twin: OnnxModel, X: np.ndarray, start: int)
     if differ.size:
         i = int(differ[0])
         t = int(np.flatnonzero(codes[i] != twin_codes[i])[0])
-        target = f" of '{model.schema.targets[t].name}'" if codes.shape[1] > 1 else ""
+        of_target = f" of '{model.schema.targets[t].name}'" if codes.shape[1] > 1 else ""
         raise ConfigurationError(
-            f"classifier '{model.classifier}': the ONNX graph predicts another label{target} "
+            f"classifier '{model.classifier}': the ONNX graph predicts another label{of_target} "
             f"for {differ.size} training instance(s) from instance {start + 1} on (first: "
             f"instance {start + i + 1}, {codes[i, t]} vs {twin_codes[i, t]}); not exported"
         )
