@@ -69,9 +69,10 @@ def _champion_session(
     rate: int,
     blocks: list[bytes],
     seen: list[dict[str, Any]],
+    until: str = "predictions",
 ) -> Iterator[ClientConnection]:
     """A live session on ``mic@champion`` that has sent ``blocks`` and received messages
-    into ``seen`` up to its first prediction."""
+    into ``seen`` up to one holding ``until`` (its first prediction; "": none)."""
     url = server.url.replace("http://", "ws://") + "/api/models/mic@champion/live"
     # no keepalive pings: a loaded machine may leave them unanswered for a while
     with connect(
@@ -80,7 +81,8 @@ def _champion_session(
         socket.send(json.dumps({"samplerate": rate, "channels": samples.shape[1]}))
         for block in blocks:
             socket.send(block)
-        _until(socket, seen, "predictions")
+        if until:
+            _until(socket, seen, until)
         yield socket
 
 
@@ -202,3 +204,56 @@ def test_deleting_the_alias_a_live_session_follows_keeps_its_version(
     assert lab.delete("/api/models/mic/aliases/latest").status_code == 422
     new_session = robot.get("/api/models/mic@champion")
     assert new_session.status_code == 404
+
+
+def test_a_flood_of_alias_moves_drops_no_stream_and_no_request(
+    make_sqlite_server: Callable[..., Server], tmp_path: Path
+) -> None:
+    """Promote, rollback and alias in a loop while a session on ``mic@champion`` streams
+    (following checked at every block): every touch is answered, by a version the alias
+    named; no request fails with a 5xx; the session switches at most once per block."""
+    import threading
+
+    server = make_sqlite_server(
+        api_keys=f"lab:write:{WRITE},robot:predict:{PREDICT}", live_follow_seconds="0"
+    )
+    _versions(server.database_url, tmp_path)
+    lab = httpx.Client(base_url=server.url, headers={"X-API-Key": WRITE}, timeout=60)
+    lab.post("/api/models/mic@1/promote").raise_for_status()
+    statuses: list[int] = []
+    stop = threading.Event()
+
+    def flood() -> None:
+        moves = [
+            ("/api/models/mic@2/promote", None),
+            ("/api/models/mic/rollback", None),
+            ("/api/models/mic@3/aliases", {"alias": "champion"}),  # not taken: no recipe
+            ("/api/models/mic@1/promote", None),
+        ]
+        while not stop.is_set():
+            for path, body in moves:
+                statuses.append(lab.post(path, json=body).status_code)
+
+    samples, rate = _as_int16(tmp_path / "unseen.wav")
+    blocks = [samples[i : i + 2048].tobytes() for i in range(0, len(samples), 2048)]
+    seen: list[dict[str, Any]] = []
+    flooding = threading.Thread(target=flood)
+    with _champion_session(server, samples, rate, blocks[:1], seen, until="") as socket:
+        flooding.start()
+        try:
+            _finish(socket, blocks[1:], seen)
+        finally:
+            stop.set()
+            flooding.join()
+    answers = [m["model"] for m in seen if "predictions" in m]
+    switches = [m for m in seen if "switched" in m]
+    warnings = [m for m in seen if "warning" in m]
+    print(
+        f"{len(statuses)} alias requests ({sorted(set(statuses))}) during {len(blocks)} "
+        f"blocks: {len(answers)} answers, {len(switches)} switches, {len(warnings)} warnings"
+    )
+    assert statuses and all(status < 500 for status in statuses)
+    assert set(statuses) <= {200, 409}  # a rollback with nothing to go back to: 409
+    assert len(answers) == 5 and set(answers) <= {"mic@1", "mic@2"}
+    assert len(switches) + len(warnings) <= len(blocks)
+    assert lab.get("/healthz").status_code == 200
