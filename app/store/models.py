@@ -15,7 +15,7 @@ one).  A reference to a model is its id, ``NAME`` (the newest version), ``NAME@V
 from __future__ import annotations
 
 import hashlib
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from datetime import datetime
 from typing import Any
@@ -405,16 +405,7 @@ def rollback_alias(store: Store, ref: str | int, alias: str = CHAMPION) -> Alias
                 f"model '{shorten(name)}' has no alias '{alias}' to roll back (set it with "
                 f"`promote` or `alias` first)"
             )
-        steps = session.scalars(
-            select(ModelAliasEventRow)
-            .where(
-                ModelAliasEventRow.name == name,
-                ModelAliasEventRow.alias == alias,
-                ModelAliasEventRow.undone.is_(False),
-            )
-            .order_by(ModelAliasEventRow.id.desc())
-        ).all()
-        for step in steps:
+        for step in _alias_steps(session, name, alias):
             if step.version != current.version and _version_row(session, name, step.version):
                 target = _version_row(session, name, step.version)
                 assert target is not None
@@ -473,6 +464,31 @@ def delete_alias(store: Store, ref: str | int, alias: str) -> AliasMove:
         )
         session.delete(current)
         return AliasMove(alias, _info(session, target), current.version)
+
+
+#: History steps read per query by :func:`_alias_steps`.
+ALIAS_STEPS_PAGE = 16
+
+
+def _alias_steps(session: Session, name: str, alias: str) -> Iterator[ModelAliasEventRow]:
+    """The alias's moves not undone, newest first, read a page at a time: a rollback
+    usually stops at the second, and an alias moved 20,000 times took 0.9 s to read whole."""
+    before: int | None = None
+    while True:
+        query = select(ModelAliasEventRow).where(
+            ModelAliasEventRow.name == name,
+            ModelAliasEventRow.alias == alias,
+            ModelAliasEventRow.undone.is_(False),
+        )
+        if before is not None:
+            query = query.where(ModelAliasEventRow.id < before)
+        page = session.scalars(
+            query.order_by(ModelAliasEventRow.id.desc()).limit(ALIAS_STEPS_PAGE)
+        ).all()
+        yield from page
+        if len(page) < ALIAS_STEPS_PAGE:
+            return
+        before = page[-1].id
 
 
 def _alias_row(session: Session, name: str, alias: str) -> ModelAliasRow | None:

@@ -120,6 +120,43 @@ def test_an_alias_is_deleted_and_set_again_starts_afresh(store: Store) -> None:
     }
 
 
+def test_a_rollback_reads_the_history_a_page_at_a_time(
+    store: Store, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An alias moved many times (a flood of promotes) is stepped back reading a few of
+    its moves, and across pages when the newest ones are all the same version."""
+    from sqlalchemy import event
+    from sqlalchemy.orm import Session
+
+    from app.store.tables import ModelAliasEventRow
+
+    for _ in range(3):
+        _save(store)
+    set_alias(store, "mic@1", "champion")
+    for _ in range(5):
+        set_alias(store, "mic@2", "champion")  # the same version, moved to again
+    for version in [3, 2] * 40:
+        set_alias(store, f"mic@{version}", "champion")
+    loaded: list[object] = []
+
+    def count(session: Session, instance: object) -> None:
+        if isinstance(instance, ModelAliasEventRow):
+            loaded.append(instance)
+
+    event.listen(Session, "loaded_as_persistent", count)
+    try:
+        assert rollback_alias(store, "mic").model.label == "mic@3"
+    finally:
+        event.remove(Session, "loaded_as_persistent", count)
+    assert 0 < len(loaded) <= store_models.ALIAS_STEPS_PAGE  # not the 86 moves
+    monkeypatch.setattr(store_models, "ALIAS_STEPS_PAGE", 2)
+    for version in (2, 1):  # back over the moves to 2 (undone, then equal), pages of 2
+        set_alias(store, f"mic@{version}", "champion")
+    set_alias(store, "mic@2", "champion")
+    set_alias(store, "mic@2", "champion")
+    assert rollback_alias(store, "mic").model.label == "mic@1"
+
+
 def test_aliases_that_would_read_otherwise_are_refused(store: Store) -> None:
     _save(store)
     for alias in ["3", "latest", "", "with space", "x" * 101]:
