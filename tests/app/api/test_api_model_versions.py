@@ -7,12 +7,14 @@ from __future__ import annotations
 
 import contextlib
 import json
+import shutil
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
 import httpx
 import numpy as np
+import pytest
 from websockets.sync.client import ClientConnection, connect
 
 from app.schemas.datasets import ImportRequest
@@ -51,6 +53,24 @@ def _versions(store_url: str, tmp_path: Path) -> list[tuple[float, float, str, s
     finally:
         store.dispose()
     _, touches = write_session(tmp_path, "unseen", n_touches=5, seed=99)
+    return touches
+
+
+@pytest.fixture(scope="module")
+def prepared(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[Any]]:
+    """A store holding :func:`_versions`' models, made once for the tests that copy it,
+    and the unseen session's touches (``unseen.wav`` beside it)."""
+    folder = tmp_path_factory.mktemp("versions")
+    touches = _versions(f"sqlite:///{folder / 'touchbench.db'}", folder)
+    return folder, touches
+
+
+def _copy_of(prepared: tuple[Path, list[Any]], tmp_path: Path) -> list[Any]:
+    """The prepared store and session in ``tmp_path`` (the store the server there opens);
+    the session's touches."""
+    folder, touches = prepared
+    for name in ("touchbench.db", "unseen.wav"):
+        shutil.copy(folder / name, tmp_path / name)
     return touches
 
 
@@ -166,15 +186,17 @@ def test_a_live_session_follows_the_champion_mid_stream(
 
 
 def test_deleting_the_alias_a_live_session_follows_keeps_its_version(
-    make_sqlite_server: Callable[..., Server], tmp_path: Path
+    make_sqlite_server: Callable[..., Server],
+    tmp_path: Path,
+    prepared: tuple[Path, list[Any]],
 ) -> None:
     """``DELETE /api/models/NAME/aliases/ALIAS`` needs a write key, says 404 for a missing
     alias and 409 for a version it no longer points at; a session on ``NAME@champion``
     keeps answering with its version and says so once."""
+    touches = _copy_of(prepared, tmp_path)
     server = make_sqlite_server(
         api_keys=f"lab:write:{WRITE},robot:predict:{PREDICT}", live_follow_seconds="0"
     )
-    touches = _versions(server.database_url, tmp_path)
     lab = httpx.Client(base_url=server.url, headers={"X-API-Key": WRITE}, timeout=60)
     robot = httpx.Client(base_url=server.url, headers={"X-API-Key": PREDICT}, timeout=60)
     lab.post("/api/models/mic@1/promote").raise_for_status()
@@ -207,17 +229,19 @@ def test_deleting_the_alias_a_live_session_follows_keeps_its_version(
 
 
 def test_a_flood_of_alias_moves_drops_no_stream_and_no_request(
-    make_sqlite_server: Callable[..., Server], tmp_path: Path
+    make_sqlite_server: Callable[..., Server],
+    tmp_path: Path,
+    prepared: tuple[Path, list[Any]],
 ) -> None:
     """Promote, rollback and alias in a loop while a session on ``mic@champion`` streams
     (following checked at every block): every touch is answered, by a version the alias
     named; no request fails with a 5xx; the session switches at most once per block."""
     import threading
 
+    _copy_of(prepared, tmp_path)
     server = make_sqlite_server(
         api_keys=f"lab:write:{WRITE},robot:predict:{PREDICT}", live_follow_seconds="0"
     )
-    _versions(server.database_url, tmp_path)
     lab = httpx.Client(base_url=server.url, headers={"X-API-Key": WRITE}, timeout=60)
     lab.post("/api/models/mic@1/promote").raise_for_status()
     statuses: list[int] = []
