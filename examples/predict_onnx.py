@@ -55,7 +55,12 @@ def main(model_path: str, instance_path: str) -> None:
     session = onnxruntime.InferenceSession(model_path, providers=["CPUExecutionProvider"])
     metadata = session.get_modelmeta().custom_metadata_map
     columns = json.loads(metadata["touchbench.features"])
-    targets = json.loads(metadata["touchbench.targets"])
+    if "touchbench.targets" in metadata:
+        targets = json.loads(metadata["touchbench.targets"])
+    else:  # a graph exported before the key was written: one target
+        labels = json.loads(metadata["touchbench.labels"])
+        targets = [{"name": "", "labels": labels, "label": "label"}]
+        targets[0]["probabilities"] = "probabilities"
     with open(instance_path, encoding="utf-8") as handle:
         instance = json.load(handle)
     outputs = [output.name for output in session.get_outputs()]

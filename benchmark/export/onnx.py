@@ -552,8 +552,9 @@ def metadata(model: TrainedModel) -> dict[str, str]:
     their labels, the classifier and library versions (JSON values under ``touchbench.*``).
 
     ``touchbench.targets`` lists every target as ``{"name", "labels", "label",
-    "probabilities"}``, the last two the names of its outputs; a model of one target also
-    has ``touchbench.target`` and ``touchbench.labels``, its outputs ``label`` and
+    "probabilities"}``, the last two the names of its outputs (a regressor's as ``{"name",
+    "value_column"}``, its column of ``value``); a model of one target also has
+    ``touchbench.target`` and ``touchbench.labels``, its outputs ``label`` and
     ``probabilities``.
     """
     features = [model.schema.features[i] for i in usable_feature_columns(model.schema)]
@@ -571,13 +572,15 @@ def metadata(model: TrainedModel) -> dict[str, str]:
         ),
         "touchbench.targets": json.dumps(
             [
-                {
+                {"name": target.name, "value_column": column}
+                if model.regression
+                else {
                     "name": target.name,
-                    "labels": [] if model.regression else list(target.values),
+                    "labels": list(target.values),
                     "label": output_names(target.name, several)[0],
                     "probabilities": output_names(target.name, several)[1],
                 }
-                for target in targets
+                for column, target in enumerate(targets)
             ]
         ),
         "touchbench.versions": json.dumps(model.versions),
