@@ -10,15 +10,20 @@ one ``CreateTensorWithDataAsOrtValue`` over a ``float[n_features]`` buffer, ``Ru
 
 ``instance.json`` holds one instance as ``{"attribute": value}``: numbers for numeric
 attributes, labels (text) for nominal ones, ``null`` for a missing value.  It prints
-``{"label": ..., "probabilities": {...}}`` (or ``{"value": [...]}`` for a regressor).
+``{"label": ..., "probabilities": {...}}`` (or ``{"value": [...]}`` for a regressor); for
+a model of several targets, each target's answer under its name:
+``{"label": {"gesture": "tap", "place": "arm"}, "probabilities": {"gesture": {...}, ...}}``.
 
 The graph's metadata says how to fill its input:
 
 - ``touchbench.features``: JSON list of the input's columns in order, each
   ``{"name", "kind"}`` and, for a nominal attribute, its ``labels`` (the column holds the
   index of the label, NaN when missing);
-- ``touchbench.labels``: JSON list of the target's labels; output ``label`` is an index
-  into it, and ``probabilities``' columns follow it.
+- ``touchbench.targets``: JSON list of the targets, each ``{"name", "labels", "label",
+  "probabilities"}``: the output named by ``label`` is an index into ``labels``, and the
+  columns of the output named by ``probabilities`` follow them (``label`` and
+  ``probabilities`` for one target, ``label_<name>`` and ``probabilities_<name>`` for
+  several).
 """
 
 from __future__ import annotations
@@ -50,7 +55,12 @@ def main(model_path: str, instance_path: str) -> None:
     session = onnxruntime.InferenceSession(model_path, providers=["CPUExecutionProvider"])
     metadata = session.get_modelmeta().custom_metadata_map
     columns = json.loads(metadata["touchbench.features"])
-    labels = json.loads(metadata["touchbench.labels"])
+    if "touchbench.targets" in metadata:
+        targets = json.loads(metadata["touchbench.targets"])
+    else:  # a graph exported before the key was written: one target
+        labels = json.loads(metadata["touchbench.labels"])
+        targets = [{"name": "", "labels": labels, "label": "label"}]
+        targets[0]["probabilities"] = "probabilities"
     with open(instance_path, encoding="utf-8") as handle:
         instance = json.load(handle)
     outputs = [output.name for output in session.get_outputs()]
@@ -62,12 +72,26 @@ def main(model_path: str, instance_path: str) -> None:
     if "value" in results:
         print(json.dumps({"value": results["value"][0].tolist()}))
         return
-    answer: dict = {"label": labels[int(results["label"][0])]}
-    if "probabilities" in results:
-        probabilities = results["probabilities"][0]
-        answer["probabilities"] = {
-            label: float(p) for label, p in zip(labels, probabilities, strict=True)
-        }
+    labels, probabilities = {}, {}
+    for target in targets:
+        names = target["labels"]
+        labels[target["name"]] = names[int(results[target["label"]][0])]
+        if target["probabilities"] in results:
+            row = results[target["probabilities"]][0]
+            probabilities[target["name"]] = {
+                label: float(p) for label, p in zip(names, row, strict=True)
+            }
+    if len(targets) == 1:
+        [name] = labels
+        answer: dict = {"label": labels[name]}
+        if probabilities:
+            answer["probabilities"] = probabilities[name]
+    else:
+        answer = (
+            {"label": labels, "probabilities": probabilities}
+            if probabilities
+            else {"label": labels}
+        )
     print(json.dumps(answer))
 
 

@@ -209,6 +209,9 @@ def _costs(
 
 
 def _print_multitarget(suite_name: str | None, as_json: bool) -> None:
+    from benchmark.catalogue import get_spec
+    from benchmark.export.multitarget import exports_multitarget
+    from benchmark.export.onnx import exports_onnx
     from benchmark.multitarget import META_METHODS, multitarget_configurations, parse_config
     from benchmark.multitarget.suites import multitarget_suite
 
@@ -229,6 +232,7 @@ def _print_multitarget(suite_name: str | None, as_json: bool) -> None:
                 "method": spec.name,
                 "follows": spec.follows,
                 "binary_only": spec.binary_only,
+                "onnx": exports_multitarget(meta, bool(base) and exports_onnx(get_spec(base))),
             }
         )
     if as_json:
@@ -236,7 +240,7 @@ def _print_multitarget(suite_name: str | None, as_json: bool) -> None:
         return
     table(
         f"{len(entries)} multi-target configurations",
-        ["id", "method", "base", "follows", "targets"],
+        ["id", "method", "base", "follows", "targets", "onnx"],
         [
             (
                 e["id"],
@@ -244,6 +248,7 @@ def _print_multitarget(suite_name: str | None, as_json: bool) -> None:
                 e["base"] or "",
                 e["follows"],
                 "binary only" if e["binary_only"] else "any",
+                "✓" if e["onnx"] else "",
             )
             for e in entries
         ],

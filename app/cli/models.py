@@ -277,12 +277,29 @@ def alias_command(
         str,
         typer.Argument(metavar="ALIAS", help="The alias, e.g. champion.", show_default=False),
     ],
+    delete: Annotated[
+        bool,
+        typer.Option(
+            "--delete",
+            help="Delete the alias instead (MODEL: the name, or NAME@VERSION to delete it "
+            "only while it points there); sessions following it keep their version.",
+        ),
+    ] = False,
     as_json: JsonOption = False,
 ) -> None:
     """Point an alias of a model (NAME@ALIAS) at one of its versions."""
-    from app.services.models import move_alias
+    from app.services.models import move_alias, remove_alias
 
-    _moved(move_alias(get_state(ctx).store, _alias_request(model_ref, alias)), as_json)
+    request = _alias_request(model_ref, alias)
+    if not delete:
+        _moved(move_alias(get_state(ctx).store, request), as_json)
+        return
+    gone = remove_alias(get_state(ctx).store, request)
+    if as_json:
+        print_json(gone.to_json())
+        return
+    name = gone.model.rpartition("@")[0]
+    info(f"deleted {name}@{gone.alias} (it pointed at version {gone.version})")
 
 
 def promote_command(

@@ -222,6 +222,15 @@ class AliasBody(Request):
     alias: AliasName = Field(default="champion", description="The alias (champion).")
 
 
+class AliasDeleted(Schema):
+    """An alias removed (``DELETE /api/models/{model}/aliases/{alias}``): the version it
+    pointed at."""
+
+    alias: str
+    model: str = Field(description="NAME@VERSION it pointed at.")
+    version: int
+
+
 class AliasMoved(Schema):
     """An alias set or stepped back: the version it points at now, and before."""
 

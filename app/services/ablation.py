@@ -19,6 +19,7 @@ from app.schemas.ablation import (
 )
 from app.schemas.runs import BenchRequest
 from app.services.importance import feature_names, refittable_run
+from app.services.progress import throttled
 from app.services.report import run_view
 from app.services.runs import RunOptions, fold_plan, prepare_problem, task_memory
 from app.services.tuning import run_specs
@@ -95,7 +96,8 @@ def run_ablation(
     jobs : int
         Local worker processes of the engine.
     on_progress : callable
-        Hears the result so far (``complete`` false) after every finished task.
+        Hears the result so far (``complete`` false) after a finished task, at most every
+        :data:`app.services.progress.PROGRESS_SECONDS`.
 
     Raises
     ------
@@ -113,10 +115,11 @@ def run_ablation(
     from benchmark.run.ablation import ablate  # start-up time: the engine's imports
 
     results: dict[tuple[str, str], list[TaskResult]] = {}
+    tell = throttled(on_progress, lambda: plan.summary(results))
 
     def heard(group: str, result: TaskResult) -> None:
         results.setdefault((group, result.key.classifier), []).append(result)
-        on_progress(plan.summary(results))
+        tell()
 
     options = plan.options
     max_memory, _ = task_memory(

@@ -15,6 +15,7 @@ from app.schemas.learning import (
     LearningCurveRequest,
     LearningCurveResult,
 )
+from app.services.progress import throttled
 from app.services.runs import (
     DEFAULT_METRIC,
     RunOptions,
@@ -50,7 +51,8 @@ def learning_curve(
     jobs : int
         Local worker processes of the engine.
     on_progress : callable
-        Hears the curve so far (``complete`` false) after every finished task.
+        Hears the curve so far (``complete`` false) after a finished task, at most every
+        :data:`app.services.progress.PROGRESS_SECONDS`.
 
     Raises
     ------
@@ -73,10 +75,11 @@ def learning_curve(
         for fold in plan.folds[fraction]
     ]
     results: dict[float, list[TaskResult]] = {}
+    tell = throttled(on_progress, lambda: plan.summary(results))
 
     def heard(result: TaskResult) -> None:
         results.setdefault(fractions[result.key.repeat], []).append(result)
-        on_progress(plan.summary(results))
+        tell()
 
     run_tasks(
         plan.problem,

@@ -20,6 +20,7 @@ import numpy as np
 
 from app.errors import ConflictError, FieldError
 from app.schemas.models import (
+    AliasDeleted,
     AliasRequest,
     Engine,
     MissingPolicy,
@@ -35,6 +36,7 @@ from app.store.models import (
     AliasMove,
     ModelInfo,
     check_model_name,
+    delete_alias,
     load_artifact,
     rollback_alias,
     save_model,
@@ -184,6 +186,16 @@ def move_alias(store: Store, request: AliasRequest) -> AliasMove:
 def roll_back(store: Store, request: AliasRequest) -> AliasMove:
     """Point ``NAME@alias`` back at the version it pointed at before its last move."""
     return rollback_alias(store, request.model, request.alias)
+
+
+def remove_alias(store: Store, request: AliasRequest) -> AliasDeleted:
+    """Delete ``NAME@alias`` (``alias --delete``, ``DELETE .../aliases/{alias}``): the name
+    then names nothing until set again; live sessions following it keep the version they
+    hold and say so once (:class:`app.services.live.ModelFollower`).  The one rule: a
+    ``request.model`` that names a version (``NAME@3``) deletes the alias only while it
+    points there (``ConflictError`` otherwise), as :func:`delete_alias` checks."""
+    move = delete_alias(store, request.model, request.alias)
+    return AliasDeleted(alias=move.alias, model=move.model.label, version=move.model.version)
 
 
 @dataclass

@@ -15,7 +15,7 @@ one).  A reference to a model is its id, ``NAME`` (the newest version), ``NAME@V
 from __future__ import annotations
 
 import hashlib
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from datetime import datetime
 from typing import Any
@@ -405,16 +405,7 @@ def rollback_alias(store: Store, ref: str | int, alias: str = CHAMPION) -> Alias
                 f"model '{shorten(name)}' has no alias '{alias}' to roll back (set it with "
                 f"`promote` or `alias` first)"
             )
-        steps = session.scalars(
-            select(ModelAliasEventRow)
-            .where(
-                ModelAliasEventRow.name == name,
-                ModelAliasEventRow.alias == alias,
-                ModelAliasEventRow.undone.is_(False),
-            )
-            .order_by(ModelAliasEventRow.id.desc())
-        ).all()
-        for step in steps:
+        for step in _alias_steps(session, name, alias):
             if step.version != current.version and _version_row(session, name, step.version):
                 target = _version_row(session, name, step.version)
                 assert target is not None
@@ -425,6 +416,79 @@ def rollback_alias(store: Store, ref: str | int, alias: str = CHAMPION) -> Alias
             f"'{shorten(name)}@{alias}' has pointed at no other version that still exists "
             f"(now version {current.version}): nothing to roll back to"
         )
+
+
+def delete_alias(store: Store, ref: str | int, alias: str) -> AliasMove:
+    """Remove ``NAME@alias``; returns the version it pointed at (``model``, and
+    ``previous``).  Its history is marked undone, so that the alias set again later starts
+    afresh (``rollback`` does not step back past its deletion).
+
+    A ``ref`` that names one version (an id, ``NAME@VERSION``) deletes the alias only while
+    it points at that version: an alias another client moved since is not removed unseen.
+
+    Raises
+    ------
+    FieldError
+        An invalid alias (``alias``).
+    NotFoundError
+        No such model, or the model has no such alias.
+    ConflictError
+        ``ref`` names a version the alias does not point at.
+    """
+    try:
+        check_alias(alias)
+    except AppError as error:
+        raise FieldError("alias", str(error)) from None
+    with store.session() as session:
+        row = _row(session, ref)
+        current = _alias_row(session, row.name, alias)
+        if current is None:
+            known = _aliases(session, {row.name})
+            names = sorted(a for aliases in known.values() for a in aliases)
+            raise NotFoundError(
+                f"model '{shorten(row.name)}' has no alias '{alias}' (aliases: "
+                f"{', '.join(names) or 'none'})"
+            )
+        if is_pinned(ref) and current.version != row.version:
+            raise ConflictError(
+                f"'{shorten(row.name)}@{alias}' points at version {current.version}, not "
+                f"{row.version}: not deleted (name the model without a version to delete it "
+                "whatever it points at)"
+            )
+        target = _version_row(session, row.name, current.version)
+        assert target is not None  # deleting a version deletes the aliases on it
+        session.execute(
+            update(ModelAliasEventRow)
+            .where(ModelAliasEventRow.name == row.name, ModelAliasEventRow.alias == alias)
+            .values(undone=True)
+        )
+        session.delete(current)
+        return AliasMove(alias, _info(session, target), current.version)
+
+
+#: History steps read per query by :func:`_alias_steps`.
+ALIAS_STEPS_PAGE = 16
+
+
+def _alias_steps(session: Session, name: str, alias: str) -> Iterator[ModelAliasEventRow]:
+    """The alias's moves not undone, newest first, read a page at a time: a rollback
+    usually stops at the second, and an alias moved 20,000 times took 0.9 s to read whole."""
+    before: int | None = None
+    while True:
+        query = select(ModelAliasEventRow).where(
+            ModelAliasEventRow.name == name,
+            ModelAliasEventRow.alias == alias,
+            ModelAliasEventRow.undone.is_(False),
+        )
+        if before is not None:
+            query = query.where(ModelAliasEventRow.id < before)
+        page = session.scalars(
+            query.order_by(ModelAliasEventRow.id.desc()).limit(ALIAS_STEPS_PAGE)
+        ).all()
+        yield from page
+        if len(page) < ALIAS_STEPS_PAGE:
+            return
+        before = page[-1].id
 
 
 def _alias_row(session: Session, name: str, alias: str) -> ModelAliasRow | None:

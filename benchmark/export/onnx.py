@@ -30,7 +30,7 @@ import copy
 import json
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NoReturn
 
 import numpy as np
 from sklearn.base import BaseEstimator
@@ -53,7 +53,7 @@ INPUT, LABEL, PROBABILITIES, VALUE = "features", "label", "probabilities", "valu
 SUPPORTED = (
     "scikit-learn's trees, forests, bagged trees, boosting, linear models, SVMs, "
     "naive Bayes, discriminant analysis, k-NN, MLPs, XGBoost, LightGBM and CatBoost, "
-    "one target, flat features"
+    "flat features; several targets: cr, cc, bcc, lc, ps and nsr over one of those"
 )
 
 
@@ -196,35 +196,86 @@ def convert(model: TrainedModel) -> Any:
     ConfigurationError
         No converter for the model.
     """
-    estimator = model.estimator
     if len(model.schema.target_indices) != 1:
-        _refuse(model, "several targets")
-    if not hasattr(estimator, "steps") or len(estimator.steps) != 2:
-        _refuse(model, type(estimator).__name__)
-    preprocess, final = estimator.steps[0][1], estimator.steps[1][1]
-    reason = _unsupported(final)
-    if reason is not None or isinstance(preprocess, str):
-        _refuse(model, reason or type(final).__name__)
-    unwrapped = _unwrap(model, final)
-    onnx_model = _convert_pipeline(model, preprocess, unwrapped)
-    _route_missing_values(onnx_model, unwrapped.estimator)
-    _finish(onnx_model, model, unwrapped)
+        # a cycle at import time: the multi-target graphs are built of this module's
+        from benchmark.export.multitarget import convert_multitarget
+
+        return convert_multitarget(model)
+    n_labels = 0 if model.regression else model.n_classes[0]
+    onnx_model = convert_pipeline(
+        model.classifier,
+        model.estimator,
+        n_inputs=len(usable_feature_columns(model.schema)),
+        n_labels=n_labels,
+    )
+    add_metadata(onnx_model, model)
     return onnx_model
 
 
-def _refuse(model: TrainedModel, what: str) -> None:
+def convert_pipeline(
+    classifier: str,
+    estimator: BaseEstimator,
+    *,
+    n_inputs: int,
+    n_labels: int,
+    codes: np.ndarray | None = None,
+) -> Any:
+    """The graph of a fitted ``[preprocess, final]`` pipeline, without metadata.
+
+    Parameters
+    ----------
+    classifier : str
+        The catalogue id (or configuration), for messages.
+    estimator : Pipeline
+        Fitted; its preprocessing takes ``n_inputs`` float columns.
+    n_inputs : int
+        Width of the input ``features``.
+    n_labels : int
+        Columns of ``probabilities`` (0: a regressor, whose output is ``value``).
+    codes : ndarray of shape (n_final_classes,), optional
+        The label code each of the final estimator's classes stands for (a multi-target
+        link trained on re-coded classes); default: its classes are the codes.
+
+    Raises
+    ------
+    ConfigurationError
+        No converter for the estimator.
+    """
+    if not hasattr(estimator, "steps") or len(estimator.steps) != 2:
+        _refuse(classifier, type(estimator).__name__)
+    preprocess, final = estimator.steps[0][1], estimator.steps[1][1]
+    reason = _unsupported(final)
+    if reason is not None or isinstance(preprocess, str):
+        _refuse(classifier, reason or type(final).__name__)
+    unwrapped = _unwrap(classifier, final, regression=n_labels == 0)
+    if codes is not None and unwrapped.classes is not None:
+        # a link trained on classes re-coded 0 .. m - 1: what it predicts is a position
+        # in ``codes`` (its own classes are those positions, all present)
+        own = unwrapped.classes.astype(np.int64)
+        if not np.array_equal(own, np.arange(own.size)) and not unwrapped.encoded:
+            _refuse(classifier, "classes other than the positions of its codes")
+        unwrapped = Unwrapped(unwrapped.estimator, np.asarray(codes)[own], encoded=True)
+    onnx_model = _convert_pipeline(classifier, preprocess, unwrapped, n_inputs, n_labels == 0)
+    _route_missing_values(onnx_model, unwrapped.estimator)
+    probabilities = n_labels > 0 and hasattr(estimator, "predict_proba")
+    _finish(onnx_model, unwrapped, n_labels, probabilities=probabilities)
+    onnx_model.graph.name = f"touchbench_{classifier}"
+    return onnx_model
+
+
+def _refuse(classifier: str, what: str) -> NoReturn:
     raise ConfigurationError(
-        f"classifier '{model.classifier}' ({what}) has no ONNX converter; exportable: {SUPPORTED}"
+        f"classifier '{classifier}' ({what}) has no ONNX converter; exportable: {SUPPORTED}"
     )
 
 
-def _unwrap(model: TrainedModel, final: BaseEstimator) -> Unwrapped:
+def _unwrap(classifier: str, final: BaseEstimator, *, regression: bool) -> Unwrapped:
     name = type(final).__name__
-    classes = None if model.regression else np.asarray(final.classes_)
+    classes = None if regression else np.asarray(final.classes_)
     if name == "LabelEncodedClassifier" or name in _WRAPPED_BOOSTERS:
         inner = final.estimator_ if name == "LabelEncodedClassifier" else final.model_
         if inner is None:
-            _refuse(model, "a single class in training: nothing to convert")
+            _refuse(classifier, "a single class in training: nothing to convert")
         return Unwrapped(inner, classes, encoded=True)
     return Unwrapped(final, classes, encoded=False)
 
@@ -250,7 +301,13 @@ def _listed_columns(preprocess: BaseEstimator) -> BaseEstimator:
     return listed
 
 
-def _convert_pipeline(model: TrainedModel, preprocess: BaseEstimator, unwrapped: Unwrapped) -> Any:
+def _convert_pipeline(
+    classifier: str,
+    preprocess: BaseEstimator,
+    unwrapped: Unwrapped,
+    n_inputs: int,
+    regression: bool,
+) -> Any:
     """skl2onnx's graph of ``[preprocess, estimator]`` with its default output names."""
     from skl2onnx import convert_sklearn
     from skl2onnx.common.data_types import FloatTensorType
@@ -259,9 +316,8 @@ def _convert_pipeline(model: TrainedModel, preprocess: BaseEstimator, unwrapped:
     _register_boosters()
     estimator = unwrapped.estimator
     pipeline = Pipeline([("preprocess", _listed_columns(preprocess)), ("model", estimator)])
-    n_features = len(usable_feature_columns(model.schema))
     options: dict[int, dict[str, Any]] = {}
-    if not model.regression:
+    if not regression:
         # given for every classifier: skl2onnx would give a ZipMap option to those without
         # probabilities, which refuse it
         options[id(estimator)] = {"zipmap": False} if hasattr(estimator, "predict_proba") else {}
@@ -271,14 +327,14 @@ def _convert_pipeline(model: TrainedModel, preprocess: BaseEstimator, unwrapped:
         with _plain_missing_flags():
             return convert_sklearn(
                 pipeline,
-                initial_types=[(INPUT, FloatTensorType([None, n_features]))],
+                initial_types=[(INPUT, FloatTensorType([None, n_inputs]))],
                 options=options,
                 target_opset=TARGET_OPSET,
             )
     except (RuntimeError, NotImplementedError, ValueError, TypeError, KeyError) as error:
         first = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
         raise ConfigurationError(
-            f"classifier '{model.classifier}': the ONNX converter refused it ({first[:200]})"
+            f"classifier '{classifier}': the ONNX converter refused it ({first[:200]})"
         ) from None
 
 
@@ -417,9 +473,9 @@ def _route_missing_values(onnx_model: Any, estimator: BaseEstimator) -> None:
         node.attribute.append(helper.make_attribute("nodes_missing_value_tracks_true", tracks))
 
 
-def _finish(onnx_model: Any, model: TrainedModel, unwrapped: Unwrapped) -> None:
-    """Rename the outputs, map labels and probability columns to the schema's, and
-    write the metadata a program needs to build an input row and read the answer."""
+def _finish(onnx_model: Any, unwrapped: Unwrapped, n_labels: int, *, probabilities: bool) -> None:
+    """Rename the outputs, and map labels and probability columns to the target's
+    ``n_labels`` codes (0: a regressor's ``value``)."""
     from onnx import TensorProto, helper, numpy_helper
 
     graph = onnx_model.graph
@@ -428,12 +484,11 @@ def _finish(onnx_model: Any, model: TrainedModel, unwrapped: Unwrapped) -> None:
         if public not in outputs:  # a converter's inner result of the name the output takes
             _rename(graph, public, f"touchbench_inner_{public}")
     new_outputs = []
-    if model.regression:
+    if n_labels == 0:
         _rename(graph, outputs[0], VALUE)
         new_outputs.append(helper.make_tensor_value_info(VALUE, TensorProto.FLOAT, [None, None]))
     else:
         assert unwrapped.classes is not None
-        n_labels = model.n_classes[0]
         classes = unwrapped.classes.astype(np.int64)
         raw_label = "touchbench_raw_label"
         _rename(graph, outputs[0], raw_label)
@@ -454,7 +509,7 @@ def _finish(onnx_model: Any, model: TrainedModel, unwrapped: Unwrapped) -> None:
         else:
             graph.node.append(helper.make_node("Identity", [flat_label], [LABEL]))
         new_outputs.append(helper.make_tensor_value_info(LABEL, TensorProto.INT64, [None]))
-        if _gives_probabilities(model):
+        if probabilities:
             expand = np.zeros((classes.size, n_labels), dtype=np.float32)
             expand[np.arange(classes.size), classes] = 1.0
             _rename(graph, outputs[1], "touchbench_raw_probabilities")
@@ -473,16 +528,6 @@ def _finish(onnx_model: Any, model: TrainedModel, unwrapped: Unwrapped) -> None:
             )
     del graph.output[:]
     graph.output.extend(new_outputs)
-    graph.name = f"touchbench_{model.classifier}"
-    for key, value in metadata(model).items():
-        entry = onnx_model.metadata_props.add()
-        entry.key, entry.value = key, value
-
-
-def _gives_probabilities(model: TrainedModel) -> bool:
-    """As :meth:`TrainedModel.predict_proba` decides (a pipeline has ``predict_proba``
-    where its final estimator has)."""
-    return not model.regression and hasattr(model.estimator, "predict_proba")
 
 
 def _rename(graph: Any, old: str, new: str) -> None:
@@ -495,12 +540,27 @@ def _rename(graph: Any, old: str, new: str) -> None:
                 node.input[i] = new
 
 
+def add_metadata(onnx_model: Any, model: TrainedModel) -> None:
+    """Write :func:`metadata` into the graph."""
+    for key, value in metadata(model).items():
+        entry = onnx_model.metadata_props.add()
+        entry.key, entry.value = key, value
+
+
 def metadata(model: TrainedModel) -> dict[str, str]:
-    """The graph's metadata: the input's columns (name, kind, labels), the target and its
-    labels, the classifier and library versions (JSON values under ``touchbench.*``)."""
+    """The graph's metadata: the input's columns (name, kind, labels), the targets and
+    their labels, the classifier and library versions (JSON values under ``touchbench.*``).
+
+    ``touchbench.targets`` lists every target as ``{"name", "labels", "label",
+    "probabilities"}``, the last two the names of its outputs (a regressor's as ``{"name",
+    "value_column"}``, its column of ``value``); a model of one target also has
+    ``touchbench.target`` and ``touchbench.labels``, its outputs ``label`` and
+    ``probabilities``.
+    """
     features = [model.schema.features[i] for i in usable_feature_columns(model.schema)]
-    target = model.schema.targets[0]
-    return {
+    targets = model.schema.targets
+    several = len(targets) > 1
+    entries = {
         "touchbench.classifier": model.classifier,
         "touchbench.features": json.dumps(
             [
@@ -510,10 +570,40 @@ def metadata(model: TrainedModel) -> dict[str, str]:
                 for a in features
             ]
         ),
-        "touchbench.target": target.name,
-        "touchbench.labels": json.dumps(list(target.values) if not model.regression else []),
+        "touchbench.targets": json.dumps(
+            [
+                {"name": target.name, "value_column": column}
+                if model.regression
+                else {
+                    "name": target.name,
+                    "labels": list(target.values),
+                    "label": output_names(target.name, several)[0],
+                    "probabilities": output_names(target.name, several)[1],
+                }
+                for column, target in enumerate(targets)
+            ]
+        ),
         "touchbench.versions": json.dumps(model.versions),
     }
+    if not several:
+        entries["touchbench.target"] = targets[0].name
+        entries["touchbench.labels"] = json.dumps(
+            list(targets[0].values) if not model.regression else []
+        )
+    return entries
+
+
+def output_names(target: str, several: bool) -> tuple[str, str]:
+    """A target's label and probabilities outputs: ``label`` and ``probabilities`` for a
+    model of one target, ``label_<target>`` and ``probabilities_<target>`` otherwise."""
+    if not several:
+        return LABEL, PROBABILITIES
+    return f"{LABEL}_{target}", f"{PROBABILITIES}_{target}"
+
+
+#: Training instances checked per ONNX Runtime call in :func:`check_twin`: both sides'
+#: intermediate arrays (a forest's per-tree probabilities) grow with the rows of one call.
+CHECK_ROWS = 4096
 
 
 def check_twin(model: TrainedModel, data: bytes, X: np.ndarray) -> None:
@@ -526,7 +616,9 @@ def check_twin(model: TrainedModel, data: bytes, X: np.ndarray) -> None:
         Naming the largest difference and where.
     """
     try:
-        _check_twin(model, OnnxModel(model.schema, model.classifier, data), X)
+        twin = OnnxModel(model.schema, model.classifier, data)
+        for start in range(0, max(len(X), 1), CHECK_ROWS):
+            _check_twin(model, twin, X[start : start + CHECK_ROWS], start)
     except ConfigurationError:
         raise
     except Exception as error:  # ONNX Runtime's own errors, said in one line
@@ -537,31 +629,41 @@ def check_twin(model: TrainedModel, data: bytes, X: np.ndarray) -> None:
         ) from None
 
 
-def _check_twin(model: TrainedModel, twin: OnnxModel, X: np.ndarray) -> None:
+def _check_twin(model: TrainedModel, twin: OnnxModel, X: np.ndarray, start: int) -> None:
+    """Check rows ``start ..`` of the training instances (``X`` holds them)."""
     if model.regression:
         native = model.predict_values(X)
         mine = twin.predict_values(X)
-        _check_close(model, "value", native, mine)
+        _check_close(model, "value", native, mine, start)
         return
     codes, probabilities = model.predict_with_proba(X)
     twin_codes, twin_probabilities = twin.predict_with_proba(X)
-    differ = np.flatnonzero(codes[:, 0] != twin_codes[:, 0])
+    differ = np.flatnonzero((codes != twin_codes).any(axis=1))
     if differ.size:
         i = int(differ[0])
+        t = int(np.flatnonzero(codes[i] != twin_codes[i])[0])
+        of_target = f" of '{model.schema.targets[t].name}'" if codes.shape[1] > 1 else ""
         raise ConfigurationError(
-            f"classifier '{model.classifier}': the ONNX graph predicts another label for "
-            f"{differ.size} of {len(codes)} training instance(s) (first: instance {i + 1}, "
-            f"{codes[i, 0]} vs {twin_codes[i, 0]}); not exported"
+            f"classifier '{model.classifier}': the ONNX graph predicts another label{of_target} "
+            f"for {differ.size} training instance(s) from instance {start + 1} on (first: "
+            f"instance {start + i + 1}, {codes[i, t]} vs {twin_codes[i, t]}); not exported"
         )
     if probabilities is not None:
         if twin_probabilities is None:
             raise ConfigurationError(
                 f"classifier '{model.classifier}': the ONNX graph gives no probabilities"
             )
-        _check_close(model, "probability", probabilities[0], twin_probabilities[0])
+        several = len(probabilities) > 1
+        for target, native, mine in zip(
+            model.schema.targets, probabilities, twin_probabilities, strict=True
+        ):
+            what = f"probability of '{target.name}'" if several else "probability"
+            _check_close(model, what, native, mine, start)
 
 
-def _check_close(model: TrainedModel, what: str, native: np.ndarray, mine: np.ndarray) -> None:
+def _check_close(
+    model: TrainedModel, what: str, native: np.ndarray, mine: np.ndarray, start: int
+) -> None:
     """Refuse a difference over :data:`TOLERANCE`: absolute for probabilities, relative to
     the value (at least 1) for a regressor's values, which float32 holds to ~1e-7 of
     their size."""
@@ -575,8 +677,8 @@ def _check_close(model: TrainedModel, what: str, native: np.ndarray, mine: np.nd
     relative = " (relative)" if what == "value" else ""
     raise ConfigurationError(
         f"classifier '{model.classifier}': the ONNX graph's {what} differs from the model's "
-        f"by {difference[i, j]:.3g}{relative} (instance {i + 1}, column {j + 1}; at most "
-        f"{TOLERANCE:g} allowed); not exported"
+        f"by {difference[i, j]:.3g}{relative} (instance {start + i + 1}, column {j + 1}; at "
+        f"most {TOLERANCE:g} allowed); not exported"
     )
 
 
@@ -632,17 +734,20 @@ class OnnxModel:
         return list(self._session.run(list(names), {INPUT: features}))
 
     def predict_with_proba(self, X: np.ndarray) -> tuple[np.ndarray, list[np.ndarray] | None]:
-        """Codes of shape (n_instances, 1) and the probabilities (a list of one matrix of
-        shape (n_instances, n_labels), float64) or None, as
+        """Codes of shape (n_instances, n_targets) and the probabilities (a list of one
+        matrix of shape (n_instances, n_labels[t]) per target, float64) or None, as
         :meth:`TrainedModel.predict_with_proba`."""
-        if PROBABILITIES not in self._outputs:
-            [label] = self._run(X, [LABEL])
-            return label.astype(np.int64).reshape(-1, 1), None
-        label, proba = self._run(X, [LABEL, PROBABILITIES])
-        return label.astype(np.int64).reshape(-1, 1), [proba.astype(np.float64)]
+        names = [output_names(t.name, len(self.schema.targets) > 1) for t in self.schema.targets]
+        labels = [label for label, _ in names]
+        if any(proba not in self._outputs for _, proba in names):
+            answers = self._run(X, labels)
+            return np.column_stack([a.astype(np.int64).reshape(-1) for a in answers]), None
+        answers = self._run(X, labels + [proba for _, proba in names])
+        codes = np.column_stack([a.astype(np.int64).reshape(-1) for a in answers[: len(labels)]])
+        return codes, [a.astype(np.float64) for a in answers[len(labels) :]]
 
     def predict(self, X: np.ndarray) -> np.ndarray:
-        """Predicted codes of shape (n_instances, 1)."""
+        """Predicted codes of shape (n_instances, n_targets)."""
         return self.predict_with_proba(X)[0]
 
     def predict_values(self, X: np.ndarray) -> np.ndarray:

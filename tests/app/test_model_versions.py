@@ -16,6 +16,7 @@ from app.schemas.models import TrainRequest
 from app.store import models as store_models
 from app.store.database import Store
 from app.store.models import (
+    delete_alias,
     delete_model,
     get_model,
     list_models,
@@ -86,6 +87,74 @@ def test_alias_moves_and_rollback_steps_back_through_its_history(store: Store) -
     delete_model(store, "mic@2")  # its alias goes with it
     with pytest.raises(NotFoundError, match="has no alias 'champion'"):
         get_model(store, "mic@champion")
+
+
+def test_an_alias_is_deleted_and_set_again_starts_afresh(store: Store) -> None:
+    for _ in range(3):
+        _save(store)
+    for version in (1, 2):
+        set_alias(store, f"mic@{version}", "champion")
+    with pytest.raises(ConflictError, match=r"'mic@champion' points at version 2, not 1"):
+        delete_alias(store, "mic@1", "champion")  # moved since the caller looked
+    assert model_version(store, "mic@champion")[2] == "mic@2"
+    gone = delete_alias(store, "mic@2", "champion")
+    assert (gone.alias, gone.model.label, gone.previous) == ("champion", "mic@2", 2)
+    with pytest.raises(NotFoundError, match=r"model 'mic' has no alias 'champion' \(aliases: none"):
+        delete_alias(store, "mic", "champion")
+    with pytest.raises(NotFoundError, match="has no alias 'champion'"):
+        model_version(store, "mic@champion")
+    with pytest.raises(FieldError, match="'latest' is not an alias"):
+        delete_alias(store, "mic", "latest")
+    with pytest.raises(NotFoundError, match="no model 'other'"):
+        delete_alias(store, "other", "champion")
+    # set again: its history before the deletion is not stepped back into
+    assert set_alias(store, "mic@3", "champion").previous is None
+    with pytest.raises(ConflictError, match="nothing to roll back to"):
+        rollback_alias(store, "mic")
+    set_alias(store, "mic@1", "staging")
+    assert delete_alias(store, "mic", "staging").model.label == "mic@1"  # a name: any version
+    assert {m.version: m.aliases for m in list_models(store)} == {
+        1: (),
+        2: (),
+        3: ("champion",),
+    }
+
+
+def test_a_rollback_reads_the_history_a_page_at_a_time(
+    store: Store, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An alias moved many times (a flood of promotes) is stepped back reading a few of
+    its moves, and across pages when the newest ones are all the same version."""
+    from sqlalchemy import event
+    from sqlalchemy.orm import Session
+
+    from app.store.tables import ModelAliasEventRow
+
+    for _ in range(3):
+        _save(store)
+    set_alias(store, "mic@1", "champion")
+    for _ in range(5):
+        set_alias(store, "mic@2", "champion")  # the same version, moved to again
+    for version in [3, 2] * 40:
+        set_alias(store, f"mic@{version}", "champion")
+    loaded: list[object] = []
+
+    def count(session: Session, instance: object) -> None:
+        if isinstance(instance, ModelAliasEventRow):
+            loaded.append(instance)
+
+    event.listen(Session, "loaded_as_persistent", count)
+    try:
+        assert rollback_alias(store, "mic").model.label == "mic@3"
+    finally:
+        event.remove(Session, "loaded_as_persistent", count)
+    assert 0 < len(loaded) <= store_models.ALIAS_STEPS_PAGE  # not the 86 moves
+    monkeypatch.setattr(store_models, "ALIAS_STEPS_PAGE", 2)
+    for version in (2, 1):  # back over the moves to 2 (undone, then equal), pages of 2
+        set_alias(store, f"mic@{version}", "champion")
+    set_alias(store, "mic@2", "champion")
+    set_alias(store, "mic@2", "champion")
+    assert rollback_alias(store, "mic").model.label == "mic@1"
 
 
 def test_aliases_that_would_read_otherwise_are_refused(store: Store) -> None:
@@ -209,10 +278,18 @@ def test_the_cli_promotes_aliases_and_rolls_back(
     ]
     back = run_cli(capsys, store_url, "rollback", "mic")
     assert back.code == 0 and "mic@champion is now version 1 (was version 3)" in back.err
+    deleted = run_cli(capsys, store_url, "alias", "--delete", "mic", "staging")
+    assert deleted.code == 0 and "deleted mic@staging (it pointed at version 2)" in deleted.err
+    as_json = run_cli(capsys, store_url, "alias", "mic", "champion", "--delete", "--json")
+    assert as_json.json() == {"alias": "champion", "model": "mic@1", "version": 1}
+    assert run_cli(capsys, store_url, "promote", "mic@3").code == 0
     refused = [
+        (("alias", "--delete", "mic", "staging"), "model 'mic' has no alias 'staging'"),
+        (("alias", "--delete", "mic@2", "champion"), "points at version 3, not 2"),
+        (("alias", "--delete", "mic", "latest"), "'latest' is not an alias"),
         (("alias", "mic@2", "2"), "ALIAS: an alias starts with a letter"),
         (("promote", "mic@9"), "model 'mic' has no version 9"),
-        (("rollback", "mic"), "nothing to roll back to"),
+        (("rollback", "mic"), "nothing to roll back to"),  # set again after its deletion
         (("rollback", "mic", "--alias", "beta"), "no alias 'beta' to roll back"),
     ]
     for args, words in refused:

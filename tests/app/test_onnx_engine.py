@@ -8,6 +8,7 @@ import subprocess
 import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import Any
 
 import onnxruntime
 import pytest
@@ -74,12 +75,19 @@ def test_export_the_example_program_and_predict_agree(
             row["probabilities"]["gesture"], abs=1e-5
         )
 
-    # one instance, as a robot's program has it: attribute -> number or label
+    assert _example_answer(arff, 0, graph, tmp_path)["label"] == rows[0]["gesture"]
+    imports = [line for line in EXAMPLE.read_text().splitlines() if "import " in line]
+    assert not [line for line in imports if "app" in line or "benchmark" in line]
+
+
+def _example_answer(arff: Path, row: int, graph: Path, tmp_path: Path) -> Any:
+    """What the example program prints for instance ``row`` of ``arff``, given as a robot's
+    program has it: attribute -> number or label."""
     data = read_data_file(arff)
     instance = {
-        attribute.name: attribute.label(data.values[0, i])
+        attribute.name: attribute.label(data.values[row, i])
         if attribute.kind == "nominal"
-        else float(data.values[0, i])
+        else float(data.values[row, i])
         for i, attribute in enumerate(data.schema.attributes)
     }
     (tmp_path / "instance.json").write_text(json.dumps(instance))
@@ -91,9 +99,7 @@ def test_export_the_example_program_and_predict_agree(
         cwd=tmp_path,
         env={"PATH": "/usr/bin:/bin"},  # no PYTHONPATH: touchbench is not importable there
     )
-    assert json.loads(answer.stdout)["label"] == rows[0]["gesture"]
-    imports = [line for line in EXAMPLE.read_text().splitlines() if "import " in line]
-    assert not [line for line in imports if "app" in line or "benchmark" in line]
+    return json.loads(answer.stdout)
 
 
 def test_what_has_no_converter_is_refused_in_one_line(
@@ -222,3 +228,44 @@ def make_server_on(tmp_path: Path) -> Iterator[Callable[[str], Server]]:
     yield make
     for generator in generators:
         next(generator, None)
+
+
+def test_a_chain_of_two_targets_exports_and_every_engine_gives_both_labels(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """`export-model` of a classifier chain, `predict --engine onnx` against `native`, and
+    the example program's answer for every target."""
+    from tests.app.synthetic import touch_arff
+
+    url = f"sqlite:///{tmp_path / 'touchbench.db'}"
+    arff = touch_arff(tmp_path / "touch.arff", n=45)
+    assert run_cli(capsys, url, "import", str(arff)).code == 0
+    trained = run_cli(capsys, url, "train", "touch", "-c", "cc:rf", "--name", "chain")
+    assert trained.code == 0, trained.err
+    graph = tmp_path / "chain.onnx"
+    done = run_cli(capsys, url, "export-model", "chain", "-o", str(graph), "--json")
+    assert done.code == 0, done.err
+    assert done.json()["checked_instances"] == 45
+    native = run_cli(capsys, url, "predict", "chain", str(arff), "--engine", "native", "--json")
+    onnx = run_cli(capsys, url, "predict", "chain", str(arff), "--engine", "onnx", "--json")
+    assert native.code == onnx.code == 0, onnx.err
+    rows, twin_rows = native.json()["predictions"], onnx.json()["predictions"]
+    for target in ("gesture", "place"):
+        assert [r[target] for r in twin_rows] == [r[target] for r in rows]
+        for row, twin_row in zip(rows, twin_rows, strict=True):
+            assert twin_row["probabilities"][target] == pytest.approx(
+                row["probabilities"][target], abs=1e-5
+            )
+
+    printed = _example_answer(arff, 1, graph, tmp_path)
+    assert printed["label"] == {"gesture": rows[1]["gesture"], "place": rows[1]["place"]}
+    assert set(printed["probabilities"]) == {"gesture", "place"}
+
+    refused = run_cli(capsys, url, "train", "touch", "-c", "pcc:logistic", "--name", "pcc")
+    assert refused.code == 0, refused.err
+    not_exported = run_cli(capsys, url, "export-model", "pcc", "-o", str(tmp_path / "p.onnx"))
+    assert not_exported.code == 2 and not_exported.err.count("\n") == 1
+    assert "several targets: cr, cc, bcc, lc, ps and nsr" in not_exported.err
+    listing = run_cli(capsys, url, "classifiers", "--multi-target", "--json").json()
+    marks = {entry["id"]: entry["onnx"] for entry in listing["classifiers"]}
+    assert marks["cc:rf"] and marks["lc:xgb"] and not marks["cc:j48"] and not marks["ecc:rf"]

@@ -1,5 +1,5 @@
 """Models: train (a job, 202), list, describe, delete, predict (JSON instances or a file), and
-the aliases of their versions (alias, promote, rollback).
+the aliases of their versions (alias, promote, rollback, delete an alias).
 
 ``{model_ref}`` is an id, ``NAME`` (its newest version), ``NAME@VERSION`` or ``NAME@ALIAS``.
 """
@@ -22,6 +22,7 @@ from app.api.uploads import form_request, in_client_words, save_upload
 from app.schemas.jobs import JobCreated
 from app.schemas.models import (
     AliasBody,
+    AliasDeleted,
     AliasMoved,
     AliasRequest,
     ModelList,
@@ -97,6 +98,16 @@ def alias(model_ref: str, body: AliasBody, store: StoreDep) -> AliasMoved:
     from app.services.models import move_alias
 
     return move_alias(store, AliasRequest(model=model_ref, alias=body.alias)).to_schema()
+
+
+@router.delete("/{model_ref}/aliases/{alias}", response_model=AliasDeleted)
+def unalias(model_ref: str, alias: str, store: StoreDep) -> AliasDeleted:
+    """Delete ``NAME@alias`` (``touchbench alias --delete``): 404 when there is no such
+    alias, 409 when ``model_ref`` names a version (``NAME@3``) the alias no longer points
+    at; live sessions following it keep their version and say so once."""
+    from app.services.models import remove_alias
+
+    return remove_alias(store, AliasRequest(model=model_ref, alias=alias))
 
 
 @router.post("/{model_ref}/promote", response_model=AliasMoved)

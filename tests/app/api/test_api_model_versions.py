@@ -5,12 +5,16 @@ write key."""
 
 from __future__ import annotations
 
+import contextlib
 import json
-from collections.abc import Callable
+import shutil
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
 import httpx
+import numpy as np
+import pytest
 from websockets.sync.client import ClientConnection, connect
 
 from app.schemas.datasets import ImportRequest
@@ -52,12 +56,72 @@ def _versions(store_url: str, tmp_path: Path) -> list[tuple[float, float, str, s
     return touches
 
 
+@pytest.fixture(scope="module")
+def prepared(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[Any]]:
+    """A store holding :func:`_versions`' models, made once for the tests that copy it,
+    and the unseen session's touches (``unseen.wav`` beside it)."""
+    folder = tmp_path_factory.mktemp("versions")
+    touches = _versions(f"sqlite:///{folder / 'touchbench.db'}", folder)
+    return folder, touches
+
+
+def _copy_of(prepared: tuple[Path, list[Any]], tmp_path: Path) -> list[Any]:
+    """The prepared store and session in ``tmp_path`` (the store the server there opens);
+    the session's touches."""
+    folder, touches = prepared
+    for name in ("touchbench.db", "unseen.wav"):
+        shutil.copy(folder / name, tmp_path / name)
+    return touches
+
+
 def _until(socket: ClientConnection, seen: list[dict[str, Any]], key: str) -> None:
     """Receive messages into ``seen`` until one holds ``key``."""
     while True:
         seen.append(json.loads(socket.recv(timeout=120)))
         if key in seen[-1]:
             return
+
+
+@contextlib.contextmanager
+def _champion_session(
+    server: Server,
+    samples: np.ndarray,
+    rate: int,
+    blocks: list[bytes],
+    seen: list[dict[str, Any]],
+    until: str = "predictions",
+) -> Iterator[ClientConnection]:
+    """A live session on ``mic@champion`` that has sent ``blocks`` and received messages
+    into ``seen`` up to one holding ``until`` (its first prediction; "": none)."""
+    url = server.url.replace("http://", "ws://") + "/api/models/mic@champion/live"
+    # no keepalive pings: a loaded machine may leave them unanswered for a while
+    with connect(
+        url, additional_headers={"X-API-Key": PREDICT}, open_timeout=60, ping_interval=None
+    ) as socket:
+        socket.send(json.dumps({"samplerate": rate, "channels": samples.shape[1]}))
+        for block in blocks:
+            socket.send(block)
+        if until:
+            _until(socket, seen, until)
+        yield socket
+
+
+def _finish(
+    socket: ClientConnection, blocks: list[bytes], seen: list[dict[str, Any]], until: str = ""
+) -> None:
+    """Send the last ``blocks`` and the end, receive into ``seen`` (past a message holding
+    ``until`` first) until the server closes the stream as ended."""
+    for block in blocks:
+        socket.send(block)
+    socket.send(json.dumps({"end": True}))
+    if until:
+        _until(socket, seen, until)
+    try:
+        while True:
+            seen.append(json.loads(socket.recv(timeout=120)))
+    except Exception:  # closed: the stream ended
+        pass
+    assert (socket.close_code, socket.close_reason) == (1000, "stream ended")
 
 
 def test_a_live_session_follows_the_champion_mid_stream(
@@ -84,31 +148,15 @@ def test_a_live_session_follows_the_champion_mid_stream(
         parts.append([part[i : i + frames].tobytes() for i in range(0, len(part), frames)])
         start = cut
     seen: list[dict[str, Any]] = []
-    url = server.url.replace("http://", "ws://") + "/api/models/mic@champion/live"
-    # no keepalive pings: a loaded machine may leave them unanswered for a while
-    with connect(
-        url, additional_headers={"X-API-Key": PREDICT}, open_timeout=60, ping_interval=None
-    ) as socket:
-        socket.send(json.dumps({"samplerate": rate, "channels": samples.shape[1]}))
-        for block in parts[0]:
-            socket.send(block)
-        _until(socket, seen, "predictions")  # the first touch, by version 1
+    with _champion_session(server, samples, rate, parts[0], seen) as socket:
+        # the first touch, by version 1
         moved = lab.post("/api/models/mic@2/promote")
         assert moved.json() == {"alias": "champion", "model": "mic@2", "version": 2, "previous": 1}
         for block in parts[1]:
             socket.send(block)
         _until(socket, seen, "switched")
         lab.post("/api/models/mic@3/promote").raise_for_status()  # no recipe: not taken
-        for block in parts[2]:
-            socket.send(block)
-        socket.send(json.dumps({"end": True}))
-        _until(socket, seen, "warning")
-        try:
-            while True:
-                seen.append(json.loads(socket.recv(timeout=120)))
-        except Exception:  # closed: the stream ended
-            pass
-        assert (socket.close_code, socket.close_reason) == (1000, "stream ended")
+        _finish(socket, parts[2], seen, until="warning")
 
     answers = [m["model"] for m in seen if "predictions" in m]
     assert len(answers) == 5  # every touch of the stream, none dropped by the switch
@@ -135,3 +183,101 @@ def test_a_live_session_follows_the_champion_mid_stream(
     assert predicted.status_code == 200 and predicted.json()["model"] == "mic@1"
     lab.close()
     robot.close()
+
+
+def test_deleting_the_alias_a_live_session_follows_keeps_its_version(
+    make_sqlite_server: Callable[..., Server],
+    tmp_path: Path,
+    prepared: tuple[Path, list[Any]],
+) -> None:
+    """``DELETE /api/models/NAME/aliases/ALIAS`` needs a write key, says 404 for a missing
+    alias and 409 for a version it no longer points at; a session on ``NAME@champion``
+    keeps answering with its version and says so once."""
+    touches = _copy_of(prepared, tmp_path)
+    server = make_sqlite_server(
+        api_keys=f"lab:write:{WRITE},robot:predict:{PREDICT}", live_follow_seconds="0"
+    )
+    lab = httpx.Client(base_url=server.url, headers={"X-API-Key": WRITE}, timeout=60)
+    robot = httpx.Client(base_url=server.url, headers={"X-API-Key": PREDICT}, timeout=60)
+    lab.post("/api/models/mic@1/promote").raise_for_status()
+
+    samples, rate = _as_int16(tmp_path / "unseen.wav")
+    frames, cut = 2048, int(touches[2][0] * rate)
+    parts = [samples[:cut], samples[cut:]]
+    blocks = [[p[i : i + frames].tobytes() for i in range(0, len(p), frames)] for p in parts]
+    seen: list[dict[str, Any]] = []
+    with _champion_session(server, samples, rate, blocks[0], seen) as socket:
+        refused = robot.delete("/api/models/mic/aliases/champion")
+        assert refused.status_code == 403 and "needs a write key" in refused.text
+        stale = lab.delete("/api/models/mic@2/aliases/champion")
+        assert stale.status_code == 409 and "points at version 1, not 2" in stale.text
+        gone = lab.delete("/api/models/mic/aliases/champion")
+        assert gone.status_code == 200, gone.text
+        assert gone.json() == {"alias": "champion", "model": "mic@1", "version": 1}
+        _finish(socket, blocks[1], seen)
+
+    answers = [m["model"] for m in seen if "predictions" in m]
+    assert answers == ["mic@1"] * 5  # every touch, by the version the session held
+    warnings = [m["warning"] for m in seen if "warning" in m]
+    assert len(warnings) == 1 and "has no alias 'champion'" in warnings[0]
+    assert "the session keeps its model" in warnings[0]
+    missing = lab.delete("/api/models/mic/aliases/champion")
+    assert missing.status_code == 404 and "has no alias 'champion'" in missing.text
+    assert lab.delete("/api/models/mic/aliases/latest").status_code == 422
+    new_session = robot.get("/api/models/mic@champion")
+    assert new_session.status_code == 404
+
+
+def test_a_flood_of_alias_moves_drops_no_stream_and_no_request(
+    make_sqlite_server: Callable[..., Server],
+    tmp_path: Path,
+    prepared: tuple[Path, list[Any]],
+) -> None:
+    """Promote, rollback and alias in a loop while a session on ``mic@champion`` streams
+    (following checked at every block): every touch is answered, by a version the alias
+    named; no request fails with a 5xx; the session switches at most once per block."""
+    import threading
+
+    _copy_of(prepared, tmp_path)
+    server = make_sqlite_server(
+        api_keys=f"lab:write:{WRITE},robot:predict:{PREDICT}", live_follow_seconds="0"
+    )
+    lab = httpx.Client(base_url=server.url, headers={"X-API-Key": WRITE}, timeout=60)
+    lab.post("/api/models/mic@1/promote").raise_for_status()
+    statuses: list[int] = []
+    stop = threading.Event()
+
+    def flood() -> None:
+        moves = [
+            ("/api/models/mic@2/promote", None),
+            ("/api/models/mic/rollback", None),
+            ("/api/models/mic@3/aliases", {"alias": "champion"}),  # not taken: no recipe
+            ("/api/models/mic@1/promote", None),
+        ]
+        while not stop.is_set():
+            for path, body in moves:
+                statuses.append(lab.post(path, json=body).status_code)
+
+    samples, rate = _as_int16(tmp_path / "unseen.wav")
+    blocks = [samples[i : i + 2048].tobytes() for i in range(0, len(samples), 2048)]
+    seen: list[dict[str, Any]] = []
+    flooding = threading.Thread(target=flood)
+    with _champion_session(server, samples, rate, blocks[:1], seen, until="") as socket:
+        flooding.start()
+        try:
+            _finish(socket, blocks[1:], seen)
+        finally:
+            stop.set()
+            flooding.join()
+    answers = [m["model"] for m in seen if "predictions" in m]
+    switches = [m for m in seen if "switched" in m]
+    warnings = [m for m in seen if "warning" in m]
+    print(
+        f"{len(statuses)} alias requests ({sorted(set(statuses))}) during {len(blocks)} "
+        f"blocks: {len(answers)} answers, {len(switches)} switches, {len(warnings)} warnings"
+    )
+    assert statuses and all(status < 500 for status in statuses)
+    assert set(statuses) <= {200, 409}  # a rollback with nothing to go back to: 409
+    assert len(answers) == 5 and set(answers) <= {"mic@1", "mic@2"}
+    assert len(switches) + len(warnings) <= len(blocks)
+    assert lab.get("/healthz").status_code == 200

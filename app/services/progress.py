@@ -1,0 +1,37 @@
+"""Progress of a long answer (a learning curve, an ablation) told at most so often.
+
+Such an answer hears of every finished task, but its summary so far is built from every
+result yet (quadratic over the job) and is written to the job's row each time: a learning
+curve of 20 classifiers x 20 fractions x 10 folds spent ~170 s of CPU on 4,000 summaries
+of 33 KB each.  Told at most every :data:`PROGRESS_SECONDS`, that work follows the job's
+duration, not its number of tasks squared.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from typing import TypeVar
+
+#: Least seconds between two progress reports of one answer.
+PROGRESS_SECONDS = 1.0
+
+T = TypeVar("T")
+
+
+def throttled(
+    on_progress: Callable[[T], None], summary: Callable[[], T], seconds: float = PROGRESS_SECONDS
+) -> Callable[[], None]:
+    """A function that calls ``on_progress(summary())`` if ``seconds`` passed since it last
+    did (the first call always does); ``summary`` is built only then."""
+    last = -math.inf
+
+    def tell() -> None:
+        nonlocal last
+        now = time.monotonic()
+        if now - last >= seconds:
+            last = now
+            on_progress(summary())
+
+    return tell
