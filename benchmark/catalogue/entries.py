@@ -277,7 +277,7 @@ NEURAL_ENTRIES: tuple[tuple[str, dict[str, Any], str, int], ...] = (
 )
 NEURAL_LIMITS = (
     "sequence data sets only; missing values imputed by the training mean; early stopping "
-    "on 15 % of the training fold; CPU, one thread per worker"
+    "on 15 % of the training fold, then a refit on all of it; CPU, one thread per worker"
 )
 
 

@@ -85,6 +85,30 @@ def test_early_stopping_keeps_the_best_epoch_of_the_inner_validation_split() -> 
     assert model.n_epochs_ < 40
 
 
+def test_refit_trains_a_new_network_on_the_whole_fold_for_the_best_epoch_count() -> None:
+    X, y, layout = windows()
+    refitted = quick("cnn1d", layout, max_epochs=12, patience=3).fit(X, y)[-1]
+    kept = quick("cnn1d", layout, max_epochs=12, patience=3, refit=False).fit(X, y)[-1]
+    assert (refitted.n_epochs_, refitted.best_epoch_) == (kept.n_epochs_, kept.best_epoch_)
+    assert refitted.weights_ != kept.weights_  # not the best epoch's weights of the search
+    # The same seed, every instance, the best epoch count and no validation split.
+    whole = quick(
+        "cnn1d", layout, max_epochs=kept.best_epoch_, refit=False, validation_fraction=0.0
+    ).fit(X, y)[-1]
+    assert whole.weights_ == refitted.weights_
+
+
+def test_a_network_stored_before_refit_existed_loads_as_it_was_trained() -> None:
+    X, y, layout = windows()
+    model = quick("cnn1d", layout, max_epochs=1).fit(X, y)[-1]
+    state = model.__getstate__()
+    del state["refit"]
+    old = NeuralSequenceClassifier.__new__(NeuralSequenceClassifier)
+    old.__setstate__(state)
+    assert old.get_params()["refit"] is False  # it kept the best epoch's weights
+    np.testing.assert_array_equal(old.predict_proba(X), model.predict_proba(X))
+
+
 def test_early_stopping_holds_out_whole_groups_when_given_them() -> None:
     y = np.arange(60) % 3
     groups = np.repeat(np.arange(20), 3)  # a recording's three windows, one of each class
@@ -101,14 +125,14 @@ def test_early_stopping_holds_out_whole_groups_when_given_them() -> None:
 def test_the_engine_and_training_give_the_groups_to_a_network_only() -> None:
     X, y, layout = windows()
     groups = np.arange(len(y)) // 4
-    network = quick("cnn1d", layout)
+    network = quick("cnn1d", layout, refit=False)  # the weights of the split's best epoch
     assert group_fit_params(network, groups)["classifier__groups"] is not None
     assert group_fit_params(network, None) == {}
     assert group_fit_params(build_pipeline("rf", n_features=layout.stop), groups) == {}
     with pytest.raises(ValueError, match="one entry per instance"):
         network.fit(X, y, classifier__groups=groups[:-1])
     grouped = network.fit(X, y, **group_fit_params(network, groups))[-1]
-    ungrouped = quick("cnn1d", layout).fit(X, y)[-1]
+    ungrouped = quick("cnn1d", layout, refit=False).fit(X, y)[-1]
     assert grouped.weights_ != ungrouped.weights_  # another validation split was held out
 
 
