@@ -16,13 +16,19 @@ clones it into ``/tmp/touchbench-real-data``):
 
 For each, the script prints what touchbench read (recordings, channels, rate, notes) and
 the accuracy of ``minirocket``, ``interval-forest`` and ``rf`` through touchbench's engine
-beside aeon's ``MiniRocketClassifier``, aeon's ``RandomIntervalClassifier`` (extra trees,
-as touchbench's entry) and scikit-learn's ``RandomForestClassifier`` fitted by hand on the
-same windows and the same stratified folds (one slide = one instance).  The goal is
-agreement within 2 points.
+beside a peer fitted by hand on the same windows and the same stratified folds (one slide
+= one instance): aeon's ``MiniRocketClassifier``; for the interval forest, aeon's own
+``RandomIntervals`` set to touchbench's seven statistics over the same three
+representations and counts, with the same extra trees (:class:`AeonIntervalForest`), and
+as references aeon's ``RandomIntervalClassifier`` (its own statistics, the series only)
+and ``TimeSeriesForestClassifier``; scikit-learn's ``RandomForestClassifier`` on the flat
+columns.  Beside each: the accuracy of every fold, and recording by recording how many
+predictions differ and which side alone is right (a sign test), since on a few hundred
+slides one point is a few recordings; ``--seeds N`` refits both sides under N seeds.  The
+goal is agreement within 2 points.
 
     .venv/bin/python perf/real_data.py [--biotac PATH] [--fabric PATH] [--per-class 10]
-        [--folds 5] [--jobs 1]
+        [--folds 5] [--jobs 1] [--seeds 1]
 """
 
 from __future__ import annotations
@@ -39,7 +45,14 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from aeon.classification.convolution_based import MiniRocketClassifier
+from aeon.classification.interval_based import RandomIntervalClassifier, TimeSeriesForestClassifier
+from aeon.transformations.collection.interval_based import RandomIntervals
+from aeon.utils.numba import stats
+from scipy.stats import binomtest
+from sklearn.ensemble import ExtraTreesClassifier, RandomForestClassifier
 
+from app.errors import USER_ERRORS
 from app.services.extraction import extract_dataset
 from benchmark.estimators import build_estimator
 from benchmark.evaluation.leaderboard import build_leaderboard
@@ -145,10 +158,6 @@ class AeonIntervalForest:
         return [X, np.diff(X, axis=-1), np.abs(np.fft.rfft(X, axis=-1))]
 
     def fit(self, X: np.ndarray, y: np.ndarray) -> AeonIntervalForest:
-        from aeon.transformations.collection.interval_based import RandomIntervals
-        from aeon.utils.numba import stats
-        from sklearn.ensemble import ExtraTreesClassifier
-
         features = [getattr(stats, name) for name in AEON_STATISTICS]
         self.transforms_ = [
             RandomIntervals(
@@ -172,28 +181,23 @@ class AeonIntervalForest:
 @dataclass(frozen=True)
 class Peer:
     """A plain aeon / scikit-learn classifier: what it is, how to make one with a seed, and
-    whether it reads the windows (n, n_channels, length) or the flat columns."""
+    what it reads: ``windows`` (n, n_channels, length) as touchbench has them, ``float32``
+    windows (aeon's rockets compute in float32) or the ``flat`` columns (n, n_columns)."""
 
     label: str
     make: Callable[[int], Any]
-    windows: bool = True
+    reads: str = "windows"
 
 
 def peers(n_channels: int, length: int) -> dict[str, list[Peer]]:
     """Per touchbench classifier, its like-for-like peer first, then other references."""
-    from aeon.classification.convolution_based import MiniRocketClassifier
-    from aeon.classification.interval_based import (
-        RandomIntervalClassifier,
-        TimeSeriesForestClassifier,
-    )
-    from sklearn.ensemble import ExtraTreesClassifier, RandomForestClassifier
-
     count = 4 + int(math.sqrt(length * n_channels))  # touchbench's default count
     return {
         "minirocket": [
             Peer(
                 "aeon MiniRocketClassifier, 10,000 kernels",
                 lambda seed: MiniRocketClassifier(n_kernels=10_000, random_state=seed),
+                reads="float32",
             )
         ],
         "interval-forest": [
@@ -222,7 +226,7 @@ def peers(n_channels: int, length: int) -> dict[str, list[Peer]]:
             Peer(
                 "scikit-learn RandomForestClassifier, 100 trees, flat columns",
                 lambda seed: RandomForestClassifier(n_estimators=100, random_state=seed),
-                windows=False,
+                reads="flat",
             )
         ],
     }
@@ -245,8 +249,6 @@ def fold_scores(predicted: np.ndarray, y: np.ndarray, folds: Sequence[Fold]) -> 
 
 def paired(ours: np.ndarray, theirs: np.ndarray, y: np.ndarray) -> str:
     """How two sets of predictions of the same recordings differ, with a sign test."""
-    from scipy.stats import binomtest
-
     only_ours = int(np.sum((ours == y) & (theirs != y)))
     only_theirs = int(np.sum((ours != y) & (theirs == y)))
     p = binomtest(only_ours, only_ours + only_theirs).pvalue if only_ours + only_theirs else 1.0
@@ -272,10 +274,14 @@ def measure(
         labels.write_text(
             "file,label\n" + "".join(f"{path.name},{label}\n" for path, label in chosen.items())
         )
-        start = time.perf_counter()
-        extracted = extract_dataset(
-            list(chosen), labels=labels, extractor="sequence", events="none", **source.extraction
-        )
+        start, options = time.perf_counter(), source.extraction
+        try:
+            extracted = extract_dataset(
+                list(chosen), labels=labels, extractor="sequence", events="none", **options
+            )
+        except USER_ERRORS as error:
+            print(f"  {source.name}: touchbench cannot read it: {error}")
+            return
         seconds = time.perf_counter() - start
     problem, _ = problem_from_dataset(extracted.dataset)
     assert problem.sequence is not None
@@ -287,8 +293,13 @@ def measure(
         f"read in {seconds:.1f} s"
     )
     print(f"    {problem.sequence.describe()}; channels: {', '.join(channels[:8])}, ...")
-    for note in [*extracted.notes, *extracted.warnings][:4]:
+    notes = [*extracted.notes, *extracted.warnings]
+    # one resampling note per recording: the first, then the other kinds of note
+    resampled = [note for note in notes if "resampled to" in note]
+    for note in [*resampled[:1], *[note for note in notes if note not in resampled][:5]]:
         print(f"    note: {note[:160]}")
+    if len(resampled) > 1:
+        print(f"    note: and {len(resampled) - 1} more recordings resampled from jittered stamps")
     folds, _ = make_folds(problem.Y, n_folds=n_folds, groups=problem.groups, seed=0)
     start = time.perf_counter()
     results = run_tasks(problem, CLASSIFIERS, folds, jobs=jobs, timeout=3600)
@@ -337,14 +348,6 @@ def compare(
     recording; return the peer's mean accuracy (seed 0)."""
     y = problem.Y[:, 0]
 
-    def data(p: Peer) -> np.ndarray:
-        # aeon's rockets compute in float32; the others take the arrays as touchbench has them
-        return (
-            windows.astype(np.float32)
-            if "Rocket" in p.label
-            else (windows if p.windows else problem.X)
-        )
-
     def ours_predict(seed: int) -> np.ndarray:
         def fit_predict(train: np.ndarray, test: np.ndarray) -> np.ndarray:
             model = build_estimator(name, problem, random_state=seed)
@@ -353,7 +356,7 @@ def compare(
         return cross_predict(fit_predict, y.size, folds)
 
     def peer_predict(p: Peer, seed: int) -> np.ndarray:
-        X = data(p)
+        X = {"windows": windows, "float32": windows.astype(np.float32), "flat": problem.X}[p.reads]
 
         def fit_predict(train: np.ndarray, test: np.ndarray) -> np.ndarray:
             return np.asarray(p.make(seed).fit(X[train], y[train]).predict(X[test]))
@@ -377,8 +380,10 @@ def compare(
         )
     if seeds > 1:
         spread = {
-            "touchbench": [np.mean(fold_scores(ours_predict(s), y, folds)) for s in range(seeds)],
-            "peer": [np.mean(fold_scores(peer_predict(peer, s), y, folds)) for s in range(seeds)],
+            "touchbench": [np.mean(mine_folds)]
+            + [np.mean(fold_scores(ours_predict(s), y, folds)) for s in range(1, seeds)],
+            "peer": [np.mean(their_folds)]
+            + [np.mean(fold_scores(peer_predict(peer, s), y, folds)) for s in range(1, seeds)],
         }
         print(
             f"      seeds 0-{seeds - 1}: "
