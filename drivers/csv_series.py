@@ -10,6 +10,8 @@
   rate (:class:`drivers.resample.Jitter`; :func:`drivers.resample.resample_even`), and a
   note says how uneven they were.
 * A delimiter at the end of every row (a trailing comma) is accepted.
+* With a time column, a row equal to the one before in every column (a sample logged
+  twice) is left out with a note; the same stamp with other values is refused.
 * ``channels`` picks columns by name (or 1-based number among the channels).
 
 Every problem is a :class:`~drivers.errors.DriverError` naming the file, and the line
@@ -123,8 +125,18 @@ def read_csv_series(
     samples = values[:, picked]
     if time is None:
         return CsvSeries(np.ascontiguousarray(samples.T), samplerate, kept_names, ())
+    repeats = _repeated_rows(values)
+    if repeats.any():
+        values, samples, first = values[~repeats], samples[~repeats], int(lines[repeats][0])
+        lines = lines[~repeats]
     times, unit = stamps_in_seconds(values[:, time], time_unit)
     rate, samples, notes = _on_even_grid(path, names[time], times, lines, samples, samplerate)
+    if repeats.any():
+        notes.insert(
+            0,
+            f"{int(repeats.sum())} row(s) repeat the row before, stamp and values (from line "
+            f"{first}): left out as logged twice",
+        )
     resampled = samplerate is None and bool(notes)
     if time_unit == "auto" and unit != "s":
         notes.insert(0, f"column '{names[time]}' holds nanoseconds")
@@ -267,6 +279,15 @@ def _pick(
     if len(set(picked)) != len(picked):
         raise DriverError(f"{path}: a channel is asked for twice")
     return picked
+
+
+def _repeated_rows(values: np.ndarray) -> np.ndarray:
+    """Rows of ``values`` (n_rows, n_columns) equal to the row before in every column,
+    time included, shape (n_rows,) bool: a sample logged twice (a recorder that writes its
+    last sample again on closing), not a second sample at the same time."""
+    repeats = np.zeros(values.shape[0], dtype=bool)
+    repeats[1:] = (values[1:] == values[:-1]).all(axis=1)
+    return repeats
 
 
 def _on_even_grid(

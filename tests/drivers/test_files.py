@@ -65,6 +65,21 @@ def test_csv_errors_name_the_line_and_column(tmp_path: Path) -> None:
         read_recording(path)
 
 
+def test_csv_rows_logged_twice_are_left_out_with_a_note(tmp_path: Path) -> None:
+    path = tmp_path / "twice.csv"
+    rows = ["timestamp,x"] + [f"{1000 + 28 * i},{i}" for i in range(6)]
+    path.write_text("\n".join([*rows, rows[-1], ""]))  # the last sample written again
+    recording = read_recording(path, time_unit="ms")
+    assert np.array_equal(recording.samples, [np.arange(6.0)])
+    assert recording.samplerate == pytest.approx(1000 / 28)
+    assert any(
+        "1 row(s) repeat the row before" in note and "line 8" in note for note in recording.notes
+    )
+    path.write_text("\n".join([*rows, rows[-1].replace(",5", ",6"), ""]))
+    with pytest.raises(DriverError, match=r"twice.csv:8: column 'timestamp': the time does not"):
+        read_recording(path, time_unit="ms")
+
+
 def test_npy_one_or_two_dimensional(tmp_path: Path) -> None:
     path = tmp_path / "signal.npy"
     np.save(path, np.arange(6.0))
