@@ -4,6 +4,7 @@ published prediction.
 Run from the repository root (ROS 1 installed, as scripts/install.sh does)::
 
     .venv/bin/python perf/ros_latency.py [--touches 40] [--block 512] [--core 0]
+                                         [--engines native,onnx] [--rounds 2]
 
 A random forest (``cc:rf``, 100 trees per target) is trained on the ``uc3m-audio``
 features of simulated 3-microphone sessions (44.1 kHz).  A rosmaster of its own is
@@ -20,7 +21,9 @@ clock when the publish of that message returned (``time.perf_counter``, one mono
 clock for every process of the machine): the whole path, ROS both ways included.  Beside
 it, the computing alone in this process (``LiveSession.feed`` of that block: detection,
 extraction, prediction), so the difference is what ROS and the node's loop add.
-Goal: p99 under 20 ms on one core.
+Goal: p99 under 20 ms on one core.  Each engine (``--engine`` of ``touchbench ros``: the
+model itself, or its ONNX twin written by ``export-model``) is measured in turn, the
+engines alternating for ``--rounds`` rounds, since this machine's speed drifts.
 
 Not a test: nothing is asserted.
 """
@@ -39,6 +42,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import soundfile
@@ -46,7 +50,8 @@ import soundfile
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from app.schemas.extraction import ExtractRequest
-from app.schemas.models import TrainRequest
+from app.schemas.models import Engine, ExportRequest, TrainRequest
+from app.services.export import export_model
 from app.services.extraction import extract_and_store
 from app.services.live import open_live
 from app.services.models import train
@@ -62,29 +67,13 @@ def percentiles(values: list[float]) -> str:
     return f"p50 {p50:7.2f} ms   p99 {p99:7.2f} ms   max {max(values):7.2f} ms   (n={len(values)})"
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--touches", type=int, default=40, help="Touches of the session.")
-    parser.add_argument("--block", type=int, default=512, help="Samples per message.")
-    parser.add_argument("--core", type=int, default=0, help="The node's core.")
-    args = parser.parse_args()
-    if shutil.which("rosmaster") is None:
-        sys.exit("ROS 1 is not installed: bash scripts/install.sh")
-    load = ", ".join(f"{value:.1f}" for value in os.getloadavg())
-    print(f"Machine load average (1, 5, 15 min): {load} on {os.cpu_count()} cores")
-    with tempfile.TemporaryDirectory() as folder_name:
-        folder = Path(folder_name)
-        url = f"sqlite:///{folder / 'touchbench.db'}"
-        store = Store(url)
-        recordings, labels = write_contact_mic_sessions(folder, trials=3, n_touches=10)
-        extract_and_store(store, ExtractRequest(recordings=recordings, labels=labels, name="t"))
-        model = train(store, TrainRequest(dataset="t", classifier="cc:rf")).name
-        session_path, _ = write_session(folder, "fresh", n_touches=args.touches, seed=1234)
-        samples, rate = soundfile.read(session_path, dtype="float32", always_2d=True)
-        np.save(folder / "audio.npy", samples.T)
-
-        # After which message each touch comes out, and the computing alone.
-        live = open_live(store, model, samplerate=rate, n_channels=samples.shape[1])
+def measure(
+    url: str, model: str, engine: Engine, samples: np.ndarray, rate: float, folder: Path, args: Any
+) -> dict[str, list[float]]:
+    """One round of one engine: the computing alone in this process, then the node."""
+    store = Store(url)
+    try:  # after which message each touch comes out, and the computing alone
+        live = open_live(store, model, samplerate=rate, n_channels=samples.shape[1], engine=engine)
         trigger, computing = [], []
         for index, begin in enumerate(range(0, len(samples), args.block)):
             block = samples[begin : begin + args.block].T.astype(np.float64)
@@ -94,53 +83,98 @@ def main() -> None:
             for _ in touches:
                 trigger.append(index)
                 computing.append(elapsed)
+    finally:
         store.dispose()
 
-        with rosmaster(str(folder / "ros"), patience=PATIENCE) as env:
-            cores = sorted(os.sched_getaffinity(0))
-            others = [c for c in cores if c != args.core] or cores
-            node = subprocess.Popen(
-                [
-                    *("taskset", "-c", str(args.core)),
-                    *(sys.executable, "-m", "app.cli.main", "--db", url, "ros"),
-                    *("--model", model, "--audio-topic", "/mic/audio"),
-                ],
-                env=env,
-                stderr=subprocess.PIPE,
-                text=True,
-            )
-            peer = Peer(
-                {**env, "OMP_NUM_THREADS": "1"},
-                str(folder / "audio.npy"),
-                *("--topic", "/mic/audio", "--info", "/mic/audio_info", "--pace"),
-                *("--chunk", str(args.block)),
-                patience=PATIENCE,
-            )
-            os.sched_setaffinity(peer.process.pid, others)
-            try:
-                peer.until(lambda: bool(peer.sent) and len(peer.touches) >= len(trigger))
-            finally:
-                node.send_signal(signal.SIGINT)
-                node.communicate(timeout=PATIENCE)
-                peer.close()
-        heard = peer.touches[: len(trigger)]
-        ros = [1000 * (t["received"] - peer.sent[i]) for t, i in zip(heard, trigger, strict=True)]
-        reported = [t["touch"]["latency_ms"] for t in heard]
+    with rosmaster(str(folder / f"ros-{engine}"), patience=PATIENCE) as env:
+        cores = sorted(os.sched_getaffinity(0))
+        others = [c for c in cores if c != args.core] or cores
+        node = subprocess.Popen(
+            [
+                *("taskset", "-c", str(args.core)),
+                *(sys.executable, "-m", "app.cli.main", "--db", url, "ros"),
+                *("--model", model, "--audio-topic", "/mic/audio", "--engine", engine),
+            ],
+            env=env,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        peer = Peer(
+            {**env, "OMP_NUM_THREADS": "1"},
+            str(folder / "audio.npy"),
+            *("--topic", "/mic/audio", "--info", "/mic/audio_info", "--pace"),
+            *("--chunk", str(args.block)),
+            patience=PATIENCE,
+        )
+        os.sched_setaffinity(peer.process.pid, others)
+        try:
+            peer.until(lambda: bool(peer.sent) and len(peer.touches) >= len(trigger))
+        finally:
+            node.send_signal(signal.SIGINT)
+            node.communicate(timeout=PATIENCE)
+            peer.close()
+    heard = peer.touches[: len(trigger)]
+    return {
+        "ros": [1000 * (t["received"] - peer.sent[i]) for t, i in zip(heard, trigger, strict=True)],
+        "computing": computing,
+        "reported": [t["touch"]["latency_ms"] for t in heard],
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--touches", type=int, default=40, help="Touches of the session.")
+    parser.add_argument("--block", type=int, default=512, help="Samples per message.")
+    parser.add_argument("--core", type=int, default=0, help="The node's core.")
+    parser.add_argument("--engines", default="native,onnx", help="Engines, comma-separated.")
+    parser.add_argument("--rounds", type=int, default=2, help="Rounds of every engine.")
+    args = parser.parse_args()
+    engines: list[Engine] = args.engines.split(",")
+    if shutil.which("rosmaster") is None:
+        sys.exit("ROS 1 is not installed: bash scripts/install.sh")
+    load = ", ".join(f"{value:.1f}" for value in os.getloadavg())
+    print(f"Machine load average (1, 5, 15 min): {load} on {os.cpu_count()} cores")
+    figures: dict[str, dict[str, list[float]]] = {
+        engine: {"ros": [], "computing": [], "reported": []} for engine in engines
+    }
+    with tempfile.TemporaryDirectory() as folder_name:
+        folder = Path(folder_name)
+        url = f"sqlite:///{folder / 'touchbench.db'}"
+        store = Store(url)
+        try:
+            recordings, labels = write_contact_mic_sessions(folder, trials=3, n_touches=10)
+            extract_and_store(store, ExtractRequest(recordings=recordings, labels=labels, name="t"))
+            model = train(store, TrainRequest(dataset="t", classifier="cc:rf")).name
+            if "onnx" in engines:
+                export_model(store, ExportRequest(model=model))
+        finally:
+            store.dispose()
+        session_path, _ = write_session(folder, "fresh", n_touches=args.touches, seed=1234)
+        samples, rate = soundfile.read(session_path, dtype="float32", always_2d=True)
+        np.save(folder / "audio.npy", samples.T)
+        for _ in range(args.rounds):
+            for engine in engines:
+                for key, values in measure(url, model, engine, samples, rate, folder, args).items():
+                    figures[engine][key] += values
     load = ", ".join(f"{value:.1f}" for value in os.getloadavg())
     print(f"Machine load average at the end: {load}")
     print(
-        f"touchbench ros, cc:rf on uc3m-audio, {len(trigger)} touches, messages of "
-        f"{args.block} samples ({1000 * args.block / rate:.1f} ms), node on core {args.core}"
+        f"touchbench ros, cc:rf on uc3m-audio, {args.touches} touches a round, {args.rounds} "
+        f"round(s), messages of {args.block} samples ({1000 * args.block / rate:.1f} ms), "
+        f"node on core {args.core}"
     )
-    rows = (
-        ("end of the touch's message -> prediction heard (ROS both ways)", ros),
-        ("computing alone (LiveSession.feed of that block, in-process)", computing),
-        ("latency_ms the node reports (from the event's last sample)", reported),
-    )
-    for title, values in rows:
-        print(f"  {title:64s} {percentiles(values)}")
-    overhead = np.percentile(ros, 50) - np.percentile(computing, 50)
-    print(f"  what ROS and the node's loop add at p50: {overhead:.2f} ms")
+    for engine in engines:
+        measured = figures[engine]
+        print(f"engine {engine}:")
+        rows = (
+            ("end of the touch's message -> prediction heard (ROS both ways)", "ros"),
+            ("computing alone (LiveSession.feed of that block, in-process)", "computing"),
+            ("latency_ms the node reports (from the event's last sample)", "reported"),
+        )
+        for title, key in rows:
+            print(f"  {title:64s} {percentiles(measured[key])}")
+        overhead = np.percentile(measured["ros"], 50) - np.percentile(measured["computing"], 50)
+        print(f"  what ROS and the node's loop add at p50: {overhead:.2f} ms")
 
 
 if __name__ == "__main__":

@@ -93,7 +93,7 @@ def printable(text: str, limit: int = MAX_CELL) -> str:
     return text if len(text) <= limit else text[: limit - 1] + "…"
 
 
-#: ``--engine``: what runs a model's predictions (``predict``, ``live``).
+#: ``--engine``: what runs a model's predictions (``predict``, ``live``, ``ros``).
 EngineOption = Annotated[
     str | None,
     typer.Option(

@@ -6,7 +6,7 @@ from typing import Annotated
 
 import typer
 
-from app.cli.output import info
+from app.cli.output import EngineOption, info
 from app.cli.requests import build_request
 from app.cli.signals import deferred_interrupts
 from app.cli.state import get_state
@@ -66,6 +66,7 @@ def ros_command(
         float | None,
         typer.Option("--info-wait", metavar="S", help="Seconds to wait for AudioInfo (5)."),
     ] = None,
+    engine: EngineOption = None,
     as_json: Annotated[
         bool, typer.Option("--json", help="Also print each touch as JSON lines on stdout.")
     ] = False,
@@ -97,6 +98,7 @@ def ros_command(
         channels=channels,
         sample_format=fmt,
         info_timeout=info_timeout,
+        engine=engine,
     )
     store = get_state(ctx).store
     transport = Ros1Transport("touchbench")

@@ -96,7 +96,7 @@ Engine = Literal["auto", "onnx", "native"]
 
 
 class EngineChoice(Request):
-    """The engine of a command that predicts (``predict``, ``live``)."""
+    """The engine of a command that predicts (``predict``, ``live``, ``ros``)."""
 
     engine: Engine = Field(
         default="auto",

@@ -7,13 +7,13 @@ from typing import Literal
 from pydantic import Field, model_validator
 
 from app.errors import FieldError
-from app.schemas.base import Request
+from app.schemas.models import EngineChoice
 
 #: How the bytes of an audio topic are coded when no ``AudioInfo`` says it.
 SampleFormat = Literal["S16LE", "S32LE", "F32LE", "MP3"]
 
 
-class RosNodeRequest(Request):
+class RosNodeRequest(EngineChoice):
     """A node that predicts every touch of an audio or taxel topic with a stored model and
     publishes each as a ``std_msgs/String`` JSON message."""
 

@@ -44,7 +44,7 @@ def run_ros_node(
     int
         Touches published.
     """
-    info, model = load_live_model(store, request.model)
+    info, model = load_live_model(store, request.model, request.engine)
     recipe = info.extraction or {}
     samplerate = request.samplerate or recipe.get("samplerate")
     channels = request.channels or recipe.get("n_channels")

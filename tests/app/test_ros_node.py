@@ -1,7 +1,7 @@
 """``touchbench ros`` on a real ROS 1 graph: a rosmaster of the test's own on a free port,
 a peer node publishing a simulated contact-mic session as audio_common AudioData, and the
 node under test as a subprocess; the touches it publishes are those ``live --replay``
-prints for the same audio."""
+prints for the same audio, with the model itself or with its ONNX twin."""
 
 from __future__ import annotations
 
@@ -18,7 +18,8 @@ import pytest
 import soundfile
 
 from app.schemas.extraction import ExtractRequest
-from app.schemas.models import TrainRequest
+from app.schemas.models import ExportRequest, TrainRequest
+from app.services.export import export_model
 from app.services.extraction import extract_and_store
 from app.services.live import open_live
 from app.services.models import train
@@ -49,7 +50,8 @@ def ros_env(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, str]
 
 @pytest.fixture(scope="module")
 def trained(tmp_path_factory: pytest.TempPathFactory) -> tuple[str, str, Path]:
-    """A store URL, a model trained on simulated sessions, and a session it never saw."""
+    """A store URL, a model trained on simulated sessions (with its ONNX twin), and a
+    session it never saw."""
     folder = tmp_path_factory.mktemp("sessions")
     url = f"sqlite:///{folder / 'touchbench.db'}"
     store = Store(url)
@@ -57,6 +59,7 @@ def trained(tmp_path_factory: pytest.TempPathFactory) -> tuple[str, str, Path]:
         recordings, labels = write_contact_mic_sessions(folder, trials=2, n_touches=8)
         extract_and_store(store, ExtractRequest(recordings=recordings, labels=labels, name="touch"))
         model = train(store, TrainRequest(dataset="touch", classifier="cc:rf"))
+        export_model(store, ExportRequest(model=model.name))
     finally:
         store.dispose()
     unseen, _ = write_session(folder, "unseen", n_touches=5, seed=99)
@@ -79,9 +82,10 @@ def stop(process: subprocess.Popen[str]) -> tuple[int, str, str]:
     return process.returncode, out, err
 
 
-@pytest.mark.parametrize("kind", ["audio", "taxels"])
+@pytest.mark.parametrize(("kind", "engine"), [("audio", "native"), ("taxels", "onnx")])
 def test_the_node_publishes_the_touches_live_replay_prints(
     kind: str,
+    engine: str,
     ros_env: dict[str, str],
     trained: tuple[str, str, Path],
     tmp_path: Path,
@@ -89,20 +93,24 @@ def test_the_node_publishes_the_touches_live_replay_prints(
 ) -> None:
     """The session cut short in the middle of its last touch, so that touch is still open
     when the stream stops: ``live`` prints it at the end of the file, the node when
-    interrupted.  As taxels, the same samples as Float32MultiArray blocks."""
+    interrupted.  As taxels, the same samples as Float32MultiArray blocks, predicted by the
+    model's ONNX twin: its labels are the model's, its probabilities within 1e-5."""
     url, model, unseen = trained
     samples, rate = soundfile.read(unseen, dtype="float32", always_2d=True)
-    whole = run_cli(capsys, url, "live", "--model", model, "--replay", str(unseen), "--json")
+    native = ("--engine", "native")
+    whole = run_cli(
+        capsys, url, "live", "--model", model, "--replay", str(unseen), "--json", *native
+    )
     assert whole.code == 0, whole.err
     last = json.loads(whole.out.splitlines()[-1])
     samples = samples[: int((last["start"] + last["end"]) / 2 * rate)]
     cut = tmp_path / "cut.wav"
     soundfile.write(cut, samples, int(rate), subtype="FLOAT")
-    replay = run_cli(capsys, url, "live", "--model", model, "--replay", str(cut), "--json")
+    replay = run_cli(capsys, url, "live", "--model", model, "--replay", str(cut), "--json", *native)
     expected = [json.loads(line) for line in replay.out.splitlines()]
     store = Store(url)
     try:  # the touches that come out while the stream flows: all but the last
-        session = open_live(store, model, samplerate=rate, n_channels=3)
+        session = open_live(store, model, samplerate=rate, n_channels=3, engine="native")
         blocks = [samples[i : i + 512].T.astype(np.float64) for i in range(0, len(samples), 512)]
         while_streaming = sum(len(session.feed(block)) for block in blocks)
     finally:
@@ -111,7 +119,7 @@ def test_the_node_publishes_the_touches_live_replay_prints(
     np.save(tmp_path / "audio.npy", samples.T)
 
     topic = ("--audio-topic" if kind == "audio" else "--taxel-topic", "/mic/signal")
-    node = start_node(ros_env, url, "--model", model, *topic)
+    node = start_node(ros_env, url, "--model", model, *topic, "--engine", engine)
     peer_options = ("--info", "/mic/audio_info") if kind == "audio" else ("--taxels",)
     peer = Peer(
         ros_env,
@@ -131,6 +139,11 @@ def test_the_node_publishes_the_touches_live_replay_prints(
     assert err.strip().splitlines()[-1] == "touchbench: interrupted"
     assert "Traceback" not in err
     got = [line["touch"] for line in peer.touches]
-    assert [t["predictions"] for t in got] == [t["predictions"] for t in expected]
+    for touch, wanted in zip(got, expected, strict=True):
+        assert touch["predictions"].keys() == wanted["predictions"].keys()
+        for target, answer in touch["predictions"].items():
+            assert answer["value"] == wanted["predictions"][target]["value"]
+            probability = wanted["predictions"][target]["probability"]
+            assert answer["probability"] == pytest.approx(probability, abs=1e-5)
     assert [(t["start"], t["end"]) for t in got] == [(t["start"], t["end"]) for t in expected]
     assert all(t["latency_ms"] >= 0 for t in got)
