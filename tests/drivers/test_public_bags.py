@@ -4,7 +4,7 @@
 The bags are not in this repository (third-party data): put them in
 ``../shared/datasets/ros-bags/`` beside the repository, or in the folder named by
 ``TOUCHBENCH_PUBLIC_BAGS``; the tests skip where they are absent.  Where they come from
-is in the README (section "ROS bags").
+is in docs/bags.md.
 """
 
 from __future__ import annotations
@@ -28,8 +28,8 @@ def public_bag(name: str) -> Path:
     path = FOLDER / name
     if not path.is_file():
         pytest.skip(
-            f"the public bag {name} is not in {FOLDER} (see the README's 'ROS bags' section "
-            "for where to get it, or set TOUCHBENCH_PUBLIC_BAGS)"
+            f"the public bag {name} is not in {FOLDER} (see docs/bags.md for where "
+            "to get it, or set TOUCHBENCH_PUBLIC_BAGS)"
         )
     return path
 
