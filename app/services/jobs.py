@@ -129,7 +129,10 @@ def carry_out_here(
         on_progress(partial)
 
     try:
-        result = _carry_out(store, request, jobs=jobs, on_progress=progress)
+        try:
+            result = _carry_out(store, request, jobs=jobs, on_progress=progress)
+        finally:  # before the end is recorded, which the heartbeat would take for a cancel
+            beat.stop()
     except KeyboardInterrupt:
         stopper.finish("cancelled" if stopper.asked else "interrupted", error="interrupted")
         raise
@@ -141,8 +144,6 @@ def carry_out_here(
         raise
     else:
         stopper.finish("done", result=result)
-    finally:
-        beat.stop()
     return job.id, result
 
 
@@ -213,7 +214,10 @@ def execute_job(store: Store, job_id: int) -> JobSchema | None:
                 job_request(job),
                 on_progress=lambda partial: record_job_progress(store, job.id, partial.to_json()),
             )
-        finally:  # before the job ends, so that whoever sees it ended finds no upload left
+        finally:
+            # before the end is recorded, which the heartbeat would take for a cancel
+            beat.stop()
+            # before the job ends, so that whoever sees it ended finds no upload left
             if folder:
                 shutil.rmtree(folder, ignore_errors=True)
     except KeyboardInterrupt:
@@ -228,8 +232,6 @@ def execute_job(store: Store, job_id: int) -> JobSchema | None:
         stopper.finish("failed", error=client_words(message, folder))
     else:
         stopper.finish("done", result=result)
-    finally:
-        beat.stop()
     return get_job(store, job.id)
 
 
@@ -252,7 +254,10 @@ class _Stopper:
 
     def stop(self) -> None:
         """The heartbeat heard a cancel (called in its thread)."""
-        self.asked = True
+        with self._lock:
+            if self._finished:  # the job's own end, seen by a heartbeat still running
+                return
+            self.asked = True
         _thread.interrupt_main()
         timer = threading.Timer(STOP_GRACE, self._end_process)
         timer.daemon = True
