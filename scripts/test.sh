@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Sets touchbench up (scripts/install.sh), starts PostgreSQL for the store tests, then runs
 # every check: ruff (lint and format), mypy, the import-linter layering contract, and pytest
-# (every store test on both SQLite and PostgreSQL) in two worker processes (pytest-xdist;
+# (every store test on both SQLite and PostgreSQL) in three worker processes (pytest-xdist;
 # each has its own PostgreSQL database and temporary folders). Extra arguments go to pytest.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -17,4 +17,4 @@ fi
 echo "== ruff" && .venv/bin/ruff check . && .venv/bin/ruff format --check .
 echo "== mypy" && .venv/bin/mypy
 echo "== import-linter" && .venv/bin/lint-imports
-echo "== pytest" && .venv/bin/pytest -n "${TOUCHBENCH_TEST_WORKERS:-2}" "$@"
+echo "== pytest" && .venv/bin/pytest -n "${TOUCHBENCH_TEST_WORKERS:-3}" "$@"
