@@ -138,8 +138,10 @@ def wrk(
     process still imports its libraries, some for longer than wrk's 2 s timeout; that is
     not counted against the measure.
     """
+    # wrk takes whole seconds only (a fraction is a usage error)
+    duration = f"-d{max(1, round(seconds))}s"
     done = subprocess.run(
-        ["wrk", "-t1", f"-c{clients}", f"-d{seconds:g}s", "--latency", "-s", str(script), url],
+        ["wrk", "-t1", f"-c{clients}", duration, "--latency", "-s", str(script), url],
         capture_output=True,
         text=True,
         check=True,
