@@ -28,6 +28,7 @@ from __future__ import annotations
 import contextlib
 import copy
 import json
+import warnings
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any, NoReturn
@@ -324,7 +325,10 @@ def _convert_pipeline(
         if type(estimator).__name__ in ("SVC", "NuSVC"):
             options[id(estimator)]["raw_scores"] = False
     try:
-        with _plain_missing_flags():
+        with _plain_missing_flags(), warnings.catch_warnings():
+            # skl2onnx reads SVC's Platt attributes, which scikit-learn 1.9 deprecates:
+            # the user exporting a model can do nothing about it
+            warnings.filterwarnings("ignore", r"Attribute `prob[AB]_`", FutureWarning)
             return convert_sklearn(
                 pipeline,
                 initial_types=[(INPUT, FloatTensorType([None, n_inputs]))],

@@ -3,6 +3,8 @@ model does; every other entry is refused in one line naming what exports."""
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 from sklearn.pipeline import Pipeline
@@ -148,3 +150,14 @@ def test_a_regressor_exports_its_values(regressor: str) -> None:
     np.testing.assert_allclose(
         twin.predict_values(data.X), model.predict_values(data.X), rtol=1e-5, atol=1e-5
     )
+
+
+def test_exporting_an_svm_with_probabilities_warns_of_nothing() -> None:
+    """skl2onnx reads SVC's Platt attributes, which scikit-learn deprecates: the user
+    exporting a model could do nothing about that warning."""
+    data = numeric_dataset()
+    model = small_model("svm-rbf", data)
+    with warnings.catch_warnings(record=True) as heard:
+        warnings.simplefilter("always")
+        export_onnx(model, data.X)
+    assert [str(warning.message) for warning in heard] == []
