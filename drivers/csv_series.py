@@ -126,18 +126,18 @@ def read_csv_series(
     if time is None:
         return CsvSeries(np.ascontiguousarray(samples.T), samplerate, kept_names, ())
     repeats = _repeated_rows(values)
+    repeated = None
     if repeats.any():
-        values, samples, first = values[~repeats], samples[~repeats], int(lines[repeats][0])
-        lines = lines[~repeats]
+        repeated = (
+            f"{int(repeats.sum())} row(s) repeat the row before, stamp and values (from line "
+            f"{int(lines[repeats][0])}): left out as logged twice"
+        )
+        values, samples, lines = values[~repeats], samples[~repeats], lines[~repeats]
     times, unit = stamps_in_seconds(values[:, time], time_unit)
     rate, samples, notes = _on_even_grid(path, names[time], times, lines, samples, samplerate)
-    if repeats.any():
-        notes.insert(
-            0,
-            f"{int(repeats.sum())} row(s) repeat the row before, stamp and values (from line "
-            f"{first}): left out as logged twice",
-        )
-    resampled = samplerate is None and bool(notes)
+    resampled = samplerate is None and bool(notes)  # the grid's notes only
+    if repeated is not None:
+        notes.insert(0, repeated)
     if time_unit == "auto" and unit != "s":
         notes.insert(0, f"column '{names[time]}' holds nanoseconds")
     step = float(np.median(np.diff(times))) if times.size > 1 else 0.0

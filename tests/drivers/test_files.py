@@ -75,6 +75,7 @@ def test_csv_rows_logged_twice_are_left_out_with_a_note(tmp_path: Path) -> None:
     assert any(
         "1 row(s) repeat the row before" in note and "line 8" in note for note in recording.notes
     )
+    assert not recording.resampled  # even stamps: nothing was put on a new grid
     path.write_text("\n".join([*rows, rows[-1].replace(",5", ",6"), ""]))
     with pytest.raises(DriverError, match=r"twice.csv:8: column 'timestamp': the time does not"):
         read_recording(path, time_unit="ms")
