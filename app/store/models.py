@@ -406,9 +406,12 @@ def rollback_alias(store: Store, ref: str | int, alias: str = CHAMPION) -> Alias
                 f"`promote` or `alias` first)"
             )
         for step in _alias_steps(session, name, alias):
-            if step.version != current.version and _version_row(session, name, step.version):
-                target = _version_row(session, name, step.version)
-                assert target is not None
+            target = (
+                _version_row(session, name, step.version)
+                if step.version != current.version
+                else None
+            )
+            if target is not None:
                 previous, current.version, current.set_at = current.version, step.version, utcnow()
                 return AliasMove(alias, _info(session, target), previous)
             step.undone = True  # the move being undone, or a version deleted since

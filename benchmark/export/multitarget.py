@@ -31,10 +31,10 @@ from benchmark.export.onnx import (
     INPUT,
     LABEL,
     PROBABILITIES,
-    SUPPORTED,
     add_metadata,
     convert_pipeline,
     output_names,
+    refuse,
 )
 from benchmark.model import TrainedModel
 from benchmark.multitarget._target_classifier import TargetClassifier
@@ -114,10 +114,7 @@ def convert_multitarget(model: TrainedModel) -> Any:
     elif kind in COMBINATIONS.values():
         answers = _combination(model, graph, n_inputs)
     else:
-        raise ConfigurationError(
-            f"classifier '{model.classifier}' ({kind.__name__}) has no ONNX converter; "
-            f"exportable: {SUPPORTED}"
-        )
+        refuse(model.classifier, kind.__name__)
     outputs = []
     for target, (label, probabilities) in zip(model.schema.targets, answers, strict=True):
         label_name, probabilities_name = output_names(target.name, several=True)

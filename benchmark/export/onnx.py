@@ -243,18 +243,18 @@ def convert_pipeline(
         No converter for the estimator.
     """
     if not hasattr(estimator, "steps") or len(estimator.steps) != 2:
-        _refuse(classifier, type(estimator).__name__)
+        refuse(classifier, type(estimator).__name__)
     preprocess, final = estimator.steps[0][1], estimator.steps[1][1]
     reason = _unsupported(final)
     if reason is not None or isinstance(preprocess, str):
-        _refuse(classifier, reason or type(final).__name__)
+        refuse(classifier, reason or type(final).__name__)
     unwrapped = _unwrap(classifier, final, regression=n_labels == 0)
     if codes is not None and unwrapped.classes is not None:
         # a link trained on classes re-coded 0 .. m - 1: what it predicts is a position
         # in ``codes`` (its own classes are those positions, all present)
         own = unwrapped.classes.astype(np.int64)
         if not np.array_equal(own, np.arange(own.size)) and not unwrapped.encoded:
-            _refuse(classifier, "classes other than the positions of its codes")
+            refuse(classifier, "classes other than the positions of its codes")
         unwrapped = Unwrapped(unwrapped.estimator, np.asarray(codes)[own], encoded=True)
     onnx_model = _convert_pipeline(classifier, preprocess, unwrapped, n_inputs, n_labels == 0)
     _route_missing_values(onnx_model, unwrapped.estimator)
@@ -264,7 +264,8 @@ def convert_pipeline(
     return onnx_model
 
 
-def _refuse(classifier: str, what: str) -> NoReturn:
+def refuse(classifier: str, what: str) -> NoReturn:
+    """Refuse ``classifier`` (``what`` of it has no converter), naming what exports."""
     raise ConfigurationError(
         f"classifier '{classifier}' ({what}) has no ONNX converter; exportable: {SUPPORTED}"
     )
@@ -276,7 +277,7 @@ def _unwrap(classifier: str, final: BaseEstimator, *, regression: bool) -> Unwra
     if name == "LabelEncodedClassifier" or name in _WRAPPED_BOOSTERS:
         inner = final.estimator_ if name == "LabelEncodedClassifier" else final.model_
         if inner is None:
-            _refuse(classifier, "a single class in training: nothing to convert")
+            refuse(classifier, "a single class in training: nothing to convert")
         return Unwrapped(inner, classes, encoded=True)
     return Unwrapped(final, classes, encoded=False)
 
