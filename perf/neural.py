@@ -8,9 +8,16 @@ per second of a trial), contact points p1 to p5 only (the trials without contact
 left out), folds grouped by trial and stratified as ``touchbench bench`` makes them:
 
 * ``bilstm`` and ``minirocket`` (and ``cnn1d``, ``resnet1d``, ``inception-time`` with
-  ``--all``) on MFCC frames (``mfcc`` with ``frames=N``: 14 coefficients x N frames a
-  channel);
-* ``rf`` and ``mlp`` on FFT band peaks (``band-peaks``).
+  ``--all``) on MFCC frames (``mfcc`` with ``frames=N``: ``--n-mfcc`` coefficients x N
+  frames a channel);
+* ``rf`` and ``mlp`` on FFT band peaks (``band-peaks``), the paper's comparison;
+* ``logistic`` and ``svm-rbf`` on the MFCCs' means over the window (``frames=1``).
+
+The windows' count is the issue's "a few thousand" (1200 trials: 3,000 windows).  The
+MFCC recipe (8 frames, 30 coefficients) was chosen on development data, trials of
+another simulator seed (2; this script's are seed 1): 8 frames against 4, 16 and 32, and
+30 coefficients against 14 (the extractor's default), 20 and 40 (figures in
+docs/neural.md).
 
 ``--contact-mic`` measures instead the issue's second comparison: simulated
 contact-microphone sessions (``touchbench simulate contact-mic``, 16 touches a session,
@@ -25,10 +32,10 @@ per epoch and peak resident memory.  An entry that refuses the windows (``miniro
 needs 9 steps, ``--frames 8`` has 8) is named and left out.  ``--install`` also
 installs PyTorch (the CPU wheel, ``torch==2.13.0``) and safetensors into a throwaway
 virtual environment and prints the time and the size added; without it the size of the
-installed distributions is printed.  Goal: ``bilstm`` >= 0.95.
+installed distributions is printed.  Goals: ``bilstm`` >= 0.95, the best entry >= 0.97.
 
-    .venv/bin/python perf/neural.py [--trials 60] [--folds 5] [--jobs 2] [--frames 32]
-                                    [--all] [--install]
+    .venv/bin/python perf/neural.py [--trials 1200] [--folds 5] [--jobs 2] [--frames 8]
+                                    [--n-mfcc 30] [--all] [--install]
     .venv/bin/python perf/neural.py --contact-mic [--sessions 8] [--folds 5] [--jobs 2]
 """
 
@@ -86,7 +93,7 @@ model = build_estimator(sys.argv[2], problem, random_state=0)
 began = time.perf_counter()
 model.fit(problem.X, problem.Y[:, 0])
 seconds = time.perf_counter() - began
-epochs = getattr(model[-1], "n_epochs_", 0) + getattr(model[-1], "n_refit_epochs_", 0)
+epochs = sum(getattr(model[-1], "n_epochs_", [])) + sum(getattr(model[-1], "n_refit_epochs_", []))
 peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 print(seconds, epochs, peak)
 """
@@ -178,10 +185,11 @@ def install(folder: Path) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--trials", type=int, default=60, help="link trials of 3 s")
+    parser.add_argument("--trials", type=int, default=1200, help="link trials of 3 s")
     parser.add_argument("--folds", type=int, default=5)
     parser.add_argument("--jobs", type=int, default=2)
-    parser.add_argument("--frames", type=int, default=32, help="MFCC frames per 1-s window")
+    parser.add_argument("--frames", type=int, default=8, help="MFCC frames per 1-s window")
+    parser.add_argument("--n-mfcc", type=int, default=30, help="MFCCs per frame")
     parser.add_argument(
         "--all", action="store_true", help="also cnn1d, resnet1d and inception-time"
     )
@@ -204,17 +212,25 @@ def main() -> None:
             f"Oscillating link: {arguments.trials} trials of 3 s, 5 contact points, "
             f"{arguments.folds}-fold by trial"
         )
-        frames = link_data(folder, arguments.trials, "mfcc", {"frames": str(arguments.frames)})
+        mfcc = {"n_mfcc": str(arguments.n_mfcc)}
+        frames = link_data(
+            folder, arguments.trials, "mfcc", {**mfcc, "frames": str(arguments.frames)}
+        )
         peaks = link_data(folder, arguments.trials, "band-peaks", {})
-        print(f"  MFCC frames ({arguments.frames} a window)")
+        means = link_data(folder, arguments.trials, "mfcc", {**mfcc, "frames": "1"})
+        print(
+            f"  MFCC frames ({arguments.n_mfcc} coefficients, {arguments.frames} frames a window)"
+        )
         common = {"folds": arguments.folds, "jobs": arguments.jobs}
         on_frames = accepted(frames, (*networks, "minirocket"))
         sequence = cross_validate_data(frames, on_frames, **common)
         print("  FFT band peaks")
         flat = cross_validate_data(peaks, ("rf", "mlp"), **common)
+        print("  MFCC means over the window")
+        flat |= cross_validate_data(means, ("logistic", "svm-rbf"), **common)
         best = max({**sequence, **flat}.items(), key=lambda item: item[1][0])
         bilstm = sequence.get("bilstm", (float("nan"),))[0]
-        print(f"  => bilstm {bilstm:.3f} (goal 0.95); best {best[0]} {best[1][0]:.3f}")
+        print(f"  => bilstm {bilstm:.3f} (goal 0.95); best {best[0]} {best[1][0]:.3f} (goal 0.97)")
         print("  One fit on every window, one thread, fresh process")
         fit_costs(frames, on_frames, folder)
         fit_costs(peaks, ("rf", "mlp"), folder)

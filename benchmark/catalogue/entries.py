@@ -252,8 +252,8 @@ def _weka(
 NEURAL_ENTRIES: tuple[tuple[str, dict[str, Any], str, int], ...] = (
     (
         "bilstm",
-        {"network": "bilstm", "hidden": 64, "layers": 1},
-        "Bidirectional LSTM (64 units a direction) over the time steps (PyTorch)",
+        {"network": "bilstm", "hidden": 64, "layers": 1, "n_networks": 3},
+        "Bidirectional LSTM (64 units a direction) over the time steps, 3 seeds (PyTorch)",
         2,
     ),
     (

@@ -17,7 +17,7 @@ layer; it returns (n, n_outputs): class scores (logits) or standardised target v
 from __future__ import annotations
 
 import itertools
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import torch
@@ -195,14 +195,21 @@ def build_network(architecture: Mapping[str, Any]) -> nn.Module:
     return NETWORKS[architecture["kind"]](architecture)
 
 
-def network_bytes(network: nn.Module) -> bytes:
-    """The network's weights and buffers in the safetensors format."""
-    state = {name: tensor.detach().contiguous() for name, tensor in network.state_dict().items()}
-    return bytes(save_tensors(state))
+def _holder(networks: Sequence[nn.Module]) -> nn.Module:
+    """What names the weights: one network itself (its weights keep the names they had
+    before ensembles), several a list (network ``i``'s names begin ``i.``)."""
+    return networks[0] if len(networks) == 1 else nn.ModuleList(networks)
 
 
-def load_network(architecture: Mapping[str, Any], weights: bytes) -> nn.Module:
-    """The network of ``architecture`` with ``weights`` (safetensors bytes), in eval mode.
+def network_bytes(networks: Sequence[nn.Module]) -> bytes:
+    """The networks' weights and buffers in the safetensors format."""
+    state = _holder(networks).state_dict()
+    return bytes(save_tensors({name: value.detach().contiguous() for name, value in state.items()}))
+
+
+def load_networks(architecture: Mapping[str, Any], weights: bytes) -> list[nn.Module]:
+    """The ``architecture["n_networks"]`` networks of ``architecture`` with ``weights``
+    (safetensors bytes), in eval mode.
 
     Raises
     ------
@@ -210,10 +217,10 @@ def load_network(architecture: Mapping[str, Any], weights: bytes) -> nn.Module:
         The weights are not safetensors, or their names or shapes differ from what the
         architecture builds.
     """
-    network = build_network(architecture)
+    networks = [build_network(architecture) for _ in range(architecture["n_networks"])]
     try:
         state = load_tensors(weights)
-        network.load_state_dict(state, strict=True)
+        _holder(networks).load_state_dict(state, strict=True)
     except Exception as exc:  # safetensors' own error types, torch's RuntimeError
         raise ValueError(f"the network's weights do not fit its architecture: {exc}") from None
-    return network.eval()
+    return [network.eval() for network in networks]

@@ -81,21 +81,22 @@ def test_two_fits_with_one_seed_give_equal_predictions(
 def test_early_stopping_keeps_the_best_epoch_of_the_inner_validation_split() -> None:
     X, y, layout = windows()
     model = quick("cnn1d", layout, max_epochs=40, patience=2).fit(X, y)[-1]
-    assert model.best_epoch_ <= model.n_epochs_ <= model.best_epoch_ + 2
-    assert model.n_epochs_ < 40
+    (best,), (run,) = model.best_epoch_, model.n_epochs_
+    assert best <= run <= best + 2
+    assert run < 40
 
 
 def test_refit_trains_a_new_network_on_the_whole_fold_for_the_best_epoch_count() -> None:
     X, y, layout = windows()
     refitted = quick("cnn1d", layout, max_epochs=12, patience=3).fit(X, y)[-1]
     kept = quick("cnn1d", layout, max_epochs=12, patience=3, refit=False).fit(X, y)[-1]
-    assert (refitted.n_epochs_, refitted.best_epoch_) == (kept.n_epochs_, kept.best_epoch_)
+    assert refitted.n_epochs_ == kept.n_epochs_ and refitted.best_epoch_ == kept.best_epoch_
+    assert refitted.n_refit_epochs_ == kept.best_epoch_ and kept.n_refit_epochs_ == 0
     assert refitted.weights_ != kept.weights_  # not the best epoch's weights of the search
     # The same seed, every instance, the best epoch count and no validation split.
-    whole = quick(
-        "cnn1d", layout, max_epochs=kept.best_epoch_, refit=False, validation_fraction=0.0
-    ).fit(X, y)[-1]
-    assert whole.weights_ == refitted.weights_
+    (best,) = kept.best_epoch_
+    whole = quick("cnn1d", layout, max_epochs=best, refit=False, validation_fraction=0.0)
+    assert whole.fit(X, y)[-1].weights_ == refitted.weights_
 
 
 def test_a_network_stored_before_refit_existed_loads_as_it_was_trained() -> None:
@@ -107,6 +108,25 @@ def test_a_network_stored_before_refit_existed_loads_as_it_was_trained() -> None
     old.__setstate__(state)
     assert old.get_params()["refit"] is False  # it kept the best epoch's weights
     np.testing.assert_array_equal(old.predict_proba(X), model.predict_proba(X))
+
+
+def test_several_networks_average_the_probabilities_of_their_seeds() -> None:
+    X, y, layout = windows()
+    ensemble = quick("cnn1d", layout, n_networks=2, random_state=3).fit(X[::2], y[::2])
+    alone = [quick("cnn1d", layout, random_state=s).fit(X[::2], y[::2]) for s in (3, 4)]
+    mean = np.mean([model.predict_proba(X[1::2]) for model in alone], axis=0)
+    np.testing.assert_allclose(ensemble.predict_proba(X[1::2]), mean, rtol=1e-6)
+    np.testing.assert_array_equal(ensemble.predict(X[1::2]), ensemble.classes_[mean.argmax(1)])
+    assert ensemble[-1].n_epochs_.tolist() == [m[-1].n_epochs_[0] for m in alone]
+    assert ensemble[-1].architecture_["n_networks"] == 2
+    # A network stored before ensembles existed: one network, its weights' own names.
+    state = alone[0][-1].__getstate__()
+    del state["n_networks"]
+    state["architecture_"] = {k: v for k, v in state["architecture_"].items() if k != "n_networks"}
+    old = NeuralSequenceClassifier.__new__(NeuralSequenceClassifier)
+    old.__setstate__(state)
+    assert old.n_networks == 1 and old.architecture_["n_networks"] == 1
+    np.testing.assert_array_equal(old.predict_proba(X), alone[0].predict_proba(X))
 
 
 def test_early_stopping_holds_out_whole_groups_when_given_them() -> None:
@@ -223,7 +243,7 @@ def test_weights_that_do_not_fit_the_architecture_are_refused_on_prediction() ->
     X, y, layout = windows()
     cnn = quick("cnn1d", layout, max_epochs=1).fit(X, y)
     lstm = quick("bilstm", layout, max_epochs=1).fit(X, y)
-    lstm[-1].__dict__.update(weights_=cnn[-1].weights_, _network=None)
+    lstm[-1].__dict__.update(weights_=cnn[-1].weights_, _networks=None)
     with pytest.raises(ValueError, match="weights do not fit its architecture"):
         lstm.predict(X)
 
