@@ -165,22 +165,31 @@ def installed_size() -> None:
     print(f"  installed size of {', '.join(ADDED)}: {total:.0f} MB")
 
 
-def install(folder: Path) -> None:
-    """Time and size of installing the CPU wheel into a fresh virtual environment."""
-    venv = folder / "venv"
+def install(
+    folder: Path,
+    packages: Sequence[str] = ("torch==2.13.0", "safetensors"),
+    base: Sequence[str] = (),
+) -> Path:
+    """Install ``packages`` into a fresh virtual environment under ``folder`` that holds
+    ``base`` already (pip's cache left out, as on a fresh machine); print the time and the
+    size added; the venv."""
+    venv = folder / f"venv-{len(list(folder.glob('venv-*')))}"
     subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
+    if base:
+        subprocess.run([str(venv / "bin/pip"), "install", "-q", *base], check=True)
     site = next((venv / "lib").glob("python*/site-packages"))
     before = sum(f.stat().st_size for f in site.rglob("*") if f.is_file())
     began = time.perf_counter()
     subprocess.run(
-        [str(venv / "bin/pip"), "install", "-q", "torch==2.13.0", "safetensors"], check=True
+        [str(venv / "bin/pip"), "install", "-q", "--no-cache-dir", *packages], check=True
     )
     seconds = time.perf_counter() - began
     after = sum(f.stat().st_size for f in site.rglob("*") if f.is_file())
     print(
-        f"  pip install torch==2.13.0 safetensors in a fresh venv: {seconds:.0f} s, "
+        f"  pip install {' '.join(packages)} in a fresh venv: {seconds:.0f} s, "
         f"{(after - before) / 2**20:.0f} MB added"
     )
+    return venv
 
 
 def main() -> None:
