@@ -11,9 +11,10 @@ candidates on the same windows, side by side in one run:
 2. Training.  The same BiLSTM (64 units a direction, dropout 0.2, one dense output;
    Adam at 1e-3, batches of 32, cross-entropy; channels standardised on the training
    part) on the same windows: the oscillating link's MFCC frames as ``perf/neural.py``
-   makes them, four fifths of the trials to train, one fifth to test.  PyTorch is our
-   own estimator (:class:`benchmark.catalogue.neural.NeuralSequenceClassifier`, one
-   network, no early stopping); Keras runs in the venv of step 1 with
+   makes them, and the first of its 5 folds (by trial, stratified) to train and test.
+   PyTorch is our own estimator
+   (:class:`benchmark.catalogue.neural.NeuralSequenceClassifier`, one network, no early
+   stopping); Keras runs in the venv of step 1 with
    ``KERAS_BACKEND=jax``.  Each in a fresh process pinned to one core with one thread
    (``OMP_NUM_THREADS``, XLA's flags), the two alternating for ``--rounds`` rounds (this
    machine's speed drifts).  Printed per round: the first epoch (JAX compiles there),
@@ -41,7 +42,10 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # perf.neural, run as a script
 
+from app.services.simulation import write_link_trials
 from benchmark.problem import problem_from_dataset
+from benchmark.run.folds import make_folds
+from benchmark.sequence import panel
 from perf.neural import install, link_data
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -68,7 +72,8 @@ for epochs in (1, 1, int(sys.argv[2])):
     seconds.append(time.perf_counter() - began)
 accuracy = float((model.predict(X[test].reshape(len(test), -1)) == y[test]).mean())
 latency = []
-for row in X[test][:300].reshape(-1, 1, channels * length):
+for i in range(300):  # the test rows, again from the first if there are fewer
+    row = X[test[i % len(test)]].reshape(1, channels * length)
     began = time.perf_counter()
     model.predict_proba(row)
     latency.append(1000 * (time.perf_counter() - began))
@@ -121,7 +126,8 @@ model.fit(X[train], y[train], batch_size=32, epochs=int(sys.argv[2]), verbose=0,
           callbacks=[Clock()])
 accuracy = float((model.predict(X[test], verbose=0).argmax(axis=1) == y[test]).mean())
 latency = []
-for row in X[test][:300, None]:
+for i in range(300):  # the test rows, again from the first if there are fewer
+    row = X[test[i % len(test)]][None]
     began = time.perf_counter()
     keras.ops.softmax(model.predict_on_batch(row))
     latency.append(1000 * (time.perf_counter() - began))
@@ -134,6 +140,9 @@ print(json.dumps({
 }))
 """
 
+#: perf/neural.py's recipe: 30 MFCCs x 8 frames a channel.
+MFCC = {"n_mfcc": "30", "frames": "8"}
+
 ONE_THREAD = {
     "OMP_NUM_THREADS": "1",
     "OPENBLAS_NUM_THREADS": "1",
@@ -144,21 +153,17 @@ ONE_THREAD = {
 
 def windows(folder: Path, trials: int) -> Path:
     """The link's windows (n, channels, length), labels and a split by trial, saved."""
-    data = link_data(folder, trials, "mfcc", {"n_mfcc": "30", "frames": "8"})
+    data = link_data(write_link_trials(folder, trials=trials, seed=1), "mfcc", MFCC)
     problem, _ = problem_from_dataset(data)
     assert problem.sequence is not None and problem.groups is not None
-    start, channels, length = (
-        problem.sequence.start,
-        problem.sequence.n_channels,
-        problem.sequence.length,
-    )
-    X = problem.X[:, start : start + channels * length].reshape(-1, channels, length)
-    groups = np.unique(problem.groups, return_inverse=True)[1]
-    test = np.flatnonzero(groups % 5 == 0)
-    train = np.flatnonzero(groups % 5 != 0)
+    X, _ = panel(problem.X, problem.sequence.shape)
+    # the first of perf/neural.py's folds: by trial, stratified (the classes take turns
+    # across trials, so every fifth trial would be one class)
+    folds, _ = make_folds(problem.Y, n_folds=5, groups=problem.groups, seed=0)
+    train, test = folds[0].train, folds[0].test
     path = folder / "windows.npz"
     np.savez(path, X=X, y=problem.Y[:, 0].astype(np.int64), train=train, test=test)
-    print(f"  windows: {len(train)} to train, {len(test)} to test, {channels} x {length}")
+    print(f"  windows: {len(train)} to train, {len(test)} to test, {X.shape[1]} x {X.shape[2]}")
     return path
 
 

@@ -68,9 +68,11 @@ ROOT = Path(__file__).resolve().parents[1]
 ADDED = ("torch", "safetensors", "sympy", "mpmath", "filelock")
 
 
-def link_data(folder: Path, trials: int, extractor: str, options: dict[str, str]) -> Dataset:
-    """The link's 1-s windows as ``extractor`` makes them, contact points only."""
-    recordings, labels = write_link_trials(folder, trials=trials, seed=1)
+def link_data(trials: tuple[list[Path], Path], extractor: str, options: dict[str, str]) -> Dataset:
+    """The 1-s windows of the link's ``trials`` (recordings and labels, as
+    :func:`write_link_trials` writes them) as ``extractor`` makes them, contact points
+    only."""
+    recordings, labels = trials
     extracted = extract_dataset(
         recordings,
         labels=labels,
@@ -222,11 +224,10 @@ def main() -> None:
             f"{arguments.folds}-fold by trial"
         )
         mfcc = {"n_mfcc": str(arguments.n_mfcc)}
-        frames = link_data(
-            folder, arguments.trials, "mfcc", {**mfcc, "frames": str(arguments.frames)}
-        )
-        peaks = link_data(folder, arguments.trials, "band-peaks", {})
-        means = link_data(folder, arguments.trials, "mfcc", {**mfcc, "frames": "1"})
+        trials = write_link_trials(folder, trials=arguments.trials, seed=1)
+        frames = link_data(trials, "mfcc", {**mfcc, "frames": str(arguments.frames)})
+        peaks = link_data(trials, "band-peaks", {})
+        means = link_data(trials, "mfcc", {**mfcc, "frames": "1"})
         print(
             f"  MFCC frames ({arguments.n_mfcc} coefficients, {arguments.frames} frames a window)"
         )
