@@ -6,6 +6,7 @@ RUN apt-get update \
     && rm -rf /var/lib/apt/lists/*
 WORKDIR /opt/touchbench
 COPY pyproject.toml README.md ./
+COPY touchbench ./touchbench
 COPY app ./app
 COPY benchmark ./benchmark
 COPY features ./features

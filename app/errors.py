@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import os
 
-from benchmark.errors import BenchmarkError
-from drivers.errors import DriverError
-from features.errors import FeatureError
+from touchbench.benchmark.errors import BenchmarkError
+from touchbench.drivers.errors import DriverError
+from touchbench.features.errors import FeatureError
 
 
 class AppError(Exception):

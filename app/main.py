@@ -13,23 +13,23 @@ from importlib import metadata
 
 from fastapi import Depends, FastAPI
 
-from app.api import main as api
-from app.api.deps import ModelCache, Service, require_api_key
-from app.api.stopping import CutByStop
-from app.api.trust import Cors, Trust
-from app.jobs.dispatcher import Dispatcher
-from app.settings import Settings, get_settings
-from app.store.database import Store
-from app.store.jobs import mark_lost_jobs
-from app.store.runs import finish_run, get_run, mark_lost_runs
-from app.web.site import install as install_web_page
+from touchbench.app.api import main as api
+from touchbench.app.api.deps import ModelCache, Service, require_api_key
+from touchbench.app.api.stopping import CutByStop
+from touchbench.app.api.trust import Cors, Trust
+from touchbench.app.jobs.dispatcher import Dispatcher
+from touchbench.app.settings import Settings, get_settings
+from touchbench.app.store.database import Store
+from touchbench.app.store.jobs import mark_lost_jobs
+from touchbench.app.store.runs import finish_run, get_run, mark_lost_runs
+from touchbench.app.web.site import install as install_web_page
 
 
 def _warm_up() -> None:
     """Import the machine-learning stack in the background, so that start-up is quick and
     the first prediction does not pay for the imports."""
-    import app.services.models  # noqa: F401
-    import benchmark.model  # noqa: F401
+    import touchbench.app.services.models
+    import touchbench.benchmark.model  # noqa: F401
 
 
 def create_app(settings: Settings | None = None) -> FastAPI:

@@ -18,8 +18,8 @@ from urllib.parse import urlsplit
 from pydantic import Field, SecretStr
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
-from app.environment import DEFAULT_DATABASE_URL, ENV_PREFIX
-from app.errors import AppError
+from touchbench.app.environment import DEFAULT_DATABASE_URL, ENV_PREFIX
+from touchbench.app.errors import AppError
 
 #: What a key may do, each role including the ones before it: ``read`` every GET;
 #: ``predict`` also predictions (JSON, file, the live WebSocket) and uploads of data sets

@@ -12,17 +12,18 @@ from __future__ import annotations
 
 import importlib
 import io
+import json
 import zipfile
 from typing import Any
 
-from benchmark.errors import ConfigurationError
+from touchbench.benchmark.errors import ConfigurationError
 
 #: Format tag written into every artifact, checked on load.
 ARTIFACT_FORMAT = "touchbench-model/1"
-#: Top-level packages whose classes a model may be made of.
+#: Packages whose classes a model may be made of.
 TRUSTED_PACKAGES = frozenset(
     {
-        "benchmark",
+        "touchbench.benchmark",
         "sklearn",
         "numpy",
         "scipy",
@@ -51,6 +52,9 @@ TRUSTED_NAMES = frozenset(
 #: Classes of trusted packages that touch files, never loaded all the same (a memory-mapped
 #: array or an ``.npz`` archive would open a path the artifact names).
 REFUSED_TYPES = frozenset({"numpy.memmap", "numpy.lib.npyio.NpzFile", "numpy.lib.npyio.DataSource"})
+#: Packages that were once installed under another name: artifacts written before
+#: touchbench became one import name call its classes ``benchmark.weka.j48.J48``.
+MOVED_PACKAGES = {"benchmark": "touchbench.benchmark"}
 
 
 def dumps_artifact(content: dict[str, Any]) -> bytes:
@@ -83,6 +87,7 @@ def loads_artifact(data: bytes) -> dict[str, Any]:
             "touchbench only loads artifacts that cannot run code: train the model again"
         )
     try:
+        data = _renamed_modules(data)
         named = skops.io.get_untrusted_types(data=data)
     except Exception as exc:
         raise ConfigurationError(f"the stored model cannot be read: {exc}") from None
@@ -110,7 +115,7 @@ def is_trusted_type(name: str) -> bool:
     if name in TRUSTED_NAMES:
         return True
     module_name, _, attribute = name.rpartition(".")
-    if not module_name or module_name.split(".", 1)[0] not in TRUSTED_PACKAGES:
+    if not any(_within(module_name, package) for package in TRUSTED_PACKAGES):
         return False
     try:
         target = getattr(importlib.import_module(module_name), attribute)
@@ -122,6 +127,48 @@ def is_trusted_type(name: str) -> bool:
 
     refused = [numpy.memmap, *(_numpy_type(name) for name in REFUSED_TYPES)]
     return not any(issubclass(target, kind) for kind in refused if kind is not None)
+
+
+def _within(module_name: str, package: str) -> bool:
+    return module_name == package or module_name.startswith(package + ".")
+
+
+def _renamed_modules(data: bytes) -> bytes:
+    """``data`` with the modules of :data:`MOVED_PACKAGES` named as they are now (an
+    artifact written before the move), else ``data`` itself."""
+    with zipfile.ZipFile(io.BytesIO(data)) as archive:
+        text = archive.read("schema.json")
+        if not any(f'"{old}.'.encode() in text for old in MOVED_PACKAGES):
+            return data
+        schema = json.loads(text)
+        if not _rename(schema):
+            return data
+        renamed = io.BytesIO()
+        with zipfile.ZipFile(renamed, "w", compression=zipfile.ZIP_DEFLATED) as copy:
+            for member in archive.infolist():
+                if member.filename == "schema.json":
+                    copy.writestr(member, json.dumps(schema))
+                else:
+                    copy.writestr(member, archive.read(member))
+    return renamed.getvalue()
+
+
+def _rename(node: Any) -> bool:
+    """Rename the moved modules in a skops schema in place; whether any was."""
+    renamed = False
+    if isinstance(node, dict):
+        for key, value in node.items():
+            if key in ("__module__", "module_path") and isinstance(value, str):
+                top, dot, rest = value.partition(".")
+                if top in MOVED_PACKAGES:
+                    node[key] = MOVED_PACKAGES[top] + dot + rest
+                    renamed = True
+            else:
+                renamed = _rename(value) or renamed
+    elif isinstance(node, list):
+        for item in node:
+            renamed = _rename(item) or renamed
+    return renamed
 
 
 def _numpy_type(name: str) -> type | None:

@@ -15,16 +15,16 @@ from typing import Any
 
 import numpy as np
 
-from benchmark.catalogue import (
+from touchbench.benchmark.catalogue import (
     CATALOGUE,
     ClassifierSpec,
     build_pipeline,
     check_sequence_input,
     get_spec,
 )
-from benchmark.catalogue import unknown_classifier_message as _unknown_message
-from benchmark.errors import ConfigurationError
-from benchmark.problem import Problem
+from touchbench.benchmark.catalogue import unknown_classifier_message as _unknown_message
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.problem import Problem
 
 __all__ = [
     "build_estimator",
@@ -37,7 +37,7 @@ __all__ = [
 
 def is_multitarget_id(classifier_id: str) -> bool:
     """Whether ``classifier_id`` names a multi-target configuration (``META:BASE`` or a META)."""
-    from benchmark.multitarget import META_METHODS
+    from touchbench.benchmark.multitarget import META_METHODS
 
     return ":" in classifier_id or classifier_id.lower() in META_METHODS
 
@@ -45,7 +45,7 @@ def is_multitarget_id(classifier_id: str) -> bool:
 def reads_sequences(classifier_id: str) -> bool:
     """Whether a catalogue id or ``META:BASE`` configuration needs a sequence data set."""
     if is_multitarget_id(classifier_id):
-        from benchmark.multitarget import parse_config
+        from touchbench.benchmark.multitarget import parse_config
 
         _, base = parse_config(classifier_id)
         return bool(base) and get_spec(base).needs_sequence
@@ -62,7 +62,7 @@ def classifier_spec(
     ConfigurationError
         Unknown id, naming the closest known one.
     """
-    from benchmark.catalogue.tuning import is_tuned_id
+    from touchbench.benchmark.catalogue.tuning import is_tuned_id
 
     if extra_specs and classifier_id in extra_specs:
         return extra_specs[classifier_id]
@@ -99,10 +99,10 @@ def check_classifier(
         (as the classifier or as a base) on flat features; an id with no regressor on
         numeric targets.
     """
-    from benchmark.multitarget import check_targets, parse_config
+    from touchbench.benchmark.multitarget import check_targets, parse_config
 
     if problem.kind == "regression":
-        from benchmark.catalogue.regressors import regressor_spec
+        from touchbench.benchmark.catalogue.regressors import regressor_spec
 
         regressor = regressor_spec(
             classifier_id, n_targets=problem.n_targets, n_instances=problem.n_instances
@@ -165,7 +165,7 @@ def build_estimator(
             random_state=random_state,
             sequence=problem.sequence,
         )
-    from benchmark.multitarget import build_multitarget
+    from touchbench.benchmark.multitarget import build_multitarget
 
     return build_multitarget(
         classifier_id,

@@ -17,14 +17,14 @@ from typing import Any, Protocol
 import numpy as np
 from sklearn.base import BaseEstimator
 
-from benchmark.artifacts import dumps_artifact, loads_artifact
-from benchmark.catalogue import get_spec
-from benchmark.dataset import Dataset, Schema
-from benchmark.errors import ConfigurationError
-from benchmark.estimators import build_estimator, check_classifier, group_fit_params
-from benchmark.evaluation.metrics import expand_proba
-from benchmark.forest_inference import forest_proba
-from benchmark.problem import feature_matrix, problem_from_dataset
+from touchbench.benchmark.artifacts import dumps_artifact, loads_artifact
+from touchbench.benchmark.catalogue import get_spec
+from touchbench.benchmark.dataset import Dataset, Schema
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.estimators import build_estimator, check_classifier, group_fit_params
+from touchbench.benchmark.evaluation.metrics import expand_proba
+from touchbench.benchmark.forest_inference import forest_proba
+from touchbench.benchmark.problem import feature_matrix, problem_from_dataset
 
 #: Libraries whose versions are recorded with a model.
 RECORDED_LIBRARIES = ("numpy", "scikit-learn", "xgboost", "aeon")
@@ -149,7 +149,7 @@ class TrainedModel:
         from sklearn.neighbors import KNeighborsClassifier
         from sklearn.tree import BaseDecisionTree
 
-        from benchmark.catalogue.neural import NeuralSequenceClassifier
+        from touchbench.benchmark.catalogue.neural import NeuralSequenceClassifier
 
         if len(self.schema.target_indices) != 1:
             return False

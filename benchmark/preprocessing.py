@@ -18,7 +18,7 @@ from sklearn.impute import SimpleImputer
 from sklearn.pipeline import Pipeline
 from sklearn.preprocessing import MinMaxScaler, OneHotEncoder, StandardScaler
 
-from benchmark.errors import ConfigurationError
+from touchbench.benchmark.errors import ConfigurationError
 
 Scaling = Literal["standard", "minmax"]
 

@@ -9,9 +9,9 @@ from typing import Literal
 
 import numpy as np
 
-from benchmark.dataset import Dataset, Schema
-from benchmark.errors import ConfigurationError
-from benchmark.sequence import SequenceLayout, find_sequence
+from touchbench.benchmark.dataset import Dataset, Schema
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.sequence import SequenceLayout, find_sequence
 
 Task = Literal["classification", "regression"]
 Kind = Literal["multiclass", "multitarget", "regression"]

@@ -15,6 +15,6 @@
 ``oscillating``  a simulated actively oscillated link with a 3-axis accelerometer
 
 Every problem is a :class:`drivers.errors.DriverError`.  Import from the modules themselves
-(``from drivers.recording import Recording``): the package imports nothing, so that catching
-a driver's error does not load NumPy.
+(``from touchbench.drivers.recording import Recording``): the package imports nothing, so
+that catching a driver's error does not load NumPy.
 """

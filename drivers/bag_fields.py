@@ -26,10 +26,10 @@ from typing import Any
 
 import numpy as np
 
-from drivers.bag_reader import close_bag, field_specs, raw_messages, reason
-from drivers.errors import DriverError
-from drivers.resample import EvenResampler, jitter_note, median_rate
-from drivers.source import Block, Source
+from touchbench.drivers.bag_reader import close_bag, field_specs, raw_messages, reason
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.resample import EvenResampler, jitter_note, median_rate
+from touchbench.drivers.source import Block, Source
 
 #: ROS base types read as numbers.
 NUMERIC = frozenset(

@@ -15,7 +15,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from drivers.errors import DriverError
+from touchbench.drivers.errors import DriverError
 
 #: ``.msg`` definitions of the audio_common_msgs types touchbench reads.
 AUDIO_MSGS: dict[str, str] = {

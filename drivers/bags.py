@@ -28,8 +28,8 @@ from typing import Any
 
 import numpy as np
 
-from drivers.bag_fields import BagFieldsSource
-from drivers.bag_reader import (
+from touchbench.drivers.bag_fields import BagFieldsSource
+from touchbench.drivers.bag_reader import (
     close_bag,
     field_specs,
     open_bag,
@@ -37,10 +37,10 @@ from drivers.bag_reader import (
     reason,
     topic_listing,
 )
-from drivers.errors import DriverError
-from drivers.mp3 import Mp3Decoder, looks_like_mp3
-from drivers.pcm import SAMPLE_FORMATS, decode_pcm
-from drivers.source import Block, Source
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.mp3 import Mp3Decoder, looks_like_mp3
+from touchbench.drivers.pcm import SAMPLE_FORMATS, decode_pcm
+from touchbench.drivers.source import Block, Source
 
 _INFO_FIELDS = {
     "channels": "uint8",

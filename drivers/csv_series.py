@@ -28,8 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
-from drivers.errors import DriverError
-from drivers.resample import jitter_of, resample_even
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.resample import jitter_of, resample_even
 
 #: Names of a time column, lower case: the common ones and those ROS tools write
 #: (``rostopic echo -p`` writes ``%time`` and ``field.header.stamp``, in nanoseconds).

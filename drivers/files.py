@@ -21,9 +21,9 @@ from pathlib import Path
 import numpy as np
 import soundfile
 
-from drivers.csv_series import read_csv_series
-from drivers.errors import DriverError
-from drivers.recording import Recording
+from touchbench.drivers.csv_series import read_csv_series
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.recording import Recording
 
 _CSV_SUFFIXES = frozenset({".csv", ".tsv", ".txt"})
 

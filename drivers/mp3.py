@@ -22,7 +22,7 @@ from collections.abc import Callable, Iterator
 import numpy as np
 import soundfile
 
-from drivers.errors import DriverError
+from touchbench.drivers.errors import DriverError
 
 #: Bytes of the stream kept behind the read position, for libsndfile's short seeks back.
 WINDOW = 1 << 20

@@ -22,8 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import lfilter
 
-from drivers.errors import DriverError
-from drivers.recording import Recording
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.recording import Recording
 
 SAMPLERATE = 3200.0
 MOTOR_HZ = 170.0

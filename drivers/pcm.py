@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from drivers.errors import DriverError
+from touchbench.drivers.errors import DriverError
 
 #: sample_format -> (numpy dtype, full scale); the names of audio_common's AudioInfo.
 SAMPLE_FORMATS: dict[str, tuple[str, float]] = {

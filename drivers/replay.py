@@ -18,9 +18,9 @@ from pathlib import Path
 import numpy as np
 import soundfile
 
-from drivers.errors import DriverError
-from drivers.files import check_rate, no_sample_rate, open_npy, read_recording
-from drivers.source import Block, RecordingSource, Source, check_finite, paced
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.files import check_rate, no_sample_rate, open_npy, read_recording
+from touchbench.drivers.source import Block, RecordingSource, Source, check_finite, paced
 
 CSV_SUFFIXES = frozenset({".csv", ".tsv", ".txt"})
 BAG_SUFFIXES = frozenset({".bag", ".mcap", ".db3"})
@@ -100,7 +100,7 @@ class FileReplaySource(Source):
             also = " and CSV files" if given[0] == "fields" else ""
             raise DriverError(f"{path}: `{given[0]}` applies to ROS bags{also} only")
         if is_bag(self.path):
-            from drivers.bags import open_bag_source
+            from touchbench.drivers.bags import open_bag_source
 
             bag = open_bag_source(
                 self.path,

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from drivers.errors import DriverError
+from touchbench.drivers.errors import DriverError
 
 #: Steps within this fraction of the median step count as even (no note).
 EVEN = 0.01

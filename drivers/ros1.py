@@ -33,8 +33,8 @@ from typing import Any
 
 import numpy as np
 
-from drivers.errors import DriverError
-from drivers.ros_transport import AUDIO_DATA, AUDIO_INFO, AudioFormat, Kind, Message
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.ros_transport import AUDIO_DATA, AUDIO_INFO, AudioFormat, Kind, Message
 
 #: Where Debian installs its Python packages (ROS 1's among them).
 DEBIAN_PACKAGES = "/usr/lib/python3/dist-packages"

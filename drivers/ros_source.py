@@ -12,11 +12,11 @@ from collections.abc import Iterator
 
 import numpy as np
 
-from drivers.errors import DriverError
-from drivers.mp3 import Mp3Decoder
-from drivers.pcm import SAMPLE_FORMATS, decode_pcm
-from drivers.ros_transport import AudioFormat, Message, RosTransport
-from drivers.source import Block, Source
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.mp3 import Mp3Decoder
+from touchbench.drivers.pcm import SAMPLE_FORMATS, decode_pcm
+from touchbench.drivers.ros_transport import AudioFormat, Message, RosTransport
+from touchbench.drivers.source import Block, Source
 
 #: Decoded samples per block of live MP3 audio (one MPEG-1 Layer III frame).
 MP3_LIVE_BLOCK = 1152

@@ -15,8 +15,8 @@ from typing import Literal
 
 import numpy as np
 
-from drivers.errors import DriverError
-from drivers.recording import Recording
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.recording import Recording
 
 TouchKind = Literal["tap", "stroke"]
 

@@ -22,8 +22,8 @@ from typing import Any
 
 import numpy as np
 
-from drivers.errors import DriverError
-from drivers.source import Block, Source
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.source import Block, Source
 
 _END = None
 #: sample format -> full scale

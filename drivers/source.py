@@ -18,8 +18,8 @@ from typing import Self
 
 import numpy as np
 
-from drivers.errors import DriverError
-from drivers.recording import Recording
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.recording import Recording
 
 #: Samples per block for live prediction (11.6 ms at 44.1 kHz): a touch is predicted once
 #: the block holding its end has arrived, so half a block of waiting adds on average to

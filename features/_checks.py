@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from features.errors import FeatureError
+from touchbench.features.errors import FeatureError
 
 
 def as_signal(y: Any, *, name: str = "y", min_samples: int = 1) -> np.ndarray:

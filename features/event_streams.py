@@ -18,12 +18,12 @@ from typing import Any
 import numpy as np
 from scipy.signal import sosfilt, sosfilt_zi
 
-from features._checks import as_samplerate
-from features.errors import FeatureError
-from features.events import EVENT_KINDS, Event, dbscan_events, dbscan_filter, runs
-from features.options import resolve_options
-from features.snr import Touch
-from features.snr_stream import SnrStream
+from touchbench.features._checks import as_samplerate
+from touchbench.features.errors import FeatureError
+from touchbench.features.events import EVENT_KINDS, Event, dbscan_events, dbscan_filter, runs
+from touchbench.features.options import resolve_options
+from touchbench.features.snr import Touch
+from touchbench.features.snr_stream import SnrStream
 
 #: Longest event in seconds unless asked otherwise.
 DEFAULT_MAX_EVENT = 60.0

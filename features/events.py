@@ -31,9 +31,9 @@ import numpy as np
 from scipy.signal import butter, sosfilt, sosfilt_zi
 from sklearn.cluster import DBSCAN
 
-from features._checks import as_samplerate, as_signal
-from features.errors import FeatureError
-from features.options import (
+from touchbench.features._checks import as_samplerate, as_signal
+from touchbench.features.errors import FeatureError
+from touchbench.features.options import (
     Option,
     fraction,
     non_negative_float,
@@ -41,7 +41,7 @@ from features.options import (
     positive_int,
     resolve_options,
 )
-from features.snr import SnrTrack, snr_track
+from touchbench.features.snr import SnrTrack, snr_track
 
 
 @dataclass(frozen=True)

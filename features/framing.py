@@ -16,8 +16,8 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 from scipy.signal import get_window
 
-from features._checks import as_positive_int, as_samplerate, as_signal
-from features.errors import FeatureError
+from touchbench.features._checks import as_positive_int, as_samplerate, as_signal
+from touchbench.features.errors import FeatureError
 
 WindowSpec = Literal["hann", "rectangular"] | np.ndarray | None
 

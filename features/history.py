@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from features.errors import FeatureError
+from touchbench.features.errors import FeatureError
 
 
 class History:

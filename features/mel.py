@@ -13,8 +13,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.fft import dct
 
-from features._checks import as_positive_int, as_samplerate
-from features.errors import FeatureError
+from touchbench.features._checks import as_positive_int, as_samplerate
+from touchbench.features.errors import FeatureError
 
 
 def hz_to_mel(frequencies: np.ndarray | float) -> np.ndarray:

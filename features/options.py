@@ -12,7 +12,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from features.errors import FeatureError
+from touchbench.features.errors import FeatureError
 
 Parser = Callable[[Any], Any]
 

@@ -10,8 +10,8 @@ import math
 
 import numpy as np
 
-from features._checks import as_positive_int, as_samplerate
-from features.errors import FeatureError
+from touchbench.features._checks import as_positive_int, as_samplerate
+from touchbench.features.errors import FeatureError
 
 
 def pitch_fft(

@@ -10,12 +10,12 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
-from features.errors import FeatureError
-from features.event_streams import DEFAULT_MAX_EVENT, open_event_stream
-from features.events import EVENT_KINDS
-from features.extractors import EXTRACTORS, Extractor, make_extractor
-from features.options import claim_options, resolve_options
-from features.stream import FeatureStream
+from touchbench.features.errors import FeatureError
+from touchbench.features.event_streams import DEFAULT_MAX_EVENT, open_event_stream
+from touchbench.features.events import EVENT_KINDS
+from touchbench.features.extractors import EXTRACTORS, Extractor, make_extractor
+from touchbench.features.options import claim_options, resolve_options
+from touchbench.features.stream import FeatureStream
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from features._checks import as_signal
+from touchbench.features._checks import as_signal
 
 
 def to_length(y: np.ndarray, length: int) -> np.ndarray:

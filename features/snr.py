@@ -21,10 +21,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import lfilter
 
-from features._checks import as_positive_int, as_samplerate, as_signal
-from features.errors import FeatureError
-from features.framing import frame
-from features.temporal import rms
+from touchbench.features._checks import as_positive_int, as_samplerate, as_signal
+from touchbench.features.errors import FeatureError
+from touchbench.features.framing import frame
+from touchbench.features.temporal import rms
 
 _FIRST_CHUNK = 1024
 

@@ -15,11 +15,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from features._checks import as_positive_int, as_samplerate
-from features.framing import frame
-from features.history import History
-from features.snr import SnrTrack, Touch, follow_floor, tracking_windows
-from features.temporal import rms
+from touchbench.features._checks import as_positive_int, as_samplerate
+from touchbench.features.framing import frame
+from touchbench.features.history import History
+from touchbench.features.snr import SnrTrack, Touch, follow_floor, tracking_windows
+from touchbench.features.temporal import rms
 
 
 @dataclass

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.signal import find_peaks, peak_prominences
 
-from features.errors import FeatureError
+from touchbench.features.errors import FeatureError
 
 
 def _check_bins(S: np.ndarray, frequencies: np.ndarray) -> np.ndarray:

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from features.errors import FeatureError
+from touchbench.features.errors import FeatureError
 
 
 @dataclass(frozen=True)

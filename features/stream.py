@@ -18,13 +18,13 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from features._checks import as_signal
-from features.errors import FeatureError
-from features.event_streams import EventStream
-from features.events import Detection, Event
-from features.extractors.base import Extractor, Instances
-from features.history import History
-from features.snr_stream import SnrStream
+from touchbench.features._checks import as_signal
+from touchbench.features.errors import FeatureError
+from touchbench.features.event_streams import EventStream
+from touchbench.features.events import Detection, Event
+from touchbench.features.extractors.base import Extractor, Instances
+from touchbench.features.history import History
+from touchbench.features.snr_stream import SnrStream
 
 
 class FeatureStream:

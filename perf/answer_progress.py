@@ -54,12 +54,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--folds", type=int, default=10)
     args = parser.parse_args()
-    from app.schemas.datasets import ImportRequest
-    from app.schemas.learning import LearningCurveRequest
-    from app.services import learning
-    from app.services.datasets import import_file
-    from app.store.database import Store
-    from benchmark.results import TaskKey, TaskResult
+    from touchbench.app.schemas.datasets import ImportRequest
+    from touchbench.app.schemas.learning import LearningCurveRequest
+    from touchbench.app.services import learning
+    from touchbench.app.services.datasets import import_file
+    from touchbench.app.store.database import Store
+    from touchbench.benchmark.results import TaskKey, TaskResult
 
     with tempfile.TemporaryDirectory() as folder:
         store = Store(f"sqlite:///{folder}/touchbench.db")

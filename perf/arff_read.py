@@ -38,10 +38,10 @@ import numpy as np
 import pandas as pd
 from generated import write_maggie_like
 
-from benchmark.dataset import Dataset
-from benchmark.errors import DataFormatError
-from benchmark.io.arff import read_arff
-from benchmark.io.dates import DateFormat
+from touchbench.benchmark.dataset import Dataset
+from touchbench.benchmark.errors import DataFormatError
+from touchbench.benchmark.io.arff import read_arff
+from touchbench.benchmark.io.dates import DateFormat
 
 DEFAULT_FOLDER = Path(__file__).resolve().parents[1].parent / "shared" / "datasets"
 

@@ -44,7 +44,7 @@ def child(path: str, how: str) -> None:
     """Read the bag ``how`` and print 'peak_kib seconds_of_audio elapsed'."""
     began = time.perf_counter()
     if how == "touchbench":
-        from drivers.replay import FileReplaySource
+        from touchbench.drivers.replay import FileReplaySource
 
         n = 0
         with FileReplaySource(path) as source:
@@ -53,7 +53,7 @@ def child(path: str, how: str) -> None:
     else:
         from rosbags.highlevel import AnyReader
 
-        from drivers.bag_reader import audio_typestore
+        from touchbench.drivers.bag_reader import audio_typestore
 
         with AnyReader([Path(path)], default_typestore=audio_typestore()) as reader:
             data = b"".join(

@@ -27,8 +27,8 @@ import soundfile
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from drivers.replay import FileReplaySource
 from tests.drivers.bagfiles import write_audio_bag
+from touchbench.drivers.replay import FileReplaySource
 
 RATE = 44100
 

@@ -25,12 +25,12 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmark.catalogue import suite
-from benchmark.estimators import reads_sequences
-from benchmark.evaluation.leaderboard import build_leaderboard
-from benchmark.io.arff import read_arff
-from benchmark.run.engine import Problem, run_tasks
-from benchmark.run.folds import make_folds
+from touchbench.benchmark.catalogue import suite
+from touchbench.benchmark.estimators import reads_sequences
+from touchbench.benchmark.evaluation.leaderboard import build_leaderboard
+from touchbench.benchmark.io.arff import read_arff
+from touchbench.benchmark.run.engine import Problem, run_tasks
+from touchbench.benchmark.run.folds import make_folds
 
 DATASETS = Path(__file__).resolve().parents[2] / "shared/datasets/uc3m-touch"
 

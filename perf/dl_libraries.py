@@ -42,11 +42,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # perf.neural, run as a script
 
-from app.services.simulation import write_link_trials
-from benchmark.problem import problem_from_dataset
-from benchmark.run.folds import make_folds
-from benchmark.sequence import panel
 from perf.neural import install, link_data
+from touchbench.app.services.simulation import write_link_trials
+from touchbench.benchmark.problem import problem_from_dataset
+from touchbench.benchmark.run.folds import make_folds
+from touchbench.benchmark.sequence import panel
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -57,7 +57,7 @@ TORCH = """
 import json, resource, sys, time
 import numpy as np
 import torch  # imported before the clock starts, as Keras and JAX are
-from benchmark.catalogue.neural import NeuralSequenceClassifier
+from touchbench.benchmark.catalogue.neural import NeuralSequenceClassifier
 data = np.load(sys.argv[1])
 X, y, train, test = data["X"], data["y"], data["train"], data["test"]
 n, channels, length = X.shape

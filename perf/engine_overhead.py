@@ -24,10 +24,10 @@ from sklearn.metrics import cohen_kappa_score, make_scorer
 from sklearn.model_selection import cross_validate
 from threadpoolctl import threadpool_limits
 
-from benchmark.catalogue import build_pipeline, get_spec
-from benchmark.io.arff import read_arff
-from benchmark.run.engine import Problem, run_tasks
-from benchmark.run.folds import Fold, make_folds
+from touchbench.benchmark.catalogue import build_pipeline, get_spec
+from touchbench.benchmark.io.arff import read_arff
+from touchbench.benchmark.run.engine import Problem, run_tasks
+from touchbench.benchmark.run.folds import Fold, make_folds
 
 DATA = (
     Path(__file__).resolve().parents[2] / "shared/datasets/uc3m-touch/mini/gesture_and_place.arff"

@@ -41,7 +41,7 @@ STREAMED = (
     + """
 import sys
 from pathlib import Path
-from app.services.extraction import extract_dataset
+from touchbench.app.services.extraction import extract_dataset
 result = extract_dataset([Path(sys.argv[1])], labels=None, extractor="uc3m-audio")
 print(result.n_events, peak_mib())
 """
@@ -51,9 +51,9 @@ WHOLE = (
     PEAK_MIB
     + """
 import sys
-from drivers.files import read_recording
-from features.events import detect_events
-from features.extractors import make_extractor
+from touchbench.drivers.files import read_recording
+from touchbench.features.events import detect_events
+from touchbench.features.extractors import make_extractor
 recording = read_recording(sys.argv[1])
 detection = detect_events("snr", recording.samples, samplerate=recording.samplerate)
 instances = make_extractor("uc3m-audio").extract(

@@ -36,14 +36,14 @@ from typing import Any  # noqa: E402
 import librosa  # noqa: E402
 import numpy as np  # noqa: E402
 
-from drivers.simulated import simulate_session  # noqa: E402
-from features.events import detect_events  # noqa: E402
-from features.extractors import make_extractor  # noqa: E402
-from features.framing import fft_frequencies, frame, power_spectrogram, stft  # noqa: E402
-from features.mel import mel_filter_bank, mel_spectrogram, mfcc  # noqa: E402
-from features.recipe import Recipe  # noqa: E402
-from features.spectral import spectral_centroid, spectral_rolloff  # noqa: E402
-from features.temporal import rms, zero_crossing_rate  # noqa: E402
+from touchbench.drivers.simulated import simulate_session  # noqa: E402
+from touchbench.features.events import detect_events  # noqa: E402
+from touchbench.features.extractors import make_extractor  # noqa: E402
+from touchbench.features.framing import fft_frequencies, frame, power_spectrogram, stft  # noqa: E402
+from touchbench.features.mel import mel_filter_bank, mel_spectrogram, mfcc  # noqa: E402
+from touchbench.features.recipe import Recipe  # noqa: E402
+from touchbench.features.spectral import spectral_centroid, spectral_rolloff  # noqa: E402
+from touchbench.features.temporal import rms, zero_crossing_rate  # noqa: E402
 
 #: extractor -> (channels, sample rate, touches per minute, segment seconds for "none")
 SENSORS: dict[str, tuple[int, float, int, float | None]] = {

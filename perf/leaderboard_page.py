@@ -35,15 +35,15 @@ sys.path.insert(0, str(ROOT))
 
 from fastapi.testclient import TestClient  # noqa: E402
 
-from app.main import create_app  # noqa: E402
-from app.schemas.datasets import ImportRequest  # noqa: E402
-from app.services.datasets import import_file  # noqa: E402
-from app.settings import Settings  # noqa: E402
-from app.store.database import Store  # noqa: E402
-from app.store.runs import create_run, finish_run, record_result  # noqa: E402
-from benchmark.catalogue import CATALOGUE  # noqa: E402
-from benchmark.results import TaskKey, TaskResult  # noqa: E402
 from tests.app.synthetic import touch_arff  # noqa: E402
+from touchbench.app.main import create_app  # noqa: E402
+from touchbench.app.schemas.datasets import ImportRequest  # noqa: E402
+from touchbench.app.services.datasets import import_file  # noqa: E402
+from touchbench.app.settings import Settings  # noqa: E402
+from touchbench.app.store.database import Store  # noqa: E402
+from touchbench.app.store.runs import create_run, finish_run, record_result  # noqa: E402
+from touchbench.benchmark.catalogue import CATALOGUE  # noqa: E402
+from touchbench.benchmark.results import TaskKey, TaskResult  # noqa: E402
 
 #: Every score a multi-class fold records, with its direction (True: higher is better).
 SCORES = (

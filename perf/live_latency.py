@@ -54,16 +54,16 @@ import numpy as np
 import soundfile
 
 if TYPE_CHECKING:
-    from app.store.database import Store
+    from touchbench.app.store.database import Store
 
 ROOT = Path(__file__).resolve().parents[1]
 
 CAPTURE = """
 import os, sys, time
 os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})
-from app.services.live import open_live
-from app.store.database import Store
-from drivers.sound import SoundDeviceSource
+from touchbench.app.services.live import open_live
+from touchbench.app.store.database import Store
+from touchbench.drivers.sound import SoundDeviceSource
 seconds, queue = float(sys.argv[2]), float(sys.argv[3])
 source = SoundDeviceSource("replay", samplerate=44100, channels=3, seconds=seconds,
                            queue_seconds=queue, block_length=int(sys.argv[4]))
@@ -96,14 +96,14 @@ def with_listed_columns(model: Any) -> Any:
 
 def networks(store: Store, here: Path, recordings: list[Path], labels: Path, sessions: int) -> None:
     """Per-touch latency of the neural entries (``cnn1d``, ``bilstm``) on MFCC frames."""
-    from app.schemas.extraction import ExtractRequest
-    from app.schemas.models import TrainRequest
-    from app.services.extraction import extract_and_store
-    from app.services.live import open_live
-    from app.services.models import load_model, train
-    from app.services.simulation import write_session
-    from drivers.replay import FileReplaySource
-    from drivers.source import LIVE_BLOCK
+    from touchbench.app.schemas.extraction import ExtractRequest
+    from touchbench.app.schemas.models import TrainRequest
+    from touchbench.app.services.extraction import extract_and_store
+    from touchbench.app.services.live import open_live
+    from touchbench.app.services.models import load_model, train
+    from touchbench.app.services.simulation import write_session
+    from touchbench.drivers.replay import FileReplaySource
+    from touchbench.drivers.source import LIVE_BLOCK
 
     frames = ExtractRequest(
         recordings=recordings, labels=labels, name="frames", extractor="mfcc", events="snr",
@@ -152,10 +152,10 @@ def networks(store: Store, here: Path, recordings: list[Path], labels: Path, ses
 
 def engines(store: Store, repeats: int) -> None:
     """Per-row latency of each entry's own estimator and of its ONNX twin, alternately."""
-    from app.schemas.models import ExportRequest, TrainRequest
-    from app.services.export import export_model, load_predictor
-    from app.services.models import train
-    from app.store.datasets import load_dataset
+    from touchbench.app.schemas.models import ExportRequest, TrainRequest
+    from touchbench.app.services.export import export_model, load_predictor
+    from touchbench.app.services.models import train
+    from touchbench.app.store.datasets import load_dataset
 
     X = load_dataset(store, "touch").X
     print(f"\n3. One row, native vs ONNX Runtime ({repeats} rows each, alternating), ms")
@@ -184,15 +184,15 @@ def engines(store: Store, repeats: int) -> None:
 
 
 def main() -> None:
-    from app.schemas.extraction import ExtractRequest
-    from app.schemas.models import TrainRequest
-    from app.services.extraction import extract_and_store
-    from app.services.live import open_live
-    from app.services.models import load_model, train
-    from app.services.simulation import write_labels, write_session
-    from app.store.database import Store
-    from drivers.replay import FileReplaySource
-    from drivers.source import LIVE_BLOCK
+    from touchbench.app.schemas.extraction import ExtractRequest
+    from touchbench.app.schemas.models import TrainRequest
+    from touchbench.app.services.extraction import extract_and_store
+    from touchbench.app.services.live import open_live
+    from touchbench.app.services.models import load_model, train
+    from touchbench.app.services.simulation import write_labels, write_session
+    from touchbench.app.store.database import Store
+    from touchbench.drivers.replay import FileReplaySource
+    from touchbench.drivers.source import LIVE_BLOCK
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sessions", type=int, default=8, help="fresh sessions replayed")

@@ -32,9 +32,9 @@ from joblib import Parallel, delayed
 from sklearn.model_selection import KFold, StratifiedKFold
 from sklearn.multioutput import MultiOutputClassifier
 
-from benchmark.catalogue import build_pipeline
-from benchmark.io.arff import read_arff
-from benchmark.multitarget import build_multitarget, multitarget_scores
+from touchbench.benchmark.catalogue import build_pipeline
+from touchbench.benchmark.io.arff import read_arff
+from touchbench.benchmark.multitarget import build_multitarget, multitarget_scores
 
 DATASETS = Path(__file__).resolve().parents[2] / "shared" / "datasets" / "uc3m-touch"
 PAPER_BCC_RF = {"mini": 0.912, "maggie": 0.904}

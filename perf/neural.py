@@ -55,13 +55,13 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # perf.sequences, run as a script
 
-from app.services.extraction import extract_dataset
-from app.services.simulation import write_contact_mic_sessions, write_link_trials
-from benchmark.dataset import Dataset
-from benchmark.errors import ConfigurationError
-from benchmark.estimators import check_classifier
-from benchmark.problem import problem_from_dataset, restrict_targets
 from perf.sequences import cross_validate, cross_validate_data
+from touchbench.app.services.extraction import extract_dataset
+from touchbench.app.services.simulation import write_contact_mic_sessions, write_link_trials
+from touchbench.benchmark.dataset import Dataset
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.estimators import check_classifier
+from touchbench.benchmark.problem import problem_from_dataset, restrict_targets
 
 ROOT = Path(__file__).resolve().parents[1]
 #: Distributions ``pip install torch==2.13.0 safetensors`` adds to this project's venv.
@@ -89,7 +89,7 @@ def link_data(trials: tuple[list[Path], Path], extractor: str, options: dict[str
 
 MEASURE = """
 import pickle, resource, sys, time
-from benchmark.estimators import build_estimator
+from touchbench.benchmark.estimators import build_estimator
 problem = pickle.load(open(sys.argv[1], "rb"))
 model = build_estimator(sys.argv[2], problem, random_state=0)
 began = time.perf_counter()

@@ -38,8 +38,8 @@ CHECK = (
     + """
 import sys, time
 import numpy as np
-from benchmark.export import onnx as export
-from benchmark.model import loads_model, model_digest
+from touchbench.benchmark.export import onnx as export
+from touchbench.benchmark.model import loads_model, model_digest
 data = open(sys.argv[1], "rb").read()
 model = loads_model(data, sha256=model_digest(data))
 X = np.tile(np.load(sys.argv[2]), (int(sys.argv[3]), 1))
@@ -58,9 +58,9 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, nargs="+", default=[1, 10])
     parser.add_argument("--classifiers", nargs="+", default=["rf", "cc:rf"])
     args = parser.parse_args()
-    from app.services.datasets import read_data_file
-    from benchmark.model import dumps_model, fit_model
-    from benchmark.problem import restrict_targets
+    from touchbench.app.services.datasets import read_data_file
+    from touchbench.benchmark.model import dumps_model, fit_model
+    from touchbench.benchmark.problem import restrict_targets
 
     full = read_data_file(MAGGIE)
     with tempfile.TemporaryDirectory() as folder:
@@ -72,7 +72,7 @@ def main() -> None:
             np.save(Path(folder) / "X.npy", data.X)
             for repeat in args.repeat:
                 for rows, how in ((10**9, "whole"), (0, "chunked")):
-                    from benchmark.export.onnx import CHECK_ROWS
+                    from touchbench.benchmark.export.onnx import CHECK_ROWS
 
                     chunk = rows or CHECK_ROWS
                     started = time.perf_counter()

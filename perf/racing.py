@@ -36,12 +36,12 @@ from typing import Any
 import numpy as np
 from scipy.stats import rankdata, studentized_range
 
-from benchmark.evaluation.leaderboard import build_leaderboard, scores_by_fold
-from benchmark.io.arff import read_arff
-from benchmark.results import Drop, TaskResult
-from benchmark.run.engine import Problem, RaceRule, run_tasks
-from benchmark.run.folds import make_folds
-from benchmark.run.racing import FIRST_ROUND, decide
+from touchbench.benchmark.evaluation.leaderboard import build_leaderboard, scores_by_fold
+from touchbench.benchmark.io.arff import read_arff
+from touchbench.benchmark.results import Drop, TaskResult
+from touchbench.benchmark.run.engine import Problem, RaceRule, run_tasks
+from touchbench.benchmark.run.folds import make_folds
+from touchbench.benchmark.run.racing import FIRST_ROUND, decide
 
 #: ``../shared/datasets`` beside the project; ``TOUCHBENCH_DATASETS`` names another place
 #: (a git worktree of the project sits elsewhere).
@@ -81,17 +81,17 @@ def regression(n: int) -> Problem:
 
 def suite_ids(problem: Problem, name: str) -> list[str]:
     if problem.kind == "regression":
-        from benchmark.catalogue.regressors import regression_suite
+        from touchbench.benchmark.catalogue.regressors import regression_suite
 
         return regression_suite(
             name, n_targets=problem.n_targets, n_instances=int(problem.X.shape[0])
         )
     if problem.n_targets > 1:
-        from benchmark.multitarget.suites import multitarget_suite
+        from touchbench.benchmark.multitarget.suites import multitarget_suite
 
         return multitarget_suite(name)
-    from benchmark.catalogue import suite
-    from benchmark.estimators import reads_sequences
+    from touchbench.benchmark.catalogue import suite
+    from touchbench.benchmark.estimators import reads_sequences
 
     return [i for i in suite(name) if not reads_sequences(i)]
 

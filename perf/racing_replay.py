@@ -30,10 +30,10 @@ from typing import Any
 
 import numpy as np
 
-from benchmark.evaluation.leaderboard import build_leaderboard
-from benchmark.results import Drop, TaskKey, TaskResult
-from benchmark.run.racing import FIRST_ROUND, RaceRule
-from benchmark.run.schedule import RoundSchedule
+from touchbench.benchmark.evaluation.leaderboard import build_leaderboard
+from touchbench.benchmark.results import Drop, TaskKey, TaskResult
+from touchbench.benchmark.run.racing import FIRST_ROUND, RaceRule
+from touchbench.benchmark.run.schedule import RoundSchedule
 
 #: Seconds of a task beyond its fit and predict (the worker's own work), as measured.
 OVERHEAD = 0.05

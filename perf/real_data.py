@@ -52,15 +52,15 @@ from aeon.utils.numba import stats
 from scipy.stats import binomtest
 from sklearn.ensemble import ExtraTreesClassifier, RandomForestClassifier
 
-from app.errors import USER_ERRORS
-from app.services.extraction import extract_dataset
-from benchmark.estimators import build_estimator
-from benchmark.evaluation.leaderboard import build_leaderboard
-from benchmark.problem import Problem, problem_from_dataset
-from benchmark.results import TaskKey
-from benchmark.run.engine import run_tasks
-from benchmark.run.folds import Fold, make_folds
-from benchmark.sequence import panel
+from touchbench.app.errors import USER_ERRORS
+from touchbench.app.services.extraction import extract_dataset
+from touchbench.benchmark.estimators import build_estimator
+from touchbench.benchmark.evaluation.leaderboard import build_leaderboard
+from touchbench.benchmark.problem import Problem, problem_from_dataset
+from touchbench.benchmark.results import TaskKey
+from touchbench.benchmark.run.engine import run_tasks
+from touchbench.benchmark.run.folds import Fold, make_folds
+from touchbench.benchmark.sequence import panel
 
 CLASSIFIERS = ("minirocket", "interval-forest", "rf")
 CLONES = Path("/tmp/touchbench-real-data")

@@ -30,12 +30,12 @@ import numpy as np
 from sklearn.base import clone
 from sklearn.model_selection import cross_validate
 
-from benchmark.catalogue.regressors import REGRESSORS
-from benchmark.estimators import build_estimator
-from benchmark.evaluation.leaderboard import build_leaderboard
-from benchmark.problem import Problem
-from benchmark.run.engine import run_tasks
-from benchmark.run.folds import Fold, make_fold_plan
+from touchbench.benchmark.catalogue.regressors import REGRESSORS
+from touchbench.benchmark.estimators import build_estimator
+from touchbench.benchmark.evaluation.leaderboard import build_leaderboard
+from touchbench.benchmark.problem import Problem
+from touchbench.benchmark.run.engine import run_tasks
+from touchbench.benchmark.run.folds import Fold, make_fold_plan
 
 PLATE = (40.0, 30.0)
 MICS = np.array([[0.0, 0.0], [40.0, 0.0], [0.0, 30.0], [40.0, 30.0]])

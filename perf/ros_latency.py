@@ -49,15 +49,15 @@ import soundfile
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from app.schemas.extraction import ExtractRequest
-from app.schemas.models import Engine, ExportRequest, TrainRequest
-from app.services.export import export_model
-from app.services.extraction import extract_and_store
-from app.services.live import open_live
-from app.services.models import train
-from app.services.simulation import write_contact_mic_sessions, write_session
-from app.store.database import Store
 from tests.drivers.ros_peer import Peer, rosmaster
+from touchbench.app.schemas.extraction import ExtractRequest
+from touchbench.app.schemas.models import Engine, ExportRequest, TrainRequest
+from touchbench.app.services.export import export_model
+from touchbench.app.services.extraction import extract_and_store
+from touchbench.app.services.live import open_live
+from touchbench.app.services.models import train
+from touchbench.app.services.simulation import write_contact_mic_sessions, write_session
+from touchbench.app.store.database import Store
 
 PATIENCE = 300.0
 
@@ -92,7 +92,7 @@ def measure(
         node = subprocess.Popen(
             [
                 *("taskset", "-c", str(args.core)),
-                *(sys.executable, "-m", "app.cli.main", "--db", url, "ros"),
+                *(sys.executable, "-m", "touchbench.app.cli.main", "--db", url, "ros"),
                 *("--model", model, "--audio-topic", "/mic/audio", "--engine", engine),
             ],
             env=env,

@@ -35,17 +35,17 @@ from pathlib import Path
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from app.services.extraction import extract_dataset
-from app.services.simulation import write_contact_mic_sessions, write_link_trials
-from benchmark.dataset import Dataset
-from benchmark.evaluation.leaderboard import build_leaderboard
-from benchmark.io.arff import read_arff
-from benchmark.problem import problem_from_dataset, restrict_targets
-from benchmark.run.engine import run_tasks
-from benchmark.run.folds import make_folds
-from benchmark.sequence import find_sequence, panel
-from features.events import Detection, Event
-from features.extractors import make_extractor
+from touchbench.app.services.extraction import extract_dataset
+from touchbench.app.services.simulation import write_contact_mic_sessions, write_link_trials
+from touchbench.benchmark.dataset import Dataset
+from touchbench.benchmark.evaluation.leaderboard import build_leaderboard
+from touchbench.benchmark.io.arff import read_arff
+from touchbench.benchmark.problem import problem_from_dataset, restrict_targets
+from touchbench.benchmark.run.engine import run_tasks
+from touchbench.benchmark.run.folds import make_folds
+from touchbench.benchmark.sequence import find_sequence, panel
+from touchbench.features.events import Detection, Event
+from touchbench.features.extractors import make_extractor
 
 SHARED = Path(__file__).resolve().parents[2] / "shared/datasets"
 FLAT = ("rf",)

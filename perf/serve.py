@@ -73,7 +73,7 @@ def start_service(db: str, folder: Path, workers: int) -> tuple[subprocess.Popen
     command = [
         sys.executable,
         "-m",
-        "app.cli.main",
+        "touchbench.app.cli.main",
         "--db",
         db,
         "serve",
@@ -219,7 +219,7 @@ def run_from_cli(db: str, request: dict[str, object]) -> tuple[float, int]:
     command = [
         sys.executable,
         "-m",
-        "app.cli.main",
+        "touchbench.app.cli.main",
         "--db",
         db,
         "bench",
@@ -244,7 +244,7 @@ def compare_runs(store: object, url: str, db: str, request: dict[str, object], r
     Returns rows of the table: wall time, and the part of it the engine ran (the run's
     ``started_at`` to ``finished_at`` in the store); medians of the rounds.
     """
-    from app.store.runs import get_run
+    from touchbench.app.store.runs import get_run
 
     def executing(run_id: int) -> float:
         run = get_run(store, run_id)  # type: ignore[arg-type]
@@ -327,13 +327,13 @@ def main() -> None:
     )
     args = parser.parse_args()
 
-    from app.schemas.datasets import ImportRequest
-    from app.schemas.models import ExportRequest, TrainRequest
-    from app.services.datasets import import_file
-    from app.services.export import export_model, load_predictor
-    from app.services.models import align_features, train
-    from app.store.database import Store
-    from benchmark.io import read_arff
+    from touchbench.app.schemas.datasets import ImportRequest
+    from touchbench.app.schemas.models import ExportRequest, TrainRequest
+    from touchbench.app.services.datasets import import_file
+    from touchbench.app.services.export import export_model, load_predictor
+    from touchbench.app.services.models import align_features, train
+    from touchbench.app.store.database import Store
+    from touchbench.benchmark.io import read_arff
 
     folder = Path(tempfile.mkdtemp(prefix="touchbench-serve-perf-"))
     db = f"sqlite:///{folder / 'perf.db'}"

@@ -48,7 +48,12 @@ def commands(store_url: str) -> dict[str, list[str]]:
         "touchbench --version": [touchbench, "--version"],
         "touchbench --help": [touchbench, "--help"],
         "touchbench datasets (empty SQLite)": [touchbench, "--db", store_url, "datasets"],
-        "python -m app.jobs.process --help": [python, "-m", "app.jobs.process", "--help"],
+        "python -m app.jobs.process --help": [
+            python,
+            "-m",
+            "touchbench.app.jobs.process",
+            "--help",
+        ],
     }
 
 

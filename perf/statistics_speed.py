@@ -30,10 +30,10 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from app.reports.plots import cd_diagram, svg_text
-from benchmark.evaluation.bayesian import correlated_ttest, signed_rank_test
-from benchmark.evaluation.score_table import ScoreTable
-from benchmark.evaluation.statistics import compare_classifiers
+from touchbench.app.reports.plots import cd_diagram, svg_text
+from touchbench.benchmark.evaluation.bayesian import correlated_ttest, signed_rank_test
+from touchbench.benchmark.evaluation.score_table import ScoreTable
+from touchbench.benchmark.evaluation.statistics import compare_classifiers
 
 
 def best_time(call: Callable[[], Any], repeat: int) -> tuple[float, Any]:

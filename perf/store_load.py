@@ -32,8 +32,8 @@ from generated import write_maggie_like
 from sqlalchemy import create_engine, text
 from sqlalchemy.engine import make_url
 
-from app.store.database import Store
-from app.store.datasets import load_dataset
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import load_dataset
 
 REPOSITORY = Path(__file__).resolve().parents[1]
 REPEATS = 3  # load times are the best of this many
@@ -43,7 +43,7 @@ REPEATS = 3  # load times are the best of this many
 #: ru_maxrss, it does not include the memory of the parent it was forked from).
 _CLI_WITH_PEAK = """
 import sys
-from app.cli.main import main
+from touchbench.app.cli.main import main
 code = main(sys.argv[1:])
 with open("/proc/self/status") as status:
     peak = next(line.split()[1] for line in status if line.startswith("VmHWM:"))

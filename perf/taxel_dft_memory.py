@@ -39,7 +39,7 @@ EXTRACT = (
     + """
 import sys
 from pathlib import Path
-from app.services.extraction import extract_dataset
+from touchbench.app.services.extraction import extract_dataset
 rate = None if sys.argv[1].endswith(".csv") else 100.0
 result = extract_dataset(
     [Path(sys.argv[1])], labels=None, extractor="taxel-dft", samplerate=rate,

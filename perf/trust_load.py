@@ -44,7 +44,16 @@ def start_service(db: str, folder: Path) -> tuple[subprocess.Popen[bytes], str]:
         "TOUCHBENCH_WORK_DIR": str(folder / "work"),
         "TOUCHBENCH_JOB_WORKERS": "1",
     }
-    command = [sys.executable, "-m", "app.cli.main", "--db", db, "serve", "--port", str(port)]
+    command = [
+        sys.executable,
+        "-m",
+        "touchbench.app.cli.main",
+        "--db",
+        db,
+        "serve",
+        "--port",
+        str(port),
+    ]
     process = subprocess.Popen(
         [*command, "--log-level", "warning"], cwd=ROOT, env=environment, start_new_session=True
     )

@@ -36,15 +36,15 @@ from sklearn.metrics import f1_score
 from sklearn.model_selection import GridSearchCV, ParameterGrid, StratifiedKFold
 from threadpoolctl import threadpool_limits
 
-from benchmark.catalogue import build_pipeline, get_spec
-from benchmark.catalogue.tuning import (
+from touchbench.benchmark.catalogue import build_pipeline, get_spec
+from touchbench.benchmark.catalogue.tuning import (
     CLASSIFIER_STEP,
     TunedClassifier,
     as_grid,
     inner_folds,
     tuned_spec,
 )
-from benchmark.io.arff import read_arff
+from touchbench.benchmark.io.arff import read_arff
 
 DATASETS = Path(__file__).resolve().parents[2] / "shared/datasets/uc3m-touch"
 

@@ -28,12 +28,12 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmark.catalogue import CATALOGUE
-from benchmark.io.arff import read_arff, write_arff
-from benchmark.problem import problem_from_dataset, restrict_targets
-from benchmark.run.engine import run_tasks
-from benchmark.run.folds import make_folds
-from benchmark.weka.reference import WEKA_DATA, cross_validated_accuracy, weka_jar
+from touchbench.benchmark.catalogue import CATALOGUE
+from touchbench.benchmark.io.arff import read_arff, write_arff
+from touchbench.benchmark.problem import problem_from_dataset, restrict_targets
+from touchbench.benchmark.run.engine import run_tasks
+from touchbench.benchmark.run.folds import make_folds
+from touchbench.benchmark.weka.reference import WEKA_DATA, cross_validated_accuracy, weka_jar
 
 UC3M = Path(__file__).resolve().parents[2] / "shared/datasets/uc3m-touch"
 WEKA_FILES = (

@@ -23,8 +23,8 @@ from typing import Any
 import numpy as np
 from sklearn.base import BaseEstimator, ClassifierMixin
 
-from benchmark.catalogue.neural import NeuralSequenceClassifier
-from benchmark.catalogue.spec import ClassifierSpec
+from touchbench.benchmark.catalogue.neural import NeuralSequenceClassifier
+from touchbench.benchmark.catalogue.spec import ClassifierSpec
 
 #: The folder of the gate's files, given to every process through the environment.
 GATE_VARIABLE = "TOUCHBENCH_TEST_GATE"

@@ -15,15 +15,15 @@ from typing import TYPE_CHECKING, Annotated, TypeVar
 
 from fastapi import Depends, Header, HTTPException, Query, Request, Response
 
-from app.jobs.dispatcher import Dispatcher
-from app.schemas.listing import Page
-from app.settings import Role, Settings
-from app.store.database import Store
-from app.store.models import ModelInfo, model_version
+from touchbench.app.jobs.dispatcher import Dispatcher
+from touchbench.app.schemas.listing import Page
+from touchbench.app.settings import Role, Settings
+from touchbench.app.store.database import Store
+from touchbench.app.store.models import ModelInfo, model_version
 
 if TYPE_CHECKING:  # scikit-learn loads on the first prediction, not at start-up
-    from app.schemas.models import Engine
-    from benchmark.model import Predictor
+    from touchbench.app.schemas.models import Engine
+    from touchbench.benchmark.model import Predictor
 
 
 #: A stored model's id, artifact sha256 and ``NAME@VERSION``
@@ -136,7 +136,7 @@ class ModelCache:
                 return cached
         # loaded with the first model: start-up time (scikit-learn loads in the service's
         # warm-up thread, not before it answers its first request)
-        from app.services.export import load_predictor
+        from touchbench.app.services.export import load_predictor
 
         info, model = load_predictor(store, key[0], engine)
         with self._lock:

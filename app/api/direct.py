@@ -27,8 +27,8 @@ from pydantic import BaseModel, ValidationError
 from starlette.requests import Request
 from starlette.responses import Response
 
-from app.api.counting import check_counts, limited_lists
-from app.api.deps import (
+from touchbench.app.api.counting import check_counts, limited_lists
+from touchbench.app.api.deps import (
     action_of,
     check_api_key,
     get_service,

@@ -17,9 +17,9 @@ from fastapi.responses import JSONResponse
 from pydantic import Field
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
-from app.errors import USER_ERRORS, ConflictError, FieldError, NotFoundError
-from app.schemas.base import Schema
-from benchmark.errors import DataFormatError
+from touchbench.app.errors import USER_ERRORS, ConflictError, FieldError, NotFoundError
+from touchbench.app.schemas.base import Schema
+from touchbench.benchmark.errors import DataFormatError
 
 log = logging.getLogger("touchbench.api")
 

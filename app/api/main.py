@@ -7,11 +7,20 @@ from __future__ import annotations
 
 from fastapi import Depends, FastAPI
 
-from app.api import errors
-from app.api.deps import require_api_key
-from app.api.routes import datasets, extractors, health, jobs, live, models, recordings, runs
-from app.api.uploads import BodyLimit
-from app.settings import Settings
+from touchbench.app.api import errors
+from touchbench.app.api.deps import require_api_key
+from touchbench.app.api.routes import (
+    datasets,
+    extractors,
+    health,
+    jobs,
+    live,
+    models,
+    recordings,
+    runs,
+)
+from touchbench.app.api.uploads import BodyLimit
+from touchbench.app.settings import Settings
 
 
 def install(app: FastAPI, settings: Settings) -> None:

@@ -15,8 +15,8 @@ import json
 
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from app.api.errors import error_body
-from app.api.trust import send_json
+from touchbench.app.api.errors import error_body
+from touchbench.app.api.trust import send_json
 
 #: What a client whose request the stop cut short reads.
 STOPPING = error_body(

@@ -21,8 +21,8 @@ from starlette.middleware.cors import CORSMiddleware
 from starlette.responses import JSONResponse, Response
 from starlette.types import ASGIApp, Receive, Scope, Send
 
-from app.api.errors import error_body
-from app.settings import host_name, origin
+from touchbench.app.api.errors import error_body
+from touchbench.app.settings import host_name, origin
 
 #: Methods that do not change state (browsers send them cross-origin as they please; the
 #: answers stay unreadable to other origins without CORS).

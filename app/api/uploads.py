@@ -16,9 +16,9 @@ from fastapi.exceptions import RequestValidationError
 from pydantic import ValidationError
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from app.api.errors import UploadTooLarge, error_body
-from app.errors import USER_ERRORS, AppError, client_words
-from app.schemas.base import Request
+from touchbench.app.api.errors import UploadTooLarge, error_body
+from touchbench.app.errors import USER_ERRORS, AppError, client_words
+from touchbench.app.schemas.base import Request
 
 RequestType = TypeVar("RequestType", bound=Request)
 

@@ -26,6 +26,6 @@ def _interrupted_quietly(
 _previous_hook = sys.excepthook
 sys.excepthook = _interrupted_quietly
 
-from app.cli.signals import redeliver_lost_interrupts  # noqa: E402 (after the hook: see above)
+from touchbench.app.cli.signals import redeliver_lost_interrupts  # noqa: E402 (after the hook: see above)
 
 redeliver_lost_interrupts()

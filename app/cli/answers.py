@@ -13,12 +13,12 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from app.cli.output import JsonOption, info, print_json, run_table, table
-from app.cli.state import get_state
-from app.schemas.runs import DEFAULT_TIMEOUT
+from touchbench.app.cli.output import JsonOption, info, print_json, run_table, table
+from touchbench.app.cli.state import get_state
+from touchbench.app.schemas.runs import DEFAULT_TIMEOUT
 
 if TYPE_CHECKING:
-    from app.schemas.certainty import RunCertainty
+    from touchbench.app.schemas.certainty import RunCertainty
 
 
 def register(app: typer.Typer) -> None:
@@ -51,7 +51,7 @@ def classes_command(
 ) -> None:
     """Show per-class precision, recall and F1, the confusion matrix (summed over folds)
     and the expected calibration error of a run's classifiers, per target."""
-    from app.reports.certainty_tables import calibrations, class_tables, score
+    from touchbench.app.reports.certainty_tables import calibrations, class_tables, score
 
     certainty = _certainty(ctx, run, classifier)
     if as_json:
@@ -88,19 +88,19 @@ def calibration_command(
 ) -> None:
     """Show the expected calibration error of a run's classifiers from their out-of-fold
     probabilities, and draw their reliability diagram."""
-    from app.reports.plots import figure_format, save_figure
+    from touchbench.app.reports.plots import figure_format, save_figure
 
     if output is not None:
         figure_format(output)
     certainty = _certainty(ctx, run, classifier)
     if output is not None:
-        from app.reports.figures import reliability_figure
+        from touchbench.app.reports.figures import reliability_figure
 
         save_figure(reliability_figure(certainty, top), output)
     if as_json:
         print_json(certainty.to_json())
     else:
-        from app.reports.certainty_tables import calibration_table
+        from touchbench.app.reports.certainty_tables import calibration_table
 
         run_table(calibration_table(certainty))
     if output is not None:
@@ -108,7 +108,7 @@ def calibration_command(
 
 
 def _certainty(ctx: typer.Context, run: int, classifiers: str | None) -> RunCertainty:
-    from app.services.certainty import run_certainty
+    from touchbench.app.services.certainty import run_certainty
 
     names = [c.strip() for c in classifiers.split(",") if c.strip()] if classifiers else None
     return run_certainty(get_state(ctx).store, run, classifiers=names)
@@ -150,9 +150,9 @@ def import_results_command(
 ) -> None:
     """Import a WEKA Experimenter results file (InstanceResultListener ARFF) as a finished
     run, so that leaderboards and reports rank the paper's classifiers beside ours."""
-    from app.cli.requests import build_request
-    from app.schemas.imported import ImportResultsRequest
-    from app.services.imported import import_results
+    from touchbench.app.cli.requests import build_request
+    from touchbench.app.schemas.imported import ImportResultsRequest
+    from touchbench.app.services.imported import import_results
 
     request = build_request(
         ImportResultsRequest,
@@ -199,9 +199,9 @@ def importance_command(
     """Permutation importance of a run's classifier on each of its outer test folds, per
     feature and per group of features (channel, feature family), with the t-test of each
     group's drop. Kept as a job: the run's web page and report show it."""
-    from app.cli.requests import build_request
-    from app.schemas.importance import ImportanceRequest, ImportanceResult
-    from app.services.jobs import carry_out_here
+    from touchbench.app.cli.requests import build_request
+    from touchbench.app.schemas.importance import ImportanceRequest, ImportanceResult
+    from touchbench.app.services.jobs import carry_out_here
 
     request = build_request(
         ImportanceRequest,
@@ -221,7 +221,7 @@ def importance_command(
     if as_json:
         print_json(found.to_json())
         return
-    from app.reports.answer_tables import importance_tables
+    from touchbench.app.reports.answer_tables import importance_tables
 
     for shown in importance_tables(found, top):
         run_table(shown)
@@ -270,11 +270,11 @@ def learning_curve_command(
     """Cross-validate classifiers on growing shares of each training fold (stratified,
     group-aware; the test folds stay whole): the share at which each comes within a point
     of its full score answers "do I need to record more?". Kept as a job with its progress."""
-    from app.cli.progress import TenthsProgress
-    from app.cli.requests import build_request
-    from app.reports.plots import figure_format, save_figure
-    from app.schemas.learning import LearningCurveRequest, LearningCurveResult
-    from app.services.jobs import carry_out_here
+    from touchbench.app.cli.progress import TenthsProgress
+    from touchbench.app.cli.requests import build_request
+    from touchbench.app.reports.plots import figure_format, save_figure
+    from touchbench.app.schemas.learning import LearningCurveRequest, LearningCurveResult
+    from touchbench.app.services.jobs import carry_out_here
 
     if output is not None:
         figure_format(output)
@@ -294,13 +294,13 @@ def learning_curve_command(
     job_id, found = carry_out_here(get_state(ctx).store, request, jobs=jobs, on_progress=progress)
     result = LearningCurveResult.model_validate(found)
     if output is not None:
-        from app.reports.figures import learning_figure
+        from touchbench.app.reports.figures import learning_figure
 
         save_figure(learning_figure(result), output)
     if as_json:
         print_json(result.to_json())
         return
-    from app.reports.answer_tables import learning_table
+    from touchbench.app.reports.answer_tables import learning_table
 
     run_table(learning_table(result))
     info(f"kept as job {job_id}" + (f"; wrote {output}" if output is not None else ""))

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from app.cli.output import (
+from touchbench.app.cli.output import (
     EXIT_FAILED,
     EXIT_INTERRUPTED,
     ExitWith,
@@ -21,14 +21,14 @@ from app.cli.output import (
     run_table,
     table,
 )
-from app.cli.state import get_state
-from app.schemas.runs import BenchRequest
+from touchbench.app.cli.state import get_state
+from touchbench.app.schemas.runs import BenchRequest
 
 if TYPE_CHECKING:
-    from app.schemas.ablation import AblationResult
-    from app.schemas.runs import LeaderboardSchema
-    from app.services.runs import IndependentResult, RunLeaderboard
-    from app.store.database import Store
+    from touchbench.app.schemas.ablation import AblationResult
+    from touchbench.app.schemas.runs import LeaderboardSchema
+    from touchbench.app.services.runs import IndependentResult, RunLeaderboard
+    from touchbench.app.store.database import Store
 
 # scikit-learn, the engine and Dask are imported by the commands that use them, so that
 # this module's other commands (runs, leaderboard, cancel) start without them.
@@ -43,7 +43,7 @@ def _default(field: str) -> Any:
 
 def _memory_default() -> str:
     """The default memory cap of a task on this machine, for ``--help``."""
-    from benchmark.run.memory import MB, default_task_memory
+    from touchbench.benchmark.run.memory import MB, default_task_memory
 
     caps = [default_task_memory(jobs) for jobs in (1, 2)]
     if caps[0] is None or caps[1] is None:
@@ -94,8 +94,8 @@ def classifiers_command(
     sequence, or -e mfcc -O frames=N) and refuse flat data sets. On numeric targets the
     same ids name regressors (--regressors lists them).
     """
-    from benchmark.catalogue import CATALOGUE, get_spec, suite
-    from benchmark.export.onnx import exports_onnx
+    from touchbench.benchmark.catalogue import CATALOGUE, get_spec, suite
+    from touchbench.benchmark.export.onnx import exports_onnx
 
     if multi_target and regressors:
         raise typer.BadParameter("give --multi-target or --regressors, not both")
@@ -103,7 +103,7 @@ def classifiers_command(
         _print_multitarget(suite_name, as_json)
         return
     if regressors:
-        from benchmark.catalogue.regressors import REGRESSORS, regression_suite
+        from touchbench.benchmark.catalogue.regressors import REGRESSORS, regression_suite
 
         ids = (
             regression_suite(suite_name, n_targets=1, n_instances=0, sequences=True)
@@ -182,7 +182,7 @@ def _costs(
     """Each entry's cost label and what the labels mean: the catalogue's hint at its
     reference shape, or (with a data set) the shape-aware estimate the engine orders a
     race and predicts a budget by."""
-    from benchmark.catalogue.costs import (
+    from touchbench.benchmark.catalogue.costs import (
         REFERENCE_CLASSES,
         REFERENCE_FEATURES,
         REFERENCE_INSTANCES,
@@ -196,7 +196,7 @@ def _costs(
             f"{REFERENCE_FEATURES} features x {REFERENCE_CLASSES} classes; --dataset "
             "NAME scales it to a data set"
         )
-    from app.store.datasets import load_schema
+    from touchbench.app.store.datasets import load_schema
 
     info, schema, _ = load_schema(get_state(ctx).store, dataset)
     classes = max((len(t.values) for t in schema.targets), default=1)
@@ -209,11 +209,15 @@ def _costs(
 
 
 def _print_multitarget(suite_name: str | None, as_json: bool) -> None:
-    from benchmark.catalogue import get_spec
-    from benchmark.export.multitarget import exports_multitarget
-    from benchmark.export.onnx import exports_onnx
-    from benchmark.multitarget import META_METHODS, multitarget_configurations, parse_config
-    from benchmark.multitarget.suites import multitarget_suite
+    from touchbench.benchmark.catalogue import get_spec
+    from touchbench.benchmark.export.multitarget import exports_multitarget
+    from touchbench.benchmark.export.onnx import exports_onnx
+    from touchbench.benchmark.multitarget import (
+        META_METHODS,
+        multitarget_configurations,
+        parse_config,
+    )
+    from touchbench.benchmark.multitarget.suites import multitarget_suite
 
     ids = (
         multitarget_suite(suite_name)
@@ -509,11 +513,11 @@ def bench_command(
     ranked by mean absolute error. Ctrl-C keeps
     every finished fold: `touchbench bench --resume RUN` carries out the rest.
     """
-    from app.cli.progress import TaskProgress
-    from app.cli.requests import build_request
-    from app.errors import ConflictError
-    from app.services.runs import RunCancelled, create_run, execute_run, independent_runs
-    from app.store.states import RunBusy
+    from touchbench.app.cli.progress import TaskProgress
+    from touchbench.app.cli.requests import build_request
+    from touchbench.app.errors import ConflictError
+    from touchbench.app.services.runs import RunCancelled, create_run, execute_run, independent_runs
+    from touchbench.app.store.states import RunBusy
 
     store = get_state(ctx).store
     values = {
@@ -548,7 +552,7 @@ def bench_command(
         _check_ablation(store, request, resume, ablate_groups)
     jobs = _check_jobs(jobs, oversubscribe)
     if scheduler is not None:
-        from benchmark.run.dask_backend import connect
+        from touchbench.benchmark.run.dask_backend import connect
 
         connect(scheduler).close()  # fail before a run exists, not after
     # On stderr whatever the output: --json keeps stdout to the JSON, not the progress.
@@ -641,7 +645,7 @@ def cancel_command(
     as_json: JsonOption = False,
 ) -> None:
     """Cancel a run: a queued run at once, a running one as soon as its process hears of it."""
-    from app.store.runs import request_cancel
+    from touchbench.app.store.runs import request_cancel
 
     run = request_cancel(get_state(ctx).store, run_id)
     if as_json:
@@ -654,7 +658,7 @@ def cancel_command(
 
 
 def _check_jobs(jobs: int, oversubscribe: bool) -> int:
-    from benchmark.run.engine import available_cores
+    from touchbench.benchmark.run.engine import available_cores
 
     cores = available_cores()
     if jobs > cores and not oversubscribe:
@@ -667,7 +671,7 @@ def _check_jobs(jobs: int, oversubscribe: bool) -> int:
 
 
 def _kept_message(store: Store, run_id: int, what: str) -> str:
-    from app.store.runs import get_run
+    from touchbench.app.store.runs import get_run
 
     run = get_run(store, run_id)
     return (
@@ -693,7 +697,7 @@ def _print_run_report(
     _print_leaderboard(ranked)
     _print_run_tables(report)
     if ablation is not None:
-        from app.reports.answer_tables import ablation_table
+        from touchbench.app.reports.answer_tables import ablation_table
 
         run_table(ablation_table(ablation))
         info(
@@ -711,9 +715,9 @@ def _check_ablation(
 ) -> None:
     """Refuse ``--ablate-groups`` before the run: a grouping that does not exist, or that
     the data set's feature names do not give."""
-    from app.cli.requests import build_request
-    from app.schemas.ablation import AblationRequest
-    from app.services.ablation import check_grouping
+    from touchbench.app.cli.requests import build_request
+    from touchbench.app.schemas.ablation import AblationRequest
+    from touchbench.app.services.ablation import check_grouping
 
     if request is not None and request.independent:
         raise typer.BadParameter("is not used with --independent", param_hint="--ablate-groups")
@@ -723,10 +727,10 @@ def _check_ablation(
 
 def _ablate(store: Store, run_id: int, grouping: str, jobs: int, as_json: bool) -> AblationResult:
     """Carry out the ablation of a finished run, as a job the store keeps."""
-    from app.cli.progress import TenthsProgress
-    from app.cli.requests import build_request
-    from app.schemas.ablation import AblationRequest, AblationResult
-    from app.services.jobs import carry_out_here
+    from touchbench.app.cli.progress import TenthsProgress
+    from touchbench.app.cli.requests import build_request
+    from touchbench.app.schemas.ablation import AblationRequest, AblationResult
+    from touchbench.app.services.jobs import carry_out_here
 
     request = build_request(AblationRequest, _ABLATION_OPTIONS, run=run_id, grouping=grouping)
     # a line per tenth of the work: an ablation reruns every classifier per group
@@ -745,8 +749,8 @@ def _ranked(
     beside: Sequence[int] = (),
 ) -> RunLeaderboard:
     """A run's leaderboard; a run without results says how to carry it out."""
-    from app.errors import AppError
-    from app.services.runs import NoResultsError, run_leaderboard
+    from touchbench.app.errors import AppError
+    from touchbench.app.services.runs import NoResultsError, run_leaderboard
 
     try:
         return run_leaderboard(store, run_id, metric=metric, baseline=baseline, beside=beside)
@@ -762,8 +766,8 @@ def _ranked(
 
 def runs_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
     """List benchmark runs with their status and progress."""
-    from app.schemas.runs import RunList
-    from app.store.runs import list_runs
+    from touchbench.app.schemas.runs import RunList
+    from touchbench.app.store.runs import list_runs
 
     runs = list_runs(get_state(ctx).store)
     if as_json:
@@ -829,7 +833,7 @@ def leaderboard_command(
         raise typer.BadParameter(
             f"'{output_format}' is not one of {', '.join(FORMATS)}", param_hint="--format"
         )
-    from app.reports.leaderboard import (
+    from touchbench.app.reports.leaderboard import (
         leaderboard_csv,
         leaderboard_markdown,
         metric_columns,
@@ -846,7 +850,7 @@ def leaderboard_command(
     elif output_format == "markdown":
         sys.stdout.write(leaderboard_markdown(run, board, columns, ranked.besides, ranked.notes()))
     elif output_format == "arff":
-        from app.reports.results_arff import write_results_arff
+        from touchbench.app.reports.results_arff import write_results_arff
 
         write_results_arff(ranked, sys.stdout)
     else:
@@ -857,7 +861,7 @@ def leaderboard_command(
 def _print_run_tables(report: LeaderboardSchema) -> None:
     """Tuned twins beside their defaults, what each fold chose, and a multi-target
     regression's scores per target (nothing of what the run lacks)."""
-    from app.reports.run_tables import run_tables
+    from touchbench.app.reports.run_tables import run_tables
 
     for shown in run_tables(report):
         run_table(shown)
@@ -889,7 +893,7 @@ def _print_independent(result: IndependentResult, as_json: bool) -> None:
 
 
 def _print_leaderboard(ranked: RunLeaderboard) -> None:
-    from app.reports.leaderboard import (
+    from touchbench.app.reports.leaderboard import (
         beside_notes,
         leaderboard_header,
         leaderboard_rows,

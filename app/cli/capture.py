@@ -16,11 +16,11 @@ from typing import Annotated
 import typer
 from rich.markup import escape
 
-from app.cli.extract import key_values
-from app.cli.output import EngineOption, JsonOption, info, print_json, table, warn
-from app.cli.state import get_state
-from app.errors import AppError
-from drivers.source import LIVE_BLOCK
+from touchbench.app.cli.extract import key_values
+from touchbench.app.cli.output import EngineOption, JsonOption, info, print_json, table, warn
+from touchbench.app.cli.state import get_state
+from touchbench.app.errors import AppError
+from touchbench.drivers.source import LIVE_BLOCK
 
 
 def register(app: typer.Typer) -> None:
@@ -32,7 +32,7 @@ def register(app: typer.Typer) -> None:
 
 def devices_command(as_json: JsonOption = False) -> None:
     """List the capture devices PortAudio sees (index, name, input channels, default rate)."""
-    from drivers.sound import list_devices
+    from touchbench.drivers.sound import list_devices
 
     devices = list_devices()
     if as_json:
@@ -85,7 +85,7 @@ def record_command(
     Touches detected while recording are shown as they end. Ctrl-C ends the take: the
     audio so far is kept and the labels file stays valid.
     """
-    from app.services.recording import record_take
+    from touchbench.app.services.recording import record_take
 
     targets = _labels(label or [])
 
@@ -148,7 +148,7 @@ def simulate_command(
     (3200 Hz), contact at one of five points or none; extract with --extractor
     band-peaks or mfcc.
     """
-    from app.services.simulation import write_contact_mic_sessions, write_link_trials
+    from touchbench.app.services.simulation import write_contact_mic_sessions, write_link_trials
 
     write = write_contact_mic_sessions if sensor is Sensor.contact_mic else write_link_trials
     paths, labels = write(out, trials=trials, seed=seed)
@@ -224,15 +224,15 @@ def live_command(
 ) -> None:
     """Predict every touch of a live stream with a model: its own event detection and
     extractor run on the stream, and each touch is printed as soon as it ends."""
-    from app.services.live import LiveSession, follower, load_live_model
-    from drivers.replay import FileReplaySource
-    from drivers.sound import SoundDeviceSource
-    from drivers.source import Source
+    from touchbench.app.services.live import LiveSession, follower, load_live_model
+    from touchbench.drivers.replay import FileReplaySource
+    from touchbench.drivers.sound import SoundDeviceSource
+    from touchbench.drivers.source import Source
 
     if (device is None) == (replay is None):
         raise AppError("give exactly one of --device DEV or --replay FILE")
-    from app.cli.requests import build_request
-    from app.schemas.models import EngineChoice
+    from touchbench.app.cli.requests import build_request
+    from touchbench.app.schemas.models import EngineChoice
 
     choice = build_request(EngineChoice, engine=engine)
     store = get_state(ctx).store

@@ -16,18 +16,18 @@ import typer
 from rich.console import Console
 from rich.progress import BarColumn, DownloadColumn, Progress, TextColumn, TimeRemainingColumn
 
-from app.cli.output import JsonOption, info, print_json, table
-from app.cli.state import get_state
-from app.errors import AppError
-from app.schemas.datasets import (
+from touchbench.app.cli.output import JsonOption, info, print_json, table
+from touchbench.app.cli.state import get_state
+from touchbench.app.errors import AppError
+from touchbench.app.schemas.datasets import (
     AttributeDescription,
     DatasetDescription,
     ImportResult,
     RenameRequest,
 )
-from app.services import datasets as service
-from app.services.datasets import ImportProgress
-from app.store.database import Store
+from touchbench.app.services import datasets as service
+from touchbench.app.services.datasets import ImportProgress
+from touchbench.app.store.database import Store
 
 DatasetArgument = Annotated[
     str, typer.Argument(metavar="DATASET", help="Data set name or id.", show_default=False)
@@ -78,8 +78,8 @@ def import_command(
 
     Nothing is stored from a file with an error, and known content is never stored twice.
     """
-    from app.cli.requests import build_request
-    from app.schemas.datasets import ImportRequest
+    from touchbench.app.cli.requests import build_request
+    from touchbench.app.schemas.datasets import ImportRequest
 
     request = build_request(
         ImportRequest,
@@ -195,7 +195,7 @@ def rename_command(
     ],
 ) -> None:
     """Give a data set another name."""
-    from app.cli.requests import build_request
+    from touchbench.app.cli.requests import build_request
 
     request = build_request(RenameRequest, {"name": "NEW"}, name=new_name)
     renamed = service.rename_dataset(get_state(ctx).store, dataset, request)

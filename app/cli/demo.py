@@ -10,8 +10,8 @@ from typing import Annotated
 
 import typer
 
-from app.cli.output import console, info, table
-from app.cli.state import get_state
+from touchbench.app.cli.output import console, info, table
+from touchbench.app.cli.state import get_state
 
 
 def register(app: typer.Typer) -> None:
@@ -31,9 +31,13 @@ def demo_command(
     Unless --db is given, the store is FOLDER/touchbench.db, so the demo never touches
     your own store.
     """
-    from app.reports.leaderboard import leaderboard_header, leaderboard_rows, metric_columns
-    from app.services.demo import run_demo
-    from app.store.database import Store
+    from touchbench.app.reports.leaderboard import (
+        leaderboard_header,
+        leaderboard_rows,
+        metric_columns,
+    )
+    from touchbench.app.services.demo import run_demo
+    from touchbench.app.store.database import Store
 
     state = get_state(ctx)
     folder.mkdir(parents=True, exist_ok=True)

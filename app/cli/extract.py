@@ -12,9 +12,9 @@ from typing import Annotated, Any
 import typer
 from rich.markup import escape
 
-from app.cli.output import info, print_json, table, warn
-from app.cli.state import get_state
-from app.errors import AppError
+from touchbench.app.cli.output import info, print_json, table, warn
+from touchbench.app.cli.state import get_state
+from touchbench.app.errors import AppError
 
 
 def register(app: typer.Typer) -> None:
@@ -36,9 +36,9 @@ def extractors_command(
     """List the extractors and event detectors with every option (-O KEY=VALUE of extract):
     its type, default and meaning.
     """
-    from app.cli.requests import build_request
-    from app.schemas.extraction import ExtractorsRequest
-    from app.services.extractors import list_extractors
+    from touchbench.app.cli.requests import build_request
+    from touchbench.app.schemas.extraction import ExtractorsRequest
+    from touchbench.app.services.extractors import list_extractors
 
     listing = list_extractors(build_request(ExtractorsRequest, samplerate=samplerate))
     if as_json:
@@ -193,9 +193,9 @@ def extract_command(
     by their time column (--fields picks columns). `touchbench extractors` lists every
     extractor's options (-O KEY=VALUE) with their type, default and meaning.
     """
-    from app.cli.requests import build_request
-    from app.schemas.extraction import ExtractRequest
-    from app.services.extraction import extract_and_store
+    from touchbench.app.cli.requests import build_request
+    from touchbench.app.schemas.extraction import ExtractRequest
+    from touchbench.app.services.extraction import extract_and_store
 
     request = build_request(
         ExtractRequest,

@@ -8,10 +8,10 @@ from __future__ import annotations
 
 import typer
 
-from app.cli.output import JsonOption, info, print_json, table
-from app.cli.state import get_state
-from app.schemas.datasets import DatasetList
-from app.services.listing import list_datasets
+from touchbench.app.cli.output import JsonOption, info, print_json, table
+from touchbench.app.cli.state import get_state
+from touchbench.app.schemas.datasets import DatasetList
+from touchbench.app.services.listing import list_datasets
 
 
 def register(app: typer.Typer) -> None:

@@ -14,12 +14,12 @@ from typing import Annotated
 
 import typer
 
-from app.cli import help as help_pages
-from app.cli.exits import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_USAGE, ExitWith
-from app.cli.lazy import LazyGroup, Subcommand
-from app.cli.signals import interrupted_status, interrupts
-from app.cli.state import CliState
-from app.environment import database_url
+from touchbench.app.cli import help as help_pages
+from touchbench.app.cli.exits import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_USAGE, ExitWith
+from touchbench.app.cli.lazy import LazyGroup, Subcommand
+from touchbench.app.cli.signals import interrupted_status, interrupts
+from touchbench.app.cli.state import CliState
+from touchbench.app.environment import database_url
 
 EXIT_UNEXPECTED = EXIT_FAILED
 
@@ -30,180 +30,188 @@ EXIT_UNEXPECTED = EXIT_FAILED
 COMMANDS = (
     Subcommand(
         "import",
-        "app.cli.datasets",
+        "touchbench.app.cli.datasets",
         "Import an ARFF or CSV file as a data set, named after the file.",
     ),
-    Subcommand("datasets", "app.cli.listing", "List the data sets in the store."),
+    Subcommand("datasets", "touchbench.app.cli.listing", "List the data sets in the store."),
     Subcommand(
         "show",
-        "app.cli.datasets",
+        "touchbench.app.cli.datasets",
         "Show a data set's schema, class distribution per target and missing values.",
     ),
     Subcommand(
         "export",
-        "app.cli.datasets",
+        "touchbench.app.cli.datasets",
         "Write a data set back as ARFF (the relation keeps MEKA's -C header for its targets).",
     ),
-    Subcommand("rename", "app.cli.datasets", "Give a data set another name."),
+    Subcommand("rename", "touchbench.app.cli.datasets", "Give a data set another name."),
     Subcommand(
         "delete",
-        "app.cli.datasets",
+        "touchbench.app.cli.datasets",
         "Delete a data set with its instances, runs and results (not while a run uses it).",
     ),
     Subcommand(
         "classifiers",
-        "app.cli.bench",
+        "touchbench.app.cli.bench",
         "List the classifier catalogue (id, WEKA name, family, capabilities).",
     ),
     Subcommand(
         "bench",
-        "app.cli.bench",
+        "touchbench.app.cli.bench",
         "Cross-validate classifiers on a data set; every finished fold is stored at once.",
     ),
-    Subcommand("runs", "app.cli.bench", "List benchmark runs with their status and progress."),
+    Subcommand(
+        "runs", "touchbench.app.cli.bench", "List benchmark runs with their status and progress."
+    ),
     Subcommand(
         "leaderboard",
-        "app.cli.bench",
+        "touchbench.app.cli.bench",
         "Show a run's leaderboard with WEKA's significance marks (v better, * worse).",
     ),
     Subcommand(
         "import-results",
-        "app.cli.answers",
+        "touchbench.app.cli.answers",
         "Import a WEKA Experimenter results file (InstanceResultListener ARFF) as a finished "
         "run, so that leaderboards and reports rank the paper's classifiers beside ours.",
     ),
     Subcommand(
         "classes",
-        "app.cli.answers",
+        "touchbench.app.cli.answers",
         "Show per-class precision, recall and F1, the confusion matrix (summed over folds) "
         "and the expected calibration error of a run's classifiers, per target.",
     ),
     Subcommand(
         "calibration",
-        "app.cli.answers",
+        "touchbench.app.cli.answers",
         "Show the expected calibration error of a run's classifiers from their out-of-fold "
         "probabilities, and draw their reliability diagram.",
     ),
     Subcommand(
         "importance",
-        "app.cli.answers",
+        "touchbench.app.cli.answers",
         "Permutation importance of a run's classifier on each of its outer test folds, per "
         "feature and per group of features (channel, feature family), with the t-test of each "
         "group's drop. Kept as a job: the run's web page and report show it.",
     ),
     Subcommand(
         "learning-curve",
-        "app.cli.answers",
+        "touchbench.app.cli.answers",
         "Cross-validate classifiers on growing shares of each training fold (stratified, "
         "group-aware; the test folds stay whole): the share at which each comes within a point "
         'of its full score answers "do I need to record more?". Kept as a job with its progress.',
     ),
     Subcommand(
         "cancel",
-        "app.cli.bench",
+        "touchbench.app.cli.bench",
         "Cancel a run: a queued run at once, a running one as soon as its process hears of it.",
     ),
     Subcommand(
         "train",
-        "app.cli.models",
+        "touchbench.app.cli.models",
         "Fit a classifier on every instance of a data set and store the model.",
     ),
     Subcommand(
         "models",
-        "app.cli.models",
+        "touchbench.app.cli.models",
         "List trained models, a row per version, with their aliases (artifacts are not read).",
     ),
     Subcommand(
         "predict",
-        "app.cli.models",
+        "touchbench.app.cli.models",
         "Predict every instance of a file; attributes are matched to the model's by name.",
     ),
     Subcommand(
         "delete-model",
-        "app.cli.models",
+        "touchbench.app.cli.models",
         "Delete a trained model (one version: NAME alone is its newest).",
     ),
     Subcommand(
-        "alias", "app.cli.models", "Point an alias of a model (NAME@ALIAS) at one of its versions."
+        "alias",
+        "touchbench.app.cli.models",
+        "Point an alias of a model (NAME@ALIAS) at one of its versions.",
     ),
     Subcommand(
         "promote",
-        "app.cli.models",
+        "touchbench.app.cli.models",
         "Make a version the model's champion: NAME@champion, which `live`, `serve` and live "
         "WebSocket sessions on it follow, answers with it from now on (`rollback` undoes).",
     ),
     Subcommand(
         "rollback",
-        "app.cli.models",
+        "touchbench.app.cli.models",
         "Point the champion (or --alias) back at the version it pointed at before its last move.",
     ),
     Subcommand(
         "export-model",
-        "app.cli.models",
+        "touchbench.app.cli.models",
         "Write a model as one ONNX graph (preprocessing and classifier), checked against the "
         "model on its training instances; predictions then run it in ONNX Runtime.",
     ),
     Subcommand(
         "extract",
-        "app.cli.extract",
+        "touchbench.app.cli.extract",
         "Detect touch events in recordings, extract features, and store them as a data set.",
     ),
     Subcommand(
         "extractors",
-        "app.cli.extract",
+        "touchbench.app.cli.extract",
         "List the extractors and event detectors with every option (-O KEY=VALUE of extract):"
         " its type, default and meaning.",
     ),
     Subcommand(
         "demo",
-        "app.cli.demo",
+        "touchbench.app.cli.demo",
         "Simulate touch sessions, extract features, benchmark, train and predict.",
     ),
     Subcommand(
         "serve",
-        "app.cli.serve",
+        "touchbench.app.cli.serve",
         "Serve the REST API (data sets, recording uploads, runs, leaderboards, models, "
         "predictions) at http://HOST:PORT/api, its documentation at /docs.",
     ),
     Subcommand(
         "compare",
-        "app.cli.reports",
+        "touchbench.app.cli.reports",
         "Compare the classifiers that all the runs share, one score per data set (the run's "
         "mean): average ranks, Friedman's test (chi-square and Iman-Davenport F), the Nemenyi"
         " critical difference, Holm's test against the best, and the groups not significantly"
         " different (Demšar 2006). With one run, its folds are the blocks (descriptive only).",
     ),
     Subcommand(
-        "plot", "app.cli.reports", "Draw one plot of a run as SVG (text kept as text) or PNG."
+        "plot",
+        "touchbench.app.cli.reports",
+        "Draw one plot of a run as SVG (text kept as text) or PNG.",
     ),
     Subcommand(
         "report",
-        "app.cli.reports",
+        "touchbench.app.cli.reports",
         "Write one self-contained HTML file (inline SVG, no network) with each run's "
         "leaderboard and marks, plots, configuration and library versions, and the comparison"
         " across runs: ready to attach to a paper's supplementary material.",
     ),
     Subcommand(
         "devices",
-        "app.cli.capture",
+        "touchbench.app.cli.capture",
         "List the capture devices PortAudio sees (index, name, input channels, default rate).",
     ),
     Subcommand(
         "record",
-        "app.cli.capture",
+        "touchbench.app.cli.capture",
         "Record a labelled take into a session folder: OUT/take-NNN.wav plus a row of "
         "OUT/labels.csv (file,TARGET...), the input of `touchbench extract`.",
     ),
-    Subcommand("simulate", "app.cli.capture", "Write simulated recordings and their labels CSV."),
+    Subcommand(
+        "simulate", "touchbench.app.cli.capture", "Write simulated recordings and their labels CSV."
+    ),
     Subcommand(
         "live",
-        "app.cli.capture",
+        "touchbench.app.cli.capture",
         "Predict every touch of a live stream with a model: its own event detection and "
         "extractor run on the stream, and each touch is printed as soon as it ends.",
     ),
     Subcommand(
         "ros",
-        "app.cli.ros",
+        "touchbench.app.cli.ros",
         "Run a ROS node that predicts every touch of an audio or taxel topic with a model and "
         "publishes each as a std_msgs/String JSON message (what `live --json` prints).",
     ),
@@ -354,8 +362,8 @@ def _failed(error: Exception) -> int:
     one line, with the traceback on request.
     """
     # loaded when a command fails: start-up time (app.errors imports the drivers and NumPy)
-    from app.cli.requests import describe
-    from app.errors import USER_ERRORS, FieldError
+    from touchbench.app.cli.requests import describe
+    from touchbench.app.errors import USER_ERRORS, FieldError
 
     if isinstance(error, USER_ERRORS):
         message = describe(error) if isinstance(error, FieldError) else str(error)
@@ -402,7 +410,7 @@ def _forget_options() -> None:
     Only a command that built a request (:mod:`app.cli.requests`) can have left them, so a
     process that has not imported that module has nothing to forget.
     """
-    requests = sys.modules.get("app.cli.requests")
+    requests = sys.modules.get("touchbench.app.cli.requests")
     if requests is not None:
         requests.reset()
 

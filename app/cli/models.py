@@ -11,12 +11,12 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from app.cli.output import EngineOption, JsonOption, info, print_json, table, warn
-from app.cli.state import get_state
+from touchbench.app.cli.output import EngineOption, JsonOption, info, print_json, table, warn
+from touchbench.app.cli.state import get_state
 
 if TYPE_CHECKING:
-    from app.schemas.models import AliasRequest
-    from app.store.models import AliasMove
+    from touchbench.app.schemas.models import AliasRequest
+    from touchbench.app.store.models import AliasMove
 
 
 def register(app: typer.Typer) -> None:
@@ -65,9 +65,9 @@ def train_command(
     as_json: JsonOption = False,
 ) -> None:
     """Fit a classifier on every instance of a data set and store the model."""
-    from app.cli.requests import build_request
-    from app.schemas.models import TrainRequest
-    from app.services.models import train
+    from touchbench.app.cli.requests import build_request
+    from touchbench.app.schemas.models import TrainRequest
+    from touchbench.app.services.models import train
 
     request = build_request(
         TrainRequest,
@@ -90,8 +90,8 @@ def train_command(
 
 def models_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
     """List trained models, a row per version, with their aliases (artifacts are not read)."""
-    from app.schemas.models import ModelList
-    from app.store.models import list_models
+    from touchbench.app.schemas.models import ModelList
+    from touchbench.app.store.models import list_models
 
     models = list_models(get_state(ctx).store)
     if as_json:
@@ -154,9 +154,9 @@ def predict_command(
     as_json: JsonOption = False,
 ) -> None:
     """Predict every instance of a file; attributes are matched to the model's by name."""
-    from app.cli.requests import build_request
-    from app.schemas.models import PredictFileRequest
-    from app.services.models import predict_file
+    from touchbench.app.cli.requests import build_request
+    from touchbench.app.schemas.models import PredictFileRequest
+    from touchbench.app.services.models import predict_file
 
     request = build_request(
         PredictFileRequest,
@@ -210,7 +210,7 @@ def delete_model_command(
     ],
 ) -> None:
     """Delete a trained model (one version: NAME alone is its newest)."""
-    from app.store.models import delete_model
+    from touchbench.app.store.models import delete_model
 
     gone = delete_model(get_state(ctx).store, model_ref)
     info(f"deleted model {gone.id} '{gone.label}'")
@@ -241,10 +241,10 @@ def export_model_command(
     label), its outputs `label` (an index into touchbench.labels) and `probabilities`. It
     is kept in the store: `predict` and `live` run it (--engine).
     """
-    from app.cli.requests import build_request
-    from app.errors import FieldError
-    from app.schemas.models import ExportRequest
-    from app.services.export import export_model
+    from touchbench.app.cli.requests import build_request
+    from touchbench.app.errors import FieldError
+    from touchbench.app.schemas.models import ExportRequest
+    from touchbench.app.services.export import export_model
 
     request = build_request(
         ExportRequest, {"model": "MODEL", "format": "--format"}, model=model_ref, format=format
@@ -288,7 +288,7 @@ def alias_command(
     as_json: JsonOption = False,
 ) -> None:
     """Point an alias of a model (NAME@ALIAS) at one of its versions."""
-    from app.services.models import move_alias, remove_alias
+    from touchbench.app.services.models import move_alias, remove_alias
 
     request = _alias_request(model_ref, alias)
     if not delete:
@@ -309,7 +309,7 @@ def promote_command(
 ) -> None:
     """Make a version the model's champion: NAME@champion, which `live`, `serve` and live
     WebSocket sessions on it follow, answers with it from now on (`rollback` undoes)."""
-    from app.services.models import move_alias
+    from touchbench.app.services.models import move_alias
 
     _moved(move_alias(get_state(ctx).store, _alias_request(model_ref, None)), as_json)
 
@@ -331,14 +331,14 @@ def rollback_command(
     as_json: JsonOption = False,
 ) -> None:
     """Point the champion (or --alias) back at the version it pointed at before its last move."""
-    from app.services.models import roll_back
+    from touchbench.app.services.models import roll_back
 
     _moved(roll_back(get_state(ctx).store, _alias_request(model_ref, alias)), as_json)
 
 
 def _alias_request(model_ref: str, alias: str | None) -> AliasRequest:
-    from app.cli.requests import build_request
-    from app.schemas.models import AliasRequest
+    from touchbench.app.cli.requests import build_request
+    from touchbench.app.schemas.models import AliasRequest
 
     return build_request(
         AliasRequest, {"model": "MODEL", "alias": "ALIAS"}, model=model_ref, alias=alias

@@ -15,13 +15,13 @@ from rich.markup import escape
 from rich.table import Table
 
 # Defined where app.cli.main finds them without rich's tables; commands take them from here.
-from app.cli.exits import EXIT_FAILED as EXIT_FAILED
-from app.cli.exits import EXIT_INTERRUPTED as EXIT_INTERRUPTED
-from app.cli.exits import ExitWith as ExitWith
-from app.schemas.base import finite
+from touchbench.app.cli.exits import EXIT_FAILED as EXIT_FAILED
+from touchbench.app.cli.exits import EXIT_INTERRUPTED as EXIT_INTERRUPTED
+from touchbench.app.cli.exits import ExitWith as ExitWith
+from touchbench.app.schemas.base import finite
 
 if TYPE_CHECKING:
-    from app.reports.run_tables import RunTable
+    from touchbench.app.reports.run_tables import RunTable
 
 #: The ``--json`` flag of every listing and result command.
 JsonOption = Annotated[bool, typer.Option("--json", help="Print only JSON on stdout.")]

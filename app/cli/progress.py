@@ -21,9 +21,9 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
-from app.cli.output import info
-from app.services.runs import Callbacks
-from benchmark.results import TaskKey, TaskResult
+from touchbench.app.cli.output import info
+from touchbench.app.services.runs import Callbacks
+from touchbench.benchmark.results import TaskKey, TaskResult
 
 
 class TaskProgress:

@@ -11,13 +11,13 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from app.cli.output import JsonOption, info, print_json, table
-from app.cli.state import get_state
+from touchbench.app.cli.output import JsonOption, info, print_json, table
+from touchbench.app.cli.state import get_state
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-    from app.services.compare import Comparison
+    from touchbench.app.services.compare import Comparison
 
 # matplotlib, scipy and the statistics are imported by the commands that use them, so that
 # `touchbench --help` starts at once.
@@ -89,10 +89,10 @@ def compare_command(
     mean): average ranks, Friedman's test (chi-square and Iman-Davenport F), the Nemenyi
     critical difference, Holm's test against the best, and the groups not significantly
     different (Demšar 2006). With one run, its folds are the blocks (descriptive only)."""
-    from app.reports.figures import cd_figure
-    from app.reports.plots import figure_format, save_figure
-    from app.services.compare import compare_runs
-    from benchmark.evaluation.score_table import missing_policy
+    from touchbench.app.reports.figures import cd_figure
+    from touchbench.app.reports.plots import figure_format, save_figure
+    from touchbench.app.services.compare import compare_runs
+    from touchbench.benchmark.evaluation.score_table import missing_policy
 
     pair = _pair(bayesian) if bayesian else None
     if plot is not None:
@@ -109,7 +109,7 @@ def compare_command(
     if plot is not None:
         save_figure(cd_figure(comparison), plot)
     if as_json:
-        from app.services.compare import comparison_schema
+        from touchbench.app.services.compare import comparison_schema
 
         print_json(comparison_schema(comparison).to_json())
     else:
@@ -146,7 +146,7 @@ def plot_command(
     missing: MissingOption = "drop-classifier",
 ) -> None:
     """Draw one plot of a run as SVG (text kept as text) or PNG."""
-    from app.reports.plots import figure_format, save_figure
+    from touchbench.app.reports.plots import figure_format, save_figure
 
     if kind not in KINDS:
         raise typer.BadParameter(f"'{kind}' is not one of {', '.join(KINDS)}", param_hint="--kind")
@@ -182,10 +182,10 @@ def report_command(
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
 
-    from app.reports.html import render_report
-    from app.reports.plots import write_atomically
-    from app.services.report import build_report
-    from benchmark.evaluation.score_table import missing_policy
+    from touchbench.app.reports.html import render_report
+    from touchbench.app.reports.plots import write_atomically
+    from touchbench.app.services.report import build_report
+    from touchbench.benchmark.evaluation.score_table import missing_policy
 
     if output.suffix.lower() not in (".html", ".htm"):
         raise typer.BadParameter(f"'{output}' must end in .html", param_hint="--output")
@@ -227,10 +227,10 @@ def _run_figure(
     alpha: float,
     missing: str,
 ) -> Figure:
-    from app.reports import figures
-    from app.services.compare import compare_runs
-    from app.services.report import run_view
-    from benchmark.evaluation.score_table import missing_policy
+    from touchbench.app.reports import figures
+    from touchbench.app.services.compare import compare_runs
+    from touchbench.app.services.report import run_view
+    from touchbench.benchmark.evaluation.score_table import missing_policy
 
     store = get_state(ctx).store
     if kind == "cd":

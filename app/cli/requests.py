@@ -14,8 +14,8 @@ from typing import Any, TypeVar
 
 from pydantic import ValidationError
 
-from app.errors import FieldError
-from app.schemas.base import Request
+from touchbench.app.errors import FieldError
+from touchbench.app.schemas.base import Request
 
 RequestType = TypeVar("RequestType", bound=Request)
 

@@ -6,11 +6,11 @@ from typing import Annotated
 
 import typer
 
-from app.cli.output import EngineOption, info
-from app.cli.requests import build_request
-from app.cli.signals import deferred_interrupts
-from app.cli.state import get_state
-from app.schemas.ros import RosNodeRequest, SampleFormat
+from touchbench.app.cli.output import EngineOption, info
+from touchbench.app.cli.requests import build_request
+from touchbench.app.cli.signals import deferred_interrupts
+from touchbench.app.cli.state import get_state
+from touchbench.app.schemas.ros import RosNodeRequest, SampleFormat
 
 
 def register(app: typer.Typer) -> None:
@@ -80,10 +80,10 @@ def ros_command(
     open and stops the node.
     """
     # start-up time: the feature stack, and ROS's modules only for this command
-    from app.cli.capture import _show
-    from app.services.ros_node import run_ros_node
-    from drivers.ros1 import Ros1Transport
-    from drivers.source import Source
+    from touchbench.app.cli.capture import _show
+    from touchbench.app.services.ros_node import run_ros_node
+    from touchbench.drivers.ros1 import Ros1Transport
+    from touchbench.drivers.source import Source
 
     fmt: SampleFormat | None = sample_format.upper() if sample_format else None  # type: ignore[assignment]
     request = build_request(

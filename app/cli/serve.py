@@ -12,7 +12,7 @@ from typing import Annotated, Any
 
 import typer
 
-from app.cli.state import get_state
+from touchbench.app.cli.state import get_state
 
 
 def register(app: typer.Typer) -> None:
@@ -57,8 +57,8 @@ def serve_command(
     """
     import uvicorn
 
-    from app.cli.stopping import GRACE, serve
-    from app.settings import get_settings
+    from touchbench.app.cli.stopping import GRACE, serve
+    from touchbench.app.settings import get_settings
 
     state = get_state(ctx)
     os.environ["TOUCHBENCH_DATABASE_URL"] = state.database_url
@@ -92,7 +92,7 @@ def serve_command(
         "server_header": False,
         "timeout_graceful_shutdown": GRACE,  # a request computing does not hold a stop
     }
-    serve(uvicorn.Config("app.main:create_app", **options))
+    serve(uvicorn.Config("touchbench.app.main:create_app", **options))
 
 
 #: Variables that set the thread count of numpy's BLAS and of OpenMP (scikit-learn, xgboost).
@@ -125,7 +125,7 @@ def _log_config(level: str) -> dict[str, Any]:
 
     config = copy.deepcopy(LOGGING_CONFIG)
     config.setdefault("filters", {})["cancelled_by_stop"] = {
-        "()": "app.cli.stopping.CancelledByStop"
+        "()": "touchbench.app.cli.stopping.CancelledByStop"
     }
     config["loggers"]["uvicorn.error"]["filters"] = ["cancelled_by_stop"]
     config["loggers"]["touchbench"] = {

@@ -8,8 +8,8 @@ from typing import TYPE_CHECKING
 import typer
 
 if TYPE_CHECKING:
-    from app.store.database import Store
-    from app.store.reading import Readable
+    from touchbench.app.store.database import Store
+    from touchbench.app.store.reading import Readable
 
 
 @dataclass
@@ -21,7 +21,7 @@ class CliState:
     def store(self) -> Store:
         if self._store is None:
             # loaded when the command runs: start-up time (SQLAlchemy and the store's tables)
-            from app.store.database import Store
+            from touchbench.app.store.database import Store
 
             self._store = Store(self.database_url)
         return self._store
@@ -33,7 +33,7 @@ class CliState:
         if self._store is not None:
             return self._store
         # loaded when the command runs: start-up time (sqlite3 only)
-        from app.store.reading import sqlite_file
+        from touchbench.app.store.reading import sqlite_file
 
         return sqlite_file(self.database_url) or self.store
 

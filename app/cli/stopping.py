@@ -29,7 +29,7 @@ import uvicorn
 from uvicorn.main import STARTUP_FAILURE
 from uvicorn.supervisors import Multiprocess
 
-from app.cli.exits import EXIT_INTERRUPTED
+from touchbench.app.cli.exits import EXIT_INTERRUPTED
 
 #: Seconds uvicorn waits for requests in flight before it cancels them.
 GRACE = 2.0

@@ -23,14 +23,14 @@ import os
 import sys
 import threading
 
-from app.jobs.leadership import Leadership, address_for
-from app.jobs.process import DATABASE_URL_VARIABLE
-from app.jobs.queue import Item, next_item
-from app.jobs.supervisor import Supervisor
-from app.settings import Settings
-from app.store.database import Store, display_url, first_line
-from app.store.jobs import mark_lost_jobs
-from app.store.runs import mark_lost_runs
+from touchbench.app.jobs.leadership import Leadership, address_for
+from touchbench.app.jobs.process import DATABASE_URL_VARIABLE
+from touchbench.app.jobs.queue import Item, next_item
+from touchbench.app.jobs.supervisor import Supervisor
+from touchbench.app.settings import Settings
+from touchbench.app.store.database import Store, display_url, first_line
+from touchbench.app.store.jobs import mark_lost_jobs
+from touchbench.app.store.runs import mark_lost_runs
 
 log = logging.getLogger("touchbench.jobs")
 
@@ -107,7 +107,13 @@ class Dispatcher:
         mark_lost_jobs(self.store)
 
     def _command(self, item: Item) -> list[str]:
-        command = [sys.executable, "-m", "app.jobs.process", "--jobs", str(self.settings.run_jobs)]
+        command = [
+            sys.executable,
+            "-m",
+            "touchbench.app.jobs.process",
+            "--jobs",
+            str(self.settings.run_jobs),
+        ]
         if self.settings.dask_scheduler:
             command += ["--scheduler", self.settings.dask_scheduler]
         return [*command, item.kind, str(item.id)]

@@ -19,7 +19,7 @@ import sys
 import threading
 import time
 
-from app.environment import DATABASE_URL_VARIABLE
+from touchbench.app.environment import DATABASE_URL_VARIABLE
 
 #: Seconds between checks that the parent service is alive.
 PARENT_CHECK_INTERVAL = 1.0
@@ -53,10 +53,10 @@ def main(argv: list[str] | None = None) -> int:
 
     # loaded once the arguments are read and the parent is watched: start-up time (``--help``
     # and a bad argument need none of it; a service that dies meanwhile ends this process)
-    from app.errors import AppError
-    from app.services.jobs import execute_job
-    from app.services.runs import RunCancelled, execute_run
-    from app.store.database import Store
+    from touchbench.app.errors import AppError
+    from touchbench.app.services.jobs import execute_job
+    from touchbench.app.services.runs import RunCancelled, execute_run
+    from touchbench.app.store.database import Store
 
     try:
         store = Store(url)

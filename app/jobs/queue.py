@@ -12,9 +12,9 @@ from collections.abc import Collection
 from dataclasses import dataclass
 from typing import Literal
 
-from app.store.database import Store
-from app.store.jobs import queued_jobs
-from app.store.runs import list_runs
+from touchbench.app.store.database import Store
+from touchbench.app.store.jobs import queued_jobs
+from touchbench.app.store.runs import list_runs
 
 Kind = Literal["run", "job"]
 

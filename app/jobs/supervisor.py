@@ -9,7 +9,7 @@ import subprocess
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
-from app.jobs.queue import Item
+from touchbench.app.jobs.queue import Item
 
 log = logging.getLogger("touchbench.jobs")
 

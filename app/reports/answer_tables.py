@@ -4,11 +4,11 @@ CLI, the HTML report and the web page alike."""
 
 from __future__ import annotations
 
-from app.reports.run_tables import RunTable
-from app.schemas.ablation import AblationResult
-from app.schemas.importance import FeatureImportance, ImportanceResult
-from app.schemas.learning import LearningCurveResult
-from app.services.answers import RunAnswers
+from touchbench.app.reports.run_tables import RunTable
+from touchbench.app.schemas.ablation import AblationResult
+from touchbench.app.schemas.importance import FeatureImportance, ImportanceResult
+from touchbench.app.schemas.learning import LearningCurveResult
+from touchbench.app.services.answers import RunAnswers
 
 #: Features listed per classifier where a run is shown (the CLI's --top lists more).
 TOP_FEATURES = 10

@@ -4,8 +4,8 @@ CLI's ``classes`` and ``calibration``, the HTML report and the web page."""
 
 from __future__ import annotations
 
-from app.reports.run_tables import RunTable
-from app.schemas.certainty import Calibration, ClassifierCertainty, RunCertainty
+from touchbench.app.reports.run_tables import RunTable
+from touchbench.app.schemas.certainty import Calibration, ClassifierCertainty, RunCertainty
 
 
 def class_tables(certainty: RunCertainty) -> list[RunTable]:

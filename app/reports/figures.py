@@ -9,15 +9,15 @@ from collections.abc import Sequence
 import numpy as np
 from matplotlib.figure import Figure
 
-from app.reports import plots
-from app.reports.certainty_tables import calibrations
-from app.schemas.certainty import RunCertainty
-from app.schemas.datasets import DatasetDescription
-from app.schemas.learning import LearningCurveResult
-from app.services.compare import Comparison
-from app.services.report import RunView
-from benchmark.errors import ConfigurationError
-from benchmark.evaluation.metrics import LOWER_IS_BETTER
+from touchbench.app.reports import plots
+from touchbench.app.reports.certainty_tables import calibrations
+from touchbench.app.schemas.certainty import RunCertainty
+from touchbench.app.schemas.datasets import DatasetDescription
+from touchbench.app.schemas.learning import LearningCurveResult
+from touchbench.app.services.compare import Comparison
+from touchbench.app.services.report import RunView
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.evaluation.metrics import LOWER_IS_BETTER
 
 #: The per-target score that ``targets`` plots show.
 PER_TARGET_METRIC = "accuracy"

@@ -18,23 +18,23 @@ from jinja2 import Environment, FileSystemLoader, StrictUndefined, select_autoes
 from markupsafe import Markup
 from matplotlib.figure import Figure
 
-from app.reports import bounds, figures
-from app.reports.answer_tables import learning_table, run_answer_tables
-from app.reports.certainty_tables import calibration_table, class_tables
-from app.reports.leaderboard import (
+from touchbench.app.reports import bounds, figures
+from touchbench.app.reports.answer_tables import learning_table, run_answer_tables
+from touchbench.app.reports.certainty_tables import calibration_table, class_tables
+from touchbench.app.reports.leaderboard import (
     beside_notes,
     leaderboard_header,
     leaderboard_rows,
     metric_columns,
 )
-from app.reports.plots import svg_text
-from app.reports.run_tables import run_tables
-from app.services.answers import RunAnswers
-from app.services.certainty import certainty_of
-from app.services.compare import Comparison
-from app.services.imported import is_imported
-from app.services.report import Report, RunView
-from benchmark.errors import BenchmarkError
+from touchbench.app.reports.plots import svg_text
+from touchbench.app.reports.run_tables import run_tables
+from touchbench.app.services.answers import RunAnswers
+from touchbench.app.services.certainty import certainty_of
+from touchbench.app.services.compare import Comparison
+from touchbench.app.services.imported import is_imported
+from touchbench.app.services.report import Report, RunView
+from touchbench.benchmark.errors import BenchmarkError
 
 TEMPLATES = Path(__file__).with_name("templates")
 

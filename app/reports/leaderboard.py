@@ -9,9 +9,9 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
-from app.services.beside import Beside, row_runs
-from app.store.runs import RunInfo
-from benchmark.evaluation.leaderboard import Leaderboard, LeaderboardRow
+from touchbench.app.services.beside import Beside, row_runs
+from touchbench.app.store.runs import RunInfo
+from touchbench.benchmark.evaluation.leaderboard import Leaderboard, LeaderboardRow
 
 #: Columns shown in tables, by kind of problem (the ranking metric always comes first).
 TABLE_METRICS = {

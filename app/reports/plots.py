@@ -29,8 +29,8 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from numpy.typing import ArrayLike
 
-from app.errors import AppError
-from app.reports.bounds import CLASSES, PANELS, first, of_all
+from touchbench.app.errors import AppError
+from touchbench.app.reports.bounds import CLASSES, PANELS, first, of_all
 
 #: Output formats of :func:`save_figure`, by file suffix.
 FORMATS = ("svg", "png")

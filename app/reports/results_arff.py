@@ -4,13 +4,13 @@ from __future__ import annotations
 
 from typing import TextIO
 
-from app.reports.leaderboard import row_note
-from app.services.runs import RunLeaderboard
-from app.services.tuning import run_specs
-from benchmark.catalogue import CATALOGUE
-from benchmark.errors import ConfigurationError
-from benchmark.evaluation.results_arff import results_to_dataset
-from benchmark.io.arff import write_arff
+from touchbench.app.reports.leaderboard import row_note
+from touchbench.app.services.runs import RunLeaderboard
+from touchbench.app.services.tuning import run_specs
+from touchbench.benchmark.catalogue import CATALOGUE
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.evaluation.results_arff import results_to_dataset
+from touchbench.benchmark.io.arff import write_arff
 
 
 def write_results_arff(ranked: RunLeaderboard, stream: TextIO) -> None:

@@ -12,7 +12,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from app.schemas.runs import FoldChoiceSchema, LeaderboardSchema, MetricValue
+from touchbench.app.schemas.runs import FoldChoiceSchema, LeaderboardSchema, MetricValue
 
 #: Per-target scores of a multi-target regression, in table order.
 REGRESSION_TARGET_METRICS = ("mae", "rmse", "r2")

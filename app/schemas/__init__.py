@@ -5,6 +5,6 @@ Each resource has its module (``datasets``, ``runs``, ``models``, ``extraction``
 models derive from :class:`Schema`, whose JSON turns NaN and infinities into ``null``.
 """
 
-from app.schemas.base import Schema
+from touchbench.app.schemas.base import Schema
 
 __all__ = ["Schema"]

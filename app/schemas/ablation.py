@@ -7,7 +7,7 @@ from typing import Literal
 
 from pydantic import Field
 
-from app.schemas.base import Request, Schema
+from touchbench.app.schemas.base import Request, Schema
 
 #: How features are grouped (:func:`benchmark.run.importance.feature_groups`).
 Grouping = Literal["channel", "family"]

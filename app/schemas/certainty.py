@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from pydantic import Field
 
-from app.schemas.base import Schema
+from touchbench.app.schemas.base import Schema
 
 
 class ClassScores(Schema):

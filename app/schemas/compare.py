@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from typing import Literal
 
-from app.schemas.base import Schema
-from benchmark.evaluation.bayesian import BayesianComparison
+from touchbench.app.schemas.base import Schema
+from touchbench.benchmark.evaluation.bayesian import BayesianComparison
 
 
 class ClassifierRank(Schema):

@@ -8,8 +8,8 @@ from typing import Any, Literal
 
 from pydantic import Field, field_validator
 
-from app.schemas.base import Request, Schema
-from app.schemas.names import DatasetName
+from touchbench.app.schemas.base import Request, Schema
+from touchbench.app.schemas.names import DatasetName
 
 FileFormat = Literal["arff", "csv"]
 

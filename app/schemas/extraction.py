@@ -10,12 +10,12 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 from pydantic import Field, field_validator, model_validator
 
-from app.errors import FieldError
-from app.schemas.base import Request, Schema
-from app.schemas.names import DatasetName
+from touchbench.app.errors import FieldError
+from touchbench.app.schemas.base import Request, Schema
+from touchbench.app.schemas.names import DatasetName
 
 if TYPE_CHECKING:
-    from features.recipe import Recipe
+    from touchbench.features.recipe import Recipe
 
 #: Suffixes of CSV time series (their `fields` are columns, not a bag topic's fields).
 CSV_SUFFIXES = frozenset({".csv", ".tsv", ".txt"})
@@ -132,10 +132,10 @@ class ExtractRequest(Request):
             than ``none``, an unknown option or a bad option value.
         """
         # Imported here for start-up time: the extractors load scipy and scikit-learn.
-        from features.errors import FeatureError
-        from features.events import EVENT_KINDS
-        from features.extractors import EXTRACTORS
-        from features.recipe import Recipe
+        from touchbench.features.errors import FeatureError
+        from touchbench.features.events import EVENT_KINDS
+        from touchbench.features.extractors import EXTRACTORS
+        from touchbench.features.recipe import Recipe
 
         if self.extractor not in EXTRACTORS:
             raise FieldError(

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pydantic import Field
 
-from app.schemas.base import Request, Schema
+from touchbench.app.schemas.base import Request, Schema
 
 
 class ImportanceRequest(Request):

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from pydantic import Field
 
-from app.schemas.base import Request
+from touchbench.app.schemas.base import Request
 
 
 class ImportResultsRequest(Request):

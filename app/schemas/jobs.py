@@ -9,12 +9,12 @@ from typing import Any, Literal
 
 from pydantic import Field
 
-from app.schemas.ablation import AblationRequest
-from app.schemas.base import Request, Schema
-from app.schemas.extraction import ExtractRequest
-from app.schemas.importance import ImportanceRequest
-from app.schemas.learning import LearningCurveRequest
-from app.schemas.models import TrainRequest
+from touchbench.app.schemas.ablation import AblationRequest
+from touchbench.app.schemas.base import Request, Schema
+from touchbench.app.schemas.extraction import ExtractRequest
+from touchbench.app.schemas.importance import ImportanceRequest
+from touchbench.app.schemas.learning import LearningCurveRequest
+from touchbench.app.schemas.models import TrainRequest
 
 JobKind = Literal["extract", "train", "ablation", "importance", "learning-curve"]
 #: The request each kind of job carries out (its JSON is the job's ``params``).

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from pydantic import Field, field_validator
 
-from app.schemas.base import Request, Schema
-from app.schemas.runs import DEFAULT_TIMEOUT, MAX_TIMEOUT, id_as_text, zero_is_no_limit
+from touchbench.app.schemas.base import Request, Schema
+from touchbench.app.schemas.runs import DEFAULT_TIMEOUT, MAX_TIMEOUT, id_as_text, zero_is_no_limit
 
 #: Fractions of each training fold when none are given (benchmark.run.learning's).
 DEFAULT_FRACTIONS = [0.1, 0.2, 0.3, 0.5, 0.7, 1.0]

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pydantic import Field
 
-from app.schemas.base import Request
+from touchbench.app.schemas.base import Request
 
 #: Most rows one listing answers: what a store accumulates over years stays out of one answer.
 MAX_LISTED = 1000

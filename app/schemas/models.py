@@ -9,9 +9,9 @@ from typing import Any, Literal
 
 from pydantic import ConfigDict, Field, model_validator
 
-from app.errors import FieldError
-from app.schemas.base import Request, Schema
-from app.schemas.names import AliasName, ModelName
+from touchbench.app.errors import FieldError
+from touchbench.app.schemas.base import Request, Schema
+from touchbench.app.schemas.names import AliasName, ModelName
 
 #: The largest id or seed (the store's integer columns are 32-bit on PostgreSQL).
 MAX_ID = 2**31 - 1

@@ -19,7 +19,7 @@ from typing import Annotated
 
 from pydantic import AfterValidator, ValidationInfo
 
-from app.errors import AppError, FieldError
+from touchbench.app.errors import AppError, FieldError
 
 #: The longest name the store keeps (the ``name`` columns are ``String(200)``).
 MAX_NAME = 200

@@ -6,8 +6,8 @@ from typing import Literal
 
 from pydantic import Field, model_validator
 
-from app.errors import FieldError
-from app.schemas.models import EngineChoice
+from touchbench.app.errors import FieldError
+from touchbench.app.schemas.models import EngineChoice
 
 #: How the bytes of an audio topic are coded when no ``AudioInfo`` says it.
 SampleFormat = Literal["S16LE", "S32LE", "F32LE", "MP3"]

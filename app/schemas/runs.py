@@ -8,8 +8,8 @@ from typing import Any, Literal
 
 from pydantic import Field, field_validator, model_validator
 
-from app.errors import FieldError
-from app.schemas.base import Request, Schema
+from touchbench.app.errors import FieldError
+from touchbench.app.schemas.base import Request, Schema
 
 #: Where a run is in its life (the rules: :mod:`app.store.states`): ``queued`` (created,
 #: waiting for a worker), ``running``, ``cancelling`` (its process was asked to stop),

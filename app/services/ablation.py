@@ -9,27 +9,27 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from app.errors import ConflictError, FieldError
-from app.schemas.ablation import (
+from touchbench.app.errors import ConflictError, FieldError
+from touchbench.app.schemas.ablation import (
     AblationEntry,
     AblationGroup,
     AblationRequest,
     AblationResult,
     Grouping,
 )
-from app.schemas.runs import BenchRequest
-from app.services.importance import feature_names, refittable_run
-from app.services.progress import throttled
-from app.services.report import run_view
-from app.services.runs import RunOptions, fold_plan, prepare_problem, task_memory
-from app.services.tuning import run_specs
-from app.store.database import Store
-from app.store.datasets import load_dataset, load_schema
-from app.store.runs import get_run
-from benchmark.dataset import Dataset
-from benchmark.evaluation.metrics import LOWER_IS_BETTER
-from benchmark.evaluation.significance import corrected_resampled_ttest
-from benchmark.results import TaskResult
+from touchbench.app.schemas.runs import BenchRequest
+from touchbench.app.services.importance import feature_names, refittable_run
+from touchbench.app.services.progress import throttled
+from touchbench.app.services.report import run_view
+from touchbench.app.services.runs import RunOptions, fold_plan, prepare_problem, task_memory
+from touchbench.app.services.tuning import run_specs
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import load_dataset, load_schema
+from touchbench.app.store.runs import get_run
+from touchbench.benchmark.dataset import Dataset
+from touchbench.benchmark.evaluation.metrics import LOWER_IS_BETTER
+from touchbench.benchmark.evaluation.significance import corrected_resampled_ttest
+from touchbench.benchmark.results import TaskResult
 
 #: Level of the t-test that decides a verdict.
 ALPHA = 0.05
@@ -62,7 +62,7 @@ def _groups(
 ) -> tuple[list[str], dict[str, list[int]]]:
     """The feature names of a run's problem and their groups of ``grouping``."""
     names = feature_names(dataset, targets)
-    from benchmark.run.importance import feature_groups  # start-up time: scikit-learn
+    from touchbench.benchmark.run.importance import feature_groups  # start-up time: scikit-learn
 
     groups = feature_groups(names).get(grouping)
     if groups is None:
@@ -112,7 +112,7 @@ def run_ablation(
         No such run.
     """
     plan = _plan(store, request)
-    from benchmark.run.ablation import ablate  # start-up time: the engine's imports
+    from touchbench.benchmark.run.ablation import ablate  # start-up time: the engine's imports
 
     results: dict[tuple[str, str], list[TaskResult]] = {}
     tell = throttled(on_progress, lambda: plan.summary(results))

@@ -5,13 +5,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from app.errors import NotFoundError
-from app.schemas.ablation import AblationResult
-from app.schemas.importance import ImportanceResult
-from app.schemas.learning import LearningCurveResult
-from app.store.database import Store
-from app.store.jobs import done_jobs_naming, done_jobs_of_run
-from app.store.runs import get_run
+from touchbench.app.errors import NotFoundError
+from touchbench.app.schemas.ablation import AblationResult
+from touchbench.app.schemas.importance import ImportanceResult
+from touchbench.app.schemas.learning import LearningCurveResult
+from touchbench.app.store.database import Store
+from touchbench.app.store.jobs import done_jobs_naming, done_jobs_of_run
+from touchbench.app.store.runs import get_run
 
 
 @dataclass(frozen=True)

@@ -22,11 +22,11 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from app.errors import FieldError
-from app.schemas.runs import BesideSchema, BesideTest
-from app.services.imported import is_imported
-from app.store.runs import RunInfo
-from benchmark.results import TaskKey, TaskResult
+from touchbench.app.errors import FieldError
+from touchbench.app.schemas.runs import BesideSchema, BesideTest
+from touchbench.app.services.imported import is_imported
+from touchbench.app.store.runs import RunInfo
+from touchbench.benchmark.results import TaskKey, TaskResult
 
 #: The t-test group of the leaderboard's own run.
 OWN = "own"

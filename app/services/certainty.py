@@ -13,7 +13,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from app.schemas.certainty import (
+from touchbench.app.schemas.certainty import (
     Calibration,
     ClassifierCertainty,
     ClassScores,
@@ -21,12 +21,12 @@ from app.schemas.certainty import (
     RunCertainty,
     TargetClasses,
 )
-from app.services.imported import is_imported
-from app.services.report import RunView, run_view
-from app.store.database import Store
-from benchmark.errors import ConfigurationError
-from benchmark.evaluation.calibration import PER_TARGET, Reliability, merge
-from benchmark.results import TaskResult
+from touchbench.app.services.imported import is_imported
+from touchbench.app.services.report import RunView, run_view
+from touchbench.app.store.database import Store
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.evaluation.calibration import PER_TARGET, Reliability, merge
+from touchbench.benchmark.results import TaskResult
 
 
 def run_certainty(

@@ -16,8 +16,8 @@ from typing import Literal
 
 import numpy as np
 
-from app.schemas.base import finite
-from app.schemas.compare import (
+from touchbench.app.schemas.base import finite
+from touchbench.app.schemas.compare import (
     BayesianOut,
     ClassifierRank,
     ComparisonOut,
@@ -29,26 +29,26 @@ from app.schemas.compare import (
     NemenyiOut,
     PairOut,
 )
-from app.services.beside import besides, merged_results
-from app.services.imported import is_imported
-from app.store.database import Store
-from app.store.runs import RunInfo, get_run, load_results
-from benchmark.errors import ConfigurationError
-from benchmark.evaluation.bayesian import (
+from touchbench.app.services.beside import besides, merged_results
+from touchbench.app.services.imported import is_imported
+from touchbench.app.store.database import Store
+from touchbench.app.store.runs import RunInfo, get_run, load_results
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.evaluation.bayesian import (
     DEFAULT_ROPE,
     BayesianComparison,
     correlated_ttest,
     signed_rank_test,
 )
-from benchmark.evaluation.metrics import LOWER_IS_BETTER
-from benchmark.evaluation.score_table import (
+from touchbench.benchmark.evaluation.metrics import LOWER_IS_BETTER
+from touchbench.benchmark.evaluation.score_table import (
     CompletedTable,
     MissingPolicy,
     ScoreTable,
     fold_score_table,
 )
-from benchmark.evaluation.statistics import RankComparison, compare_classifiers
-from benchmark.results import TaskResult
+from touchbench.benchmark.evaluation.statistics import RankComparison, compare_classifiers
+from touchbench.benchmark.results import TaskResult
 
 BlockKind = Literal["datasets", "folds"]
 

@@ -26,8 +26,8 @@ from typing import Any, TextIO
 
 import numpy as np
 
-from app.errors import AppError, ConflictError, FieldError
-from app.schemas.datasets import (
+from touchbench.app.errors import AppError, ConflictError, FieldError
+from touchbench.app.schemas.datasets import (
     AttributeDescription,
     DatasetDescription,
     DatasetSummary,
@@ -37,17 +37,17 @@ from app.schemas.datasets import (
     RenameRequest,
     RenameResult,
 )
-from app.services.limits import check_dataset_size
-from app.services.listing import summary
-from app.store import datasets as stored
-from app.store.database import Store
-from app.store.datasets import DatasetInfo, DatasetInMemory, InstanceSource
-from app.store.naming import default_name
-from benchmark.dataset import Dataset, InstanceBlock, Schema
-from benchmark.errors import DataFormatError, DataWarning
-from benchmark.io.arff import ArffWriter, open_arff, read_arff
-from benchmark.io.csv import read_csv
-from benchmark.io.textfile import FileScan, check_regular_file, open_binary, scan_file
+from touchbench.app.services.limits import check_dataset_size
+from touchbench.app.services.listing import summary
+from touchbench.app.store import datasets as stored
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import DatasetInfo, DatasetInMemory, InstanceSource
+from touchbench.app.store.naming import default_name
+from touchbench.benchmark.dataset import Dataset, InstanceBlock, Schema
+from touchbench.benchmark.errors import DataFormatError, DataWarning
+from touchbench.benchmark.io.arff import ArffWriter, open_arff, read_arff
+from touchbench.benchmark.io.csv import read_csv
+from touchbench.benchmark.io.textfile import FileScan, check_regular_file, open_binary, scan_file
 
 #: Called with (what is being done, bytes done, bytes in all) while a file is imported.
 ImportProgress = Callable[[str, int, int], None]

@@ -12,19 +12,24 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from app.schemas.models import TrainRequest
-from app.schemas.runs import BenchRequest
-from app.services.extraction import extract_dataset
-from app.services.live import TouchPrediction, open_live
-from app.services.models import Predictions, load_model, predict, train
-from app.services.runs import create_run, default_classifiers, execute_run, run_leaderboard
-from app.services.simulation import write_labels, write_session
-from app.store.database import Store
-from app.store.datasets import DatasetInfo, add_dataset, dataset_digest
-from app.store.runs import RunInfo
-from benchmark.evaluation.leaderboard import Leaderboard
-from benchmark.io.arff import read_arff, write_arff
-from drivers.replay import FileReplaySource
+from touchbench.app.schemas.models import TrainRequest
+from touchbench.app.schemas.runs import BenchRequest
+from touchbench.app.services.extraction import extract_dataset
+from touchbench.app.services.live import TouchPrediction, open_live
+from touchbench.app.services.models import Predictions, load_model, predict, train
+from touchbench.app.services.runs import (
+    create_run,
+    default_classifiers,
+    execute_run,
+    run_leaderboard,
+)
+from touchbench.app.services.simulation import write_labels, write_session
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import DatasetInfo, add_dataset, dataset_digest
+from touchbench.app.store.runs import RunInfo
+from touchbench.benchmark.evaluation.leaderboard import Leaderboard
+from touchbench.benchmark.io.arff import read_arff, write_arff
+from touchbench.drivers.replay import FileReplaySource
 
 
 @dataclass

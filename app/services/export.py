@@ -9,17 +9,17 @@ graph of operators, not code, so loading them runs nothing of the writer's.
 
 from __future__ import annotations
 
-from app.errors import ConflictError, FieldError
-from app.schemas.models import Engine, ExportRequest, ExportSchema
-from app.services.models import align_features, load_model
-from app.store.database import Store
-from app.store.datasets import load_dataset
-from app.store.exports import load_export, save_export
-from app.store.models import ModelInfo, get_model
-from benchmark.dataset import Schema
-from benchmark.errors import ConfigurationError
-from benchmark.model import Predictor
-from benchmark.problem import restrict_targets
+from touchbench.app.errors import ConflictError, FieldError
+from touchbench.app.schemas.models import Engine, ExportRequest, ExportSchema
+from touchbench.app.services.models import align_features, load_model
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import load_dataset
+from touchbench.app.store.exports import load_export, save_export
+from touchbench.app.store.models import ModelInfo, get_model
+from touchbench.benchmark.dataset import Schema
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.model import Predictor
+from touchbench.benchmark.problem import restrict_targets
 
 #: What ``auto`` picks when the model has an ONNX twin: ONNX Runtime answers one row sooner
 #: than the model's own estimator for every entry measured (perf/live_latency.py part 3,
@@ -42,7 +42,7 @@ def export_model(store: Store, request: ExportRequest) -> tuple[ExportSchema, by
     NotFoundError
         No such model.
     """
-    from benchmark.export.onnx import export_onnx  # start-up time: skl2onnx, onnxruntime
+    from touchbench.benchmark.export.onnx import export_onnx  # start-up time: skl2onnx, onnxruntime
 
     info, model = load_model(store, request.model)
     if info.dataset_id is None:
@@ -106,6 +106,6 @@ def load_predictor(
                 "predict with the native engine",
             )
         return load_model(store, info.id)
-    from benchmark.export.onnx import OnnxModel  # start-up time: onnxruntime
+    from touchbench.benchmark.export.onnx import OnnxModel  # start-up time: onnxruntime
 
     return info, OnnxModel(Schema.from_json(info.schema), info.classifier, graph)

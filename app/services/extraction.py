@@ -36,17 +36,17 @@ from typing import Any
 
 import numpy as np
 
-from app.schemas.extraction import ExtractionSummary, ExtractRequest
-from app.services.limits import check_dataset_size
-from app.store.database import Store
-from app.store.datasets import add_dataset, check_dataset_name, dataset_digest
-from benchmark.dataset import Attribute, Dataset, Schema
-from benchmark.errors import DataFormatError
-from benchmark.io.csv import csv_problem
-from drivers.replay import CSV_SUFFIXES, FileReplaySource
-from features.errors import FeatureError
-from features.extractors import Instances
-from features.recipe import Recipe
+from touchbench.app.schemas.extraction import ExtractionSummary, ExtractRequest
+from touchbench.app.services.limits import check_dataset_size
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import add_dataset, check_dataset_name, dataset_digest
+from touchbench.benchmark.dataset import Attribute, Dataset, Schema
+from touchbench.benchmark.errors import DataFormatError
+from touchbench.benchmark.io.csv import csv_problem
+from touchbench.drivers.replay import CSV_SUFFIXES, FileReplaySource
+from touchbench.features.errors import FeatureError
+from touchbench.features.extractors import Instances
+from touchbench.features.recipe import Recipe
 
 _MISSING = frozenset({"", "?"})
 

@@ -5,16 +5,16 @@ from __future__ import annotations
 
 from typing import Any
 
-from app.schemas.extraction import (
+from touchbench.app.schemas.extraction import (
     EventsInfo,
     ExtractorInfo,
     ExtractorList,
     ExtractorsRequest,
     OptionInfo,
 )
-from features.events import EVENT_KINDS
-from features.extractors import EXTRACTORS
-from features.options import Option
+from touchbench.features.events import EVENT_KINDS
+from touchbench.features.extractors import EXTRACTORS
+from touchbench.features.options import Option
 
 
 def list_extractors(request: ExtractorsRequest) -> ExtractorList:

@@ -7,18 +7,18 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from app.errors import FieldError
-from app.schemas.importance import FeatureImportance, ImportanceRequest, ImportanceResult
-from app.services.imported import is_imported
-from app.services.runs import RunOptions, fold_plan, prepare_problem
-from app.services.tuning import run_specs
-from app.store.database import Store
-from app.store.datasets import load_dataset
-from app.store.runs import RunInfo, get_run
-from benchmark.dataset import Dataset
-from benchmark.errors import ConfigurationError
-from benchmark.evaluation.significance import corrected_resampled_ttest
-from benchmark.problem import restrict_targets, usable_feature_columns
+from touchbench.app.errors import FieldError
+from touchbench.app.schemas.importance import FeatureImportance, ImportanceRequest, ImportanceResult
+from touchbench.app.services.imported import is_imported
+from touchbench.app.services.runs import RunOptions, fold_plan, prepare_problem
+from touchbench.app.services.tuning import run_specs
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import load_dataset
+from touchbench.app.store.runs import RunInfo, get_run
+from touchbench.benchmark.dataset import Dataset
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.evaluation.significance import corrected_resampled_ttest
+from touchbench.benchmark.problem import restrict_targets, usable_feature_columns
 
 
 def refittable_run(run: RunInfo) -> RunInfo:
@@ -71,7 +71,11 @@ def run_importance(
     options = RunOptions.from_config(run.config)
     folds = fold_plan(prepared, options).folds
     # the engine's fitting code (scikit-learn): imported here so the module starts fast
-    from benchmark.run.importance import Importance, feature_groups, permutation_importance
+    from touchbench.benchmark.run.importance import (
+        Importance,
+        feature_groups,
+        permutation_importance,
+    )
 
     ratio = float(np.mean([f.test.size / f.train.size for f in folds]))
 

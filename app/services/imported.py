@@ -11,16 +11,16 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from app.errors import FieldError
-from app.schemas.imported import ImportResultsRequest
-from app.services.listing import list_datasets
-from app.store.database import Store
-from app.store.datasets import load_schema
-from app.store.runs import RunInfo, add_finished_run
-from benchmark.dataset import Schema
-from benchmark.errors import DataFormatError
-from benchmark.evaluation.results_import import ImportedResults, import_weka_results
-from benchmark.io.arff import open_arff
+from touchbench.app.errors import FieldError
+from touchbench.app.schemas.imported import ImportResultsRequest
+from touchbench.app.services.listing import list_datasets
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import load_schema
+from touchbench.app.store.runs import RunInfo, add_finished_run
+from touchbench.benchmark.dataset import Schema
+from touchbench.benchmark.errors import DataFormatError
+from touchbench.benchmark.evaluation.results_import import ImportedResults, import_weka_results
+from touchbench.benchmark.io.arff import open_arff
 
 #: ``config["origin"]`` of an imported run (runs touchbench carried out have none).
 IMPORTED = "imported"

@@ -22,16 +22,16 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from app.errors import USER_ERRORS, AppError, client_words
-from app.schemas.ablation import AblationRequest
-from app.schemas.base import Request, Schema
-from app.schemas.extraction import ExtractRequest
-from app.schemas.importance import ImportanceRequest
-from app.schemas.jobs import JOB_REQUESTS, JobKind, JobSchema
-from app.schemas.learning import LearningCurveRequest
-from app.schemas.models import TrainRequest
-from app.store.database import Store
-from app.store.jobs import (
+from touchbench.app.errors import USER_ERRORS, AppError, client_words
+from touchbench.app.schemas.ablation import AblationRequest
+from touchbench.app.schemas.base import Request, Schema
+from touchbench.app.schemas.extraction import ExtractRequest
+from touchbench.app.schemas.importance import ImportanceRequest
+from touchbench.app.schemas.jobs import JOB_REQUESTS, JobKind, JobSchema
+from touchbench.app.schemas.learning import LearningCurveRequest
+from touchbench.app.schemas.models import TrainRequest
+from touchbench.app.store.database import Store
+from touchbench.app.store.jobs import (
     claim_job,
     create_job,
     finish_job,
@@ -40,7 +40,7 @@ from app.store.jobs import (
     record_job_progress,
     start_job,
 )
-from app.store.ownership import process_owner
+from touchbench.app.store.ownership import process_owner
 
 #: The kind of job of each request that answers a question after a run.
 ANSWER_KINDS: dict[type[Request], JobKind] = {
@@ -66,7 +66,7 @@ def submit_extraction(store: Store, request: ExtractRequest) -> JobSchema:
     FieldError, ConflictError
         As :func:`app.services.extraction.check_extraction` does.
     """
-    from app.services.extraction import check_extraction
+    from touchbench.app.services.extraction import check_extraction
 
     check_extraction(store, request)
     return _submit(store, "extract", request)
@@ -75,7 +75,7 @@ def submit_extraction(store: Store, request: ExtractRequest) -> JobSchema:
 def submit_training(store: Store, request: TrainRequest) -> JobSchema:
     """Queue training, once :func:`app.services.models.check_training` found nothing to
     refuse (before the job exists)."""
-    from app.services.models import check_training
+    from touchbench.app.services.models import check_training
 
     check_training(store, request)
     return _submit(store, "train", request)
@@ -151,15 +151,15 @@ def _check_answer(
     store: Store, request: AblationRequest | ImportanceRequest | LearningCurveRequest
 ) -> None:
     if isinstance(request, AblationRequest):
-        from app.services.ablation import check_ablation
+        from touchbench.app.services.ablation import check_ablation
 
         check_ablation(store, request)
     elif isinstance(request, ImportanceRequest):
-        from app.services.importance import check_importance
+        from touchbench.app.services.importance import check_importance
 
         check_importance(store, request)
     else:
-        from app.services.learning import check_learning_curve
+        from touchbench.app.services.learning import check_learning_curve
 
         check_learning_curve(store, request)
 
@@ -291,24 +291,24 @@ def _carry_out(
 ) -> dict[str, Any]:
     """The result of a job's request: the new data set, the new model, or the answer."""
     if isinstance(request, AblationRequest):
-        from app.services.ablation import run_ablation
+        from touchbench.app.services.ablation import run_ablation
 
         return run_ablation(store, request, jobs=jobs, on_progress=on_progress).to_json()
     if isinstance(request, ImportanceRequest):
-        from app.services.importance import run_importance
+        from touchbench.app.services.importance import run_importance
 
         return run_importance(store, request, on_progress=on_progress).to_json()
     if isinstance(request, LearningCurveRequest):
-        from app.services.learning import learning_curve
+        from touchbench.app.services.learning import learning_curve
 
         return learning_curve(store, request, jobs=jobs, on_progress=on_progress).to_json()
     if isinstance(request, ExtractRequest):
-        from app.services.extraction import extract_and_store
+        from touchbench.app.services.extraction import extract_and_store
 
         summary = extract_and_store(store, request).to_json()
         return {"dataset_id": summary["id"], **summary}
     assert isinstance(request, TrainRequest)
-    from app.services.models import train
+    from touchbench.app.services.models import train
 
     model = train(store, request)
     return {"model_id": model.id, **model.to_json()}

@@ -8,15 +8,15 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from app.errors import FieldError
-from app.schemas.learning import (
+from touchbench.app.errors import FieldError
+from touchbench.app.schemas.learning import (
     ClassifierCurve,
     CurvePoint,
     LearningCurveRequest,
     LearningCurveResult,
 )
-from app.services.progress import throttled
-from app.services.runs import (
+from touchbench.app.services.progress import throttled
+from touchbench.app.services.runs import (
     DEFAULT_METRIC,
     RunOptions,
     check_classifiers,
@@ -24,11 +24,11 @@ from app.services.runs import (
     fold_plan,
     prepare_problem,
 )
-from app.store.database import Store
-from app.store.datasets import load_dataset, load_schema
-from benchmark.errors import ConfigurationError
-from benchmark.evaluation.metrics import LOWER_IS_BETTER
-from benchmark.results import TaskResult
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import load_dataset, load_schema
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.evaluation.metrics import LOWER_IS_BETTER
+from touchbench.benchmark.results import TaskResult
 
 
 def check_learning_curve(store: Store, request: LearningCurveRequest) -> None:
@@ -63,8 +63,8 @@ def learning_curve(
     """
     plan = _Plan(store, request)
     # start-up time: the engine's imports (scikit-learn) load with the first curve
-    from benchmark.run.engine import run_tasks
-    from benchmark.run.folds import Fold
+    from touchbench.benchmark.run.engine import run_tasks
+    from touchbench.benchmark.run.folds import Fold
 
     # one call to the engine for every fraction (its workers start once): a fraction's
     # folds are told apart by their ``repeat``, the fraction's place in the list
@@ -115,7 +115,7 @@ class _Plan:
             raise FieldError("metric", str(error)) from None
         options = RunOptions(request.folds, 1, request.seed, request.timeout, None)
         plan = fold_plan(prepared, options)
-        from benchmark.run.learning import learning_folds  # start-up time, as above
+        from touchbench.benchmark.run.learning import learning_folds  # start-up time, as above
 
         self.request = request
         self.dataset = info.name
@@ -134,7 +134,7 @@ class _Plan:
 
     def summary(self, results: dict[float, list[TaskResult]]) -> LearningCurveResult:
         """The curves from the results so far."""
-        from benchmark.run.learning import enough_fraction  # start-up time, as above
+        from touchbench.benchmark.run.learning import enough_fraction  # start-up time, as above
 
         lower = self.metric in LOWER_IS_BETTER
         curves = []

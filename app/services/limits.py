@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from benchmark.errors import DataFormatError
+from touchbench.benchmark.errors import DataFormatError
 
 
 @dataclass(frozen=True)
@@ -31,7 +31,7 @@ class DatasetLimits:
     def configured(cls) -> DatasetLimits:
         """The limits of the settings (the environment)."""
         # start-up time: a command that lists or shows reads no settings (pydantic-settings)
-        from app.settings import get_settings
+        from touchbench.app.settings import get_settings
 
         settings = get_settings()
         return cls(targets=settings.max_targets, attributes=settings.max_attributes)

@@ -6,11 +6,11 @@ listing the store loads neither NumPy nor the file readers.
 
 from __future__ import annotations
 
-from app.schemas.datasets import DatasetSummary
-from app.schemas.listing import Page
-from app.store import listing as stored
-from app.store.listing import DatasetInfo
-from app.store.reading import Readable
+from touchbench.app.schemas.datasets import DatasetSummary
+from touchbench.app.schemas.listing import Page
+from touchbench.app.store import listing as stored
+from touchbench.app.store.listing import DatasetInfo
+from touchbench.app.store.reading import Readable
 
 
 def summary(info: DatasetInfo) -> DatasetSummary:

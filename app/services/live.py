@@ -24,15 +24,15 @@ from typing import Any
 
 import numpy as np
 
-from app.errors import AppError
-from app.schemas.models import Engine
-from app.services.export import load_predictor
-from app.store.database import Store
-from app.store.models import ModelInfo, is_pinned, model_version
-from benchmark.model import Predictor
-from features.errors import FeatureError
-from features.extractors import Instances
-from features.recipe import Recipe
+from touchbench.app.errors import AppError
+from touchbench.app.schemas.models import Engine
+from touchbench.app.services.export import load_predictor
+from touchbench.app.store.database import Store
+from touchbench.app.store.models import ModelInfo, is_pinned, model_version
+from touchbench.benchmark.model import Predictor
+from touchbench.features.errors import FeatureError
+from touchbench.features.extractors import Instances
+from touchbench.features.recipe import Recipe
 
 
 @dataclass(frozen=True)

@@ -18,8 +18,8 @@ from typing import Any
 
 import numpy as np
 
-from app.errors import ConflictError, FieldError
-from app.schemas.models import (
+from touchbench.app.errors import ConflictError, FieldError
+from touchbench.app.schemas.models import (
     AliasDeleted,
     AliasRequest,
     Engine,
@@ -29,10 +29,10 @@ from app.schemas.models import (
     PredictionRow,
     TrainRequest,
 )
-from app.services.datasets import read_data_file
-from app.store.database import Store
-from app.store.datasets import find_dataset, load_dataset
-from app.store.models import (
+from touchbench.app.services.datasets import read_data_file
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import find_dataset, load_dataset
+from touchbench.app.store.models import (
     AliasMove,
     ModelInfo,
     check_model_name,
@@ -42,12 +42,12 @@ from app.store.models import (
     save_model,
     set_alias,
 )
-from app.store.naming import shorten
-from app.store.runs import RunInfo, get_run, load_results
-from benchmark.dataset import Attribute, Dataset, Schema
-from benchmark.errors import ConfigurationError, DataFormatError
-from benchmark.model import Predictor, TrainedModel, dumps_model, fit_model, loads_model
-from benchmark.problem import Problem, problem_from_dataset, restrict_targets
+from touchbench.app.store.naming import shorten
+from touchbench.app.store.runs import RunInfo, get_run, load_results
+from touchbench.benchmark.dataset import Attribute, Dataset, Schema
+from touchbench.benchmark.errors import ConfigurationError, DataFormatError
+from touchbench.benchmark.model import Predictor, TrainedModel, dumps_model, fit_model, loads_model
+from touchbench.benchmark.problem import Problem, problem_from_dataset, restrict_targets
 
 #: Labels quoted in one warning at most.
 MAX_QUOTED = 5
@@ -101,7 +101,9 @@ def check_training(store: Store, request: TrainRequest) -> Training:
         classifier or one that cannot learn the targets (a multi-class classifier for
         several targets, or the reverse; a sequence classifier on flat features).
     """
-    from benchmark.estimators import check_classifier  # start-up time: the catalogue is big
+    from touchbench.benchmark.estimators import (
+        check_classifier,  # start-up time: the catalogue is big
+    )
 
     if request.name is not None:
         check_model_name(request.name)  # a name taken is not refused: it gets a new version
@@ -157,7 +159,7 @@ def _best_of_run(store: Store, run_ref: int) -> tuple[RunInfo, str]:
     ConflictError
         The run has no successful classifier (yet).
     """
-    from app.services.runs import run_leaderboard  # start-up time: the engine's imports
+    from touchbench.app.services.runs import run_leaderboard  # start-up time: the engine's imports
 
     run = get_run(store, run_ref)
     if not load_results(store, run.id):
@@ -336,7 +338,7 @@ def predict_file(
         Loads the model (default: :func:`app.services.export.load_predictor`).
     """
     if loader is None:
-        from app.services.export import load_predictor  # it builds on this module
+        from touchbench.app.services.export import load_predictor  # it builds on this module
 
         loader = load_predictor
     info, model = loader(store, request.model, request.engine)
@@ -362,7 +364,7 @@ def predict_path(
     """
     if info.extraction is not None and is_recording(path, model.schema):
         # Imported here: only raw recordings need the extraction stack.
-        from app.services.extraction import extract_with_recipe
+        from touchbench.app.services.extraction import extract_with_recipe
 
         extracted = extract_with_recipe(path, info.extraction)
         predictions = predict(model, extracted.dataset, source=path.name)

@@ -18,11 +18,11 @@ from pathlib import Path
 
 import soundfile
 
-from app.errors import AppError
-from benchmark.io.csv import csv_problem
-from drivers.errors import DriverError
-from drivers.sound import SoundDeviceSource
-from features.event_streams import open_event_stream
+from touchbench.app.errors import AppError
+from touchbench.benchmark.io.csv import csv_problem
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.sound import SoundDeviceSource
+from touchbench.features.event_streams import open_event_stream
 
 LABELS = "labels.csv"
 

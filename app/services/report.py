@@ -12,21 +12,21 @@ from importlib import metadata
 
 import numpy as np
 
-from app.schemas.learning import LearningCurveResult
-from app.services.answers import RunAnswers, latest_learning_curve, run_answers
-from app.services.compare import Comparison, compare_runs, with_besides
-from app.services.runs import (
+from touchbench.app.schemas.learning import LearningCurveResult
+from touchbench.app.services.answers import RunAnswers, latest_learning_curve, run_answers
+from touchbench.app.services.compare import Comparison, compare_runs, with_besides
+from touchbench.app.services.runs import (
     PerTargetSummary,
     RunLeaderboard,
     per_target_summary,
     run_leaderboard,
 )
-from app.store.database import Store
-from app.store.datasets import load_schema
-from app.store.runs import RunInfo, get_run
-from benchmark.errors import BenchmarkError, ConfigurationError
-from benchmark.evaluation.score_table import MissingPolicy, ScoreTable, fold_score_table
-from benchmark.results import TaskResult
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import load_schema
+from touchbench.app.store.runs import RunInfo, get_run
+from touchbench.benchmark.errors import BenchmarkError, ConfigurationError
+from touchbench.benchmark.evaluation.score_table import MissingPolicy, ScoreTable, fold_score_table
+from touchbench.benchmark.results import TaskResult
 
 #: Distributions whose versions a report names.
 LIBRARIES = (

@@ -12,12 +12,12 @@ from __future__ import annotations
 import json
 from collections.abc import Callable
 
-from app.schemas.ros import RosNodeRequest
-from app.services.live import LiveSession, TouchPrediction, load_live_model
-from app.store.database import Store
-from drivers.ros_source import RosAudioSource, RosTaxelSource, info_topic_of
-from drivers.ros_transport import RosTransport
-from drivers.source import Source
+from touchbench.app.schemas.ros import RosNodeRequest
+from touchbench.app.services.live import LiveSession, TouchPrediction, load_live_model
+from touchbench.app.store.database import Store
+from touchbench.drivers.ros_source import RosAudioSource, RosTaxelSource, info_topic_of
+from touchbench.drivers.ros_transport import RosTransport
+from touchbench.drivers.source import Source
 
 
 def run_ros_node(

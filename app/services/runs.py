@@ -20,8 +20,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from app.errors import AppError, FieldError
-from app.schemas.runs import (
+from touchbench.app.errors import AppError, FieldError
+from touchbench.app.schemas.runs import (
     PER_RECORDING_NOTE,
     RACE_MIN_FOLDS,
     BenchRequest,
@@ -34,13 +34,13 @@ from app.schemas.runs import (
     RunStatus,
     TunedComparisonSchema,
 )
-from app.services.beside import Beside, besides, merged_results, row_runs
-from app.services.tuning import run_specs
-from app.store.database import Store
-from app.store.datasets import load_dataset, load_schema
-from app.store.drops import forget_budget_cuts, load_drops, record_drop
-from app.store.ownership import process_owner
-from app.store.runs import (
+from touchbench.app.services.beside import Beside, besides, merged_results, row_runs
+from touchbench.app.services.tuning import run_specs
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import load_dataset, load_schema
+from touchbench.app.store.drops import forget_budget_cuts, load_drops, record_drop
+from touchbench.app.store.ownership import process_owner
+from touchbench.app.store.runs import (
     RunInfo,
     add_spent,
     claim_run,
@@ -52,19 +52,24 @@ from app.store.runs import (
     run_heartbeat,
     update_config,
 )
-from app.store.runs import (
+from touchbench.app.store.runs import (
     create_run as store_run,
 )
-from benchmark.dataset import Dataset, Schema
-from benchmark.errors import ConfigurationError
-from benchmark.problem import Problem, position_columns, problem_from_dataset, restrict_targets
-from benchmark.results import Drop, TaskKey, TaskResult
+from touchbench.benchmark.dataset import Dataset, Schema
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.problem import (
+    Problem,
+    position_columns,
+    problem_from_dataset,
+    restrict_targets,
+)
+from touchbench.benchmark.results import Drop, TaskKey, TaskResult
 
 if TYPE_CHECKING:  # scipy.stats (significance) loads when a leaderboard is first built
-    from benchmark.catalogue import ClassifierSpec
-    from benchmark.evaluation.leaderboard import Leaderboard
-    from benchmark.run.folds import FoldPlan
-    from benchmark.run.racing import RaceRule
+    from touchbench.benchmark.catalogue import ClassifierSpec
+    from touchbench.benchmark.evaluation.leaderboard import Leaderboard
+    from touchbench.benchmark.run.folds import FoldPlan
+    from touchbench.benchmark.run.racing import RaceRule
 
 #: The race's test, as the leaderboards name it.
 RACE_TEST = "corrected resampled t-test against the leader"
@@ -231,20 +236,20 @@ def default_classifiers(
     A regression (``regression_size``: its number of instances) gets the suite's
     regressors (:func:`benchmark.catalogue.regressors.regression_suite`).
     """
-    from benchmark.estimators import reads_sequences
+    from touchbench.benchmark.estimators import reads_sequences
 
     if regression_size is not None:
-        from benchmark.catalogue.regressors import regression_suite
+        from touchbench.benchmark.catalogue.regressors import regression_suite
 
         return regression_suite(
             suite_name, n_targets=n_targets, n_instances=regression_size, sequences=sequences
         )
     if n_targets > 1:
-        from benchmark.multitarget.suites import multitarget_suite
+        from touchbench.benchmark.multitarget.suites import multitarget_suite
 
         ids = multitarget_suite(suite_name)
     else:
-        from benchmark.catalogue import suite
+        from touchbench.benchmark.catalogue import suite
 
         ids = suite(suite_name)
     return [i for i in ids if sequences or not reads_sequences(i)]
@@ -266,7 +271,7 @@ def check_classifiers(
     ConfigurationError
         No classifiers; an id the run added (a suite's, a twin) does not fit.
     """
-    from benchmark.estimators import check_classifier
+    from touchbench.benchmark.estimators import check_classifier
 
     if not classifiers:
         raise ConfigurationError("no classifiers to run")
@@ -287,7 +292,7 @@ def weka_specs(commands: Sequence[str] | Mapping[str, str | None]) -> dict[str, 
     FieldError
         For ``weka``: a command line the catalogue cannot compute.
     """
-    from benchmark.catalogue import parse_weka_command
+    from touchbench.benchmark.catalogue import parse_weka_command
 
     texts = commands.values() if isinstance(commands, Mapping) else commands
     try:
@@ -390,11 +395,11 @@ def _plan_run(store: Store, request: BenchRequest) -> _Plan:
     ids = list(dict.fromkeys([*ids, *commands]))
     tuning = _tuning_config(commands, request.tune, request.budget, request.stack)
     if request.tune:
-        from app.services.tuning import with_tuned_twins
+        from touchbench.app.services.tuning import with_tuned_twins
 
         ids = with_tuned_twins(ids, commands, request.budget)
     if request.stack is not None:
-        from app.services.tuning import add_stack
+        from touchbench.app.services.tuning import add_stack
 
         ids = add_stack(ids, request.stack, multitarget=problem.kind == "multitarget")
     check_classifiers(problem, ids, run_specs(tuning, ids), asked=request.classifiers or ())
@@ -404,7 +409,7 @@ def _plan_run(store: Store, request: BenchRequest) -> _Plan:
             f"'{request.baseline}' is not a classifier of this run (classifiers: {', '.join(ids)})",
         )
     if request.aggregate == "recording":
-        from benchmark.evaluation.recordings import check_one_label
+        from touchbench.benchmark.evaluation.recordings import check_one_label
 
         try:
             check_one_label(problem.Y, problem.groups, prepared.target_names, info.name)
@@ -537,7 +542,7 @@ def execute_run(
             callbacks.on_plan(*counts)
             callbacks.on_note(f"{drop.classifier}: {drop.describe()}")
 
-        from benchmark.run.engine import RunStopped, run_tasks
+        from touchbench.benchmark.run.engine import RunStopped, run_tasks
 
         beat.start()
         began = time.monotonic()
@@ -604,7 +609,7 @@ def race_rule(run: RunInfo) -> RaceRule | None:
     race = run.config.get("race")
     if not race:
         return None
-    from benchmark.run.racing import RaceRule
+    from touchbench.benchmark.run.racing import RaceRule
 
     baseline = run.config.get("baseline")
     return RaceRule(
@@ -719,7 +724,7 @@ class RunLeaderboard:
     def report(self) -> LeaderboardSchema:
         """What ``leaderboard --json`` prints and the API serves: rows with their per-target
         scores, tuned twins against their defaults, the choices per fold."""
-        from benchmark.evaluation.tuned import compare_tuned, fold_choices
+        from touchbench.benchmark.evaluation.tuned import compare_tuned, fold_choices
 
         run, board, results = self.run, self.board, self.results
         per_target = per_target_summary(results)
@@ -787,7 +792,7 @@ def run_leaderboard(
     ConfigurationError
         A metric of the other kind of problem; an unknown metric or baseline.
     """
-    from benchmark.evaluation.leaderboard import build_leaderboard
+    from touchbench.benchmark.evaluation.leaderboard import build_leaderboard
 
     run = get_run(store, run_id)
     results = load_results(store, run.id)
@@ -833,7 +838,7 @@ def check_metric(kind: str, metric: str, *, position: bool, run_id: int | None =
     ConfigurationError
         One line naming the metric, the kind of run and the metrics it has.
     """
-    from benchmark.evaluation.metrics import COST_METRICS, REGRESSION_METRICS
+    from touchbench.benchmark.evaluation.metrics import COST_METRICS, REGRESSION_METRICS
 
     run = f"run {run_id}" if run_id is not None else "this run"
     if metric in COST_METRICS:
@@ -1031,8 +1036,8 @@ def task_memory(
         return int(max_memory_mb * 2**20), "asked"
     if scheduler is not None:
         return None, "the Dask workers' own memory limits"
-    from benchmark.run.engine import available_cores
-    from benchmark.run.memory import default_task_memory
+    from touchbench.benchmark.run.engine import available_cores
+    from touchbench.benchmark.run.memory import default_task_memory
 
     cap = default_task_memory(available_cores() if jobs == -1 else jobs, data_bytes=data_bytes)
     if cap is None:
@@ -1043,7 +1048,7 @@ def task_memory(
 
 def fold_plan(prepared: PreparedProblem, options: RunOptions) -> FoldPlan:
     """The folds a run with these options makes on this problem (the same on resume)."""
-    from benchmark.run.folds import make_fold_plan
+    from touchbench.benchmark.run.folds import make_fold_plan
 
     try:
         return make_fold_plan(

@@ -15,9 +15,9 @@ from pathlib import Path
 import numpy as np
 import soundfile
 
-from drivers.oscillating import CONTACTS, simulate_link_trial
-from drivers.oscillating import SAMPLERATE as LINK_RATE
-from drivers.simulated import SimulatedTouch, simulate_session
+from touchbench.drivers.oscillating import CONTACTS, simulate_link_trial
+from touchbench.drivers.oscillating import SAMPLERATE as LINK_RATE
+from touchbench.drivers.simulated import SimulatedTouch, simulate_session
 
 SAMPLERATE = 44100
 #: Microphone i sits nearest place i, so a touch there is heard on channel i.

@@ -9,10 +9,10 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
-from app.errors import FieldError
+from touchbench.app.errors import FieldError
 
 if TYPE_CHECKING:
-    from benchmark.catalogue import ClassifierSpec
+    from touchbench.benchmark.catalogue import ClassifierSpec
 
 
 def with_tuned_twins(
@@ -29,9 +29,14 @@ def with_tuned_twins(
     ConfigurationError
         A search space that its estimator refuses; a budget out of the engine's range.
     """
-    from benchmark.catalogue import SEARCH_SPACES
-    from benchmark.catalogue.tuning import check_budget, is_tuned_id, tuned_id, tuned_spec
-    from benchmark.estimators import classifier_spec, is_multitarget_id
+    from touchbench.benchmark.catalogue import SEARCH_SPACES
+    from touchbench.benchmark.catalogue.tuning import (
+        check_budget,
+        is_tuned_id,
+        tuned_id,
+        tuned_spec,
+    )
+    from touchbench.benchmark.estimators import classifier_spec, is_multitarget_id
 
     check_budget(budget_minutes)
     out: list[str] = []
@@ -66,10 +71,10 @@ def run_specs(config: Mapping[str, Any], classifiers: Sequence[str]) -> dict[str
     classifiers : sequence of str
         The run's classifier ids.
     """
-    from benchmark.catalogue import parse_weka_command
-    from benchmark.catalogue.stacking import stack_id, stacked_spec
-    from benchmark.catalogue.tuning import TUNED_SUFFIX, is_tuned_id, tuned_spec
-    from benchmark.estimators import classifier_spec
+    from touchbench.benchmark.catalogue import parse_weka_command
+    from touchbench.benchmark.catalogue.stacking import stack_id, stacked_spec
+    from touchbench.benchmark.catalogue.tuning import TUNED_SUFFIX, is_tuned_id, tuned_spec
+    from touchbench.benchmark.estimators import classifier_spec
 
     specs: dict[str, ClassifierSpec] = {}
     for text in (config.get("weka") or {}).values():
@@ -99,7 +104,7 @@ def add_stack(ids: Sequence[str], top_n: int, *, multitarget: bool) -> list[str]
     FieldError
         For ``stack``: a multi-target run, or more members than the run has classifiers.
     """
-    from benchmark.catalogue.stacking import check_top_n, stack_id
+    from touchbench.benchmark.catalogue.stacking import check_top_n, stack_id
 
     if multitarget:
         raise FieldError("stack", "stacks multi-class classifiers: pick one `target`")

@@ -17,8 +17,8 @@ from sqlalchemy.exc import ArgumentError, DatabaseError, OperationalError
 from sqlalchemy.sql.compiler import SQLCompiler
 from sqlalchemy.sql.elements import ClauseElement
 
-from app.errors import AppError, ConflictError
-from app.store.reading import HEAD_REVISION
+from touchbench.app.errors import AppError, ConflictError
+from touchbench.app.store.reading import HEAD_REVISION
 
 if TYPE_CHECKING:
     from sqlalchemy.orm import Session, sessionmaker

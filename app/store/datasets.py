@@ -22,14 +22,14 @@ from sqlalchemy import delete, insert, select, update
 from sqlalchemy.exc import IntegrityError, OperationalError
 from sqlalchemy.orm import Session
 
-from app.errors import AppError, ConflictError, FieldError
-from app.schemas.names import check_name
-from app.store.database import Store
-from app.store.listing import DatasetInfo
-from app.store.naming import default_name, find_row, free_name, shorten
-from app.store.ownership import owner_alive
-from app.store.tables import DatasetRow, InstanceBlockRow, InstanceRow, RunRow
-from benchmark.dataset import Dataset, InstanceBlock, Schema, dataset_blocks
+from touchbench.app.errors import AppError, ConflictError, FieldError
+from touchbench.app.schemas.names import check_name
+from touchbench.app.store.database import Store
+from touchbench.app.store.listing import DatasetInfo
+from touchbench.app.store.naming import default_name, find_row, free_name, shorten
+from touchbench.app.store.ownership import owner_alive
+from touchbench.app.store.tables import DatasetRow, InstanceBlockRow, InstanceRow, RunRow
+from touchbench.benchmark.dataset import Dataset, InstanceBlock, Schema, dataset_blocks
 
 _LITTLE_F8 = np.dtype("<f8")
 #: Instances per block when a data set held in memory is stored.

@@ -10,9 +10,9 @@ from __future__ import annotations
 
 from sqlalchemy import delete, select
 
-from app.store.database import Store
-from app.store.tables import EntryDropRow
-from benchmark.results import Drop
+from touchbench.app.store.database import Store
+from touchbench.app.store.tables import EntryDropRow
+from touchbench.benchmark.results import Drop
 
 
 def record_drop(store: Store, run_id: int, drop: Drop) -> None:

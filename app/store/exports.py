@@ -8,9 +8,9 @@ from dataclasses import dataclass
 
 from sqlalchemy import delete, select
 
-from app.errors import AppError
-from app.store.database import Store
-from app.store.tables import ModelExportRow
+from touchbench.app.errors import AppError
+from touchbench.app.store.database import Store
+from touchbench.app.store.tables import ModelExportRow
 
 #: The formats a twin may have.
 FORMATS = ("onnx",)

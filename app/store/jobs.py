@@ -11,16 +11,16 @@ from typing import Any
 
 from sqlalchemy import select, update
 
-from app.errors import NotFoundError
-from app.schemas.jobs import JobSchema
-from app.schemas.listing import Page
-from app.store import queue
-from app.store.database import Store
-from app.store.naming import is_row_id
-from app.store.ownership import mark_lost, owner_alive, process_owner
-from app.store.paging import count_rows, paged
-from app.store.states import LOST_AS
-from app.store.tables import JobRow, utcnow
+from touchbench.app.errors import NotFoundError
+from touchbench.app.schemas.jobs import JobSchema
+from touchbench.app.schemas.listing import Page
+from touchbench.app.store import queue
+from touchbench.app.store.database import Store
+from touchbench.app.store.naming import is_row_id
+from touchbench.app.store.ownership import mark_lost, owner_alive, process_owner
+from touchbench.app.store.paging import count_rows, paged
+from touchbench.app.store.states import LOST_AS
+from touchbench.app.store.tables import JobRow, utcnow
 
 #: The error a job left by a dead process is recorded with.
 _LOST_ERROR = "the worker process stopped before the job ended"

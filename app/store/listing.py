@@ -16,8 +16,8 @@ from datetime import UTC, datetime
 from types import SimpleNamespace
 from typing import Any
 
-from app.schemas.listing import Page
-from app.store.reading import Readable, fetch_all
+from touchbench.app.schemas.listing import Page
+from touchbench.app.store.reading import Readable, fetch_all
 
 #: The columns of ``datasets`` the listing reads, in the order of its rows.
 COLUMNS = (

@@ -24,14 +24,14 @@ from sqlalchemy import and_, bindparam, delete, func, select, update
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session
 
-from app.errors import AppError, ConflictError, FieldError, NotFoundError
-from app.schemas.listing import Page
-from app.schemas.models import AliasMoved, ModelSchema
-from app.schemas.names import LATEST, check_alias, check_name
-from app.store.database import Store
-from app.store.naming import find_row, is_decimal, is_row_id, may_be_name, shorten
-from app.store.paging import count_rows, paged
-from app.store.tables import (
+from touchbench.app.errors import AppError, ConflictError, FieldError, NotFoundError
+from touchbench.app.schemas.listing import Page
+from touchbench.app.schemas.models import AliasMoved, ModelSchema
+from touchbench.app.schemas.names import LATEST, check_alias, check_name
+from touchbench.app.store.database import Store
+from touchbench.app.store.naming import find_row, is_decimal, is_row_id, may_be_name, shorten
+from touchbench.app.store.paging import count_rows, paged
+from touchbench.app.store.tables import (
     MODEL_VERSION_KEY,
     DatasetRow,
     ModelAliasEventRow,

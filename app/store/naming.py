@@ -9,10 +9,10 @@ from typing import Any, Protocol, TypeVar
 from sqlalchemy import func, select
 from sqlalchemy.orm import InstrumentedAttribute, Session
 
-from app.errors import NotFoundError
-from app.schemas.names import CONTROL as _CONTROL
-from app.schemas.names import MAX_NAME
-from app.schemas.names import shown as shorten
+from touchbench.app.errors import NotFoundError
+from touchbench.app.schemas.names import CONTROL as _CONTROL
+from touchbench.app.schemas.names import MAX_NAME
+from touchbench.app.schemas.names import shown as shorten
 
 #: Names listed in a "no such ..." message.
 _NAMES_SHOWN = 10

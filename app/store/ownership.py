@@ -15,7 +15,7 @@ from typing import Any
 from sqlalchemy import select, update
 from sqlalchemy.orm import Session
 
-from app.store.naming import is_decimal
+from touchbench.app.store.naming import is_decimal
 
 #: A running item whose heartbeat is older than this has lost its process.
 STALE_AFTER = 30.0

@@ -7,8 +7,8 @@ from typing import Any, TypeVar
 
 from sqlalchemy import ColumnElement, Select, func, select
 
-from app.schemas.listing import Page
-from app.store.database import Store
+from touchbench.app.schemas.listing import Page
+from touchbench.app.store.database import Store
 
 SelectType = TypeVar("SelectType", bound=Select[Any])
 

@@ -22,9 +22,9 @@ from typing import Any
 from sqlalchemy import select, update
 from sqlalchemy.orm import Session
 
-from app.store.database import Store
-from app.store.states import ACTIVE, cancel_outcome
-from app.store.tables import utcnow
+from touchbench.app.store.database import Store
+from touchbench.app.store.states import ACTIVE, cancel_outcome
+from touchbench.app.store.tables import utcnow
 
 #: Seconds between heartbeats of the process executing an item.
 HEARTBEAT_INTERVAL = 5.0

@@ -21,18 +21,18 @@ from sqlalchemy.dialects.postgresql import insert as postgresql_insert
 from sqlalchemy.dialects.sqlite import insert as sqlite_insert
 from sqlalchemy.orm import Session
 
-from app.errors import ConflictError, NotFoundError
-from app.schemas.base import finite
-from app.schemas.listing import Page
-from app.schemas.runs import FINAL_STATUSES, RunSchema, RunStatus
-from app.store import queue
-from app.store.database import Store
-from app.store.naming import is_row_id
-from app.store.ownership import aware, mark_lost, owner_alive, process_owner
-from app.store.paging import count_rows, paged
-from app.store.states import ACTIVE, LOST_AS, check_claim, check_resume
-from app.store.tables import DatasetRow, EntryDropRow, FoldResultRow, RunRow, utcnow
-from benchmark.results import TaskKey, TaskResult
+from touchbench.app.errors import ConflictError, NotFoundError
+from touchbench.app.schemas.base import finite
+from touchbench.app.schemas.listing import Page
+from touchbench.app.schemas.runs import FINAL_STATUSES, RunSchema, RunStatus
+from touchbench.app.store import queue
+from touchbench.app.store.database import Store
+from touchbench.app.store.naming import is_row_id
+from touchbench.app.store.ownership import aware, mark_lost, owner_alive, process_owner
+from touchbench.app.store.paging import count_rows, paged
+from touchbench.app.store.states import ACTIVE, LOST_AS, check_claim, check_resume
+from touchbench.app.store.tables import DatasetRow, EntryDropRow, FoldResultRow, RunRow, utcnow
+from touchbench.benchmark.results import TaskKey, TaskResult
 
 #: Multi-target folds keep their per-target scores in the metrics column under this key.
 PER_TARGET = "per_target"

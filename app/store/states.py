@@ -25,10 +25,10 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Protocol
 
-from app.errors import ConflictError
+from touchbench.app.errors import ConflictError
 
 if TYPE_CHECKING:
-    from app.store.runs import RunInfo
+    from touchbench.app.store.runs import RunInfo
 
 #: A process executes the run.
 ACTIVE: frozenset[str] = frozenset({"running", "cancelling"})

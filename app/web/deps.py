@@ -6,7 +6,7 @@ from typing import Annotated
 
 from fastapi import Depends, Request
 
-from app.store.database import Store
+from touchbench.app.store.database import Store
 
 
 async def get_store(request: Request) -> Store:

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from typing import Protocol, TypeVar
 
-from app.reports.bounds import ROWS, Shown
-from app.schemas.listing import Page
+from touchbench.app.reports.bounds import ROWS, Shown
+from touchbench.app.schemas.listing import Page
 
 T = TypeVar("T")
 

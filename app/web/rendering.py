@@ -21,8 +21,8 @@ from urllib.parse import quote, urlencode
 
 from fastapi.responses import HTMLResponse
 
-from app.errors import AppError
-from benchmark.errors import BenchmarkError
+from touchbench.app.errors import AppError
+from touchbench.benchmark.errors import BenchmarkError
 
 if TYPE_CHECKING:  # Jinja, matplotlib and the statistics load with the first page, not at start
     from jinja2 import Environment
@@ -57,7 +57,7 @@ SECURITY_HEADERS = {
 def environment() -> Environment:
     """The report's environment with the web templates searched first, and the filters the
     web templates use."""
-    from app.reports.html import template_environment
+    from touchbench.app.reports.html import template_environment
 
     env = template_environment(TEMPLATES)
     env.filters["segment"] = lambda value: quote(str(value), safe="")
@@ -103,7 +103,7 @@ def draw(caption: str, build: Callable[[], Figure]) -> Plot:
 
 def svg_data_uri(figure: Figure) -> str:
     """The figure as a ``data:`` URI of its SVG (text kept as text)."""
-    from app.reports.plots import svg_text
+    from touchbench.app.reports.plots import svg_text
 
     encoded = base64.b64encode(svg_text(figure).encode("utf-8")).decode("ascii")
     return f"data:image/svg+xml;base64,{encoded}"

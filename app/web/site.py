@@ -16,8 +16,8 @@ from typing import Any
 from fastapi import FastAPI
 from fastapi.staticfiles import StaticFiles
 
-from app.web.rendering import STATIC
-from app.web.routes import compare, datasets, models, pages, runs
+from touchbench.app.web.rendering import STATIC
+from touchbench.app.web.routes import compare, datasets, models, pages, runs
 
 
 def install(app: FastAPI, dependencies: Sequence[Any]) -> None:

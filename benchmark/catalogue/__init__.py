@@ -18,15 +18,15 @@ from types import MappingProxyType
 
 from sklearn.pipeline import Pipeline
 
-from benchmark.catalogue.entries import SPECS as _ENTRIES
-from benchmark.catalogue.pipeline import check_sequence_input, pipeline_for_spec
-from benchmark.catalogue.plugins import plugin_specs
-from benchmark.catalogue.spaces import SEARCH_SPACES
-from benchmark.catalogue.spec import ClassifierSpec
-from benchmark.catalogue.tuning import TUNED_SUFFIX, is_tuned_id, tuned_spec
-from benchmark.catalogue.weka_schemes import scheme_for, split_command
-from benchmark.errors import ConfigurationError
-from benchmark.sequence import SequenceLayout
+from touchbench.benchmark.catalogue.entries import SPECS as _ENTRIES
+from touchbench.benchmark.catalogue.pipeline import check_sequence_input, pipeline_for_spec
+from touchbench.benchmark.catalogue.plugins import plugin_specs
+from touchbench.benchmark.catalogue.spaces import SEARCH_SPACES
+from touchbench.benchmark.catalogue.spec import ClassifierSpec
+from touchbench.benchmark.catalogue.tuning import TUNED_SUFFIX, is_tuned_id, tuned_spec
+from touchbench.benchmark.catalogue.weka_schemes import scheme_for, split_command
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.sequence import SequenceLayout
 
 __all__ = [
     "CATALOGUE",

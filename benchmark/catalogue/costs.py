@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from benchmark.catalogue.spec import ClassifierSpec
+from touchbench.benchmark.catalogue.spec import ClassifierSpec
 
 #: The shape the catalogue's ``cost`` labels describe.
 REFERENCE_INSTANCES = 2000

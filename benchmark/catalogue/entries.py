@@ -45,15 +45,21 @@ from sklearn.preprocessing import KBinsDiscretizer
 from sklearn.svm import SVC, LinearSVC, NuSVC
 from sklearn.tree import DecisionTreeClassifier, ExtraTreeClassifier
 
-from benchmark.catalogue.boosters import CatBoostNominalClassifier, LightGBMClassifier
-from benchmark.catalogue.estimators import LabelEncodedClassifier, OneRuleClassifier
-from benchmark.catalogue.model_trees import LogisticModelTree
-from benchmark.catalogue.neural import NeuralSequenceClassifier
-from benchmark.catalogue.rules import OrderedRuleClassifier
-from benchmark.catalogue.spec import ClassifierSpec, make_spec
-from benchmark.catalogue.time_series import IntervalForestClassifier, RocketClassifier
-from benchmark.catalogue.weka_schemes import weka_command
-from benchmark.weka import C45Classifier, PARTClassifier, WekaIBk, WekaNaiveBayes, WekaZeroR
+from touchbench.benchmark.catalogue.boosters import CatBoostNominalClassifier, LightGBMClassifier
+from touchbench.benchmark.catalogue.estimators import LabelEncodedClassifier, OneRuleClassifier
+from touchbench.benchmark.catalogue.model_trees import LogisticModelTree
+from touchbench.benchmark.catalogue.neural import NeuralSequenceClassifier
+from touchbench.benchmark.catalogue.rules import OrderedRuleClassifier
+from touchbench.benchmark.catalogue.spec import ClassifierSpec, make_spec
+from touchbench.benchmark.catalogue.time_series import IntervalForestClassifier, RocketClassifier
+from touchbench.benchmark.catalogue.weka_schemes import weka_command
+from touchbench.benchmark.weka import (
+    C45Classifier,
+    PARTClassifier,
+    WekaIBk,
+    WekaNaiveBayes,
+    WekaZeroR,
+)
 
 FAST = frozenset({"fast", "default"})
 DEFAULT = frozenset({"default"})

@@ -58,7 +58,7 @@ from sklearn.base import BaseEstimator, ClassifierMixin, RegressorMixin
 from sklearn.model_selection import GroupShuffleSplit, train_test_split
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from benchmark.sequence import panel
+from touchbench.benchmark.sequence import panel
 
 #: The networks an architecture may name.
 KINDS = ("bilstm", "cnn1d", "resnet1d", "inception-time")
@@ -236,7 +236,7 @@ class _NeuralSequenceModel(BaseEstimator):
         with _torch_settings() as torch:
             networks = getattr(self, "_networks", None)
             if networks is None:
-                from benchmark.catalogue.networks import load_networks  # PyTorch: on use
+                from touchbench.benchmark.catalogue.networks import load_networks  # PyTorch: on use
 
                 networks = self._networks = load_networks(self.architecture_, self.weights_)
             inputs = torch.from_numpy(sequences), torch.from_numpy(others)
@@ -451,7 +451,7 @@ def _train(
     ``model.refit`` a new network (same seed) then learns the whole training fold for
     that many epochs, else the best epoch's weights are kept.
     """
-    from benchmark.catalogue.networks import network_bytes  # PyTorch: on use
+    from touchbench.benchmark.catalogue.networks import network_bytes  # PyTorch: on use
 
     first = 0 if model.random_state is None else int(model.random_state)
     loss_of = torch.nn.CrossEntropyLoss() if y.dtype == np.int64 else torch.nn.MSELoss()
@@ -484,7 +484,7 @@ def _early_stopped(
     """A new network trained on ``train`` for ``epochs`` (default ``model.max_epochs``),
     stopped after ``model.patience`` epochs without a lower loss on ``valid`` (if any);
     the network with the best epoch's weights, epochs run, best epoch."""
-    from benchmark.catalogue.networks import build_network  # PyTorch: on use
+    from touchbench.benchmark.catalogue.networks import build_network  # PyTorch: on use
 
     torch.manual_seed(seed)
     rng = np.random.default_rng(seed)

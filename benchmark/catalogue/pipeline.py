@@ -8,10 +8,10 @@ from typing import Any
 from sklearn.base import BaseEstimator
 from sklearn.pipeline import Pipeline
 
-from benchmark.catalogue.spec import ClassifierSpec
-from benchmark.errors import ConfigurationError
-from benchmark.preprocessing import make_preprocessor
-from benchmark.sequence import SequenceLayout
+from touchbench.benchmark.catalogue.spec import ClassifierSpec
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.preprocessing import make_preprocessor
+from touchbench.benchmark.sequence import SequenceLayout
 
 #: HistGradientBoosting's limit on the labels of a native categorical feature (estimators
 #: that take ``nominal_features`` have none).
@@ -97,8 +97,8 @@ def pipeline_for_spec(
 
 def _composite(spec: ClassifierSpec, options: dict[str, Any]) -> BaseEstimator:
     """The tuned twin's search, or the stack, over whole member pipelines."""
-    from benchmark.catalogue.stacking import SelectedStack
-    from benchmark.catalogue.tuning import CLASSIFIER_STEP, TunedClassifier, as_grid
+    from touchbench.benchmark.catalogue.stacking import SelectedStack
+    from touchbench.benchmark.catalogue.tuning import CLASSIFIER_STEP, TunedClassifier, as_grid
 
     if spec.tuning is not None:
         base = spec.tuning.base

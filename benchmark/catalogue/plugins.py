@@ -18,8 +18,8 @@ import importlib
 import os
 from collections.abc import Iterable, Sequence
 
-from benchmark.catalogue.spec import ClassifierSpec
-from benchmark.errors import ConfigurationError
+from touchbench.benchmark.catalogue.spec import ClassifierSpec
+from touchbench.benchmark.errors import ConfigurationError
 
 #: The environment variable that names the plugin modules.
 PLUGINS_VARIABLE = "TOUCHBENCH_PLUGINS"

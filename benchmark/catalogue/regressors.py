@@ -47,11 +47,11 @@ from sklearn.preprocessing import StandardScaler
 from sklearn.svm import SVR, LinearSVR
 from sklearn.tree import DecisionTreeRegressor
 
-from benchmark.catalogue import CATALOGUE, SUITES, unknown_classifier_message
-from benchmark.catalogue.entries import NEURAL_ENTRIES, NEURAL_LIMITS
-from benchmark.catalogue.neural import NeuralSequenceRegressor
-from benchmark.catalogue.spec import ClassifierSpec, make_spec
-from benchmark.errors import ConfigurationError
+from touchbench.benchmark.catalogue import CATALOGUE, SUITES, unknown_classifier_message
+from touchbench.benchmark.catalogue.entries import NEURAL_ENTRIES, NEURAL_LIMITS
+from touchbench.benchmark.catalogue.neural import NeuralSequenceRegressor
+from touchbench.benchmark.catalogue.spec import ClassifierSpec, make_spec
+from touchbench.benchmark.errors import ConfigurationError
 
 __all__ = [
     "CHAIN_PREFIXES",

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from types import MappingProxyType
 
-from benchmark.catalogue.spec import SearchSpace
+from touchbench.benchmark.catalogue.spec import SearchSpace
 
 # No setting costs much more than the entry's default (the plan counts every candidate at
 # the default's cost; the tuned twin's goal is under 10x the default run): the forests keep

@@ -22,9 +22,9 @@ from sklearn.linear_model import LogisticRegression
 from sklearn.metrics import f1_score
 from sklearn.model_selection import cross_val_predict
 
-from benchmark.catalogue.spec import ClassifierSpec, Stacking
-from benchmark.catalogue.tuning import inner_folds
-from benchmark.errors import ConfigurationError
+from touchbench.benchmark.catalogue.spec import ClassifierSpec, Stacking
+from touchbench.benchmark.catalogue.tuning import inner_folds
+from touchbench.benchmark.errors import ConfigurationError
 
 #: Inner folds of the member selection and of the stacked class scores.
 INNER_FOLDS = 3

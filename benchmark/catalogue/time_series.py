@@ -30,8 +30,8 @@ from sklearn.pipeline import Pipeline, make_pipeline
 from sklearn.preprocessing import StandardScaler
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from benchmark.catalogue.intervals import RandomIntervalFeatures
-from benchmark.sequence import panel
+from touchbench.benchmark.catalogue.intervals import RandomIntervalFeatures
+from touchbench.benchmark.sequence import panel
 
 #: The transforms :class:`RocketClassifier` offers, by name.
 ROCKETS = ("minirocket", "multirocket")

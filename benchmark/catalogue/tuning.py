@@ -41,8 +41,8 @@ from sklearn.model_selection import (
 )
 from sklearn.utils.metaestimators import available_if
 
-from benchmark.catalogue.spec import ClassifierSpec, SearchSpace, Tuning
-from benchmark.errors import ConfigurationError
+from touchbench.benchmark.catalogue.spec import ClassifierSpec, SearchSpace, Tuning
+from touchbench.benchmark.errors import ConfigurationError
 
 #: Suffix of a tuned twin's id: ``rf+tuned``.
 TUNED_SUFFIX = "+tuned"

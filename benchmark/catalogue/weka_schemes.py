@@ -15,7 +15,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from benchmark.errors import ConfigurationError
+from touchbench.benchmark.errors import ConfigurationError
 
 W = "weka.classifiers."
 

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import t as student_t
 
-from benchmark.errors import ConfigurationError
+from touchbench.benchmark.errors import ConfigurationError
 
 #: Default half-width of the region of practical equivalence, in the metric's units.
 DEFAULT_ROPE = 0.01

@@ -16,10 +16,10 @@ from typing import Any, Literal
 
 import numpy as np
 
-from benchmark.errors import ConfigurationError
-from benchmark.evaluation.metrics import LOWER_IS_BETTER
-from benchmark.evaluation.significance import corrected_resampled_ttest
-from benchmark.results import Drop, TaskResult
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.evaluation.metrics import LOWER_IS_BETTER
+from touchbench.benchmark.evaluation.significance import corrected_resampled_ttest
+from touchbench.benchmark.results import Drop, TaskResult
 
 Mark = Literal["v", "*", ""]
 

@@ -18,10 +18,10 @@ from typing import Any
 
 import numpy as np
 
-from benchmark.catalogue import CATALOGUE, ClassifierSpec
-from benchmark.dataset import Attribute, Dataset, Schema
-from benchmark.errors import ConfigurationError
-from benchmark.results import TaskResult
+from touchbench.benchmark.catalogue import CATALOGUE, ClassifierSpec
+from touchbench.benchmark.dataset import Attribute, Dataset, Schema
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.results import TaskResult
 
 RELATION = "InstanceResultListener"
 

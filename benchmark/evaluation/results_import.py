@@ -16,10 +16,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from benchmark.dataset import Dataset
-from benchmark.errors import DataFormatError
-from benchmark.evaluation.results_arff import KEY_ATTRIBUTES, RELATION
-from benchmark.results import TaskKey, TaskResult
+from touchbench.benchmark.dataset import Dataset
+from touchbench.benchmark.errors import DataFormatError
+from touchbench.benchmark.evaluation.results_arff import KEY_ATTRIBUTES, RELATION
+from touchbench.benchmark.results import TaskKey, TaskResult
 
 #: touchbench's metric name -> (WEKA attribute, factor): the measures WEKA defines as we do.
 WEKA_METRICS: dict[str, tuple[str, float]] = {

@@ -16,8 +16,8 @@ from typing import Literal, cast
 
 import numpy as np
 
-from benchmark.errors import ConfigurationError
-from benchmark.results import TaskResult
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.results import TaskResult
 
 #: What to do with a classifier that has no score on a block: leave the classifier out,
 #: leave the block out, or rank it last on that block.

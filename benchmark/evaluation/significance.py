@@ -12,7 +12,7 @@ import math
 import numpy as np
 from scipy.special import stdtr
 
-from benchmark.errors import ConfigurationError
+from touchbench.benchmark.errors import ConfigurationError
 
 
 def corrected_resampled_ttest(

@@ -26,8 +26,8 @@ import numpy as np
 from scipy.stats import chi2, norm, rankdata, studentized_range
 from scipy.stats import f as f_distribution
 
-from benchmark.errors import ConfigurationError
-from benchmark.evaluation.score_table import ScoreTable
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.evaluation.score_table import ScoreTable
 
 
 @dataclass(frozen=True)

@@ -15,9 +15,9 @@ from typing import Any
 
 import numpy as np
 
-from benchmark.evaluation.leaderboard import finite, mark_against, scores_by_fold
-from benchmark.evaluation.metrics import LOWER_IS_BETTER
-from benchmark.results import TaskResult
+from touchbench.benchmark.evaluation.leaderboard import finite, mark_against, scores_by_fold
+from touchbench.benchmark.evaluation.metrics import LOWER_IS_BETTER
+from touchbench.benchmark.results import TaskResult
 
 #: Suffix of a tuned twin's id (as :data:`benchmark.catalogue.tuning.TUNED_SUFFIX`; the
 #: evaluation package does not import the catalogue).

@@ -26,8 +26,8 @@ from typing import Any
 
 import numpy as np
 
-from benchmark.errors import ConfigurationError
-from benchmark.export.onnx import (
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.export.onnx import (
     INPUT,
     LABEL,
     PROBABILITIES,
@@ -36,17 +36,17 @@ from benchmark.export.onnx import (
     output_names,
     refuse,
 )
-from benchmark.model import TrainedModel
-from benchmark.multitarget._target_classifier import TargetClassifier
-from benchmark.multitarget.bayesian_chain import BayesianClassifierChain
-from benchmark.multitarget.chains import ClassifierChain
-from benchmark.multitarget.combination import (
+from touchbench.benchmark.model import TrainedModel
+from touchbench.benchmark.multitarget._target_classifier import TargetClassifier
+from touchbench.benchmark.multitarget.bayesian_chain import BayesianClassifierChain
+from touchbench.benchmark.multitarget.chains import ClassifierChain
+from touchbench.benchmark.multitarget.combination import (
     LabelCombination,
     NearestSetReplacement,
     PrunedSets,
 )
-from benchmark.multitarget.relevance import ClassRelevance
-from benchmark.problem import usable_feature_columns
+from touchbench.benchmark.multitarget.relevance import ClassRelevance
+from touchbench.benchmark.problem import usable_feature_columns
 
 #: Meta-classifiers whose models export, by registry id and class (exact classes: a
 #: subclass that predicts otherwise, as the probabilistic chain, does not).

@@ -36,10 +36,10 @@ from typing import Any, NoReturn
 import numpy as np
 from sklearn.base import BaseEstimator
 
-from benchmark.catalogue.spec import ClassifierSpec
-from benchmark.errors import ConfigurationError
-from benchmark.model import TrainedModel
-from benchmark.problem import feature_matrix, usable_feature_columns
+from touchbench.benchmark.catalogue.spec import ClassifierSpec
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.model import TrainedModel
+from touchbench.benchmark.problem import feature_matrix, usable_feature_columns
 
 #: Opsets of the graphs written: ONNX Runtime 1.14 (2023) and later run them.
 TARGET_OPSET = {"": 17, "ai.onnx.ml": 3}
@@ -199,7 +199,7 @@ def convert(model: TrainedModel) -> Any:
     """
     if len(model.schema.target_indices) != 1:
         # a cycle at import time: the multi-target graphs are built of this module's
-        from benchmark.export.multitarget import convert_multitarget
+        from touchbench.benchmark.export.multitarget import convert_multitarget
 
         return convert_multitarget(model)
     n_labels = 0 if model.regression else model.n_classes[0]

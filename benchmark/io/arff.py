@@ -9,8 +9,8 @@ are not supported.  ``loads_arff(dumps_arff(d))`` equals ``d``.  Large files str
 
 from __future__ import annotations
 
-from benchmark.io.arff_reader import ArffReader, loads_arff, open_arff, read_arff
-from benchmark.io.arff_writer import ArffWriter, dumps_arff, write_arff
+from touchbench.benchmark.io.arff_reader import ArffReader, loads_arff, open_arff, read_arff
+from touchbench.benchmark.io.arff_writer import ArffWriter, dumps_arff, write_arff
 
 __all__ = [
     "ArffReader",

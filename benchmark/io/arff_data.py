@@ -19,10 +19,10 @@ from typing import Protocol
 
 import numpy as np
 
-from benchmark.dataset import Attribute, InstanceBlock
-from benchmark.errors import DataFormatError
-from benchmark.io.dates import DateFormat
-from benchmark.io.tokens import (
+from touchbench.benchmark.dataset import Attribute, InstanceBlock
+from touchbench.benchmark.errors import DataFormatError
+from touchbench.benchmark.io.dates import DateFormat
+from touchbench.benchmark.io.tokens import (
     CLOSE,
     OPEN,
     QUOTED,

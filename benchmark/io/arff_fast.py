@@ -35,7 +35,7 @@ from typing import Any
 
 import numpy as np
 
-from benchmark.dataset import Attribute
+from touchbench.benchmark.dataset import Attribute
 
 _FORBIDDEN = (b'"', b"\\", b"{", b"}", b"%")
 _NOT_PLAIN = re.compile(r"""^$|[\x00-\x20,'"\\{}%]""")

@@ -9,10 +9,19 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from benchmark.dataset import Attribute
-from benchmark.errors import DataFormatError
-from benchmark.io.dates import DateFormat
-from benchmark.io.tokens import CLOSE, OPEN, QUOTED, WORD, LineError, Token, describe, tokenize
+from touchbench.benchmark.dataset import Attribute
+from touchbench.benchmark.errors import DataFormatError
+from touchbench.benchmark.io.dates import DateFormat
+from touchbench.benchmark.io.tokens import (
+    CLOSE,
+    OPEN,
+    QUOTED,
+    WORD,
+    LineError,
+    Token,
+    describe,
+    tokenize,
+)
 
 
 @dataclass

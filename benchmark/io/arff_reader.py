@@ -28,13 +28,19 @@ from typing import BinaryIO, Literal
 
 import numpy as np
 
-from benchmark.dataset import Dataset, InstanceBlock, Schema, join_blocks, resolve_targets
-from benchmark.errors import ConfigurationError, DataFormatError
-from benchmark.io.arff_data import DataSection
-from benchmark.io.arff_fast import plain_plan, read_plain_block
-from benchmark.io.arff_header import Header, HeaderParser
-from benchmark.io.read_ahead import ordered_ahead
-from benchmark.io.textfile import (
+from touchbench.benchmark.dataset import (
+    Dataset,
+    InstanceBlock,
+    Schema,
+    join_blocks,
+    resolve_targets,
+)
+from touchbench.benchmark.errors import ConfigurationError, DataFormatError
+from touchbench.benchmark.io.arff_data import DataSection
+from touchbench.benchmark.io.arff_fast import plain_plan, read_plain_block
+from touchbench.benchmark.io.arff_header import Header, HeaderParser
+from touchbench.benchmark.io.read_ahead import ordered_ahead
+from touchbench.benchmark.io.textfile import (
     BLOCK_BYTES,
     SNIFF_BYTES,
     FileScan,

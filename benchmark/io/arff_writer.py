@@ -20,10 +20,10 @@ from typing import TextIO
 
 import numpy as np
 
-from benchmark.dataset import Attribute, Dataset, Schema, resolve_targets
-from benchmark.errors import ConfigurationError, DataFormatError
-from benchmark.io.arff_fast_writer import DenseRows
-from benchmark.io.dates import DateFormat
+from touchbench.benchmark.dataset import Attribute, Dataset, Schema, resolve_targets
+from touchbench.benchmark.errors import ConfigurationError, DataFormatError
+from touchbench.benchmark.io.arff_fast_writer import DenseRows
+from touchbench.benchmark.io.dates import DateFormat
 
 #: Cells a writer writes row by row before it hands dense rows to Arrow (whose import costs
 #: what formatting this many cells does).

@@ -25,9 +25,9 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmark.dataset import Attribute, Dataset, Schema, resolve_targets
-from benchmark.errors import ConfigurationError, DataFormatError, DataWarning
-from benchmark.io.textfile import read_text_file
+from touchbench.benchmark.dataset import Attribute, Dataset, Schema, resolve_targets
+from touchbench.benchmark.errors import ConfigurationError, DataFormatError, DataWarning
+from touchbench.benchmark.io.textfile import read_text_file
 
 MISSING = frozenset({"", "?", "NA", "NaN", "nan"})
 _DELIMITERS = (",", ";", "\t")

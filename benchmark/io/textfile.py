@@ -25,7 +25,7 @@ from typing import BinaryIO
 
 import numpy as np
 
-from benchmark.errors import DataFormatError
+from touchbench.benchmark.errors import DataFormatError
 
 #: Bytes looked at before anything else is read: they must look like text.
 SNIFF_BYTES = 65536

@@ -9,22 +9,26 @@ one (n_samples, n_classes[t]) matrix per target.
 
 from __future__ import annotations
 
-from benchmark.multitarget._base import MultiTargetClassifier
-from benchmark.multitarget._target_classifier import TargetClassifier
-from benchmark.multitarget._targets import TargetError
-from benchmark.multitarget.bayesian_chain import BayesianClassifierChain
-from benchmark.multitarget.chains import ClassifierChain, ProbabilisticClassifierChain
-from benchmark.multitarget.combination import LabelCombination, NearestSetReplacement, PrunedSets
-from benchmark.multitarget.ensembles import EnsembleClassifierChains, EnsemblePrunedSets
-from benchmark.multitarget.metrics import (
+from touchbench.benchmark.multitarget._base import MultiTargetClassifier
+from touchbench.benchmark.multitarget._target_classifier import TargetClassifier
+from touchbench.benchmark.multitarget._targets import TargetError
+from touchbench.benchmark.multitarget.bayesian_chain import BayesianClassifierChain
+from touchbench.benchmark.multitarget.chains import ClassifierChain, ProbabilisticClassifierChain
+from touchbench.benchmark.multitarget.combination import (
+    LabelCombination,
+    NearestSetReplacement,
+    PrunedSets,
+)
+from touchbench.benchmark.multitarget.ensembles import EnsembleClassifierChains, EnsemblePrunedSets
+from touchbench.benchmark.multitarget.metrics import (
     LOSS_METRICS,
     MULTILABEL_METRICS,
     MULTITARGET_METRICS,
     multitarget_scores,
 )
-from benchmark.multitarget.multilabel import MultiLabelAdapter
-from benchmark.multitarget.rakeld import RAkELd
-from benchmark.multitarget.registry import (
+from touchbench.benchmark.multitarget.multilabel import MultiLabelAdapter
+from touchbench.benchmark.multitarget.rakeld import RAkELd
+from touchbench.benchmark.multitarget.registry import (
     DEFAULT_BASES,
     META_METHODS,
     MetaSpec,
@@ -33,8 +37,8 @@ from benchmark.multitarget.registry import (
     multitarget_configurations,
     parse_config,
 )
-from benchmark.multitarget.relevance import ClassRelevance
-from benchmark.multitarget.superclass import SuperClassClassifier
+from touchbench.benchmark.multitarget.relevance import ClassRelevance
+from touchbench.benchmark.multitarget.superclass import SuperClassClassifier
 
 __all__ = [
     "DEFAULT_BASES",

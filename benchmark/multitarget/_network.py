@@ -14,9 +14,9 @@ import numpy as np
 from sklearn.base import clone
 from sklearn.utils import check_random_state
 
-from benchmark.multitarget._base import MultiTargetClassifier
-from benchmark.multitarget._target_classifier import TargetClassifier
-from benchmark.multitarget._targets import TargetError, one_hot
+from touchbench.benchmark.multitarget._base import MultiTargetClassifier
+from touchbench.benchmark.multitarget._target_classifier import TargetClassifier
+from touchbench.benchmark.multitarget._targets import TargetError, one_hot
 
 
 class TargetNetwork(MultiTargetClassifier):

@@ -11,7 +11,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from benchmark.errors import ConfigurationError
+from touchbench.benchmark.errors import ConfigurationError
 
 
 class TargetError(ConfigurationError, ValueError):

@@ -8,9 +8,9 @@ from typing import Any
 import numpy as np
 from sklearn.utils import check_random_state
 
-from benchmark.multitarget._network import TargetNetwork
-from benchmark.multitarget._targets import TargetError
-from benchmark.multitarget.dependence import (
+from touchbench.benchmark.multitarget._network import TargetNetwork
+from touchbench.benchmark.multitarget._targets import TargetError
+from touchbench.benchmark.multitarget.dependence import (
     maximum_spanning_tree,
     mutual_information_matrix,
     orient_tree,

@@ -8,8 +8,8 @@ from typing import Any
 
 import numpy as np
 
-from benchmark.multitarget._network import TargetNetwork, chain_order
-from benchmark.multitarget._targets import one_hot
+from touchbench.benchmark.multitarget._network import TargetNetwork, chain_order
+from touchbench.benchmark.multitarget._targets import one_hot
 
 
 class ClassifierChain(TargetNetwork):

@@ -8,9 +8,9 @@ from typing import Any
 import numpy as np
 from sklearn.base import clone
 
-from benchmark.multitarget._base import MultiTargetClassifier
-from benchmark.multitarget._target_classifier import TargetClassifier
-from benchmark.multitarget._targets import all_binary, combination_marginals
+from touchbench.benchmark.multitarget._base import MultiTargetClassifier
+from touchbench.benchmark.multitarget._target_classifier import TargetClassifier
+from touchbench.benchmark.multitarget._targets import all_binary, combination_marginals
 
 
 class LabelCombination(MultiTargetClassifier):

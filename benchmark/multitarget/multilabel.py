@@ -20,9 +20,14 @@ from scipy import sparse
 from sklearn.base import clone
 from sklearn.utils import check_random_state
 
-from benchmark.multitarget._base import MultiTargetClassifier
-from benchmark.multitarget._target_classifier import TargetClassifier
-from benchmark.multitarget._targets import TargetError, all_binary, one_hot, random_partition
+from touchbench.benchmark.multitarget._base import MultiTargetClassifier
+from touchbench.benchmark.multitarget._target_classifier import TargetClassifier
+from touchbench.benchmark.multitarget._targets import (
+    TargetError,
+    all_binary,
+    one_hot,
+    random_partition,
+)
 
 #: Methods that need a base classifier, and those that have none.
 METHODS_WITH_BASE = ("br", "cc", "lp", "rakeld", "rakelo")

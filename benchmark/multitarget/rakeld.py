@@ -8,9 +8,9 @@ from typing import Any
 import numpy as np
 from sklearn.utils import check_random_state
 
-from benchmark.multitarget._base import MultiTargetClassifier, check_at_least_one
-from benchmark.multitarget._targets import random_partition
-from benchmark.multitarget.combination import NearestSetReplacement
+from touchbench.benchmark.multitarget._base import MultiTargetClassifier, check_at_least_one
+from touchbench.benchmark.multitarget._targets import random_partition
+from touchbench.benchmark.multitarget.combination import NearestSetReplacement
 
 
 class PartitionedCombinations(MultiTargetClassifier):

@@ -14,19 +14,23 @@ from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any
 
-from benchmark.catalogue import ClassifierSpec, build_pipeline, get_spec
-from benchmark.errors import ConfigurationError
-from benchmark.multitarget._base import MultiTargetClassifier
-from benchmark.multitarget._targets import all_binary
-from benchmark.multitarget.bayesian_chain import BayesianClassifierChain
-from benchmark.multitarget.chains import ClassifierChain, ProbabilisticClassifierChain
-from benchmark.multitarget.combination import LabelCombination, NearestSetReplacement, PrunedSets
-from benchmark.multitarget.ensembles import EnsembleClassifierChains, EnsemblePrunedSets
-from benchmark.multitarget.multilabel import MultiLabelAdapter
-from benchmark.multitarget.rakeld import RAkELd
-from benchmark.multitarget.relevance import ClassRelevance
-from benchmark.multitarget.superclass import SuperClassClassifier
-from benchmark.sequence import SequenceLayout
+from touchbench.benchmark.catalogue import ClassifierSpec, build_pipeline, get_spec
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.multitarget._base import MultiTargetClassifier
+from touchbench.benchmark.multitarget._targets import all_binary
+from touchbench.benchmark.multitarget.bayesian_chain import BayesianClassifierChain
+from touchbench.benchmark.multitarget.chains import ClassifierChain, ProbabilisticClassifierChain
+from touchbench.benchmark.multitarget.combination import (
+    LabelCombination,
+    NearestSetReplacement,
+    PrunedSets,
+)
+from touchbench.benchmark.multitarget.ensembles import EnsembleClassifierChains, EnsemblePrunedSets
+from touchbench.benchmark.multitarget.multilabel import MultiLabelAdapter
+from touchbench.benchmark.multitarget.rakeld import RAkELd
+from touchbench.benchmark.multitarget.relevance import ClassRelevance
+from touchbench.benchmark.multitarget.superclass import SuperClassClassifier
+from touchbench.benchmark.sequence import SequenceLayout
 
 #: Factory signature: (base estimator or preprocessor, random_state, n_classes) -> estimator.
 Factory = Callable[[Any, int | None, Sequence[int] | None], MultiTargetClassifier]

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from benchmark.multitarget._network import TargetNetwork
+from touchbench.benchmark.multitarget._network import TargetNetwork
 
 
 class ClassRelevance(TargetNetwork):

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from benchmark.errors import ConfigurationError
-from benchmark.multitarget.registry import META_METHODS, multitarget_configurations
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.multitarget.registry import META_METHODS, multitarget_configurations
 
 #: Quick configurations for smoke runs and the demo.
 FAST = ("cr:nb", "bcc:nb", "cr:j48", "cc:j48", "bcc:j48", "lc:j48")

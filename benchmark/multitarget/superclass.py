@@ -8,9 +8,9 @@ from typing import Any
 import numpy as np
 from sklearn.utils import check_random_state
 
-from benchmark.multitarget.dependence import error_dependence_matrix
-from benchmark.multitarget.rakeld import PartitionedCombinations
-from benchmark.multitarget.relevance import ClassRelevance
+from touchbench.benchmark.multitarget.dependence import error_dependence_matrix
+from touchbench.benchmark.multitarget.rakeld import PartitionedCombinations
+from touchbench.benchmark.multitarget.relevance import ClassRelevance
 
 _TRAINING_PERCENT = 67
 

@@ -16,11 +16,11 @@ from typing import Any
 
 import numpy as np
 
-from benchmark.errors import ConfigurationError
-from benchmark.problem import Problem
-from benchmark.results import TaskResult
-from benchmark.run.folds import Fold
-from benchmark.sequence import SequenceLayout
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.problem import Problem
+from touchbench.benchmark.results import TaskResult
+from touchbench.benchmark.run.folds import Fold
+from touchbench.benchmark.sequence import SequenceLayout
 
 
 def without_columns(problem: Problem, columns: Sequence[int]) -> Problem:
@@ -100,7 +100,7 @@ def ablate(
     dict of str to list of TaskResult
         Per group, the engine's results (classifier-major).
     """
-    from benchmark.run.engine import run_tasks
+    from touchbench.benchmark.run.engine import run_tasks
 
     out: dict[str, list[TaskResult]] = {}
     for name, columns in groups.items():

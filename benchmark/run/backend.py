@@ -13,9 +13,9 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Protocol, runtime_checkable
 
-from benchmark.results import TaskKey, TaskResult
-from benchmark.run.schedule import TaskSource
-from benchmark.run.task import failed_result
+from touchbench.benchmark.results import TaskKey, TaskResult
+from touchbench.benchmark.run.schedule import TaskSource
+from touchbench.benchmark.run.task import failed_result
 
 __all__ = [
     "STOP_POLL",

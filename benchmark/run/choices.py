@@ -13,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Iterator, Sequence
 from typing import Any
 
-from benchmark.catalogue.spec import jsonable
+from touchbench.benchmark.catalogue.spec import jsonable
 
 #: Key of the whole model's choice in a multi-target record: a model over the joint target
 #: combinations (LC, PS, NSR) searches once for every target.

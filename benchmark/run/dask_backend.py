@@ -18,9 +18,9 @@ from dataclasses import dataclass
 from queue import Empty, SimpleQueue
 from typing import TYPE_CHECKING, Any
 
-from benchmark.errors import BenchmarkError, ConfigurationError
-from benchmark.results import TaskKey, TaskResult
-from benchmark.run.backend import (
+from touchbench.benchmark.errors import BenchmarkError, ConfigurationError
+from touchbench.benchmark.results import TaskKey, TaskResult
+from touchbench.benchmark.run.backend import (
     STOP_POLL,
     ResultCallback,
     RunStopped,
@@ -29,9 +29,9 @@ from benchmark.run.backend import (
     timed_out,
     worker_could_not_start,
 )
-from benchmark.run.schedule import TaskSource
-from benchmark.run.task import failed_result
-from benchmark.run.worker import Worker, WorkerDiedError
+from touchbench.benchmark.run.schedule import TaskSource
+from touchbench.benchmark.run.task import failed_result
+from touchbench.benchmark.run.worker import Worker, WorkerDiedError
 
 if TYPE_CHECKING:
     from distributed import Future

@@ -20,19 +20,19 @@ import pickle
 import time
 from collections.abc import Callable, Collection, Mapping, Sequence
 
-from benchmark.catalogue import ClassifierSpec
-from benchmark.catalogue.costs import Shape, estimate_seconds
-from benchmark.errors import ConfigurationError
-from benchmark.estimators import check_classifier, classifier_spec, is_multitarget_id
-from benchmark.problem import Problem
-from benchmark.results import Drop, TaskKey, TaskResult
-from benchmark.run.backend import Backend, RunStopped, StartCallback, StopCheck
-from benchmark.run.dask_backend import DaskBackend
-from benchmark.run.folds import Fold
-from benchmark.run.local_backend import LocalBackend
-from benchmark.run.racing import RaceRule
-from benchmark.run.schedule import RoundSchedule, TaskList, TaskSource, test_train_ratio
-from benchmark.run.task import TaskContext
+from touchbench.benchmark.catalogue import ClassifierSpec
+from touchbench.benchmark.catalogue.costs import Shape, estimate_seconds
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.estimators import check_classifier, classifier_spec, is_multitarget_id
+from touchbench.benchmark.problem import Problem
+from touchbench.benchmark.results import Drop, TaskKey, TaskResult
+from touchbench.benchmark.run.backend import Backend, RunStopped, StartCallback, StopCheck
+from touchbench.benchmark.run.dask_backend import DaskBackend
+from touchbench.benchmark.run.folds import Fold
+from touchbench.benchmark.run.local_backend import LocalBackend
+from touchbench.benchmark.run.racing import RaceRule
+from touchbench.benchmark.run.schedule import RoundSchedule, TaskList, TaskSource, test_train_ratio
+from touchbench.benchmark.run.task import TaskContext
 
 __all__ = [
     "Problem",
@@ -220,7 +220,9 @@ def cost_hints(
     """Predicted seconds of one fold of each classifier on this problem's shape
     (:func:`benchmark.catalogue.costs.estimate_seconds`); a multi-target configuration
     costs its base classifier once per target."""
-    from benchmark.multitarget import parse_config  # loads scikit-learn's meta-estimators
+    from touchbench.benchmark.multitarget import (
+        parse_config,  # loads scikit-learn's meta-estimators
+    )
 
     n_train = max(int(f.train.size) for f in folds)
     n_classes = max(problem.n_classes) if problem.kind != "regression" else 1

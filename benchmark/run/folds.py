@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from sklearn.model_selection import GroupKFold, KFold, StratifiedGroupKFold, StratifiedKFold
 
-from benchmark.errors import ConfigurationError
+from touchbench.benchmark.errors import ConfigurationError
 
 
 @dataclass(frozen=True)

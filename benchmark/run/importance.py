@@ -17,12 +17,12 @@ from typing import Any
 
 import numpy as np
 
-from benchmark.catalogue import ClassifierSpec
-from benchmark.errors import ConfigurationError
-from benchmark.estimators import build_estimator
-from benchmark.evaluation.metrics import confusion_matrix, confusion_scores
-from benchmark.problem import Problem
-from benchmark.run.folds import Fold
+from touchbench.benchmark.catalogue import ClassifierSpec
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.estimators import build_estimator
+from touchbench.benchmark.evaluation.metrics import confusion_matrix, confusion_scores
+from touchbench.benchmark.problem import Problem
+from touchbench.benchmark.run.folds import Fold
 
 #: ``CHANNEL[T]``: a sample of a window (sequence data sets).
 _WINDOW = re.compile(r"^(?P<channel>.+)\[(?P<t>\d+)\]$")

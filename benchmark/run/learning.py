@@ -14,8 +14,8 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from benchmark.errors import ConfigurationError
-from benchmark.run.folds import Fold
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.run.folds import Fold
 
 
 def training_order(

@@ -15,8 +15,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from multiprocessing.connection import wait
 
-from benchmark.errors import BenchmarkError
-from benchmark.run.backend import (
+from touchbench.benchmark.errors import BenchmarkError
+from touchbench.benchmark.run.backend import (
     STOP_POLL,
     ResultCallback,
     RunStopped,
@@ -25,9 +25,9 @@ from benchmark.run.backend import (
     timed_out,
     worker_could_not_start,
 )
-from benchmark.run.schedule import TaskSource
-from benchmark.run.task import failed_result
-from benchmark.run.worker import Worker, WorkerDiedError
+from touchbench.benchmark.run.schedule import TaskSource
+from touchbench.benchmark.run.task import failed_result
+from touchbench.benchmark.run.worker import Worker, WorkerDiedError
 
 __all__ = ["LocalBackend"]
 

@@ -23,10 +23,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from benchmark.errors import ConfigurationError
-from benchmark.evaluation.leaderboard import mark_against
-from benchmark.evaluation.metrics import LOWER_IS_BETTER
-from benchmark.results import Drop
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.evaluation.leaderboard import mark_against
+from touchbench.benchmark.evaluation.metrics import LOWER_IS_BETTER
+from touchbench.benchmark.results import Drop
 
 #: The first round after which entries may be dropped: fewer folds say too little.
 FIRST_ROUND = 3

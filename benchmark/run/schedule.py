@@ -26,8 +26,8 @@ from collections import deque
 from collections.abc import Callable, Collection, Mapping, Sequence
 from typing import Protocol, runtime_checkable
 
-from benchmark.results import Drop, TaskKey, TaskResult
-from benchmark.run.racing import RaceRule, race_round
+from touchbench.benchmark.results import Drop, TaskKey, TaskResult
+from touchbench.benchmark.run.racing import RaceRule, race_round
 
 __all__ = ["RoundSchedule", "TaskList", "TaskSource"]
 

@@ -18,15 +18,19 @@ from typing import Any
 
 import numpy as np
 
-from benchmark.catalogue import ClassifierSpec
-from benchmark.estimators import build_estimator, group_fit_params
-from benchmark.evaluation.calibration import PER_TARGET, reliability
-from benchmark.evaluation.metrics import confusion_matrix, expand_proba, multiclass_scores
-from benchmark.evaluation.recordings import Recordings
-from benchmark.problem import Problem
-from benchmark.results import Status, TaskKey, TaskResult
-from benchmark.run.choices import chosen_params
-from benchmark.run.folds import Fold
+from touchbench.benchmark.catalogue import ClassifierSpec
+from touchbench.benchmark.estimators import build_estimator, group_fit_params
+from touchbench.benchmark.evaluation.calibration import PER_TARGET, reliability
+from touchbench.benchmark.evaluation.metrics import (
+    confusion_matrix,
+    expand_proba,
+    multiclass_scores,
+)
+from touchbench.benchmark.evaluation.recordings import Recordings
+from touchbench.benchmark.problem import Problem
+from touchbench.benchmark.results import Status, TaskKey, TaskResult
+from touchbench.benchmark.run.choices import chosen_params
+from touchbench.benchmark.run.folds import Fold
 
 #: At most this many distinct warnings are kept per task.
 MAX_WARNINGS = 5
@@ -155,7 +159,7 @@ def _groups(model: Any, problem: Problem, fold: Fold) -> dict[str, np.ndarray]:
 
 
 def _run_regression(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResult:
-    from benchmark.evaluation.regression import regression_scores
+    from touchbench.benchmark.evaluation.regression import regression_scores
 
     problem = context.problem
     model = build_estimator(key.classifier, problem, random_state=context.random_state)
@@ -189,7 +193,7 @@ def _run_regression(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResul
 
 
 def _run_multitarget(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResult:
-    from benchmark.multitarget import multitarget_scores
+    from touchbench.benchmark.multitarget import multitarget_scores
 
     problem = context.problem
     model = build_estimator(

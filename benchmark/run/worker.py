@@ -26,8 +26,8 @@ import time
 from multiprocessing.connection import Connection
 from typing import Any
 
-from benchmark.results import TaskKey, TaskResult
-from benchmark.run.task import describe_exception, execute_task
+from touchbench.benchmark.results import TaskKey, TaskResult
+from touchbench.benchmark.run.task import describe_exception, execute_task
 
 #: Characters of a dead worker's stderr quoted in the error.
 STDERR_TAIL = 300
@@ -64,7 +64,7 @@ class Worker:
         command = [
             sys.executable,
             "-c",
-            "from benchmark.run.worker import serve; serve()",
+            "from touchbench.benchmark.run.worker import serve; serve()",
             str(child_in),
             str(child_out),
             str(max_memory or 0),

@@ -6,10 +6,10 @@ scikit-learn's estimator contract.  :mod:`benchmark.weka.reference` runs the rea
 check them.
 """
 
-from benchmark.weka.c45 import C45Classifier
-from benchmark.weka.ibk import WekaIBk
-from benchmark.weka.naive_bayes import WekaNaiveBayes
-from benchmark.weka.part import PARTClassifier
-from benchmark.weka.zeror import WekaZeroR
+from touchbench.benchmark.weka.c45 import C45Classifier
+from touchbench.benchmark.weka.ibk import WekaIBk
+from touchbench.benchmark.weka.naive_bayes import WekaNaiveBayes
+from touchbench.benchmark.weka.part import PARTClassifier
+from touchbench.benchmark.weka.zeror import WekaZeroR
 
 __all__ = ["C45Classifier", "PARTClassifier", "WekaIBk", "WekaNaiveBayes", "WekaZeroR"]

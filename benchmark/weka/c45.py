@@ -24,8 +24,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from sklearn.utils.validation import check_is_fitted
 
-from benchmark.weka._data import NanClassifier, check_test_data, check_training_data
-from benchmark.weka._splits import (
+from touchbench.benchmark.weka._data import NanClassifier, check_test_data, check_training_data
+from touchbench.benchmark.weka._splits import (
     SMALL,
     Split,
     SplitSelector,

@@ -21,7 +21,7 @@ from typing import Literal
 import numpy as np
 from sklearn.utils.validation import check_is_fitted
 
-from benchmark.weka._data import NanClassifier, check_test_data, check_training_data
+from touchbench.benchmark.weka._data import NanClassifier, check_test_data, check_training_data
 
 Weighting = Literal["none", "inverse", "similarity"]
 

@@ -22,8 +22,8 @@ import numpy as np
 from scipy.special import ndtr
 from sklearn.utils.validation import check_is_fitted
 
-from benchmark.weka._data import NanClassifier, check_test_data, check_training_data
-from benchmark.weka.discretize import mdl_cut_points
+from touchbench.benchmark.weka._data import NanClassifier, check_test_data, check_training_data
+from touchbench.benchmark.weka.discretize import mdl_cut_points
 
 NumericModel = Literal["normal", "kernel", "discretize"]
 

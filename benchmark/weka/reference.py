@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmark.errors import ConfigurationError
+from touchbench.benchmark.errors import ConfigurationError
 
 #: Where Debian's ``weka`` package puts the jar and WEKA's example data files.
 WEKA_JARS = ("/usr/share/java/weka.jar", "/usr/share/java/weka-3.6.14.jar")

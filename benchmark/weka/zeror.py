@@ -14,7 +14,7 @@ from sklearn.utils import Tags
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from benchmark.weka._data import NanClassifier
+from touchbench.benchmark.weka._data import NanClassifier
 
 
 class WekaZeroR(NanClassifier):

@@ -10,14 +10,14 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from features.errors import FeatureError
-from features.extractors.band_peaks import BandPeaks
-from features.extractors.base import Extractor, Instances
-from features.extractors.mfcc import Mfcc
-from features.extractors.sequence import Sequence
-from features.extractors.taxel_dft import TaxelDft
-from features.extractors.uc3m_audio import Uc3mAudio, uc3m_feature_names
-from features.extractors.window import Window
+from touchbench.features.errors import FeatureError
+from touchbench.features.extractors.band_peaks import BandPeaks
+from touchbench.features.extractors.base import Extractor, Instances
+from touchbench.features.extractors.mfcc import Mfcc
+from touchbench.features.extractors.sequence import Sequence
+from touchbench.features.extractors.taxel_dft import TaxelDft
+from touchbench.features.extractors.uc3m_audio import Uc3mAudio, uc3m_feature_names
+from touchbench.features.extractors.window import Window
 
 EXTRACTORS: dict[str, type[Extractor]] = {
     extractor.name: extractor

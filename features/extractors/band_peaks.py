@@ -22,13 +22,13 @@ from typing import ClassVar
 
 import numpy as np
 
-from features.errors import FeatureError
-from features.events import Detection
-from features.extractors.base import Extractor, Instances
-from features.framing import fft_frequencies, window_function
-from features.options import Option, frequency_bands, positive_int
-from features.spectral import band_peak
-from features.temporal import rms
+from touchbench.features.errors import FeatureError
+from touchbench.features.events import Detection
+from touchbench.features.extractors.base import Extractor, Instances
+from touchbench.features.framing import fft_frequencies, window_function
+from touchbench.features.options import Option, frequency_bands, positive_int
+from touchbench.features.spectral import band_peak
+from touchbench.features.temporal import rms
 
 DEFAULT_BANDS: tuple[tuple[float, float], ...] = ((0.0, 120.0), (500.0, 550.0), (825.0, 925.0))
 

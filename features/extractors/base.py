@@ -10,10 +10,10 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from features._checks import as_samplerate
-from features.errors import FeatureError
-from features.events import Detection, Event
-from features.options import Option, resolve_options
+from touchbench.features._checks import as_samplerate
+from touchbench.features.errors import FeatureError
+from touchbench.features.events import Detection, Event
+from touchbench.features.options import Option, resolve_options
 
 
 @dataclass

@@ -23,18 +23,18 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from features.events import Detection
-from features.extractors.base import (
+from touchbench.features.events import Detection
+from touchbench.features.extractors.base import (
     Extractor,
     Instances,
     channel_labels,
     channel_suffixed,
     sequence_names,
 )
-from features.framing import frame, power_spectrogram
-from features.mel import mel_filter_bank, mel_spectrogram, mfcc
-from features.options import Option, positive_float, positive_int
-from features.resample import to_length
+from touchbench.features.framing import frame, power_spectrogram
+from touchbench.features.mel import mel_filter_bank, mel_spectrogram, mfcc
+from touchbench.features.options import Option, positive_float, positive_int
+from touchbench.features.resample import to_length
 
 
 class Mfcc(Extractor):

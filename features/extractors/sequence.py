@@ -28,12 +28,12 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from features.errors import FeatureError
-from features.events import Detection, Event
-from features.extractors.base import Instances, channel_labels, sequence_names
-from features.extractors.window import Window, baselines
-from features.options import Option, flag, non_negative_int, positive_int
-from features.resample import to_length
+from touchbench.features.errors import FeatureError
+from touchbench.features.events import Detection, Event
+from touchbench.features.extractors.base import Instances, channel_labels, sequence_names
+from touchbench.features.extractors.window import Window, baselines
+from touchbench.features.options import Option, flag, non_negative_int, positive_int
+from touchbench.features.resample import to_length
 
 #: Steps per channel when events are detected and no length is given.
 DEFAULT_LENGTH = 256

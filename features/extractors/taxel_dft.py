@@ -30,11 +30,11 @@ from typing import ClassVar
 
 import numpy as np
 
-from features.errors import FeatureError
-from features.events import Detection
-from features.extractors.base import Extractor, Instances, channel_suffixed
-from features.framing import frame, frame_count, stft
-from features.options import Option, non_negative_int, positive_int
+from touchbench.features.errors import FeatureError
+from touchbench.features.events import Detection
+from touchbench.features.extractors.base import Extractor, Instances, channel_suffixed
+from touchbench.features.framing import frame, frame_count, stft
+from touchbench.features.options import Option, non_negative_int, positive_int
 
 #: Below this rate only the DC bin is dropped by default (see the module docstring).
 FULL_DROP_RATE = 400.0

@@ -47,16 +47,16 @@ from typing import ClassVar
 
 import numpy as np
 
-from features.errors import FeatureError
-from features.events import Detection, Event
-from features.extractors.base import Extractor, Instances, channel_suffixed
-from features.framing import fft_frequencies, stft
-from features.options import Option, flag
-from features.pitch import pitch_autocorrelation, pitch_fft, pitch_wavelet
-from features.snr import SnrTrack, snr_track
-from features.spectral import spectral_centroid, spectral_flux, spectral_rolloff
-from features.stats import SegmentStatistics, segment_statistics
-from features.temporal import zero_crossings
+from touchbench.features.errors import FeatureError
+from touchbench.features.events import Detection, Event
+from touchbench.features.extractors.base import Extractor, Instances, channel_suffixed
+from touchbench.features.framing import fft_frequencies, stft
+from touchbench.features.options import Option, flag
+from touchbench.features.pitch import pitch_autocorrelation, pitch_fft, pitch_wavelet
+from touchbench.features.snr import SnrTrack, snr_track
+from touchbench.features.spectral import spectral_centroid, spectral_flux, spectral_rolloff
+from touchbench.features.stats import SegmentStatistics, segment_statistics
+from touchbench.features.temporal import zero_crossings
 
 WINDOW_LENGTH = 256
 SAMPLERATE = 44100.0

@@ -15,9 +15,9 @@ from typing import ClassVar
 
 import numpy as np
 
-from features.events import Detection, Event
-from features.extractors.base import Extractor, Instances, channel_suffixed
-from features.options import Option, positive_int
+from touchbench.features.events import Detection, Event
+from touchbench.features.extractors.base import Extractor, Instances, channel_suffixed
+from touchbench.features.options import Option, positive_int
 
 
 class Window(Extractor):

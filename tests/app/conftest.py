@@ -12,7 +12,7 @@ import pytest
 from sqlalchemy import create_engine, text
 from sqlalchemy.engine import make_url
 
-from app.store.database import Store
+from touchbench.app.store.database import Store
 
 DEFAULT_POSTGRES = "postgresql://postgres:postgres@127.0.0.1:5432/test"
 

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 from sklearn.base import BaseEstimator, ClassifierMixin
 
-from benchmark.catalogue.spec import ClassifierSpec
+from touchbench.benchmark.catalogue.spec import ClassifierSpec
 
 #: Bytes the fit asks for.
 HOG_BYTES = 2**30

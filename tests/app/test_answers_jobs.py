@@ -9,13 +9,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.schemas.importance import ImportanceRequest
-from app.services.answers import latest_ablation
-from app.services.jobs import execute_job, submit_answer
-from app.store.database import Store
-from app.store.jobs import list_jobs
 from tests.app.cli_runner import run_cli
 from tests.app.synthetic import touch_arff
+from touchbench.app.schemas.importance import ImportanceRequest
+from touchbench.app.services.answers import latest_ablation
+from touchbench.app.services.jobs import execute_job, submit_answer
+from touchbench.app.store.database import Store
+from touchbench.app.store.jobs import list_jobs
 
 
 def mics_arff(path: Path, *, n: int = 90, seed: int = 0) -> Path:

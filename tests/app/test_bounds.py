@@ -5,16 +5,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from app.reports import bounds
-from app.reports.plots import (
+from tests.app.test_plots import svg_texts
+from touchbench.app.reports import bounds
+from touchbench.app.reports.plots import (
     class_distribution_figure,
     confusion_figure,
     per_target_figure,
     svg_text,
 )
-from app.schemas.listing import Page
-from app.web.listing import newest
-from tests.app.test_plots import svg_texts
+from touchbench.app.schemas.listing import Page
+from touchbench.app.web.listing import newest
 
 
 def test_first_last_and_names_count_what_they_leave_out() -> None:

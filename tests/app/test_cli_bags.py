@@ -9,9 +9,6 @@ import numpy as np
 import pytest
 import soundfile
 
-from app.store.database import Store
-from app.store.datasets import load_dataset
-from drivers.simulated import SimulatedTouch, simulate_session
 from tests.app.cli_runner import run_cli
 from tests.drivers.bagfiles import (
     BIOTAC_MSG,
@@ -24,6 +21,9 @@ from tests.drivers.bagfiles import (
     write_fields_bag,
     write_other_audio_bag,
 )
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import load_dataset
+from touchbench.drivers.simulated import SimulatedTouch, simulate_session
 
 RATE = 44100
 DELAY = 0.25  # the audio starts this long after the bag's first message

@@ -15,12 +15,12 @@ from pathlib import Path
 import pytest
 from sqlalchemy import create_engine, text
 
-from app.store.database import Store
-from app.store.datasets import add_dataset, dataset_digest
-from benchmark.io.arff import loads_arff
 from tests.app.cli_runner import run_cli
 from tests.app.synthetic import touch_arff
 from tests.gate import Gate
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import add_dataset, dataset_digest
+from touchbench.benchmark.io.arff import loads_arff
 
 METRIC_KEYS = {
     "accuracy",
@@ -211,7 +211,7 @@ def test_a_killed_run_resumes_without_repeating_or_duplicating(
     imported(capsys, store_url, touch_arff(tmp_path / "touch.arff", n=300))
     gate = Gate(tmp_path / "gate")  # its fits wait for the test: killed after exactly 13 tasks
     environment = {**os.environ, **gate.environment()}
-    bench = [sys.executable, "-m", "app.cli.main", "--db", store_url, "bench"]
+    bench = [sys.executable, "-m", "touchbench.app.cli.main", "--db", store_url, "bench"]
     command = [*bench, "touch", "--target", "gesture", "-c", "zeror,gate,nb", "--folds", "10"]
     child = subprocess.Popen(
         command, env=environment, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE

@@ -8,12 +8,12 @@ from pathlib import Path
 
 import pytest
 
-from app.schemas.runs import BenchRequest
-from app.services.runs import NoResultsError, create_run, run_leaderboard
-from app.store.database import Store
 from tests.app.cli_runner import CliResult, run_cli
 from tests.app.rows import count_rows
 from tests.app.synthetic import position_arff, touch_arff
+from touchbench.app.schemas.runs import BenchRequest
+from touchbench.app.services.runs import NoResultsError, create_run, run_leaderboard
+from touchbench.app.store.database import Store
 
 
 @pytest.fixture

@@ -22,8 +22,8 @@ import numpy as np
 import pytest
 import soundfile
 
-from app.services.simulation import write_labels, write_session
 from tests.app.cli_runner import run_cli
+from touchbench.app.services.simulation import write_labels, write_session
 
 ROOT = Path(__file__).resolve().parents[2]
 RATE = 44100
@@ -48,7 +48,7 @@ def _touchbench(
     home: Path, db: str, *args: str, timeout: float = 120
 ) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        [sys.executable, "-m", "app.cli.main", "--db", db, *args],
+        [sys.executable, "-m", "touchbench.app.cli.main", "--db", db, *args],
         capture_output=True,
         text=True,
         timeout=timeout,
@@ -83,7 +83,7 @@ def test_capture_returns_the_raw_file_samples(device: tuple[Path, np.ndarray]) -
     home, expected = device
     script = (
         "import numpy as np\n"
-        "from drivers.sound import SoundDeviceSource\n"
+        "from touchbench.drivers.sound import SoundDeviceSource\n"
         "with SoundDeviceSource('replay', samplerate=44100, channels=3, seconds=2.0) as s:\n"
         "    blocks = list(s.blocks())\n"
         "x = np.concatenate([b.samples for b in blocks], axis=1)\n"
@@ -214,7 +214,7 @@ def test_ctrl_c_keeps_the_take_so_far_and_a_valid_labels_file(
         [
             sys.executable,
             "-m",
-            "app.cli.main",
+            "touchbench.app.cli.main",
             "--db",
             f"sqlite:///{tmp_path / 'x.db'}",
             "record",
@@ -302,7 +302,7 @@ def test_a_missing_portaudio_is_one_line_that_names_the_package(tmp_path: Path) 
     script = (
         "import ctypes.util, sys\n"
         "ctypes.util.find_library = lambda name: None  # as on a machine without it\n"
-        "from app.cli.main import main\n"
+        "from touchbench.app.cli.main import main\n"
         f"sys.exit(main(['--db', 'sqlite:///{tmp_path / 'x.db'}', 'devices']))\n"
     )
     result = subprocess.run(

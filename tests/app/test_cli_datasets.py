@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from benchmark.io.arff import read_arff
 from tests.app.cli_runner import run_cli
+from touchbench.benchmark.io.arff import read_arff
 
 TOUCH_ARFF = """% two targets, MEKA style
 @relation 'touch: -C 2'

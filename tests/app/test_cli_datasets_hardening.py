@@ -11,16 +11,16 @@ from pathlib import Path
 
 import pytest
 
-from app.schemas.datasets import ImportRequest
-from app.services import datasets as dataset_service
-from app.services.listing import list_datasets
-from app.store import datasets as store_datasets
-from app.store.database import Store
-from app.store.tables import RunRow
-from benchmark.errors import DataFormatError
-from benchmark.io.arff import read_arff
 from tests.app.cli_runner import CliResult, run_cli
 from tests.app.test_cli_datasets import TOUCH_ARFF, write
+from touchbench.app.schemas.datasets import ImportRequest
+from touchbench.app.services import datasets as dataset_service
+from touchbench.app.services.listing import list_datasets
+from touchbench.app.store import datasets as store_datasets
+from touchbench.app.store.database import Store
+from touchbench.app.store.tables import RunRow
+from touchbench.benchmark.errors import DataFormatError
+from touchbench.benchmark.io.arff import read_arff
 
 
 def one_error_line(result: CliResult, *expected: str) -> str:
@@ -264,7 +264,7 @@ def test_delete_is_refused_while_a_live_run_uses_the_dataset(
     age: timedelta | None,
     refused: bool,
 ) -> None:
-    from app.store.ownership import process_owner
+    from touchbench.app.store.ownership import process_owner
 
     imported = run_cli(capsys, store_url, "import", str(write(tmp_path, "mini.arff", TOUCH_ARFF)))
     assert imported.code == 0

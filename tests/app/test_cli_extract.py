@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from app.services.simulation import write_labels, write_session
 from tests.app.cli_runner import run_cli
+from touchbench.app.services.simulation import write_labels, write_session
 
 
 @pytest.fixture

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from app.cli.main import global_options_first, main
 from tests.app.synthetic import touch_arff
+from touchbench.app.cli.main import global_options_first, main
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -43,7 +43,7 @@ def test_global_options_are_moved_before_the_command(args: list[str], expected: 
 def test_bench_with_json_redirected_shows_progress_lines_on_stderr(tmp_path: Path) -> None:
     url = f"sqlite:///{tmp_path / 'progress.db'}"
     data = touch_arff(tmp_path / "touch.arff", n=60)
-    command = [sys.executable, "-m", "app.cli.main"]
+    command = [sys.executable, "-m", "touchbench.app.cli.main"]
     imported = subprocess.run(
         [*command, "import", str(data), "--db", url], capture_output=True, text=True, cwd=ROOT
     )

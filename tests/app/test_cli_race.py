@@ -30,7 +30,7 @@ RACE = ["--target", "gesture", "--folds", "5", "--race", "--seed", "3"]
 #: Runs each command line of the JSON list in argv[1] with touchbench's main, in order.
 BENCH_TWICE = (
     "import json, sys\n"
-    "from app.cli.main import main\n"
+    "from touchbench.app.cli.main import main\n"
     "for command in json.loads(sys.argv[1]):\n"
     "    code = main(command)\n"
     "    if code:\n"

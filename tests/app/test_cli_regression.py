@@ -7,10 +7,10 @@ from pathlib import Path
 
 import pytest
 
-from app.services.models import predict_records
-from app.store.database import Store
 from tests.app.cli_runner import CliResult, run_cli
 from tests.app.synthetic import position_arff, touch_arff
+from touchbench.app.services.models import predict_records
+from touchbench.app.store.database import Store
 
 
 @pytest.fixture

@@ -10,10 +10,10 @@ from pathlib import Path
 
 import pytest
 
-from benchmark.evaluation.statistics import nemenyi_critical_difference
 from tests.app.cli_runner import run_cli
 from tests.app.synthetic import touch_arff
 from tests.app.test_plots import FETCHES, svg_texts
+from touchbench.benchmark.evaluation.statistics import nemenyi_critical_difference
 
 CLASSIFIERS = "zeror,nb,j48"
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 import pytest
 from pydantic import Field, model_validator
 
-from app.cli.requests import build_request, describe
-from app.errors import FieldError
-from app.schemas.base import Request
+from touchbench.app.cli.requests import build_request, describe
+from touchbench.app.errors import FieldError
+from touchbench.app.schemas.base import Request
 
 
 class _Example(Request):

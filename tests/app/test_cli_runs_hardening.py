@@ -17,11 +17,11 @@ from typing import Any
 import pytest
 from sqlalchemy import create_engine, event, text
 
-from app.store.database import Store
-from app.store.models import list_models
 from tests.app.cli_runner import run_cli
 from tests.app.synthetic import touch_arff
 from tests.gate import Gate
+from touchbench.app.store.database import Store
+from touchbench.app.store.models import list_models
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -49,7 +49,7 @@ def _bench_process(
 ) -> subprocess.Popen[bytes]:
     """``touchbench bench`` in a subprocess that knows the ``gate`` entry; with
     ``ignore_sigint`` it starts as a background job of a script does, SIGINT ignored."""
-    command = [sys.executable, "-m", "app.cli.main", "--db", url, "bench", *args]
+    command = [sys.executable, "-m", "touchbench.app.cli.main", "--db", url, "bench", *args]
 
     def ignore() -> None:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -115,7 +115,16 @@ def test_an_interrupt_keeps_the_folds_and_resume_finishes(
     assert "3 of 10 tasks are stored" in message
     gate.open()
     resumed = subprocess.run(
-        [sys.executable, "-m", "app.cli.main", "--db", store_url, "bench", "--resume", "1"],
+        [
+            sys.executable,
+            "-m",
+            "touchbench.app.cli.main",
+            "--db",
+            store_url,
+            "bench",
+            "--resume",
+            "1",
+        ],
         cwd=ROOT,
         env={**os.environ, **gate.environment()},
         capture_output=True,
@@ -213,7 +222,7 @@ def test_bench_refusals_exit_2_and_leave_no_run(
 def test_an_unreachable_scheduler_leaves_no_run(
     capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    monkeypatch.setattr("benchmark.run.dask_backend.CONNECT_TIMEOUT", "1s")
+    monkeypatch.setattr("touchbench.benchmark.run.dask_backend.CONNECT_TIMEOUT", "1s")
     url = f"sqlite:///{tmp_path / 's.db'}"
     _import(capsys, url, touch_arff(tmp_path / "t.arff"), "touch")
     result = run_cli(
@@ -333,8 +342,8 @@ def test_an_old_store_migrates_and_finished_runs_become_done(tmp_path: Path) -> 
     from alembic import command
     from alembic.config import Config
 
-    from app.store.database import MIGRATIONS
-    from app.store.reading import HEAD_REVISION
+    from touchbench.app.store.database import MIGRATIONS
+    from touchbench.app.store.reading import HEAD_REVISION
 
     url = f"sqlite:///{tmp_path / 'old.db'}"
     engine = create_engine(url)
@@ -369,7 +378,7 @@ def test_an_old_store_migrates_and_finished_runs_become_done(tmp_path: Path) -> 
 def test_every_help_page_reads_well(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
     import typer
 
-    from app.cli.main import app
+    from touchbench.app.cli.main import app
 
     url = f"sqlite:///{tmp_path / 'h.db'}"
     names = [c.name for c in typer.main.get_command(app).commands.values()]  # type: ignore[attr-defined]
@@ -390,7 +399,7 @@ def test_error_lines_are_not_wrapped(tmp_path: Path) -> None:
         [
             sys.executable,
             "-m",
-            "app.cli.main",
+            "touchbench.app.cli.main",
             "--db",
             f"sqlite:///{tmp_path / 'w.db'}",
             "show",
@@ -411,7 +420,15 @@ def test_processes_opening_a_new_store_at_once_migrate_it_once(store_url: str) -
     environment = {**os.environ, "PYTHONPATH": str(ROOT)}
     processes = [
         subprocess.Popen(
-            [sys.executable, "-m", "app.cli.main", "--db", store_url, "datasets", "--json"],
+            [
+                sys.executable,
+                "-m",
+                "touchbench.app.cli.main",
+                "--db",
+                store_url,
+                "datasets",
+                "--json",
+            ],
             cwd=ROOT,
             env=environment,
             stdout=subprocess.PIPE,

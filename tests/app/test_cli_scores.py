@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 from sqlalchemy import create_engine, text
 
-from app.store.database import Store
-from app.store.datasets import add_dataset
-from benchmark.dataset import Attribute, Dataset, Schema
 from tests.app.cli_runner import run_cli
 from tests.app.synthetic import touch_arff
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import add_dataset
+from touchbench.benchmark.dataset import Attribute, Dataset, Schema
 
 PER_RECORDING = "scored per recording: each test recording's windows pooled"
 

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from app.services.runs import default_classifiers
 from tests.app.cli_runner import run_cli
+from touchbench.app.services.runs import default_classifiers
 
 
 @pytest.fixture

@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pytest
 
-from app.cli.signals import Interrupted, deferred_interrupts
-from app.services import datasets
 from tests.app.cli_runner import run_cli
 from tests.app.synthetic import touch_arff
+from touchbench.app.cli.signals import Interrupted, deferred_interrupts
+from touchbench.app.services import datasets
 
 
 def test_the_first_interrupt_asks_and_the_end_of_the_block_raises() -> None:

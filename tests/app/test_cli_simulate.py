@@ -10,9 +10,9 @@ import pytest
 from sklearn.ensemble import RandomForestClassifier
 from sklearn.model_selection import GroupKFold, cross_val_score
 
-from app.services.extraction import extract_dataset
-from drivers.oscillating import CONTACTS, simulate_link_trial
 from tests.app.cli_runner import run_cli
+from touchbench.app.services.extraction import extract_dataset
+from touchbench.drivers.oscillating import CONTACTS, simulate_link_trial
 
 
 def test_simulate_contact_mic_writes_sessions_extract_reads(

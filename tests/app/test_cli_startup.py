@@ -14,19 +14,26 @@ from pathlib import Path
 import pytest
 import typer
 
-import app.cli
-from app.cli.lazy import LazyGroup
-from app.cli.main import COMMANDS, main
-from app.environment import DEFAULT_DATABASE_URL, database_url
-from app.settings import Settings
+import touchbench.app.cli
 from tests.app.cli_runner import run_cli
+from touchbench.app.cli.lazy import LazyGroup
+from touchbench.app.cli.main import COMMANDS, main
+from touchbench.app.environment import DEFAULT_DATABASE_URL, database_url
+from touchbench.app.settings import Settings
 
 ROOT = Path(__file__).resolve().parents[2]
 TOUCHBENCH = Path(sys.executable).with_name("touchbench")
 
 #: Modules that no command's start-up needs before it is chosen (the store, the engine's
 #: libraries, the request and response types).
-HEAVY = ("sqlalchemy", "numpy", "pydantic", "app.store", "app.services", "app.schemas")
+HEAVY = (
+    "sqlalchemy",
+    "numpy",
+    "pydantic",
+    "touchbench.app.store",
+    "touchbench.app.services",
+    "touchbench.app.schemas",
+)
 #: Every module that defines commands.
 COMMAND_MODULES = tuple(dict.fromkeys(command.module for command in COMMANDS))
 
@@ -56,7 +63,7 @@ def test_the_table_is_what_the_modules_register() -> None:
 
 def test_every_module_with_commands_is_in_the_table() -> None:
     defining = set()
-    for module in pkgutil.iter_modules(app.cli.__path__, "app.cli."):
+    for module in pkgutil.iter_modules(touchbench.app.cli.__path__, "touchbench.app.cli."):
         if hasattr(importlib.import_module(module.name), "register"):
             defining.add(module.name)
     assert defining == set(COMMAND_MODULES)
@@ -149,23 +156,28 @@ def _heavy(modules: set[str]) -> set[str]:
 @pytest.mark.parametrize("option", ["--version", "--help", "-h"])
 def test_version_and_help_import_no_command(option: str, tmp_path: Path) -> None:
     imported = _imported(option, cwd=tmp_path)
-    assert "app.cli.main" in imported and "typer" in imported
+    assert "touchbench.app.cli.main" in imported and "typer" in imported
     assert _heavy(imported) == set()
     assert imported.isdisjoint(COMMAND_MODULES)
 
 
 def test_a_command_imports_its_own_module_only(tmp_path: Path) -> None:
     imported = _imported("datasets", cwd=tmp_path)  # the store in the current folder
-    assert "app.cli.listing" in imported and "sqlalchemy" in imported
-    assert imported & set(COMMAND_MODULES) == {"app.cli.listing"}
+    assert "touchbench.app.cli.listing" in imported and "sqlalchemy" in imported
+    assert imported & set(COMMAND_MODULES) == {"touchbench.app.cli.listing"}
     # Once the store exists (the first command made and migrated it), listing it reads one
     # table through sqlite3 alone: no SQLAlchemy, no NumPy.
     again = _imported("datasets", cwd=tmp_path)
-    assert "app.store.listing" in again and "sqlite3" in again
-    assert {"sqlalchemy", "numpy", "app.store.tables", "app.store.database"} & again == set()
+    assert "touchbench.app.store.listing" in again and "sqlite3" in again
+    assert {
+        "sqlalchemy",
+        "numpy",
+        "touchbench.app.store.tables",
+        "touchbench.app.store.database",
+    } & again == set()
     assert "pydantic_settings" not in imported  # the store's URL is all a command reads
     help_only = _imported("train", "--help", cwd=tmp_path)
-    assert help_only & set(COMMAND_MODULES) == {"app.cli.models"}
+    assert help_only & set(COMMAND_MODULES) == {"touchbench.app.cli.models"}
 
 
 def test_the_chosen_commands_module_is_frozen_once(tmp_path: Path) -> None:
@@ -173,9 +185,9 @@ def test_the_chosen_commands_module_is_frozen_once(tmp_path: Path) -> None:
     and calling the CLI again in the same process freezes nothing more."""
     script = (
         "import gc, sys\n"
-        "from app.cli.main import main\n"
+        "from touchbench.app.cli.main import main\n"
         "assert main(sys.argv[1:]) == 0\n"
-        "from app.cli.listing import datasets_command\n"
+        "from touchbench.app.cli.listing import datasets_command\n"
         "assert gc.is_tracked(datasets_command)\n"
         "frozen = not any(o is datasets_command for o in gc.get_objects())\n"
         "made_since = []\n"
@@ -195,7 +207,7 @@ def test_the_chosen_commands_module_is_frozen_once(tmp_path: Path) -> None:
 
 
 def test_the_job_process_help_imports_no_store(tmp_path: Path) -> None:
-    program = (sys.executable, "-m", "app.jobs.process")
+    program = (sys.executable, "-m", "touchbench.app.jobs.process")
     imported = _imported("--help", cwd=tmp_path, program=program)
     assert "argparse" in imported
     assert _heavy(imported) == set()

@@ -23,7 +23,7 @@ from tests.app.test_cli_datasets_hardening import one_error_line, stored_names
 
 
 def _command(database: str, *args: str) -> list[str]:
-    return [sys.executable, "-m", "app.cli.main", "--db", database, *args]
+    return [sys.executable, "-m", "touchbench.app.cli.main", "--db", database, *args]
 
 
 def _environment() -> dict[str, str]:
@@ -179,8 +179,8 @@ def test_an_early_ctrl_c_of_import_prints_no_traceback(tmp_path: Path, delay: fl
 
 FINALISER_INTERRUPTED = """
 import signal, sys, time
-import app.cli
-from app.cli.signals import Interrupted, interrupts
+import touchbench.app.cli
+from touchbench.app.cli.signals import Interrupted, interrupts
 
 class Finalised:
     def __del__(self):

@@ -8,8 +8,8 @@ from types import MappingProxyType
 
 import pytest
 
-import benchmark.catalogue
-import benchmark.estimators
+import touchbench.benchmark.catalogue
+import touchbench.benchmark.estimators
 from tests.app.cli_runner import run_cli
 from tests.app.synthetic import touch_arff
 
@@ -118,11 +118,11 @@ def test_a_stack_on_several_targets_and_a_tune_without_space_exit_2(
 def test_a_space_parameter_the_estimator_lacks_exits_2(
     capsys: pytest.CaptureFixture[str], db: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    catalogue = dict(benchmark.catalogue.CATALOGUE)
+    catalogue = dict(touchbench.benchmark.catalogue.CATALOGUE)
     catalogue["logistic"] = replace(catalogue["logistic"], search_space={"penalty_c": (1.0,)})
     patched = MappingProxyType(catalogue)
-    monkeypatch.setattr(benchmark.catalogue, "CATALOGUE", patched)
-    monkeypatch.setattr(benchmark.estimators, "CATALOGUE", patched)
+    monkeypatch.setattr(touchbench.benchmark.catalogue, "CATALOGUE", patched)
+    monkeypatch.setattr(touchbench.benchmark.estimators, "CATALOGUE", patched)
     result = run_cli(
         capsys, db, "bench", "touch", "--target", "gesture", "-c", "logistic", "--tune"
     )

@@ -8,17 +8,17 @@ from pathlib import Path
 
 import pytest
 
-from app.errors import NotFoundError
-from app.services.compare import compare_runs, comparison_schema
-from app.store.database import Store
-from app.store.datasets import add_dataset, dataset_digest
-from app.store.runs import create_run, finish_run, record_result
-from benchmark.errors import ConfigurationError
-from benchmark.io.arff import read_arff
-from benchmark.results import TaskKey, TaskResult
 from tests.app.cli_runner import run_cli
 from tests.app.synthetic import touch_arff
 from tests.benchmark.test_statistics import DEMSAR_AUC, DEMSAR_NAMES
+from touchbench.app.errors import NotFoundError
+from touchbench.app.services.compare import compare_runs, comparison_schema
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import add_dataset, dataset_digest
+from touchbench.app.store.runs import create_run, finish_run, record_result
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.io.arff import read_arff
+from touchbench.benchmark.results import TaskKey, TaskResult
 
 FOLDS = 2
 

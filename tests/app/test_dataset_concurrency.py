@@ -12,12 +12,12 @@ from pathlib import Path
 
 import numpy as np
 
-from app.errors import AppError
-from app.store.database import Store
-from app.store.datasets import DatasetInMemory, add_dataset_stream
-from app.store.listing import list_datasets
-from benchmark.dataset import Attribute, Dataset, InstanceBlock, Schema
 from tests.app.test_cli_datasets import TOUCH_ARFF
+from touchbench.app.errors import AppError
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import DatasetInMemory, add_dataset_stream
+from touchbench.app.store.listing import list_datasets
+from touchbench.benchmark.dataset import Attribute, Dataset, InstanceBlock, Schema
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 
@@ -115,7 +115,7 @@ def test_four_processes_import_under_one_name_and_exactly_one_wins(
         files.append(path)
     Store(store_url).dispose()  # migrated once: this test is about imports, not migrations
     environment = {**os.environ, "PYTHONPATH": str(REPOSITORY)}
-    command = [sys.executable, "-m", "app.cli.main", "--db", store_url, "import"]
+    command = [sys.executable, "-m", "touchbench.app.cli.main", "--db", store_url, "import"]
     processes = [
         subprocess.Popen(
             [*command, str(path), "--name", "robot1"],

@@ -6,13 +6,13 @@ import numpy as np
 import pytest
 import soundfile
 
-from app.services.extraction import extract_dataset, read_labels
-from benchmark.dataset import resolve_targets
-from benchmark.errors import DataFormatError
-from drivers.errors import DriverError
-from drivers.simulated import SimulatedSession, SimulatedTouch, simulate_session
-from features.errors import FeatureError
-from features.extractors import uc3m_feature_names
+from touchbench.app.services.extraction import extract_dataset, read_labels
+from touchbench.benchmark.dataset import resolve_targets
+from touchbench.benchmark.errors import DataFormatError
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.simulated import SimulatedSession, SimulatedTouch, simulate_session
+from touchbench.features.errors import FeatureError
+from touchbench.features.extractors import uc3m_feature_names
 
 SAMPLERATE = 44100
 
@@ -362,9 +362,9 @@ def test_band_peaks_on_one_second_segments_of_an_accelerometer(tmp_path: Path) -
 def test_extraction_streams_the_instances_of_whole_array_extraction(
     two_sessions: list[Path],
 ) -> None:
-    from drivers.files import read_recording
-    from features.events import detect_events
-    from features.extractors import make_extractor
+    from touchbench.drivers.files import read_recording
+    from touchbench.features.events import detect_events
+    from touchbench.features.extractors import make_extractor
 
     result = extract_dataset(two_sessions, labels=None, extractor="uc3m-audio")
     whole = []
@@ -422,7 +422,7 @@ def test_recordings_of_different_sample_rates_cannot_share_a_data_set(tmp_path: 
 _PEAK_SCRIPT = """
 import sys
 from pathlib import Path
-from app.services.extraction import extract_dataset
+from touchbench.app.services.extraction import extract_dataset
 result = extract_dataset([Path(sys.argv[1])], labels=None, extractor="uc3m-audio")
 status = Path("/proc/self/status").read_text().splitlines()
 peak = next(int(line.split()[1]) for line in status if line.startswith("VmHWM:"))

@@ -13,16 +13,16 @@ import numpy as np
 import pytest
 from sqlalchemy import func, select
 
-import app.services.datasets as services
-import app.store.datasets as store_datasets
-import benchmark.io.arff_reader as arff_reader
-from app.store.database import Store
-from app.store.datasets import load_dataset
-from app.store.listing import list_datasets
-from app.store.tables import InstanceBlockRow
-from benchmark.errors import DataFormatError
-from benchmark.io.arff import read_arff
+import touchbench.app.services.datasets as services
+import touchbench.app.store.datasets as store_datasets
+import touchbench.benchmark.io.arff_reader as arff_reader
 from tests.app.cli_runner import run_cli
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import load_dataset
+from touchbench.app.store.listing import list_datasets
+from touchbench.app.store.tables import InstanceBlockRow
+from touchbench.benchmark.errors import DataFormatError
+from touchbench.benchmark.io.arff import read_arff
 
 HEADER = (
     "@relation 'plain: -C 1'\n@attribute g {tap,slap}\n"

@@ -22,15 +22,15 @@ import numpy as np
 import pytest
 from sqlalchemy import func, select
 
-from app.store.database import Store
-from app.store.listing import list_datasets
-from app.store.tables import InstanceBlockRow, InstanceRow
+from touchbench.app.store.database import Store
+from touchbench.app.store.listing import list_datasets
+from touchbench.app.store.tables import InstanceBlockRow, InstanceRow
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 PEAK_BOUND_MB = 400
 _CLI_WITH_PEAK = """
 import sys
-from app.cli.main import main
+from touchbench.app.cli.main import main
 code = main(sys.argv[1:])
 with open("/proc/self/status") as status:
     peak = next(line.split()[1] for line in status if line.startswith("VmHWM:"))
@@ -43,7 +43,7 @@ sys.exit(code)
 _CLI_WITH_CTRL_C = """
 import signal, sys
 signal.signal(signal.SIGINT, signal.default_int_handler)
-from app.cli.main import main
+from touchbench.app.cli.main import main
 sys.exit(main(sys.argv[1:]))
 """
 

@@ -11,16 +11,16 @@ from typing import Any
 
 import pytest
 
-from app.schemas.datasets import ImportRequest
-from app.schemas.models import TrainRequest
-from app.services import jobs
-from app.services.datasets import import_file
-from app.services.jobs import execute_job, job_request, submit_training
-from app.store.database import Store
-from app.store.jobs import create_job, list_jobs
-from app.store.models import list_models
-from app.store.queue import CANCEL_POLL
 from tests.app.synthetic import touch_arff
+from touchbench.app.schemas.datasets import ImportRequest
+from touchbench.app.schemas.models import TrainRequest
+from touchbench.app.services import jobs
+from touchbench.app.services.datasets import import_file
+from touchbench.app.services.jobs import execute_job, job_request, submit_training
+from touchbench.app.store.database import Store
+from touchbench.app.store.jobs import create_job, list_jobs
+from touchbench.app.store.models import list_models
+from touchbench.app.store.queue import CANCEL_POLL
 
 
 @pytest.fixture

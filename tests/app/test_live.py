@@ -9,16 +9,16 @@ import numpy as np
 import pytest
 import soundfile
 
-from app.errors import AppError
-from app.schemas.extraction import ExtractRequest
-from app.schemas.models import TrainRequest
-from app.services.extraction import extract_and_store, extract_dataset
-from app.services.live import LiveSession, open_live
-from app.services.models import load_model, predict, train
-from app.services.simulation import write_labels, write_session
-from app.store.database import Store
-from drivers.replay import FileReplaySource
 from tests.app.cli_runner import run_cli
+from touchbench.app.errors import AppError
+from touchbench.app.schemas.extraction import ExtractRequest
+from touchbench.app.schemas.models import TrainRequest
+from touchbench.app.services.extraction import extract_and_store, extract_dataset
+from touchbench.app.services.live import LiveSession, open_live
+from touchbench.app.services.models import load_model, predict, train
+from touchbench.app.services.simulation import write_labels, write_session
+from touchbench.app.store.database import Store
+from touchbench.drivers.replay import FileReplaySource
 
 
 @pytest.fixture

@@ -17,18 +17,18 @@ from typing import Any
 
 import pytest
 
-from benchmark.run.memory import MB, default_task_memory, read_meminfo
 from tests.app.cli_runner import run_cli
 from tests.app.synthetic import touch_arff
+from touchbench.benchmark.run.memory import MB, default_task_memory, read_meminfo
 
 ROOT = Path(__file__).resolve().parents[2]
 #: The machine the subprocess's CLI sees: 1 GiB available of 4 GiB.
 SMALL_MACHINE = {"MemTotal": 4 * 2**30, "MemAvailable": 2**30}
 SCRIPT = """
 import sys
-import benchmark.run.memory as memory
+import touchbench.benchmark.run.memory as memory
 memory.read_meminfo = lambda path='/proc/meminfo': {machine!r}
-from app.cli.main import main
+from touchbench.app.cli.main import main
 sys.exit(main(sys.argv[1:]))
 """
 
@@ -103,9 +103,9 @@ def test_the_cap_shrinks_with_the_jobs_and_keeps_a_reserve() -> None:
 
 @pytest.mark.parametrize("value", ["0.5", "-1", "lots"])
 def test_a_cap_that_is_not_a_size_is_refused(value: str) -> None:
-    from app.cli.requests import build_request, describe
-    from app.errors import FieldError
-    from app.schemas.runs import BenchRequest
+    from touchbench.app.cli.requests import build_request, describe
+    from touchbench.app.errors import FieldError
+    from touchbench.app.schemas.runs import BenchRequest
 
     with pytest.raises(FieldError) as refused:
         build_request(

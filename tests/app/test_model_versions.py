@@ -11,11 +11,12 @@ from pathlib import Path
 import pytest
 from sqlalchemy import select
 
-from app.errors import ConflictError, FieldError, NotFoundError
-from app.schemas.models import TrainRequest
-from app.store import models as store_models
-from app.store.database import Store
-from app.store.models import (
+from tests.app.cli_runner import run_cli
+from touchbench.app.errors import ConflictError, FieldError, NotFoundError
+from touchbench.app.schemas.models import TrainRequest
+from touchbench.app.store import models as store_models
+from touchbench.app.store.database import Store
+from touchbench.app.store.models import (
     delete_alias,
     delete_model,
     get_model,
@@ -25,8 +26,7 @@ from app.store.models import (
     save_model,
     set_alias,
 )
-from app.store.tables import DatasetRow, ModelRow
-from tests.app.cli_runner import run_cli
+from touchbench.app.store.tables import DatasetRow, ModelRow
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 
@@ -128,7 +128,7 @@ def test_a_rollback_reads_the_history_a_page_at_a_time(
     from sqlalchemy import event
     from sqlalchemy.orm import Session
 
-    from app.store.tables import ModelAliasEventRow
+    from touchbench.app.store.tables import ModelAliasEventRow
 
     for _ in range(3):
         _save(store)
@@ -221,8 +221,8 @@ def test_a_version_taken_meanwhile_is_retried(
 
 SAVER = """
 import sys
-from app.store.database import Store
-from app.store.models import save_model
+from touchbench.app.store.database import Store
+from touchbench.app.store.models import save_model
 store = Store(sys.argv[1])
 print(sys.argv[2], flush=True)
 sys.stdin.readline()  # both processes start saving together

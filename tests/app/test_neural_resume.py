@@ -13,14 +13,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.store.database import Store
-from app.store.datasets import add_dataset, dataset_digest
-from benchmark.catalogue import get_spec
-from benchmark.estimators import build_estimator
-from benchmark.problem import problem_from_dataset
-from benchmark.run.folds import make_fold_plan
 from tests.benchmark.test_sequences import sequence_dataset, shapes
 from tests.gate import CNN1D_PARAMS, SMALL, Gate
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import add_dataset, dataset_digest
+from touchbench.benchmark.catalogue import get_spec
+from touchbench.benchmark.estimators import build_estimator
+from touchbench.benchmark.problem import problem_from_dataset
+from touchbench.benchmark.run.folds import make_fold_plan
 
 FOLDS = 3
 
@@ -48,7 +48,7 @@ def test_a_network_run_killed_mid_training_resumes_to_the_same_scores(tmp_path: 
     gate = Gate(tmp_path / "gate")
     gate.open()  # every fit goes through; its started-* file says its training began
     environment = {**os.environ, **gate.environment()}
-    bench = [sys.executable, "-m", "app.cli.main", "--db", url, "bench"]
+    bench = [sys.executable, "-m", "touchbench.app.cli.main", "--db", url, "bench"]
     child = subprocess.Popen(
         [*bench, "shapes", "-c", "gate-cnn1d", "--folds", str(FOLDS), "--jobs", "1"],
         env=environment,

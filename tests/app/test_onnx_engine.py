@@ -13,17 +13,17 @@ from typing import Any
 import onnxruntime
 import pytest
 
-from app.schemas.extraction import ExtractRequest
-from app.schemas.models import TrainRequest
-from app.services.datasets import read_data_file
-from app.services.extraction import extract_and_store
-from app.services.models import train
-from app.services.simulation import write_labels, write_session
-from app.store.database import Store
 from tests.app.api.conftest import Server, _servers
 from tests.app.api.test_api_bench_request import CLI_WORDS
 from tests.app.api.test_api_live import _pcm_blocks, _stream, _ws_url
 from tests.app.cli_runner import run_cli
+from touchbench.app.schemas.extraction import ExtractRequest
+from touchbench.app.schemas.models import TrainRequest
+from touchbench.app.services.datasets import read_data_file
+from touchbench.app.services.extraction import extract_and_store
+from touchbench.app.services.models import train
+from touchbench.app.services.simulation import write_labels, write_session
+from touchbench.app.store.database import Store
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "predict_onnx.py"

@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.errors import AppError
-from app.reports.plots import (
+from touchbench.app.errors import AppError
+from touchbench.app.reports.plots import (
     cd_diagram,
     class_distribution_figure,
     confusion_figure,

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from app.services import progress
-from app.services.progress import throttled
+from touchbench.app.services import progress
+from touchbench.app.services.progress import throttled
 
 
 def test_progress_is_summarised_and_told_at_most_every_so_many_seconds(

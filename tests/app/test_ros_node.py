@@ -17,17 +17,17 @@ import numpy as np
 import pytest
 import soundfile
 
-from app.schemas.extraction import ExtractRequest
-from app.schemas.models import ExportRequest, TrainRequest
-from app.services.export import export_model
-from app.services.extraction import extract_and_store
-from app.services.live import open_live
-from app.services.models import train
-from app.services.simulation import write_contact_mic_sessions, write_session
-from app.store.database import Store
-from drivers.ros1 import DEBIAN_PACKAGES
 from tests.app.cli_runner import run_cli
 from tests.drivers.ros_peer import Peer, rosmaster
+from touchbench.app.schemas.extraction import ExtractRequest
+from touchbench.app.schemas.models import ExportRequest, TrainRequest
+from touchbench.app.services.export import export_model
+from touchbench.app.services.extraction import extract_and_store
+from touchbench.app.services.live import open_live
+from touchbench.app.services.models import train
+from touchbench.app.services.simulation import write_contact_mic_sessions, write_session
+from touchbench.app.store.database import Store
+from touchbench.drivers.ros1 import DEBIAN_PACKAGES
 
 ROS_MISSING = shutil.which("rosmaster") is None or not Path(DEBIAN_PACKAGES, "rospy").is_dir()
 pytestmark = pytest.mark.skipif(
@@ -68,7 +68,7 @@ def trained(tmp_path_factory: pytest.TempPathFactory) -> tuple[str, str, Path]:
 
 def start_node(env: dict[str, str], url: str, *args: str) -> subprocess.Popen[str]:
     return subprocess.Popen(
-        [sys.executable, "-m", "app.cli.main", "--db", url, "ros", *args],
+        [sys.executable, "-m", "touchbench.app.cli.main", "--db", url, "ros", *args],
         env=env,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,

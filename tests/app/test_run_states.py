@@ -8,11 +8,12 @@ import sys
 
 import pytest
 
-from app.errors import ConflictError
-from app.store.database import Store
-from app.store.datasets import add_dataset
-from app.store.ownership import process_owner
-from app.store.runs import (
+from tests.app.test_store import small_dataset
+from touchbench.app.errors import ConflictError
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import add_dataset
+from touchbench.app.store.ownership import process_owner
+from touchbench.app.store.runs import (
     claim_run,
     create_run,
     finish_run,
@@ -23,8 +24,7 @@ from app.store.runs import (
     requeue_run,
     should_stop,
 )
-from app.store.states import RunBusy
-from tests.app.test_store import small_dataset
+from touchbench.app.store.states import RunBusy
 
 
 def _run(store: Store) -> int:
@@ -98,7 +98,7 @@ def test_a_lost_process_leaves_its_run_interrupted_or_cancelled(
     if asked:  # the cancel was asked while the process lived; it died before it stopped
         from sqlalchemy import update
 
-        from app.store.tables import RunRow
+        from touchbench.app.store.tables import RunRow
 
         with store.session() as session:
             session.execute(update(RunRow).values(status="cancelling", cancel_requested=True))

@@ -11,10 +11,10 @@ from typing import Any
 import pytest
 from fastapi.testclient import TestClient
 
-from app.main import create_app
-from app.settings import Settings
 from tests.app.cli_runner import run_cli
 from tests.app.synthetic import position_arff, touch_arff
+from touchbench.app.main import create_app
+from touchbench.app.settings import Settings
 
 
 class _Tables(HTMLParser):

@@ -11,7 +11,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 _PROBE = """
 import numpy  # loaded before the pin, as in the serve process
-from app.cli.serve import pin_native_threads
+from touchbench.app.cli.serve import pin_native_threads
 pin_native_threads()
 import sklearn.ensemble  # OpenMP loaded after it, as a worker does
 from threadpoolctl import threadpool_info

@@ -12,20 +12,20 @@ import numpy as np
 import pytest
 from sqlalchemy import func, select
 
-from app.errors import AppError, NotFoundError
-from app.store import datasets as store_datasets
-from app.store.database import Store
-from app.store.datasets import (
+from touchbench.app.errors import AppError, NotFoundError
+from touchbench.app.store import datasets as store_datasets
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import (
     add_dataset,
     dataset_digest,
     delete_dataset,
     find_dataset,
     load_dataset,
 )
-from app.store.listing import COLUMNS, count_datasets, list_datasets
-from app.store.reading import SQLiteFile, sqlite_file
-from app.store.tables import DatasetRow, InstanceBlockRow, InstanceRow
-from benchmark.dataset import Attribute, Dataset, Schema
+from touchbench.app.store.listing import COLUMNS, count_datasets, list_datasets
+from touchbench.app.store.reading import SQLiteFile, sqlite_file
+from touchbench.app.store.tables import DatasetRow, InstanceBlockRow, InstanceRow
+from touchbench.benchmark.dataset import Attribute, Dataset, Schema
 
 
 def small_dataset(n: int = 7, relation: str = "touch: -C 1") -> Dataset:
@@ -173,8 +173,8 @@ def test_head_revision_constant_matches_the_migrations() -> None:
     from alembic.config import Config
     from alembic.script import ScriptDirectory
 
-    from app.store.database import MIGRATIONS
-    from app.store.reading import HEAD_REVISION
+    from touchbench.app.store.database import MIGRATIONS
+    from touchbench.app.store.reading import HEAD_REVISION
 
     config = Config()
     config.set_main_option("script_location", str(MIGRATIONS))
@@ -182,7 +182,7 @@ def test_head_revision_constant_matches_the_migrations() -> None:
 
 
 def test_a_fresh_store_is_migrated_to_head(store: Store) -> None:
-    from app.store.reading import HEAD_REVISION
+    from touchbench.app.store.reading import HEAD_REVISION
 
     assert store.revision() == HEAD_REVISION
 
@@ -191,7 +191,7 @@ def _alembic(connection: Any, action: str, revision: str) -> None:
     from alembic import command
     from alembic.config import Config
 
-    from app.store.database import MIGRATIONS
+    from touchbench.app.store.database import MIGRATIONS
 
     config = Config()
     config.set_main_option("script_location", str(MIGRATIONS))

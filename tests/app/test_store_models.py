@@ -9,17 +9,17 @@ import os
 import pytest
 from sqlalchemy import create_engine, func, select, text
 
-from app.errors import NotFoundError
-from app.store.database import Store
-from app.store.models import (
+from tests.app.test_store import _alembic
+from touchbench.app.errors import NotFoundError
+from touchbench.app.store.database import Store
+from touchbench.app.store.models import (
     delete_model,
     load_artifact,
     model_version,
     rename_model,
     save_model,
 )
-from app.store.tables import ModelArtifactRow
-from tests.app.test_store import _alembic
+from touchbench.app.store.tables import ModelArtifactRow
 
 
 def _add(store: Store, name: str, artifact: bytes) -> int:

@@ -10,9 +10,9 @@ from pathlib import Path
 
 import pytest
 
-from app.errors import AppError
-from app.store.database import Store, display_url
 from tests.app.cli_runner import run_cli
+from touchbench.app.errors import AppError
+from touchbench.app.store.database import Store, display_url
 
 ROOT = Path(__file__).resolve().parents[2]
 PASSWORD = "pa55word-of-the-test"
@@ -66,7 +66,7 @@ def test_serve_on_a_store_it_cannot_reach_says_so_without_the_password(tmp_path:
         "TOUCHBENCH_WORK_DIR": str(tmp_path / "work"),
     }
     done = subprocess.run(
-        [sys.executable, "-m", "app.cli.main", "serve", "--port", "1"],
+        [sys.executable, "-m", "touchbench.app.cli.main", "serve", "--port", "1"],
         cwd=ROOT,
         env=environment,
         capture_output=True,

@@ -6,12 +6,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmark.errors import ConfigurationError
-from benchmark.problem import Problem
-from benchmark.run.ablation import without_columns
-from benchmark.run.folds import make_fold_plan
-from benchmark.run.learning import enough_fraction, learning_folds
-from benchmark.sequence import SequenceLayout
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.problem import Problem
+from touchbench.benchmark.run.ablation import without_columns
+from touchbench.benchmark.run.folds import make_fold_plan
+from touchbench.benchmark.run.learning import enough_fraction, learning_folds
+from touchbench.benchmark.sequence import SequenceLayout
 
 FRACTIONS = (0.1, 0.25, 0.5, 1.0)
 

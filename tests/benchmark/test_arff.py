@@ -10,10 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmark.dataset import Attribute, Dataset, Schema, resolve_targets
-from benchmark.errors import DataFormatError
-from benchmark.io.arff import dumps_arff, loads_arff, read_arff, write_arff
-from benchmark.io.dates import DateFormat
+from touchbench.benchmark.dataset import Attribute, Dataset, Schema, resolve_targets
+from touchbench.benchmark.errors import DataFormatError
+from touchbench.benchmark.io.arff import dumps_arff, loads_arff, read_arff, write_arff
+from touchbench.benchmark.io.dates import DateFormat
 
 NAN = np.nan
 

@@ -12,11 +12,11 @@ import io
 import numpy as np
 import pytest
 
-from benchmark.dataset import Attribute, Dataset, Schema
-from benchmark.errors import DataFormatError
-from benchmark.io import arff_writer
-from benchmark.io.arff import ArffWriter, dumps_arff, loads_arff
 from tests.benchmark.test_arff import CANONICAL, _random_dataset
+from touchbench.benchmark.dataset import Attribute, Dataset, Schema
+from touchbench.benchmark.errors import DataFormatError
+from touchbench.benchmark.io import arff_writer
+from touchbench.benchmark.io.arff import ArffWriter, dumps_arff, loads_arff
 
 
 def both_texts(dataset: Dataset, monkeypatch: pytest.MonkeyPatch) -> tuple[str, str]:

@@ -16,12 +16,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmark.dataset import Dataset
-from benchmark.errors import DataFormatError
-from benchmark.io import arff_reader
-from benchmark.io.arff import dumps_arff, loads_arff, open_arff, read_arff
 from tests.app.test_cli_datasets import TOUCH_ARFF
 from tests.benchmark.test_arff import CANONICAL, HEADER, MESSY, _random_dataset
+from touchbench.benchmark.dataset import Dataset
+from touchbench.benchmark.errors import DataFormatError
+from touchbench.benchmark.io import arff_reader
+from touchbench.benchmark.io.arff import dumps_arff, loads_arff, open_arff, read_arff
 
 PARSERS = ("tokenizer", "vectorised", "auto")
 
@@ -96,7 +96,7 @@ def test_plain_block_edge_cases_read_as_the_tokenizer_reads_them(case: str) -> N
 
 
 def test_the_fast_path_is_taken_and_refuses_what_it_cannot_prove() -> None:
-    from benchmark.io.arff_fast import plain_plan, read_plain_block
+    from touchbench.benchmark.io.arff_fast import plain_plan, read_plain_block
 
     plan = plain_plan(loads_arff(NOMINAL_HEADER).schema.attributes)
     assert plan is not None
@@ -116,7 +116,7 @@ SPELLINGS = ["nan", "-nan", "NaN", "inf", "-Infinity", "+1", "1.", ".5", "-0", "
 
 
 def test_the_fast_path_reads_every_spelling_of_a_number_as_python_does() -> None:
-    from benchmark.io.arff_fast import plain_plan, read_plain_block
+    from touchbench.benchmark.io.arff_fast import plain_plan, read_plain_block
 
     plan = plain_plan(loads_arff(NOMINAL_HEADER).schema.attributes)
     assert plan is not None
@@ -177,7 +177,7 @@ def test_every_float_text_reads_as_python_reads_it() -> None:
         for v in values[:300]
     ]
     body = "".join(f"tap,{text},{text}\n" for text in texts)
-    from benchmark.io.arff_fast import plain_plan, read_plain_block
+    from touchbench.benchmark.io.arff_fast import plain_plan, read_plain_block
 
     plan = plain_plan(loads_arff(NOMINAL_HEADER).schema.attributes)
     assert plan is not None
@@ -190,7 +190,7 @@ def test_every_float_text_reads_as_python_reads_it() -> None:
 
 def test_a_block_arrow_reads_in_several_batches_reads_alike() -> None:
     """Over a megabyte of rows (Arrow parses it in batches), missing values everywhere."""
-    from benchmark.io.arff_fast import plain_plan, read_plain_block
+    from touchbench.benchmark.io.arff_fast import plain_plan, read_plain_block
 
     rng = np.random.default_rng(3)
     labels = np.array(["tap", "'slap'", "0", "'1'", "?"])

@@ -11,10 +11,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmark.artifacts import dumps_artifact, is_trusted_type, loads_artifact
-from benchmark.errors import ConfigurationError
-from benchmark.model import dumps_model, fit_model, loads_model, model_digest
 from tests.benchmark.test_model import dataset
+from touchbench.benchmark.artifacts import dumps_artifact, is_trusted_type, loads_artifact
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.model import dumps_model, fit_model, loads_model, model_digest
 
 
 class _Touch:
@@ -78,7 +78,7 @@ def test_an_artifact_naming_untrusted_types_is_refused_before_loading(
 def test_only_classes_of_trusted_packages_are_trusted() -> None:
     assert is_trusted_type("sklearn.ensemble._forest.RandomForestClassifier")
     assert is_trusted_type("xgboost.sklearn.XGBClassifier")
-    assert is_trusted_type("benchmark.multitarget.chains.ClassifierChain")
+    assert is_trusted_type("touchbench.benchmark.multitarget.chains.ClassifierChain")
     assert not is_trusted_type("numpy.save")  # a function of a trusted package
     assert not is_trusted_type("numpy.load")
     assert not is_trusted_type("numpy.memmap")

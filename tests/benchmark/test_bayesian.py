@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from baycomp import CorrelatedTTest, SignedRankTest
 
-from benchmark.errors import ConfigurationError
-from benchmark.evaluation.bayesian import correlated_ttest, signed_rank_test
-from benchmark.evaluation.significance import corrected_resampled_ttest
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.evaluation.bayesian import correlated_ttest, signed_rank_test
+from touchbench.benchmark.evaluation.significance import corrected_resampled_ttest
 
 
 def folds(seed: int, shift: float, n: int = 10) -> tuple[np.ndarray, np.ndarray]:

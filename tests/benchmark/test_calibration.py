@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmark.evaluation.calibration import Reliability, merge, reliability
+from touchbench.benchmark.evaluation.calibration import Reliability, merge, reliability
 
 
 def _calibrated(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:

@@ -14,8 +14,8 @@ from sklearn.svm import SVC
 from sklearn.tree import DecisionTreeClassifier
 from threadpoolctl import threadpool_limits
 
-from benchmark.artifacts import dumps_artifact, loads_artifact
-from benchmark.catalogue import (
+from touchbench.benchmark.artifacts import dumps_artifact, loads_artifact
+from touchbench.benchmark.catalogue import (
     CATALOGUE,
     ClassifierSpec,
     build_pipeline,
@@ -23,10 +23,10 @@ from benchmark.catalogue import (
     parse_weka_command,
     suite,
 )
-from benchmark.catalogue.estimators import LabelEncodedClassifier, OneRuleClassifier
-from benchmark.errors import ConfigurationError
-from benchmark.sequence import SequenceLayout
-from benchmark.weka import C45Classifier, WekaIBk, WekaNaiveBayes, WekaZeroR
+from touchbench.benchmark.catalogue.estimators import LabelEncodedClassifier, OneRuleClassifier
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.sequence import SequenceLayout
+from touchbench.benchmark.weka import C45Classifier, WekaIBk, WekaNaiveBayes, WekaZeroR
 
 FAMILIES = {
     "majority",
@@ -139,7 +139,7 @@ def test_weka_names_only_on_estimators_that_compute_what_weka_computes() -> None
     assert {"zeror", "j48", "nb", "ibk"} <= named
     for classifier_id in named:
         estimator = get_spec(classifier_id).make_estimator()
-        assert type(estimator).__module__.startswith("benchmark.weka."), classifier_id
+        assert type(estimator).__module__.startswith("touchbench.benchmark.weka."), classifier_id
     commands = [CATALOGUE[i].weka_command for i in named]
     assert len(set(commands)) == len(commands), "two entries claim the same WEKA command"
 

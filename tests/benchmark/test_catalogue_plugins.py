@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from benchmark.catalogue.plugins import plugin_specs
-from benchmark.errors import ConfigurationError
+from touchbench.benchmark.catalogue.plugins import plugin_specs
+from touchbench.benchmark.errors import ConfigurationError
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -42,7 +42,7 @@ def test_an_id_of_the_catalogue_cannot_be_taken() -> None:
 
 def _classifiers(tmp_path: Path, plugins: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        [sys.executable, "-m", "app.cli.main", "classifiers", "--json"],
+        [sys.executable, "-m", "touchbench.app.cli.main", "classifiers", "--json"],
         env={**os.environ, "PYTHONPATH": str(ROOT), "TOUCHBENCH_PLUGINS": plugins},
         capture_output=True,
         text=True,

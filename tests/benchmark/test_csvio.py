@@ -7,9 +7,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmark.dataset import Attribute
-from benchmark.errors import DataFormatError
-from benchmark.io.csv import read_csv, sniff_delimiter
+from touchbench.benchmark.dataset import Attribute
+from touchbench.benchmark.errors import DataFormatError
+from touchbench.benchmark.io.csv import read_csv, sniff_delimiter
 
 NAN = np.nan
 

@@ -16,15 +16,15 @@ import numpy as np
 import pytest
 from sklearn.base import BaseEstimator, ClassifierMixin
 
-from benchmark.catalogue import ClassifierSpec, get_spec
-from benchmark.errors import ConfigurationError
-from benchmark.run.backend import Backend, RunStopped
-from benchmark.run.dask_backend import DaskBackend
-from benchmark.run.engine import Problem, TaskKey, TaskResult, plan_tasks, run_tasks
-from benchmark.run.folds import make_folds
-from benchmark.run.local_backend import LocalBackend
-from benchmark.run.schedule import TaskList
-from benchmark.run.task import TaskContext
+from touchbench.benchmark.catalogue import ClassifierSpec, get_spec
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.run.backend import Backend, RunStopped
+from touchbench.benchmark.run.dask_backend import DaskBackend
+from touchbench.benchmark.run.engine import Problem, TaskKey, TaskResult, plan_tasks, run_tasks
+from touchbench.benchmark.run.folds import make_folds
+from touchbench.benchmark.run.local_backend import LocalBackend
+from touchbench.benchmark.run.schedule import TaskList
+from touchbench.benchmark.run.task import TaskContext
 
 # Deliberately misbehaving classifiers.  The engine's workers import them from this module.
 
@@ -293,7 +293,7 @@ def test_dask_local_cluster_runs_the_same_tasks(problem, folds, dask_scheduler) 
 
 
 def test_an_unreachable_scheduler_is_a_configuration_error(problem, folds, monkeypatch) -> None:
-    monkeypatch.setattr("benchmark.run.dask_backend.CONNECT_TIMEOUT", "1s")
+    monkeypatch.setattr("touchbench.benchmark.run.dask_backend.CONNECT_TIMEOUT", "1s")
     with pytest.raises(ConfigurationError, match="cannot reach the Dask scheduler"):
         run_tasks(problem, ["nb"], folds, scheduler="tcp://127.0.0.1:9", timeout=TIMEOUT)
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmark.errors import ConfigurationError
-from benchmark.run.folds import make_folds
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.run.folds import make_folds
 
 
 def check_partition(folds: list, n: int, n_repeats: int = 1) -> None:

@@ -9,9 +9,9 @@ from sklearn.linear_model import LogisticRegression
 from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import StandardScaler
 
-from benchmark.forest_inference import forest_proba
-from benchmark.model import fit_model
 from tests.benchmark.test_model import dataset
+from touchbench.benchmark.forest_inference import forest_proba
+from touchbench.benchmark.model import fit_model
 
 
 def _data(n: int = 300) -> tuple[np.ndarray, np.ndarray]:

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from benchmark.problem import Problem
-from benchmark.run.folds import make_fold_plan
-from benchmark.run.importance import feature_groups, permutation_importance
+from touchbench.benchmark.problem import Problem
+from touchbench.benchmark.run.folds import make_fold_plan
+from touchbench.benchmark.run.importance import feature_groups, permutation_importance
 
 
 def test_the_deciding_feature_ranks_first_and_noise_near_zero() -> None:

@@ -7,10 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from benchmark.errors import ConfigurationError
-from benchmark.evaluation.leaderboard import build_leaderboard
-from benchmark.evaluation.significance import corrected_resampled_ttest
-from benchmark.results import TaskKey, TaskResult
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.evaluation.leaderboard import build_leaderboard
+from touchbench.benchmark.evaluation.significance import corrected_resampled_ttest
+from touchbench.benchmark.results import TaskKey, TaskResult
 
 OFFSETS = np.linspace(-0.02, 0.02, 10)
 

@@ -9,14 +9,14 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 
-from benchmark.catalogue import get_spec
-from benchmark.catalogue.pipeline import check_sequence_input
-from benchmark.catalogue.stacking import check_top_n
-from benchmark.catalogue.tuning import check_budget, tuned_spec
-from benchmark.errors import ConfigurationError
-from benchmark.estimators import check_classifier
-from benchmark.problem import Problem, problem_from_dataset
 from tests.benchmark.test_problem import make
+from touchbench.benchmark.catalogue import get_spec
+from touchbench.benchmark.catalogue.pipeline import check_sequence_input
+from touchbench.benchmark.catalogue.stacking import check_top_n
+from touchbench.benchmark.catalogue.tuning import check_budget, tuned_spec
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.estimators import check_classifier
+from touchbench.benchmark.problem import Problem, problem_from_dataset
 
 #: A CLI flag (``--budget``) or command (``touchbench classifiers``).
 CLI_WORDS = re.compile(r"(^|[\s`'\"(])--?[a-zA-Z]|touchbench [a-z]")

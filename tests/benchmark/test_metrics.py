@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from sklearn import metrics as skm
 
-from benchmark.evaluation.metrics import (
+from touchbench.benchmark.evaluation.metrics import (
     LOWER_IS_BETTER,
     MULTICLASS_METRICS,
     confusion_matrix,

@@ -5,9 +5,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmark.dataset import Attribute, Dataset, Schema
-from benchmark.errors import ConfigurationError
-from benchmark.model import TrainedModel, dumps_model, fit_model, loads_model, model_digest
+from touchbench.benchmark.dataset import Attribute, Dataset, Schema
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.model import (
+    TrainedModel,
+    dumps_model,
+    fit_model,
+    loads_model,
+    model_digest,
+)
 
 
 def dataset(n: int = 90, targets: int = 1) -> Dataset:

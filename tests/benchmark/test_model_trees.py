@@ -6,8 +6,8 @@ import numpy as np
 from sklearn.linear_model import LogisticRegression
 from sklearn.tree import DecisionTreeClassifier
 
-from benchmark.artifacts import dumps_artifact, loads_artifact
-from benchmark.catalogue.model_trees import LogisticModelTree
+from touchbench.benchmark.artifacts import dumps_artifact, loads_artifact
+from touchbench.benchmark.catalogue.model_trees import LogisticModelTree
 
 
 def regimes(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:

@@ -19,24 +19,24 @@ import skops.io
 from sklearn.base import clone
 from sklearn.pipeline import Pipeline
 
-from benchmark.artifacts import dumps_artifact, loads_artifact
-from benchmark.catalogue import build_pipeline, get_spec
-from benchmark.catalogue.neural import (
+from tests.benchmark.test_sequences import sequence_dataset, shapes
+from touchbench.benchmark.artifacts import dumps_artifact, loads_artifact
+from touchbench.benchmark.catalogue import build_pipeline, get_spec
+from touchbench.benchmark.catalogue.neural import (
     NeuralSequenceClassifier,
     NeuralSequenceRegressor,
     _validation_split,
     check_architecture,
 )
-from benchmark.catalogue.regressors import REGRESSORS, regression_suite, regressor_spec
-from benchmark.dataset import Attribute, Dataset, Schema
-from benchmark.errors import ConfigurationError
-from benchmark.estimators import check_classifier, group_fit_params
-from benchmark.model import dumps_model, fit_model, loads_model, model_digest
-from benchmark.problem import Problem, problem_from_dataset
-from benchmark.run.engine import run_tasks
-from benchmark.run.folds import Fold, make_folds
-from benchmark.sequence import SequenceLayout, sequence_names
-from tests.benchmark.test_sequences import sequence_dataset, shapes
+from touchbench.benchmark.catalogue.regressors import REGRESSORS, regression_suite, regressor_spec
+from touchbench.benchmark.dataset import Attribute, Dataset, Schema
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.estimators import check_classifier, group_fit_params
+from touchbench.benchmark.model import dumps_model, fit_model, loads_model, model_digest
+from touchbench.benchmark.problem import Problem, problem_from_dataset
+from touchbench.benchmark.run.engine import run_tasks
+from touchbench.benchmark.run.folds import Fold, make_folds
+from touchbench.benchmark.sequence import SequenceLayout, sequence_names
 
 QUICK = {"max_epochs": 6, "learning_rate": 0.01}
 

@@ -9,11 +9,12 @@ import numpy as np
 import pytest
 from sklearn.pipeline import Pipeline
 
-from benchmark.catalogue import SPECS
-from benchmark.dataset import Attribute, Dataset, Schema
-from benchmark.errors import ConfigurationError
-from benchmark.estimators import build_estimator
-from benchmark.export.onnx import (
+from tests.benchmark.test_model import dataset as nominal_dataset
+from touchbench.benchmark.catalogue import SPECS
+from touchbench.benchmark.dataset import Attribute, Dataset, Schema
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.estimators import build_estimator
+from touchbench.benchmark.export.onnx import (
     LABEL,
     PROBABILITIES,
     TOLERANCE,
@@ -21,9 +22,8 @@ from benchmark.export.onnx import (
     export_onnx,
     exports_onnx,
 )
-from benchmark.model import TrainedModel, fit_model
-from benchmark.problem import problem_from_dataset
-from tests.benchmark.test_model import dataset as nominal_dataset
+from touchbench.benchmark.model import TrainedModel, fit_model
+from touchbench.benchmark.problem import problem_from_dataset
 
 EXPORTABLE = [spec.id for spec in SPECS if exports_onnx(spec)]
 REFUSED = [spec.id for spec in SPECS if not exports_onnx(spec)]
@@ -129,7 +129,7 @@ def test_a_graph_that_predicts_otherwise_is_refused_naming_the_difference() -> N
     model = fit_model(data, "logistic")
     graph = export_onnx(model, data.X)
     other = fit_model(numeric_dataset(12), "logistic")  # another fit: other probabilities
-    from benchmark.export.onnx import check_twin
+    from touchbench.benchmark.export.onnx import check_twin
 
     with pytest.raises(
         ConfigurationError, match=r"(another label for|differs from the model.s by)"

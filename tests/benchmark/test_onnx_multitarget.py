@@ -9,14 +9,14 @@ import json
 import numpy as np
 import pytest
 
-from benchmark.dataset import Dataset
-from benchmark.errors import ConfigurationError
-from benchmark.estimators import build_estimator
-from benchmark.export import onnx as onnx_export
-from benchmark.export.onnx import TOLERANCE, OnnxModel, check_twin, export_onnx
-from benchmark.model import TrainedModel, fit_model
-from benchmark.problem import problem_from_dataset
 from tests.benchmark.test_model import dataset as nominal_dataset
+from touchbench.benchmark.dataset import Dataset
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.estimators import build_estimator
+from touchbench.benchmark.export import onnx as onnx_export
+from touchbench.benchmark.export.onnx import TOLERANCE, OnnxModel, check_twin, export_onnx
+from touchbench.benchmark.model import TrainedModel, fit_model
+from touchbench.benchmark.problem import problem_from_dataset
 
 
 def two_targets() -> Dataset:

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmark.errors import ConfigurationError
-from benchmark.preprocessing import make_preprocessor
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.preprocessing import make_preprocessor
 
 NAN = np.nan
 

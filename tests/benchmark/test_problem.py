@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmark.dataset import Attribute, Dataset, Schema
-from benchmark.errors import ConfigurationError
-from benchmark.problem import problem_from_dataset
+from touchbench.benchmark.dataset import Attribute, Dataset, Schema
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.problem import problem_from_dataset
 
 NAN = np.nan
 

@@ -13,16 +13,16 @@ from typing import Any
 import numpy as np
 import pytest
 
-from benchmark.catalogue.costs import Shape, cost_label, estimate_seconds
-from benchmark.errors import ConfigurationError
-from benchmark.estimators import classifier_spec
-from benchmark.evaluation.leaderboard import build_leaderboard
-from benchmark.problem import Problem
-from benchmark.results import Drop, TaskKey, TaskResult
-from benchmark.run.engine import RaceRule, run_tasks
-from benchmark.run.folds import make_folds
-from benchmark.run.schedule import RoundSchedule
 from tests.gate import CLASSIFIERS, Gate
+from touchbench.benchmark.catalogue.costs import Shape, cost_label, estimate_seconds
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.estimators import classifier_spec
+from touchbench.benchmark.evaluation.leaderboard import build_leaderboard
+from touchbench.benchmark.problem import Problem
+from touchbench.benchmark.results import Drop, TaskKey, TaskResult
+from touchbench.benchmark.run.engine import RaceRule, run_tasks
+from touchbench.benchmark.run.folds import make_folds
+from touchbench.benchmark.run.schedule import RoundSchedule
 
 TIMEOUT = 120.0
 

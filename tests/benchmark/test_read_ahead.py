@@ -9,7 +9,7 @@ from collections.abc import Iterator
 
 import pytest
 
-from benchmark.io.read_ahead import ordered_ahead
+from touchbench.benchmark.io.read_ahead import ordered_ahead
 
 
 def _read_ahead_threads() -> list[threading.Thread]:

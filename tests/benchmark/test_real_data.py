@@ -7,10 +7,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmark.evaluation.leaderboard import build_leaderboard
-from benchmark.io.arff import read_arff
-from benchmark.run.engine import Problem, run_tasks
-from benchmark.run.folds import make_folds
+from touchbench.benchmark.evaluation.leaderboard import build_leaderboard
+from touchbench.benchmark.io.arff import read_arff
+from touchbench.benchmark.run.engine import Problem, run_tasks
+from touchbench.benchmark.run.folds import make_folds
 
 pytestmark = pytest.mark.shared
 

@@ -6,12 +6,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmark.catalogue import CATALOGUE
-from benchmark.errors import ConfigurationError
-from benchmark.evaluation.recordings import Recordings, check_one_label
-from benchmark.problem import Problem
-from benchmark.run.folds import make_folds
-from benchmark.run.task import TaskContext, TaskKey, execute_task
+from touchbench.benchmark.catalogue import CATALOGUE
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.evaluation.recordings import Recordings, check_one_label
+from touchbench.benchmark.problem import Problem
+from touchbench.benchmark.run.folds import make_folds
+from touchbench.benchmark.run.task import TaskContext, TaskKey, execute_task
 
 #: 12 recordings of 10 windows each, classes alternating by recording.
 GROUPS = np.repeat([f"take{i:02d}.wav" for i in range(12)], 10).astype(object)

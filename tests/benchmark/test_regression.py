@@ -8,22 +8,22 @@ import pytest
 from sklearn.metrics import mean_absolute_error, r2_score, root_mean_squared_error
 from threadpoolctl import threadpool_limits
 
-from benchmark.catalogue.regressors import (
+from touchbench.benchmark.catalogue.regressors import (
     GP_MAX_INSTANCES,
     NATIVE_MULTI_OUTPUT,
     REGRESSORS,
     regression_suite,
     regressor_spec,
 )
-from benchmark.dataset import Attribute, Dataset, Schema
-from benchmark.errors import ConfigurationError
-from benchmark.estimators import build_estimator
-from benchmark.evaluation.leaderboard import build_leaderboard
-from benchmark.evaluation.regression import regression_scores
-from benchmark.problem import Problem, problem_from_dataset
-from benchmark.results import TaskKey, TaskResult
-from benchmark.run.folds import make_fold_plan
-from benchmark.sequence import SequenceLayout
+from touchbench.benchmark.dataset import Attribute, Dataset, Schema
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.estimators import build_estimator
+from touchbench.benchmark.evaluation.leaderboard import build_leaderboard
+from touchbench.benchmark.evaluation.regression import regression_scores
+from touchbench.benchmark.problem import Problem, problem_from_dataset
+from touchbench.benchmark.results import TaskKey, TaskResult
+from touchbench.benchmark.run.folds import make_fold_plan
+from touchbench.benchmark.sequence import SequenceLayout
 
 
 def numeric_dataset(n: int = 40, *, nominal_target: bool = False, seed: int = 0) -> Dataset:

@@ -9,13 +9,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmark.catalogue import CATALOGUE, parse_weka_command
-from benchmark.errors import ConfigurationError
-from benchmark.evaluation.results_arff import RESULT_ATTRIBUTES, results_to_dataset, weka_measures
-from benchmark.io.arff import dumps_arff, loads_arff, read_arff
-from benchmark.problem import Problem
-from benchmark.run.folds import make_folds
-from benchmark.run.task import TaskContext, TaskKey, TaskResult, execute_task
+from touchbench.benchmark.catalogue import CATALOGUE, parse_weka_command
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.evaluation.results_arff import (
+    RESULT_ATTRIBUTES,
+    results_to_dataset,
+    weka_measures,
+)
+from touchbench.benchmark.io.arff import dumps_arff, loads_arff, read_arff
+from touchbench.benchmark.problem import Problem
+from touchbench.benchmark.run.folds import make_folds
+from touchbench.benchmark.run.task import TaskContext, TaskKey, TaskResult, execute_task
 
 
 @pytest.fixture(scope="module")

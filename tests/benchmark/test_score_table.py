@@ -7,10 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from benchmark.errors import ConfigurationError
-from benchmark.evaluation.score_table import MissingCell, ScoreTable, fold_score_table
-from benchmark.evaluation.statistics import compare_classifiers
-from benchmark.results import TaskKey, TaskResult
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.evaluation.score_table import MissingCell, ScoreTable, fold_score_table
+from touchbench.benchmark.evaluation.statistics import compare_classifiers
+from touchbench.benchmark.results import TaskKey, TaskResult
 
 
 def table_with_a_hole() -> ScoreTable:

@@ -11,16 +11,16 @@ from sklearn.ensemble import RandomForestClassifier
 from sklearn.model_selection import cross_val_score
 from threadpoolctl import threadpool_limits
 
-from benchmark.artifacts import is_trusted_type
-from benchmark.catalogue import build_pipeline
-from benchmark.catalogue.neural import KINDS as NETWORKS
-from benchmark.dataset import Attribute, Dataset, Schema
-from benchmark.errors import ConfigurationError
-from benchmark.estimators import check_classifier, reads_sequences
-from benchmark.io.arff import dumps_arff, loads_arff
-from benchmark.model import dumps_model, fit_model, loads_model, model_digest
-from benchmark.problem import problem_from_dataset
-from benchmark.sequence import find_sequence, panel, sequence_names
+from touchbench.benchmark.artifacts import is_trusted_type
+from touchbench.benchmark.catalogue import build_pipeline
+from touchbench.benchmark.catalogue.neural import KINDS as NETWORKS
+from touchbench.benchmark.dataset import Attribute, Dataset, Schema
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.estimators import check_classifier, reads_sequences
+from touchbench.benchmark.io.arff import dumps_arff, loads_arff
+from touchbench.benchmark.model import dumps_model, fit_model, loads_model, model_digest
+from touchbench.benchmark.problem import problem_from_dataset
+from touchbench.benchmark.sequence import find_sequence, panel, sequence_names
 
 CHANNELS, LENGTH = ("x", "z"), 48
 

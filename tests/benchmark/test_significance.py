@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from benchmark.errors import ConfigurationError
-from benchmark.evaluation.significance import corrected_resampled_ttest
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.evaluation.significance import corrected_resampled_ttest
 
 
 def test_hand_computed_example() -> None:

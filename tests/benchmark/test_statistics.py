@@ -14,9 +14,9 @@ from autorank._util import get_sorted_rank_groups
 from scipy.stats import friedmanchisquare
 from statsmodels.stats.multitest import multipletests
 
-from benchmark.errors import ConfigurationError
-from benchmark.evaluation.score_table import ScoreTable
-from benchmark.evaluation.statistics import (
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.evaluation.score_table import ScoreTable
+from touchbench.benchmark.evaluation.statistics import (
     compare_classifiers,
     friedman_test,
     nemenyi_critical_difference,

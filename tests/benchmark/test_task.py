@@ -11,10 +11,16 @@ import numpy as np
 import pytest
 from sklearn.base import BaseEstimator, ClassifierMixin
 
-from benchmark.catalogue import CATALOGUE, get_spec
-from benchmark.problem import Problem
-from benchmark.run.folds import Fold, make_folds
-from benchmark.run.task import TaskContext, TaskKey, TaskResult, execute_task, pickled_size
+from touchbench.benchmark.catalogue import CATALOGUE, get_spec
+from touchbench.benchmark.problem import Problem
+from touchbench.benchmark.run.folds import Fold, make_folds
+from touchbench.benchmark.run.task import (
+    TaskContext,
+    TaskKey,
+    TaskResult,
+    execute_task,
+    pickled_size,
+)
 
 
 class WarningClassifier(ClassifierMixin, BaseEstimator):
@@ -135,7 +141,7 @@ def test_pickled_size_counts_bytes_and_is_nan_for_unpicklable_objects() -> None:
 
 @pytest.mark.parametrize("bad", [{"Y": [[0], [5]]}, {"Y": [[0.5], [1]]}, {"n_classes": (2, 2)}])
 def test_problem_validates_its_targets(bad: dict) -> None:
-    from benchmark.errors import ConfigurationError
+    from touchbench.benchmark.errors import ConfigurationError
 
     args = {"X": np.zeros((2, 1)), "Y": [[0], [1]], "n_classes": (2,), "target_names": ("t",)}
     with pytest.raises(ConfigurationError):

@@ -12,16 +12,16 @@ import pytest
 from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.neighbors import KNeighborsClassifier
 
-from benchmark.catalogue import CATALOGUE, SEARCH_SPACES, build_pipeline, get_spec
-from benchmark.catalogue.spec import ClassifierSpec
-from benchmark.catalogue.stacking import stacked_spec
-from benchmark.catalogue.tuning import TunedClassifier, check_search_space, tuned_spec
-from benchmark.errors import ConfigurationError
-from benchmark.evaluation.tuned import compare_tuned
-from benchmark.problem import Problem
-from benchmark.results import TaskKey, TaskResult
-from benchmark.run.folds import Fold
-from benchmark.run.task import TaskContext, execute_task
+from touchbench.benchmark.catalogue import CATALOGUE, SEARCH_SPACES, build_pipeline, get_spec
+from touchbench.benchmark.catalogue.spec import ClassifierSpec
+from touchbench.benchmark.catalogue.stacking import stacked_spec
+from touchbench.benchmark.catalogue.tuning import TunedClassifier, check_search_space, tuned_spec
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.evaluation.tuned import compare_tuned
+from touchbench.benchmark.problem import Problem
+from touchbench.benchmark.results import TaskKey, TaskResult
+from touchbench.benchmark.run.folds import Fold
+from touchbench.benchmark.run.task import TaskContext, execute_task
 
 
 class RowSpy(ClassifierMixin, BaseEstimator):
@@ -171,13 +171,13 @@ def test_chosen_parameters_round_trip_through_json_and_older_results_still_read(
 
 
 def test_a_multi_target_model_records_what_each_inner_search_chose() -> None:
-    from benchmark.multitarget import (
+    from touchbench.benchmark.multitarget import (
         ClassRelevance,
         EnsembleClassifierChains,
         LabelCombination,
         RAkELd,
     )
-    from benchmark.run.choices import chosen_params
+    from touchbench.benchmark.run.choices import chosen_params
 
     rng = np.random.default_rng(2)
     X = rng.normal(size=(120, 3))
@@ -216,7 +216,7 @@ def test_the_planned_rounds_are_the_rounds_the_search_runs(n_candidates: int) ->
     from sklearn.experimental import enable_halving_search_cv  # noqa: F401
     from sklearn.model_selection import HalvingGridSearchCV, StratifiedKFold
 
-    from benchmark.catalogue.tuning import _search_cost, schedule
+    from touchbench.benchmark.catalogue.tuning import _search_cost, schedule
 
     rng = np.random.default_rng(3)
     X = rng.normal(size=(540, 2))

@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 import soundfile
 
-from drivers.bag_reader import audio_typestore
-from drivers.mp3 import frame_length
-from drivers.pcm import SAMPLE_FORMATS
+from touchbench.drivers.bag_reader import audio_typestore
+from touchbench.drivers.mp3 import frame_length
+from touchbench.drivers.pcm import SAMPLE_FORMATS
 
 #: A same-named AudioData of another package (the ROS 2 'audio_common' of mgonzs13).
 OTHER_AUDIO_DATA = (

@@ -29,8 +29,8 @@ from typing import Any
 
 import numpy as np
 
-from drivers.pcm import SAMPLE_FORMATS
-from drivers.ros1 import audio_types, import_rospy, master_environment
+from touchbench.drivers.pcm import SAMPLE_FORMATS
+from touchbench.drivers.ros1 import audio_types, import_rospy, master_environment
 
 _print_lock = threading.Lock()
 

@@ -10,10 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from drivers.errors import DriverError
-from drivers.mp3 import ChunkStream, frame_length, looks_like_mp3
-from drivers.replay import FileReplaySource
 from tests.drivers.bagfiles import encode, mp3_stream, pieces, write_audio_bag
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.mp3 import ChunkStream, frame_length, looks_like_mp3
+from touchbench.drivers.replay import FileReplaySource
 
 RATE = 44100
 #: Samples one MPEG-1 layer III frame decodes to.

@@ -9,10 +9,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from drivers.bag_reader import topic_listing
-from drivers.errors import DriverError
-from drivers.replay import FileReplaySource
 from tests.drivers.bagfiles import BIOTAC_MSG, BIOTAC_TYPE, float_array, write_fields_bag
+from touchbench.drivers.bag_reader import topic_listing
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.replay import FileReplaySource
 
 START = 1_700_000_000 * 10**9  # the bag's first message, in ns
 N = 400

@@ -5,10 +5,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from drivers.errors import DriverError
-from drivers.files import read_recording
-from drivers.replay import FileReplaySource
 from tests.drivers.csvfiles import write_biotac_csv
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.files import read_recording
+from touchbench.drivers.replay import FileReplaySource
 
 
 def _sines(n: int, rate: float = 100.0) -> np.ndarray:

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 import soundfile
 
-from drivers.errors import DriverError
-from drivers.files import read_recording
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.files import read_recording
 
 
 @pytest.mark.parametrize(("suffix", "subtype"), [(".wav", "PCM_16"), (".flac", "PCM_24")])

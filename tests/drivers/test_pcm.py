@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from drivers.errors import DriverError
-from drivers.pcm import decode_pcm
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.pcm import decode_pcm
 
 
 def test_frames_are_deinterleaved_and_scaled_to_full_scale() -> None:

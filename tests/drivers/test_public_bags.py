@@ -15,9 +15,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from drivers.errors import DriverError
-from drivers.replay import FileReplaySource
 from tests.conftest import SHARED_DATASETS
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.replay import FileReplaySource
 
 FOLDER = Path(os.environ.get("TOUCHBENCH_PUBLIC_BAGS", SHARED_DATASETS / "ros-bags"))
 PCM = {"samplerate": 16000, "channels": 1, "sample_format": "S16LE"}

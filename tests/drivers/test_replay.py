@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 import soundfile
 
-from drivers.errors import DriverError
-from drivers.files import read_recording
-from drivers.replay import FileReplaySource
 from tests.drivers.bagfiles import write_audio_bag
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.files import read_recording
+from touchbench.drivers.replay import FileReplaySource
 
 
 def _joined(source: FileReplaySource) -> np.ndarray:

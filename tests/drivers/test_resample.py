@@ -7,8 +7,14 @@ import itertools
 import numpy as np
 import pytest
 
-from drivers.errors import DriverError
-from drivers.resample import EvenResampler, jitter_note, jitter_of, median_rate, resample_even
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.resample import (
+    EvenResampler,
+    jitter_note,
+    jitter_of,
+    median_rate,
+    resample_even,
+)
 
 
 def _stamps(n: int = 2000, seed: int = 0) -> np.ndarray:

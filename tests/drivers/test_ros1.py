@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from drivers.ros1 import DEBIAN_PACKAGES
-from drivers.ros_transport import AUDIO_DATA, AUDIO_INFO
+from touchbench.drivers.ros1 import DEBIAN_PACKAGES
+from touchbench.drivers.ros_transport import AUDIO_DATA, AUDIO_INFO
 
 pytestmark = pytest.mark.skipif(
     not Path(DEBIAN_PACKAGES, "rospy").is_dir(),
@@ -19,7 +19,7 @@ pytestmark = pytest.mark.skipif(
 
 SCRIPT = """
 import sys
-from drivers.ros1 import DEBIAN_PACKAGES, audio_types, import_rospy
+from touchbench.drivers.ros1 import DEBIAN_PACKAGES, audio_types, import_rospy
 import_rospy()
 data, info = audio_types()
 import numpy, yaml

@@ -9,10 +9,10 @@ from collections.abc import Iterator
 import numpy as np
 import pytest
 
-from drivers.errors import DriverError
-from drivers.ros_source import RosAudioSource, RosTaxelSource, info_topic_of
-from drivers.ros_transport import AudioFormat, Kind, Message
 from tests.drivers.bagfiles import mp3_stream, pieces
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.ros_source import RosAudioSource, RosTaxelSource, info_topic_of
+from touchbench.drivers.ros_transport import AudioFormat, Kind, Message
 
 
 class ListTransport:

@@ -5,9 +5,9 @@ from itertools import pairwise
 import numpy as np
 import pytest
 
-from drivers.errors import DriverError
-from drivers.simulated import SimulatedTouch, simulate_session
-from drivers.source import RecordingSource
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.simulated import SimulatedTouch, simulate_session
+from touchbench.drivers.source import RecordingSource
 
 
 def test_sessions_are_reproducible_from_the_seed() -> None:

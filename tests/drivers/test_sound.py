@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from drivers.errors import DriverError
-from drivers.sound import find_device
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.sound import find_device
 
 
 def test_an_unknown_device_points_to_the_listing_not_a_command() -> None:

@@ -3,11 +3,17 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from drivers.simulated import SimulatedTouch, simulate_session
-from features.errors import FeatureError
-from features.events import EVENT_KINDS, detect_dbscan, detect_events, detect_none, detect_snr
-from features.snr import snr_track
 from tests.features.signals import click_train
+from touchbench.drivers.simulated import SimulatedTouch, simulate_session
+from touchbench.features.errors import FeatureError
+from touchbench.features.events import (
+    EVENT_KINDS,
+    detect_dbscan,
+    detect_events,
+    detect_none,
+    detect_snr,
+)
+from touchbench.features.snr import snr_track
 
 SAMPLERATE = 44100.0
 WINDOW_SECONDS = 256 / SAMPLERATE

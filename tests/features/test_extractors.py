@@ -5,12 +5,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from drivers.simulated import SimulatedTouch, simulate_session
-from features.errors import FeatureError
-from features.events import EVENT_KINDS, Detection, Event, detect_events, detect_snr
-from features.extractors import EXTRACTORS, make_extractor, uc3m_feature_names
-from features.extractors.uc3m_audio import CHANNEL_FEATURES
 from tests.features.signals import sine
+from touchbench.drivers.simulated import SimulatedTouch, simulate_session
+from touchbench.features.errors import FeatureError
+from touchbench.features.events import EVENT_KINDS, Detection, Event, detect_events, detect_snr
+from touchbench.features.extractors import EXTRACTORS, make_extractor, uc3m_feature_names
+from touchbench.features.extractors.uc3m_audio import CHANNEL_FEATURES
 
 SAMPLERATE = 44100.0
 WINDOW_MS = 1000 * 256 / SAMPLERATE

@@ -3,9 +3,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from features.errors import FeatureError
-from features.framing import fft_frequencies, frame, frame_count, power_spectrogram, stft
 from tests.features.signals import sine
+from touchbench.features.errors import FeatureError
+from touchbench.features.framing import fft_frequencies, frame, frame_count, power_spectrogram, stft
 
 
 def test_frame_is_a_strided_view_in_librosa_layout() -> None:

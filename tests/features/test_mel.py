@@ -4,10 +4,10 @@ import librosa
 import numpy as np
 import pytest
 
-from features.errors import FeatureError
-from features.framing import frame, power_spectrogram
-from features.mel import hz_to_mel, mel_filter_bank, mel_spectrogram, mel_to_hz, mfcc
 from tests.features.signals import sine, white_noise
+from touchbench.features.errors import FeatureError
+from touchbench.features.framing import frame, power_spectrogram
+from touchbench.features.mel import hz_to_mel, mel_filter_bank, mel_spectrogram, mel_to_hz, mfcc
 
 SAMPLERATE = 16000.0
 FRAME, HOP = 480, 160  # 30 ms and 10 ms at 16 kHz

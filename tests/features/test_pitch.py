@@ -3,10 +3,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from features.errors import FeatureError
-from features.framing import fft_frequencies, frame, stft
-from features.pitch import pitch_autocorrelation, pitch_fft, pitch_wavelet
 from tests.features.signals import sine, white_noise
+from touchbench.features.errors import FeatureError
+from touchbench.features.framing import fft_frequencies, frame, stft
+from touchbench.features.pitch import pitch_autocorrelation, pitch_fft, pitch_wavelet
 
 SAMPLERATE = 44100.0
 

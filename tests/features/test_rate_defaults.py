@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from features.errors import FeatureError
-from features.events import Detection, Event
-from features.extractors import EXTRACTORS, make_extractor
-from features.recipe import Recipe
+from touchbench.features.errors import FeatureError
+from touchbench.features.events import Detection, Event
+from touchbench.features.extractors import EXTRACTORS, make_extractor
+from touchbench.features.recipe import Recipe
 
 
 @pytest.mark.parametrize(("rate", "drop"), [(800.0, 4), (750.0, 4), (400.0, 4), (100.0, 1)])

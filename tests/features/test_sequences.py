@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmark.sequence import find_sequence
-from features.errors import FeatureError
-from features.events import Detection, Event, detect_events
-from features.extractors import make_extractor
-from features.resample import to_length
+from touchbench.benchmark.sequence import find_sequence
+from touchbench.features.errors import FeatureError
+from touchbench.features.events import Detection, Event, detect_events
+from touchbench.features.extractors import make_extractor
+from touchbench.features.resample import to_length
 
 
 def test_to_length_averages_down_and_interpolates_up() -> None:

@@ -5,10 +5,15 @@ import numpy as np
 import pytest
 from scipy.signal import find_peaks, peak_prominences
 
-from features.errors import FeatureError
-from features.framing import fft_frequencies, frame, stft
-from features.spectral import band_peak, spectral_centroid, spectral_flux, spectral_rolloff
 from tests.features.signals import sine, white_noise
+from touchbench.features.errors import FeatureError
+from touchbench.features.framing import fft_frequencies, frame, stft
+from touchbench.features.spectral import (
+    band_peak,
+    spectral_centroid,
+    spectral_flux,
+    spectral_rolloff,
+)
 
 SAMPLERATE = 44100.0
 N_FFT = 256

@@ -3,8 +3,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from features.errors import FeatureError
-from features.stats import segment_statistics
+from touchbench.features.errors import FeatureError
+from touchbench.features.stats import segment_statistics
 
 
 def test_statistics_of_each_segment_and_zeros_for_an_empty_one() -> None:

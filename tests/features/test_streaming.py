@@ -5,16 +5,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from drivers.simulated import SimulatedTouch, simulate_session
-from features.errors import FeatureError
-from features.event_streams import EventStream, open_event_stream
-from features.events import detect_events
-from features.extractors.base import Instances
-from features.history import History
-from features.recipe import Recipe
-from features.snr import snr_track
-from features.snr_stream import SnrStream
 from tests.features.signals import click_train
+from touchbench.drivers.simulated import SimulatedTouch, simulate_session
+from touchbench.features.errors import FeatureError
+from touchbench.features.event_streams import EventStream, open_event_stream
+from touchbench.features.events import detect_events
+from touchbench.features.extractors.base import Instances
+from touchbench.features.history import History
+from touchbench.features.recipe import Recipe
+from touchbench.features.snr import snr_track
+from touchbench.features.snr_stream import SnrStream
 
 SAMPLERATE = 44100.0
 BLOCKS = (100, 256, 1000, 4096, 1 << 20)

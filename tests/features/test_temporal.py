@@ -4,9 +4,9 @@ import librosa
 import numpy as np
 import pytest
 
-from features.framing import frame
-from features.temporal import peak_level, rms, zero_crossing_rate, zero_crossings
 from tests.features.signals import sine, white_noise
+from touchbench.features.framing import frame
+from touchbench.features.temporal import peak_level, rms, zero_crossing_rate, zero_crossings
 
 SAMPLERATE = 44100.0
 

@@ -13,10 +13,10 @@ from typing import Annotated
 from fastapi import APIRouter, File, Form, Request, Response, UploadFile, status
 from fastapi.responses import StreamingResponse
 
-from app.api.deps import PageDep, ServiceDep, StoreDep, paginate
-from app.api.downloads import attachment
-from app.api.uploads import form_request, save_upload
-from app.schemas.datasets import (
+from touchbench.app.api.deps import PageDep, ServiceDep, StoreDep, paginate
+from touchbench.app.api.downloads import attachment
+from touchbench.app.api.uploads import form_request, save_upload
+from touchbench.app.schemas.datasets import (
     DatasetDescription,
     DatasetList,
     DatasetSummary,
@@ -25,17 +25,17 @@ from app.schemas.datasets import (
     RenameRequest,
     RenameResult,
 )
-from app.services.datasets import (
+from touchbench.app.services.datasets import (
     delete_dataset,
     describe_dataset,
     export_dataset,
     import_file,
     rename_dataset,
 )
-from app.services.listing import list_datasets
-from app.store.database import Store
-from app.store.datasets import find_dataset
-from app.store.listing import count_datasets
+from touchbench.app.services.listing import list_datasets
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import find_dataset
+from touchbench.app.store.listing import count_datasets
 
 router = APIRouter(prefix="/api/datasets", tags=["datasets"])
 

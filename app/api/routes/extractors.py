@@ -6,8 +6,8 @@ from typing import Annotated
 
 from fastapi import APIRouter, Query
 
-from app.schemas.extraction import ExtractorList, ExtractorsRequest
-from app.services.extractors import list_extractors
+from touchbench.app.schemas.extraction import ExtractorList, ExtractorsRequest
+from touchbench.app.services.extractors import list_extractors
 
 router = APIRouter(prefix="/api/extractors", tags=["extraction"])
 

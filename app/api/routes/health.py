@@ -8,8 +8,8 @@ from fastapi import APIRouter
 from fastapi.responses import JSONResponse
 from sqlalchemy import text
 
-from app.api.deps import StoreDep
-from app.schemas.base import Schema
+from touchbench.app.api.deps import StoreDep
+from touchbench.app.schemas.base import Schema
 
 router = APIRouter(tags=["health"])
 

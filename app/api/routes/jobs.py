@@ -5,14 +5,14 @@ from __future__ import annotations
 
 from fastapi import APIRouter, Request, Response, status
 
-from app.api.deps import PageDep, ServiceDep, StoreDep, paginate
-from app.errors import ConflictError, NotFoundError
-from app.schemas.ablation import AblationRequest
-from app.schemas.importance import ImportanceRequest
-from app.schemas.jobs import JobCreated, JobList, JobSchema
-from app.schemas.learning import LearningCurveRequest
-from app.services.jobs import submit_answer
-from app.store.jobs import count_jobs, get_job, list_jobs, request_job_cancel
+from touchbench.app.api.deps import PageDep, ServiceDep, StoreDep, paginate
+from touchbench.app.errors import ConflictError, NotFoundError
+from touchbench.app.schemas.ablation import AblationRequest
+from touchbench.app.schemas.importance import ImportanceRequest
+from touchbench.app.schemas.jobs import JobCreated, JobList, JobSchema
+from touchbench.app.schemas.learning import LearningCurveRequest
+from touchbench.app.services.jobs import submit_answer
+from touchbench.app.store.jobs import count_jobs, get_job, list_jobs, request_job_cancel
 
 router = APIRouter(prefix="/api/jobs", tags=["jobs"])
 
@@ -75,9 +75,9 @@ def cancel(job_id: int, store: StoreDep) -> JobSchema:
 def learning_curve_svg(job_id: int, store: StoreDep) -> Response:
     """The curves of a learning-curve job, as far as it has come."""
     # start-up time: matplotlib loads with the first figure drawn
-    from app.reports.figures import learning_figure
-    from app.reports.plots import svg_text
-    from app.schemas.learning import LearningCurveResult
+    from touchbench.app.reports.figures import learning_figure
+    from touchbench.app.reports.plots import svg_text
+    from touchbench.app.schemas.learning import LearningCurveResult
 
     job = get_job(store, job_id)
     if job.kind != "learning-curve":

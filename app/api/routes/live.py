@@ -28,14 +28,14 @@ import numpy as np
 from fastapi import APIRouter, WebSocket, WebSocketDisconnect
 from starlette.concurrency import run_in_threadpool
 
-from app.api.deps import KeyRefused, Service, key_name
-from app.errors import USER_ERRORS
-from app.schemas.models import Engine
-from drivers.errors import DriverError
-from drivers.pcm import SAMPLE_FORMATS, decode_pcm
+from touchbench.app.api.deps import KeyRefused, Service, key_name
+from touchbench.app.errors import USER_ERRORS
+from touchbench.app.schemas.models import Engine
+from touchbench.drivers.errors import DriverError
+from touchbench.drivers.pcm import SAMPLE_FORMATS, decode_pcm
 
 if TYPE_CHECKING:  # start-up time: the feature stack loads with the first session
-    from app.services.live import LiveSession
+    from touchbench.app.services.live import LiveSession
 
 router = APIRouter(tags=["models"])
 
@@ -110,7 +110,7 @@ def _open(
 ) -> LiveSession:
     """The session, opened in a worker thread: the first one imports the feature stack and
     scikit-learn, which must not hold the event loop (and its other sockets' pings) up."""
-    from app.services.live import open_live  # start-up time: see above
+    from touchbench.app.services.live import open_live  # start-up time: see above
 
     return open_live(
         service.store,

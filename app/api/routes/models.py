@@ -16,11 +16,11 @@ from typing import Annotated
 
 from fastapi import APIRouter, File, Form, Request, Response, UploadFile, status
 
-from app.api.deps import PageDep, Service, ServiceDep, StoreDep, paginate, request_size
-from app.api.direct import DirectRoute
-from app.api.uploads import form_request, in_client_words, save_upload
-from app.schemas.jobs import JobCreated
-from app.schemas.models import (
+from touchbench.app.api.deps import PageDep, Service, ServiceDep, StoreDep, paginate, request_size
+from touchbench.app.api.direct import DirectRoute
+from touchbench.app.api.uploads import form_request, in_client_words, save_upload
+from touchbench.app.schemas.jobs import JobCreated
+from touchbench.app.schemas.models import (
     AliasBody,
     AliasDeleted,
     AliasMoved,
@@ -32,8 +32,8 @@ from app.schemas.models import (
     PredictRequest,
     TrainRequest,
 )
-from app.services.jobs import submit_training
-from app.store.models import count_models, delete_model, get_model, list_models
+from touchbench.app.services.jobs import submit_training
+from touchbench.app.store.models import count_models, delete_model, get_model, list_models
 
 router = APIRouter(prefix="/api/models", tags=["models"])
 #: Predictions of JSON instances: documented by FastAPI, answered by a direct handler (the
@@ -73,7 +73,7 @@ def onnx_graph(model_ref: str, service: ServiceDep) -> Response:
     """The model as one ONNX graph (input ``features``, outputs ``label`` and
     ``probabilities``; attribute and label names in its metadata), exported and checked on
     the training instances the first time it is asked for, then kept in the store."""
-    from app.services.export import stored_export
+    from touchbench.app.services.export import stored_export
 
     info, graph, exported = stored_export(service.store, model_ref)
     if exported:
@@ -95,7 +95,7 @@ def remove(model_ref: str, service: ServiceDep) -> ModelSchema:
 @router.post("/{model_ref}/aliases", response_model=AliasMoved)
 def alias(model_ref: str, body: AliasBody, store: StoreDep) -> AliasMoved:
     """Point ``NAME@alias`` at the version ``model_ref`` names (``touchbench alias``)."""
-    from app.services.models import move_alias
+    from touchbench.app.services.models import move_alias
 
     return move_alias(store, AliasRequest(model=model_ref, alias=body.alias)).to_schema()
 
@@ -105,7 +105,7 @@ def unalias(model_ref: str, alias: str, store: StoreDep) -> AliasDeleted:
     """Delete ``NAME@alias`` (``touchbench alias --delete``): 404 when there is no such
     alias, 409 when ``model_ref`` names a version (``NAME@3``) the alias no longer points
     at; live sessions following it keep their version and say so once."""
-    from app.services.models import remove_alias
+    from touchbench.app.services.models import remove_alias
 
     return remove_alias(store, AliasRequest(model=model_ref, alias=alias))
 
@@ -114,7 +114,7 @@ def unalias(model_ref: str, alias: str, store: StoreDep) -> AliasDeleted:
 def promote(model_ref: str, store: StoreDep) -> AliasMoved:
     """Make the version ``model_ref`` names the champion: predictions and live sessions on
     ``NAME@champion`` answer with it from now on (``touchbench promote``)."""
-    from app.services.models import move_alias
+    from touchbench.app.services.models import move_alias
 
     return move_alias(store, AliasRequest(model=model_ref)).to_schema()
 
@@ -123,7 +123,7 @@ def promote(model_ref: str, store: StoreDep) -> AliasMoved:
 def rollback(model_ref: str, store: StoreDep, body: AliasBody | None = None) -> AliasMoved:
     """Point the champion (or ``alias``) of the model back at the version it pointed at
     before its last move (``touchbench rollback``)."""
-    from app.services.models import roll_back
+    from touchbench.app.services.models import roll_back
 
     alias = "champion" if body is None else body.alias
     return roll_back(store, AliasRequest(model=model_ref, alias=alias)).to_schema()
@@ -145,7 +145,7 @@ async def predict_instances(model_ref: str, body: PredictRequest, service: Servi
 def _predict_records(service: Service, model_ref: str, body: PredictRequest, size: int) -> bytes:
     """The prediction report as JSON (written here once, not validated again against the
     response model it was built from); its CPU time is recorded for ``size``."""
-    from app.services.models import records_report
+    from touchbench.app.services.models import records_report
 
     info, trained = service.models.get(service.store, model_ref, body.engine)
     start = time.thread_time()
@@ -174,7 +174,7 @@ def predict_upload(
     targets), or of a raw recording, whose instances are extracted with the model's own
     recipe (as ``touchbench predict MODEL take.wav``).  The upload is bounded by the
     service's upload limit (``max_upload_mb``), and so is the extraction's work."""
-    from app.services.models import predict_file
+    from touchbench.app.services.models import predict_file
 
     with tempfile.TemporaryDirectory(dir=_work_dir(service)) as folder:
         fields = {"model": model_ref, "engine": engine}

@@ -9,11 +9,11 @@ from typing import Annotated
 
 from fastapi import APIRouter, File, Form, UploadFile, status
 
-from app.api.deps import ServiceDep
-from app.api.uploads import form_request, in_client_words, save_upload
-from app.schemas.extraction import DEFAULT_EXTRACTOR, ExtractRequest
-from app.schemas.jobs import JobCreated
-from app.services.jobs import submit_extraction
+from touchbench.app.api.deps import ServiceDep
+from touchbench.app.api.uploads import form_request, in_client_words, save_upload
+from touchbench.app.schemas.extraction import DEFAULT_EXTRACTOR, ExtractRequest
+from touchbench.app.schemas.jobs import JobCreated
+from touchbench.app.services.jobs import submit_extraction
 
 router = APIRouter(prefix="/api/datasets", tags=["datasets"])
 

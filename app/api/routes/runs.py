@@ -13,17 +13,23 @@ from typing import Annotated, Literal
 from fastapi import APIRouter, File, Form, Query, Request, Response, UploadFile, status
 from fastapi.responses import PlainTextResponse
 
-from app.api.deps import PageDep, ServiceDep, StoreDep, paginate
-from app.api.uploads import form_request, save_upload
-from app.schemas.ablation import AblationResult
-from app.schemas.certainty import RunCertainty
-from app.schemas.imported import ImportResultsRequest
-from app.schemas.runs import BenchRequest, LeaderboardSchema, RunCreated, RunList, RunSchema
-from app.services.answers import latest_ablation
-from app.services.certainty import run_certainty
-from app.services.imported import import_results
-from app.services.runs import create_run, run_leaderboard
-from app.store.runs import count_runs, get_run, list_runs, request_cancel, requeue_run
+from touchbench.app.api.deps import PageDep, ServiceDep, StoreDep, paginate
+from touchbench.app.api.uploads import form_request, save_upload
+from touchbench.app.schemas.ablation import AblationResult
+from touchbench.app.schemas.certainty import RunCertainty
+from touchbench.app.schemas.imported import ImportResultsRequest
+from touchbench.app.schemas.runs import (
+    BenchRequest,
+    LeaderboardSchema,
+    RunCreated,
+    RunList,
+    RunSchema,
+)
+from touchbench.app.services.answers import latest_ablation
+from touchbench.app.services.certainty import run_certainty
+from touchbench.app.services.imported import import_results
+from touchbench.app.services.runs import create_run, run_leaderboard
+from touchbench.app.store.runs import count_runs, get_run, list_runs, request_cancel, requeue_run
 
 router = APIRouter(prefix="/api/runs", tags=["runs"])
 
@@ -111,7 +117,11 @@ def leaderboard(
     run, board = ranked.run, ranked.board
     if format == "json":
         return ranked.report()
-    from app.reports.leaderboard import leaderboard_csv, leaderboard_markdown, metric_columns
+    from touchbench.app.reports.leaderboard import (
+        leaderboard_csv,
+        leaderboard_markdown,
+        metric_columns,
+    )
 
     columns = metric_columns(run, board)
     if format == "csv":
@@ -119,7 +129,7 @@ def leaderboard(
     elif format == "markdown":
         text = leaderboard_markdown(run, board, columns, ranked.besides, ranked.notes())
     else:
-        from app.reports.results_arff import write_results_arff
+        from touchbench.app.reports.results_arff import write_results_arff
 
         buffer = io.StringIO()
         write_results_arff(ranked, buffer)
@@ -167,8 +177,8 @@ def calibration_svg(
     top: Annotated[int, Query(ge=1, le=50)] = 5,
 ) -> Response:
     """The reliability diagram of the run's best ``top`` classifiers with probabilities."""
-    from app.reports.figures import reliability_figure
-    from app.reports.plots import svg_text
+    from touchbench.app.reports.figures import reliability_figure
+    from touchbench.app.reports.plots import svg_text
 
     certainty = run_certainty(store, run_id, classifiers=_classifiers(classifier))
     svg = svg_text(reliability_figure(certainty, top))

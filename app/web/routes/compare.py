@@ -11,13 +11,13 @@ from typing import Annotated
 from fastapi import APIRouter, Query
 from fastapi.responses import HTMLResponse
 
-from app.errors import AppError
-from app.reports.bounds import Shown
-from app.store.runs import RunInfo, count_runs, list_runs
-from app.web.deps import StoreDep
-from app.web.listing import newest
-from app.web.rendering import draw, render
-from benchmark.errors import BenchmarkError
+from touchbench.app.errors import AppError
+from touchbench.app.reports.bounds import Shown
+from touchbench.app.store.runs import RunInfo, count_runs, list_runs
+from touchbench.app.web.deps import StoreDep
+from touchbench.app.web.listing import newest
+from touchbench.app.web.rendering import draw, render
+from touchbench.benchmark.errors import BenchmarkError
 
 router = APIRouter(prefix="/fragments/compare", include_in_schema=False)
 
@@ -30,9 +30,9 @@ def compare(
     alpha: Annotated[float, Query(gt=0, lt=1)] = 0.05,
 ) -> HTMLResponse:
     """One run ranks its classifiers over its folds; several, over their data sets."""
-    from app.reports.figures import cd_figure
-    from app.reports.html import comparison_context
-    from app.services.compare import compare_runs
+    from touchbench.app.reports.figures import cd_figure
+    from touchbench.app.reports.html import comparison_context
+    from touchbench.app.services.compare import compare_runs
 
     context: dict[str, object] = {
         "runs": _with_results(newest(count_runs(store), partial(list_runs, store))),

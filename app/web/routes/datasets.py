@@ -9,15 +9,15 @@ from functools import partial
 from fastapi import APIRouter
 from fastapi.responses import HTMLResponse
 
-from app.services.answers import latest_learning_curve
-from app.services.datasets import describe_dataset
-from app.services.listing import list_datasets
-from app.store.listing import count_datasets
-from app.store.runs import count_runs, list_runs
-from app.web.deps import StoreDep
-from app.web.listing import newest
-from app.web.rendering import draw, render
-from app.web.routes.pages import Ref
+from touchbench.app.services.answers import latest_learning_curve
+from touchbench.app.services.datasets import describe_dataset
+from touchbench.app.services.listing import list_datasets
+from touchbench.app.store.listing import count_datasets
+from touchbench.app.store.runs import count_runs, list_runs
+from touchbench.app.web.deps import StoreDep
+from touchbench.app.web.listing import newest
+from touchbench.app.web.rendering import draw, render
+from touchbench.app.web.routes.pages import Ref
 
 router = APIRouter(prefix="/fragments/datasets", include_in_schema=False)
 
@@ -33,8 +33,8 @@ def datasets(store: StoreDep) -> HTMLResponse:
 def dataset(dataset: Ref, store: StoreDep) -> HTMLResponse:
     """Attributes, class distribution per target (table and plot), the runs on it, and its
     newest learning curve (table and plot) when one was computed."""
-    from app.reports.answer_tables import learning_table
-    from app.reports.figures import dataset_classes_figure, learning_figure
+    from touchbench.app.reports.answer_tables import learning_table
+    from touchbench.app.reports.figures import dataset_classes_figure, learning_figure
 
     description = describe_dataset(store, dataset)
     curve = latest_learning_curve(store, description.id, description.name)

@@ -7,14 +7,14 @@ from functools import partial
 from fastapi import APIRouter
 from fastapi.responses import HTMLResponse
 
-from app.schemas.runs import FINAL_STATUSES
-from app.store.jobs import count_jobs, list_jobs
-from app.store.models import count_models, get_model, list_models
-from app.web.deps import StoreDep
-from app.web.listing import newest
-from app.web.rendering import render
-from app.web.routes.pages import Ref
-from benchmark.dataset import Schema
+from touchbench.app.schemas.runs import FINAL_STATUSES
+from touchbench.app.store.jobs import count_jobs, list_jobs
+from touchbench.app.store.models import count_models, get_model, list_models
+from touchbench.app.web.deps import StoreDep
+from touchbench.app.web.listing import newest
+from touchbench.app.web.rendering import render
+from touchbench.app.web.routes.pages import Ref
+from touchbench.benchmark.dataset import Schema
 
 router = APIRouter(prefix="/fragments/models", include_in_schema=False)
 

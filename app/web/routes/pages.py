@@ -12,7 +12,7 @@ from typing import Annotated
 from fastapi import APIRouter, Path, Query
 from fastapi.responses import HTMLResponse
 
-from app.web.rendering import render
+from touchbench.app.web.rendering import render
 
 router = APIRouter(include_in_schema=False)
 

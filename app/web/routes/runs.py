@@ -12,25 +12,25 @@ from typing import TYPE_CHECKING, Annotated, Any
 from fastapi import APIRouter, Query
 from fastapi.responses import HTMLResponse
 
-from app.errors import NotFoundError
-from app.reports.answer_tables import run_answer_tables
-from app.reports.run_tables import run_tables
-from app.schemas.runs import FINAL_STATUSES
-from app.services.answers import run_answers
-from app.services.listing import list_datasets
-from app.services.runs import NoResultsError, run_leaderboard
-from app.store.listing import count_datasets
-from app.store.runs import count_runs, get_run, list_runs
-from app.web.deps import StoreDep
-from app.web.listing import newest
-from app.web.rendering import draw, render
-from app.web.routes.pages import Ref
+from touchbench.app.errors import NotFoundError
+from touchbench.app.reports.answer_tables import run_answer_tables
+from touchbench.app.reports.run_tables import run_tables
+from touchbench.app.schemas.runs import FINAL_STATUSES
+from touchbench.app.services.answers import run_answers
+from touchbench.app.services.listing import list_datasets
+from touchbench.app.services.runs import NoResultsError, run_leaderboard
+from touchbench.app.store.listing import count_datasets
+from touchbench.app.store.runs import count_runs, get_run, list_runs
+from touchbench.app.web.deps import StoreDep
+from touchbench.app.web.listing import newest
+from touchbench.app.web.rendering import draw, render
+from touchbench.app.web.routes.pages import Ref
 
 # The plots and the statistics (matplotlib, scipy) load with the first fragment that needs
 # them, so that the service starts at once.
 if TYPE_CHECKING:
-    from app.services.report import RunView
-    from app.services.runs import RunLeaderboard
+    from touchbench.app.services.report import RunView
+    from touchbench.app.services.runs import RunLeaderboard
 
 router = APIRouter(prefix="/fragments/runs", include_in_schema=False)
 
@@ -54,8 +54,8 @@ def run_form(
     store: StoreDep, dataset: Annotated[str | None, Query(max_length=200)] = None
 ) -> HTMLResponse:
     """The form that starts a run: data sets with their targets, suites, classifier ids."""
-    from benchmark.catalogue import CATALOGUE, SUITES
-    from benchmark.multitarget import multitarget_configurations
+    from touchbench.benchmark.catalogue import CATALOGUE, SUITES
+    from touchbench.benchmark.multitarget import multitarget_configurations
 
     return render(
         "fragments/run_form.html.j2",
@@ -109,8 +109,8 @@ def leaderboard(
 @router.get("/{run_id}/plots", response_class=HTMLResponse)
 def plots(run_id: int, store: StoreDep, metric: Metric = None) -> HTMLResponse:
     """Every fold's score, per-target scores and class counts."""
-    from app.reports import figures
-    from app.services.report import run_view
+    from touchbench.app.reports import figures
+    from touchbench.app.services.report import run_view
 
     run = get_run(store, run_id)
     if run.n_results == 0:
@@ -128,9 +128,9 @@ def classifier(
     run_id: int, classifier: Ref, store: StoreDep, metric: Metric = None, baseline: Baseline = None
 ) -> HTMLResponse:
     """A classifier's confusion matrix, its scores and its folds beside the baseline's."""
-    from app.reports import figures
-    from app.reports.leaderboard import mean_std
-    from app.services.report import run_view
+    from touchbench.app.reports import figures
+    from touchbench.app.reports.leaderboard import mean_std
+    from touchbench.app.services.report import run_view
 
     view = run_view(store, run_id, metric=metric or None, baseline=baseline or None)
     if classifier not in view.run.classifiers:
@@ -158,9 +158,9 @@ def classifier(
 
 def _how_sure(view: RunView, classifier: str) -> dict[str, Any] | None:
     """The classifier's per-class tables and its calibration (none for a regression)."""
-    from app.reports import figures
-    from app.reports.certainty_tables import calibrations, class_tables
-    from app.services.certainty import certainty_of
+    from touchbench.app.reports import figures
+    from touchbench.app.reports.certainty_tables import calibrations, class_tables
+    from touchbench.app.services.certainty import certainty_of
 
     if view.run.kind == "regression" or not view.board.row(classifier).n_ok:
         return None
@@ -185,7 +185,7 @@ def _how_sure(view: RunView, classifier: str) -> dict[str, Any] | None:
 
 def _folds(view: RunView, shown: list[str]) -> dict[str, Any]:
     """Per-fold scores of ``shown`` as a table and a strip plot."""
-    from app.reports import figures
+    from touchbench.app.reports import figures
 
     table = view.fold_scores()
     return {
@@ -201,13 +201,13 @@ def _folds(view: RunView, shown: list[str]) -> dict[str, Any]:
 def _table(ranked: RunLeaderboard, *, chosen_baseline: str | None) -> dict[str, Any]:
     """The leaderboard's header (metric columns sortable), rows, and the pickers' options;
     with runs beside it, where each row comes from and how it is compared."""
-    from app.reports.leaderboard import (
+    from touchbench.app.reports.leaderboard import (
         beside_notes,
         leaderboard_header,
         leaderboard_rows,
         metric_columns,
     )
-    from benchmark.evaluation.metrics import LOWER_IS_BETTER
+    from touchbench.benchmark.evaluation.metrics import LOWER_IS_BETTER
 
     run, board, besides = ranked.run, ranked.board, ranked.besides
     columns = metric_columns(run, board)

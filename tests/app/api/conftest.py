@@ -48,7 +48,7 @@ class Server:
         command = [
             sys.executable,
             "-m",
-            "app.cli.main",
+            "touchbench.app.cli.main",
             "--db",
             self.database_url,
             "serve",

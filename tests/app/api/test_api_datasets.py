@@ -9,10 +9,10 @@ from pathlib import Path
 import httpx
 import pytest
 
-from app.services.simulation import write_labels, write_session
 from tests.app.api.conftest import Server, finished
 from tests.app.cli_runner import run_cli
 from tests.app.synthetic import touch_arff
+from touchbench.app.services.simulation import write_labels, write_session
 
 
 def _upload(server: Server, path: Path, **fields: str) -> httpx.Response:

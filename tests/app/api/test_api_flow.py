@@ -7,11 +7,11 @@ from pathlib import Path
 
 import pytest
 
-from app.store.database import Store
-from app.store.models import rename_model
 from tests.app.api.conftest import Server, finished
 from tests.app.cli_runner import run_cli
 from tests.app.synthetic import touch_arff
+from touchbench.app.store.database import Store
+from touchbench.app.store.models import rename_model
 
 
 def _import(capsys: pytest.CaptureFixture[str], url: str, path: Path, name: str) -> None:

@@ -14,14 +14,14 @@ import soundfile
 from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect
 
-from app.schemas.extraction import ExtractRequest
-from app.schemas.models import TrainRequest
-from app.services.extraction import extract_and_store
-from app.services.models import train
-from app.services.simulation import write_labels, write_session
-from app.store.database import Store
 from tests.app.api.conftest import Server
 from tests.app.cli_runner import run_cli
+from touchbench.app.schemas.extraction import ExtractRequest
+from touchbench.app.schemas.models import TrainRequest
+from touchbench.app.services.extraction import extract_and_store
+from touchbench.app.services.models import train
+from touchbench.app.services.simulation import write_labels, write_session
+from touchbench.app.store.database import Store
 
 
 @pytest.fixture

@@ -17,17 +17,17 @@ import numpy as np
 import pytest
 from websockets.sync.client import ClientConnection, connect
 
-from app.schemas.datasets import ImportRequest
-from app.schemas.extraction import ExtractRequest
-from app.schemas.models import TrainRequest
-from app.services.datasets import import_file
-from app.services.extraction import extract_and_store
-from app.services.models import train
-from app.services.simulation import SAMPLERATE, write_labels, write_session
-from app.store.database import Store
 from tests.app.api.conftest import Server
 from tests.app.api.test_api_live import _as_int16
 from tests.app.synthetic import touch_arff
+from touchbench.app.schemas.datasets import ImportRequest
+from touchbench.app.schemas.extraction import ExtractRequest
+from touchbench.app.schemas.models import TrainRequest
+from touchbench.app.services.datasets import import_file
+from touchbench.app.services.extraction import extract_and_store
+from touchbench.app.services.models import train
+from touchbench.app.services.simulation import SAMPLERATE, write_labels, write_session
+from touchbench.app.store.database import Store
 
 WRITE = "lab-write-key-0123456789"
 PREDICT = "robot-predict-key-0123456789"

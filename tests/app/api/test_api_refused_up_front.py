@@ -9,10 +9,10 @@ from typing import Any
 
 import httpx
 
-from app.store.database import Store
-from app.store.tables import RunRow
 from tests.app.api.conftest import Server, finished
 from tests.app.synthetic import touch_arff
+from touchbench.app.store.database import Store
+from touchbench.app.store.tables import RunRow
 
 #: A data set whose second target, place, has no known value.
 UNLABELLED_PLACE = """@relation 'half: -C 2'

@@ -146,8 +146,8 @@ def test_references_that_no_row_can_have_are_404_on_both_stores(
 
 
 def test_target_counts_and_names_are_told_apart() -> None:
-    from app.schemas.datasets import parse_targets
-    from app.store.naming import is_row_id
+    from touchbench.app.schemas.datasets import parse_targets
+    from touchbench.app.store.naming import is_row_id
 
     assert (parse_targets("2"), parse_targets("-2"), parse_targets("²")) == (2, -2, ["²"])
     assert parse_targets("--2") == ["--2"] and parse_targets("a, b") == ["a", "b"]

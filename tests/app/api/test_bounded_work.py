@@ -18,10 +18,10 @@ import httpx
 import numpy as np
 import soundfile
 
-from app.reports import bounds
 from tests.app.api.conftest import ROOT, Server
 from tests.app.synthetic import touch_arff
 from tests.app.web.conftest import figure_texts
+from touchbench.app.reports import bounds
 
 #: Far above what a bounded service needs, far below what the issue measured (9.2 GB).
 PEAK_RSS_BOUND_MB = 1024
@@ -109,7 +109,15 @@ def test_imports_over_the_limits_are_refused_in_one_line(
 
     # the CLI's import obeys the same settings: exit 2, one line naming the file and count
     cli = subprocess.run(
-        [sys.executable, "-m", "app.cli.main", "--db", server.database_url, "import", str(wide)],
+        [
+            sys.executable,
+            "-m",
+            "touchbench.app.cli.main",
+            "--db",
+            server.database_url,
+            "import",
+            str(wide),
+        ],
         cwd=ROOT,
         env=server.environment,
         capture_output=True,

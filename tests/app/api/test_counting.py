@@ -9,8 +9,8 @@ import json
 import pytest
 from fastapi.exceptions import RequestValidationError
 
-from app.api.counting import check_counts, limited_lists
-from app.schemas.models import PredictRequest
+from touchbench.app.api.counting import check_counts, limited_lists
+from touchbench.app.schemas.models import PredictRequest
 
 LISTS = {"instances": 5}
 

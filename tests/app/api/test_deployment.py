@@ -18,9 +18,9 @@ import httpx
 import pytest
 import yaml
 
-from app.settings import Settings
 from tests.app.api.conftest import ROOT, Server, finished, free_port
 from tests.app.synthetic import touch_arff
+from touchbench.app.settings import Settings
 
 COMPOSE = ROOT / "docker-compose.yml"
 
@@ -32,7 +32,7 @@ def _compose() -> dict[str, Any]:
 def test_the_compose_file_names_what_exists() -> None:
     import typer
 
-    from app.cli.main import app as cli
+    from touchbench.app.cli.main import app as cli
 
     services = _compose()["services"]
     assert {"db", "api", "scheduler", "worker"} <= set(services)

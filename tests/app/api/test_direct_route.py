@@ -15,17 +15,17 @@ from fastapi import APIRouter, Depends, Header, Response
 from fastapi.testclient import TestClient
 from pydantic import SecretStr
 
-from app.api.deps import ServiceDep, StoreDep, require_api_key
-from app.api.direct import DirectRoute
-from app.api.routes.models import predict_instances
-from app.main import create_app
-from app.schemas.datasets import ImportRequest
-from app.schemas.models import PredictionReport, PredictRequest, TrainRequest
-from app.services.datasets import import_file
-from app.services.models import train
-from app.settings import Settings
-from app.store.database import Store
 from tests.app.synthetic import touch_arff
+from touchbench.app.api.deps import ServiceDep, StoreDep, require_api_key
+from touchbench.app.api.direct import DirectRoute
+from touchbench.app.api.routes.models import predict_instances
+from touchbench.app.main import create_app
+from touchbench.app.schemas.datasets import ImportRequest
+from touchbench.app.schemas.models import PredictionReport, PredictRequest, TrainRequest
+from touchbench.app.services.datasets import import_file
+from touchbench.app.services.models import train
+from touchbench.app.settings import Settings
+from touchbench.app.store.database import Store
 
 DIRECT = "/api/models/{model}/predict"
 THROUGH_FASTAPI = "/fastapi/models/{model}/predict"

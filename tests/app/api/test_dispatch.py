@@ -15,17 +15,17 @@ from pathlib import Path
 
 import pytest
 
-from app.jobs import dispatcher as dispatching
-from app.jobs.dispatcher import Dispatcher, dispatch_address
-from app.schemas.datasets import ImportRequest
-from app.schemas.runs import BenchRequest
-from app.services.datasets import import_file
-from app.services.runs import create_run
-from app.settings import Settings
-from app.store.database import Store
-from app.store.runs import get_run
 from tests.app.api.conftest import Server, finished
 from tests.app.synthetic import touch_arff
+from touchbench.app.jobs import dispatcher as dispatching
+from touchbench.app.jobs.dispatcher import Dispatcher, dispatch_address
+from touchbench.app.schemas.datasets import ImportRequest
+from touchbench.app.schemas.runs import BenchRequest
+from touchbench.app.services.datasets import import_file
+from touchbench.app.services.runs import create_run
+from touchbench.app.settings import Settings
+from touchbench.app.store.database import Store
+from touchbench.app.store.runs import get_run
 
 
 def test_two_service_processes_run_one_job_at_a_time_each_once(

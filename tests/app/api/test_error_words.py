@@ -26,7 +26,7 @@ def _cli_words() -> re.Pattern[str]:
     message; the commands are the CLI's own, so that "touchbench does not ..." is prose."""
     import typer.main
 
-    from app.cli.main import app
+    from touchbench.app.cli.main import app
 
     commands = sorted(typer.main.get_command(app).commands, key=len, reverse=True)  # type: ignore[attr-defined]
     return re.compile(r"--[a-z]|touchbench (?:" + "|".join(map(re.escape, commands)) + r")\b")

@@ -10,9 +10,12 @@ from pathlib import Path
 import pytest
 from sqlalchemy import update
 
-from app.errors import ConflictError
-from app.store.database import Store
-from app.store.jobs import (
+from tests.app.api.conftest import Server, finished
+from tests.app.cli_runner import run_cli
+from tests.app.synthetic import touch_arff
+from touchbench.app.errors import ConflictError
+from touchbench.app.store.database import Store
+from touchbench.app.store.jobs import (
     claim_job,
     create_job,
     finish_job,
@@ -20,10 +23,7 @@ from app.store.jobs import (
     mark_lost_jobs,
     request_job_cancel,
 )
-from app.store.tables import JobRow
-from tests.app.api.conftest import Server, finished
-from tests.app.cli_runner import run_cli
-from tests.app.synthetic import touch_arff
+from touchbench.app.store.tables import JobRow
 
 
 def _training(

@@ -105,7 +105,7 @@ def test_job_processes_have_no_password_on_their_command_line(
     processes = {
         pid: _read(Path(f"/proc/{pid}/cmdline")) for pid in _descendants(server.process.pid)
     }
-    jobs = [pid for pid, argv in processes.items() if "app.jobs.process" in argv]
+    jobs = [pid for pid, argv in processes.items() if "touchbench.app.jobs.process" in argv]
     assert len(jobs) == 1, processes
     for pid, argv in processes.items():
         assert not any(PASSWORD in argument for argument in argv), (pid, argv)

@@ -12,15 +12,15 @@ from pathlib import Path
 import pytest
 from fastapi.testclient import TestClient
 
-from app.api.deps import INLINE_SECONDS, ModelCache, request_size
-from app.main import create_app
-from app.schemas.datasets import ImportRequest
-from app.schemas.models import TrainRequest
-from app.services.datasets import import_file
-from app.services.models import predict_records, train
-from app.settings import Settings
-from app.store.database import Store
 from tests.app.synthetic import touch_arff
+from touchbench.app.api.deps import INLINE_SECONDS, ModelCache, request_size
+from touchbench.app.main import create_app
+from touchbench.app.schemas.datasets import ImportRequest
+from touchbench.app.schemas.models import TrainRequest
+from touchbench.app.services.datasets import import_file
+from touchbench.app.services.models import predict_records, train
+from touchbench.app.settings import Settings
+from touchbench.app.store.database import Store
 
 
 def test_a_model_runs_inline_only_once_it_is_known_to_be_quick() -> None:

@@ -32,7 +32,13 @@ def _serve(tmp_path: Path, *arguments: str, **settings: str) -> subprocess.Compl
         if not key.startswith("TOUCHBENCH_") or key == "TOUCHBENCH_TEST_POSTGRES_URL"
     }
     environment.update({f"TOUCHBENCH_{key.upper()}": value for key, value in settings.items()})
-    command = [sys.executable, "-m", "app.cli.main", "--db", f"sqlite:///{tmp_path / 's.db'}"]
+    command = [
+        sys.executable,
+        "-m",
+        "touchbench.app.cli.main",
+        "--db",
+        f"sqlite:///{tmp_path / 's.db'}",
+    ]
     return subprocess.run(
         [*command, "serve", "--port", str(free_port()), *arguments],
         cwd=ROOT,
@@ -231,9 +237,9 @@ def test_without_keys_changes_are_logged_as_keyless(
 def test_every_route_a_predict_key_may_change_exists_and_lets_it_in(tmp_path: Path) -> None:
     from fastapi.testclient import TestClient
 
-    from app.api.deps import PREDICT_ROUTES
-    from app.main import create_app
-    from app.settings import Settings
+    from touchbench.app.api.deps import PREDICT_ROUTES
+    from touchbench.app.main import create_app
+    from touchbench.app.settings import Settings
 
     settings = Settings(
         database_url=f"sqlite:///{tmp_path / 's.db'}",

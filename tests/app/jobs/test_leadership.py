@@ -9,7 +9,7 @@ from collections.abc import Iterator
 
 import pytest
 
-from app.jobs.leadership import Leadership, address_for
+from touchbench.app.jobs.leadership import Leadership, address_for
 
 #: A deadlock guard, not a measure: a wake-up ends a wait of this length far sooner.
 LONG = 600.0

@@ -9,7 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from app.jobs.process import DATABASE_URL_VARIABLE
+from touchbench.app.jobs.process import DATABASE_URL_VARIABLE
 
 ROOT = Path(__file__).resolve().parents[3]
 #: Nothing listens on port 1: the connection is refused at once.
@@ -21,7 +21,7 @@ def _process(*arguments: str, url: str | None) -> subprocess.CompletedProcess[st
     if url is not None:
         environment[DATABASE_URL_VARIABLE] = url
     return subprocess.run(
-        [sys.executable, "-m", "app.jobs.process", *arguments],
+        [sys.executable, "-m", "touchbench.app.jobs.process", *arguments],
         cwd=ROOT,
         env=environment,
         capture_output=True,

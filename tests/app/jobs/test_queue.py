@@ -9,14 +9,14 @@ from pathlib import Path
 
 from sqlalchemy import update
 
-from app.jobs.queue import Item, next_item, waiting
-from app.store.database import Store
-from app.store.datasets import add_dataset, dataset_digest
-from app.store.jobs import create_job
-from app.store.runs import create_run
-from app.store.tables import JobRow, RunRow
-from benchmark.io.arff import read_arff
 from tests.app.synthetic import touch_arff
+from touchbench.app.jobs.queue import Item, next_item, waiting
+from touchbench.app.store.database import Store
+from touchbench.app.store.datasets import add_dataset, dataset_digest
+from touchbench.app.store.jobs import create_job
+from touchbench.app.store.runs import create_run
+from touchbench.app.store.tables import JobRow, RunRow
+from touchbench.benchmark.io.arff import read_arff
 
 START = datetime(2026, 1, 1, tzinfo=UTC)
 

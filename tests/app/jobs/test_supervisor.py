@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from app.jobs.queue import Item
-from app.jobs.supervisor import Supervisor
+from touchbench.app.jobs.queue import Item
+from touchbench.app.jobs.supervisor import Supervisor
 
 #: Item 1 exits 0 and item 2 exits 3 once their file ``go-ID`` exists; item 3 sleeps until
 #: it is ended.  Each first writes its variable ``SECRET`` to ``env-ID``.

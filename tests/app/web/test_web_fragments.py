@@ -12,12 +12,12 @@ from urllib.parse import quote
 
 import pytest
 
-from app.web.rendering import CONTENT_SECURITY_POLICY
 from tests.app.api.conftest import Server
 from tests.app.cli_runner import run_cli
 from tests.app.synthetic import touch_arff
 from tests.app.test_plots import FETCHES
 from tests.app.web.conftest import figure_texts
+from touchbench.app.web.rendering import CONTENT_SECURITY_POLICY
 
 MARKUP_NAME = "<i>mark<i>"  # markup, without the slash a name may not hold
 MARKUP_ATTRIBUTE = "<img src=x onerror=alert(1)>"

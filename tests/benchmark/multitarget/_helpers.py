@@ -9,7 +9,7 @@ import numpy as np
 from sklearn.linear_model import LogisticRegression
 from sklearn.tree import DecisionTreeClassifier
 
-from benchmark.multitarget import (
+from touchbench.benchmark.multitarget import (
     BayesianClassifierChain,
     ClassifierChain,
     ClassRelevance,

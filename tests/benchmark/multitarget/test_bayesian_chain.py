@@ -6,16 +6,16 @@ import numpy as np
 import pytest
 from sklearn.utils import check_random_state
 
-from benchmark.errors import ConfigurationError
-from benchmark.multitarget import BayesianClassifierChain
-from benchmark.multitarget.dependence import (
+from tests.benchmark.multitarget._helpers import logistic
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.multitarget import BayesianClassifierChain
+from touchbench.benchmark.multitarget.dependence import (
     CHI2_CRITICAL_2DOF,
     error_dependence_matrix,
     maximum_spanning_tree,
     mutual_information_matrix,
     orient_tree,
 )
-from tests.benchmark.multitarget._helpers import logistic
 
 A, B, C = 0, 1, 2
 

@@ -6,13 +6,13 @@ import numpy as np
 import pytest
 from sklearn.utils import check_random_state
 
-from benchmark.errors import ConfigurationError
-from benchmark.multitarget import (
+from tests.benchmark.multitarget._helpers import logistic, three_targets, tree
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.multitarget import (
     ClassifierChain,
     EnsembleClassifierChains,
     ProbabilisticClassifierChain,
 )
-from tests.benchmark.multitarget._helpers import logistic, three_targets, tree
 
 
 def mirrored_targets(n_samples: int = 200, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmark.multitarget import (
+from tests.benchmark.multitarget._helpers import logistic, three_targets, tree
+from touchbench.benchmark.multitarget import (
     EnsemblePrunedSets,
     LabelCombination,
     NearestSetReplacement,
@@ -13,7 +14,6 @@ from benchmark.multitarget import (
     RAkELd,
     SuperClassClassifier,
 )
-from tests.benchmark.multitarget._helpers import logistic, three_targets, tree
 
 
 def counted(combinations: dict[tuple[int, ...], int]) -> np.ndarray:

@@ -11,8 +11,8 @@ from sklearn.base import clone
 from sklearn.exceptions import NotFittedError
 from sklearn.utils.estimator_checks import check_estimator
 
-from benchmark.errors import ConfigurationError
 from tests.benchmark.multitarget._helpers import META_FACTORIES, logistic, three_targets, tree
+from touchbench.benchmark.errors import ConfigurationError
 
 #: Checks of ``check_estimator`` that assume single-output classifiers.  Multi-target
 #: estimators take a 2-D ``Y`` of integer codes and return a list from predict_proba:

@@ -7,8 +7,12 @@ from typing import Any
 import numpy as np
 import pytest
 
-from benchmark.errors import ConfigurationError
-from benchmark.multitarget import MULTILABEL_METRICS, MULTITARGET_METRICS, multitarget_scores
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.multitarget import (
+    MULTILABEL_METRICS,
+    MULTITARGET_METRICS,
+    multitarget_scores,
+)
 
 # Four instances, two targets (3 and 2 classes).
 Y_TRUE = np.array([[0, 1], [1, 0], [2, 1], [2, 0]])

@@ -6,14 +6,14 @@ import numpy as np
 import pytest
 from sklearn.base import clone
 
-from benchmark.errors import ConfigurationError
-from benchmark.multitarget import MultiLabelAdapter
-from benchmark.multitarget.multilabel import (
+from tests.benchmark.multitarget._helpers import logistic
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.multitarget import MultiLabelAdapter
+from touchbench.benchmark.multitarget.multilabel import (
     METHODS_WITH_BASE,
     METHODS_WITHOUT_BASE,
     METHODS_WITHOUT_PROBABILITIES,
 )
-from tests.benchmark.multitarget._helpers import logistic
 
 
 def labels(n_samples: int = 120, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from sklearn.model_selection import StratifiedKFold
 
-from benchmark.io.arff import read_arff
-from benchmark.multitarget import build_multitarget, multitarget_scores
+from touchbench.benchmark.io.arff import read_arff
+from touchbench.benchmark.multitarget import build_multitarget, multitarget_scores
 
 SAMPLE = 600
 

@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 from sklearn.base import clone
 
-from benchmark.catalogue import CATALOGUE
-from benchmark.errors import ConfigurationError
-from benchmark.multitarget import (
+from tests.benchmark.multitarget._helpers import three_targets
+from touchbench.benchmark.catalogue import CATALOGUE
+from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.multitarget import (
     DEFAULT_BASES,
     META_METHODS,
     MultiTargetClassifier,
@@ -17,7 +18,6 @@ from benchmark.multitarget import (
     multitarget_configurations,
     parse_config,
 )
-from tests.benchmark.multitarget._helpers import three_targets
 
 MEKA_METHODS = ("cr", "cc", "bcc", "pcc", "lc", "ps", "eps", "ecc", "rakeld", "nsr", "scc")
 

@@ -9,13 +9,13 @@ from sklearn.impute import SimpleImputer
 from sklearn.pipeline import make_pipeline
 from sklearn.svm import SVC
 
-from benchmark.multitarget import (
+from tests.benchmark.multitarget._helpers import META_FACTORIES, logistic, three_targets
+from touchbench.benchmark.multitarget import (
     ClassRelevance,
     LabelCombination,
     TargetClassifier,
     build_multitarget,
 )
-from tests.benchmark.multitarget._helpers import META_FACTORIES, logistic, three_targets
 
 
 def independent_pair(n_samples: int = 160, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:

@@ -14,11 +14,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmark.catalogue import build_pipeline, get_spec
-from benchmark.dataset import Dataset
-from benchmark.io.arff import read_arff, write_arff
-from benchmark.problem import problem_from_dataset
-from benchmark.weka.reference import WEKA_DATA, cross_validated_accuracy, predictions, weka_jar
+from touchbench.benchmark.catalogue import build_pipeline, get_spec
+from touchbench.benchmark.dataset import Dataset
+from touchbench.benchmark.io.arff import read_arff, write_arff
+from touchbench.benchmark.problem import problem_from_dataset
+from touchbench.benchmark.weka.reference import (
+    WEKA_DATA,
+    cross_validated_accuracy,
+    predictions,
+    weka_jar,
+)
 
 pytestmark = pytest.mark.skipif(
     weka_jar() is None or not WEKA_DATA.is_dir(),

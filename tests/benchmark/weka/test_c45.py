@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmark.weka import C45Classifier
-from benchmark.weka.c45 import added_errors
+from touchbench.benchmark.weka import C45Classifier
+from touchbench.benchmark.weka.c45 import added_errors
 
 NAN = np.nan
 

@@ -16,7 +16,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[3]
 SCRIPT = """
 import numpy as np
-from benchmark.weka.c45 import C45Classifier
+from touchbench.benchmark.weka.c45 import C45Classifier
 
 def peak():
     with open("/proc/self/status") as status:

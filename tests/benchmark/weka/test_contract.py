@@ -8,8 +8,14 @@ from collections.abc import Callable
 from sklearn.base import BaseEstimator
 from sklearn.utils.estimator_checks import parametrize_with_checks
 
-from benchmark.catalogue.boosters import CatBoostNominalClassifier, LightGBMClassifier
-from benchmark.weka import C45Classifier, PARTClassifier, WekaIBk, WekaNaiveBayes, WekaZeroR
+from touchbench.benchmark.catalogue.boosters import CatBoostNominalClassifier, LightGBMClassifier
+from touchbench.benchmark.weka import (
+    C45Classifier,
+    PARTClassifier,
+    WekaIBk,
+    WekaNaiveBayes,
+    WekaZeroR,
+)
 
 
 @parametrize_with_checks(

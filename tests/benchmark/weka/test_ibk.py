@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmark.weka import WekaIBk
+from touchbench.benchmark.weka import WekaIBk
 
 NAN = np.nan
 

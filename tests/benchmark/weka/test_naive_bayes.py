@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmark.weka import WekaNaiveBayes
-from benchmark.weka.discretize import mdl_cut_points
+from touchbench.benchmark.weka import WekaNaiveBayes
+from touchbench.benchmark.weka.discretize import mdl_cut_points
 
 NAN = np.nan
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmark.weka import PARTClassifier
 from tests.benchmark.weka.test_c45 import NOMINAL, WEATHER
+from touchbench.benchmark.weka import PARTClassifier
 
 NAN = np.nan
 

@@ -1,0 +1,157 @@
+"""touchbench installs as one import name: the wheel, a fresh environment, old stores.
+
+The wheel is built from a copy of the repository's package folders, installed with its
+dependencies (the core, no extra) into a new virtual environment outside the repository,
+and used there as a researcher would: the console script, ``import``, a store written
+before the move.
+"""
+
+from __future__ import annotations
+
+import ast
+import gzip
+import json
+import shutil
+import subprocess
+import sys
+import venv
+import zipfile
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PARTS = ("app", "benchmark", "features", "drivers")
+BEFORE = ROOT / "tests" / "app" / "store" / "data" / "before-one-package"
+
+
+def _python_files() -> list[Path]:
+    folders = [ROOT / part for part in (*PARTS, "touchbench", "tests", "perf", "examples")]
+    return [path for folder in folders if not folder.is_symlink() for path in folder.rglob("*.py")]
+
+
+def test_no_module_imports_a_part_by_its_old_top_level_name() -> None:
+    found = []
+    for path in _python_files():
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            names = []
+            if isinstance(node, ast.Import):
+                names = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                names = [node.module]
+            found += [
+                f"{path.relative_to(ROOT)}:{node.lineno}: {name}"
+                for name in names
+                if name.split(".")[0] in PARTS
+            ]
+    assert found == []
+
+
+def test_the_package_links_each_part_to_its_top_level_folder() -> None:
+    for part in PARTS:
+        link = ROOT / "touchbench" / part
+        assert link.is_symlink() and link.resolve() == ROOT / part, part
+
+
+@pytest.fixture(scope="module")
+def wheel(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The wheel built from a copy of the repository (the build writes beside its sources)."""
+    source = tmp_path_factory.mktemp("source")
+    for name in ("pyproject.toml", "README.md"):
+        shutil.copy(ROOT / name, source / name)
+    for folder in (*PARTS, "touchbench"):
+        shutil.copytree(
+            ROOT / folder,
+            source / folder,
+            symlinks=True,
+            ignore=shutil.ignore_patterns("__pycache__"),
+        )
+    dist = tmp_path_factory.mktemp("dist")
+    built = subprocess.run(
+        [sys.executable, "-m", "pip", "wheel", str(source), "--no-deps", "--no-build-isolation"]
+        + ["--wheel-dir", str(dist), "--quiet"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert built.returncode == 0, built.stderr[-3000:]
+    (path,) = dist.glob("touchbench-*.whl")
+    return path
+
+
+def test_the_wheel_installs_one_top_level_name(wheel: Path) -> None:
+    with zipfile.ZipFile(wheel) as archive:
+        tops = {name.split("/", 1)[0] for name in archive.namelist()}
+        names = set(archive.namelist())
+    assert {top for top in tops if not top.endswith(".dist-info")} == {"touchbench"}
+    # the data files that the service and the store read at run time came along
+    assert "touchbench/app/store/migrations/env.py" in names
+    assert "touchbench/app/web/templates/base.html.j2" in names
+    assert "touchbench/py.typed" in names
+
+
+@pytest.fixture(scope="module")
+def environment(wheel: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A new virtual environment with the wheel and its core dependencies."""
+    folder = tmp_path_factory.mktemp("fresh") / "venv"
+    venv.EnvBuilder(with_pip=True).create(folder)
+    installed = subprocess.run(
+        [str(folder / "bin" / "python"), "-m", "pip", "install", "--quiet", str(wheel)],
+        capture_output=True,
+        text=True,
+        timeout=1800,
+    )
+    assert installed.returncode == 0, installed.stderr[-3000:]
+    return folder
+
+
+@pytest.mark.slow
+def test_a_fresh_environment_runs_the_console_script(environment: Path, tmp_path: Path) -> None:
+    done = subprocess.run(
+        [str(environment / "bin" / "touchbench"), "--version"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith("touchbench ")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", PARTS)
+def test_a_fresh_environment_has_no_other_top_level_name(
+    environment: Path, tmp_path: Path, name: str
+) -> None:
+    done = subprocess.run(
+        [str(environment / "bin" / "python"), "-c", f"import {name}"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        timeout=120,
+    )
+    assert done.returncode == 1 and f"No module named '{name}'" in done.stderr
+
+
+@pytest.mark.slow
+def test_a_fresh_environment_loads_a_model_stored_before_the_move(
+    environment: Path, tmp_path: Path
+) -> None:
+    database = tmp_path / "touchbench.db"
+    with gzip.open(BEFORE / "store.db.gz") as packed, database.open("wb") as unpacked:
+        shutil.copyfileobj(packed, unpacked)
+    touchbench = [str(environment / "bin" / "touchbench"), "--db", f"sqlite:///{database}"]
+    data = tmp_path / "robot.arff"
+    exported = subprocess.run(
+        [*touchbench, "export", "robot", "-o", str(data)], capture_output=True, text=True
+    )
+    assert exported.returncode == 0, exported.stderr
+    predicted = subprocess.run(
+        [*touchbench, "predict", "old-cc", str(data), "--json"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert predicted.returncode == 0, predicted.stderr
+    expected = json.loads((BEFORE / "predictions-old-cc.json").read_text())
+    assert json.loads(predicted.stdout)["predictions"] == expected
