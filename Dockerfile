@@ -12,7 +12,7 @@ COPY benchmark ./benchmark
 COPY features ./features
 COPY drivers ./drivers
 # PyTorch's CPU build (the default Linux wheel on PyPI carries CUDA libraries of several GB).
-RUN pip install --no-cache-dir --extra-index-url https://download.pytorch.org/whl/cpu .
+RUN pip install --no-cache-dir --extra-index-url https://download.pytorch.org/whl/cpu '.[all]'
 RUN useradd --create-home touchbench && mkdir -p /var/lib/touchbench \
     && chown touchbench /var/lib/touchbench
 USER touchbench

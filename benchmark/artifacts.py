@@ -17,6 +17,7 @@ import zipfile
 from typing import Any
 
 from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.extras import EXTRA_OF, require
 
 #: Format tag written into every artifact, checked on load.
 ARTIFACT_FORMAT = "touchbench-model/1"
@@ -78,6 +79,8 @@ def loads_artifact(data: bytes) -> dict[str, Any]:
     ConfigurationError
         The bytes are not a skops artifact, name a type outside
         :data:`TRUSTED_PACKAGES` (or a function), or are not a touchbench model.
+    MissingExtraError
+        The model is made of a library of an extra that is not installed.
     """
     import skops.io
 
@@ -91,6 +94,8 @@ def loads_artifact(data: bytes) -> dict[str, Any]:
         named = skops.io.get_untrusted_types(data=data)
     except Exception as exc:
         raise ConfigurationError(f"the stored model cannot be read: {exc}") from None
+    optional = {name.split(".", 1)[0] for name in named} & EXTRA_OF.keys()
+    require(sorted(optional), "the stored model")
     refused = [name for name in named if not is_trusted_type(name)]
     if refused:
         shown = ", ".join(refused[:3]) + (f" (+{len(refused) - 3})" if len(refused) > 3 else "")

@@ -24,6 +24,7 @@ from touchbench.benchmark.catalogue import (
 )
 from touchbench.benchmark.catalogue import unknown_classifier_message as _unknown_message
 from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.extras import require
 from touchbench.benchmark.problem import Problem
 
 __all__ = [
@@ -107,6 +108,7 @@ def check_classifier(
         regressor = regressor_spec(
             classifier_id, n_targets=problem.n_targets, n_instances=problem.n_instances
         )
+        require(regressor.requires, f"regressor '{classifier_id}'")
         check_sequence_input(regressor, problem.sequence)
         return regressor
     names = ", ".join(problem.target_names)
@@ -114,9 +116,12 @@ def check_classifier(
         _, base = parse_config(classifier_id)
         check_targets(classifier_id, problem.n_classes, problem.target_names)
         if base:
-            check_sequence_input(classifier_spec(base, extra_specs), problem.sequence)
+            base_spec = classifier_spec(base, extra_specs)
+            require(base_spec.requires, f"classifier '{classifier_id}'")
+            check_sequence_input(base_spec, problem.sequence)
         return None
     spec = classifier_spec(classifier_id, extra_specs)
+    require(spec.requires, f"classifier '{classifier_id}'")
     check_sequence_input(spec, problem.sequence)
     if problem.kind == "multitarget":
         raise ConfigurationError(

@@ -5,8 +5,8 @@
 # web-page tests drive through Playwright; wrk, the HTTP load generator of perf/serve.py;
 # ROS 1 (rosmaster, rospy, genpy) for `touchbench ros` and its tests, which reach these
 # system packages from the venv through drivers/ros1.py only),
-# a .venv/ at the repository root, and touchbench
-# with its test tools installed (editable) inside it.
+# a .venv/ at the repository root, and touchbench with every extra and its test tools
+# installed (editable) inside it, at the versions of scripts/constraints.txt.
 # Safe to run again: it only does what is missing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -37,11 +37,12 @@ apt_install libportaudio2 libsndfile1 weka default-jre-headless chromium wrk \
 "$PYTHON" -c 'import ensurepip, venv' 2>/dev/null || apt_install python3-venv
 
 [ -x .venv/bin/python ] || "$PYTHON" -m venv .venv
-stamp=".venv/.installed-$(cat pyproject.toml | sha256sum | cut -c1-16)"
+stamp=".venv/.installed-$(cat pyproject.toml scripts/constraints.txt | sha256sum | cut -c1-16)"
 if [ ! -f "$stamp" ]; then
-  echo "installing touchbench and its dependencies into .venv/" >&2
+  echo "installing touchbench with every extra and its test tools into .venv/" >&2
   .venv/bin/python -m pip install -q --upgrade pip
-  .venv/bin/python -m pip install -q -e '.[test]'
+  # the exact versions tested on this machine (scripts/constraints.txt), every extra
+  .venv/bin/python -m pip install -q -c scripts/constraints.txt -e '.[all,test]'
   rm -f .venv/.installed-*
   touch "$stamp"
 fi

@@ -67,9 +67,9 @@ def wheel(tmp_path_factory: pytest.TempPathFactory) -> Path:
             ignore=shutil.ignore_patterns("__pycache__"),
         )
     dist = tmp_path_factory.mktemp("dist")
+    build = [sys.executable, "-m", "pip", "wheel", str(source), "--no-deps", "--quiet"]
     built = subprocess.run(
-        [sys.executable, "-m", "pip", "wheel", str(source), "--no-deps", "--no-build-isolation"]
-        + ["--wheel-dir", str(dist), "--quiet"],
+        [*build, "--no-build-isolation", "--wheel-dir", str(dist)],
         capture_output=True,
         text=True,
         timeout=600,

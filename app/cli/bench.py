@@ -94,8 +94,11 @@ def classifiers_command(
     sequence, or -e mfcc -O frames=N) and refuse flat data sets. On numeric targets the
     same ids name regressors (--regressors lists them).
     """
+    from rich.markup import escape
+
     from touchbench.benchmark.catalogue import CATALOGUE, get_spec, suite
     from touchbench.benchmark.export.onnx import exports_onnx
+    from touchbench.benchmark.extras import extras_of
 
     if multi_target and regressors:
         raise typer.BadParameter("give --multi-target or --regressors, not both")
@@ -134,6 +137,8 @@ def classifiers_command(
                         "limits": s.limits,
                         "search_space": s.to_json()["search_space"],
                         "onnx": exports_onnx(s),
+                        "extras": [extra.name for extra in extras_of(s.requires)],
+                        "installed": s.installed,
                     }
                     for s in specs
                 ],
@@ -156,6 +161,7 @@ def classifiers_command(
             "onnx",
             "cost",
             "suites",
+            "extra",
         ],
         [
             (
@@ -170,10 +176,15 @@ def classifiers_command(
                 yes if exports_onnx(s) else "",
                 costs[s.id],
                 ",".join(sorted(s.suites)),
+                ("" if s.installed else "✗") + ",".join(e.name for e in extras_of(s.requires)),
             )
             for s in specs
         ],
+        whole=("extra",),
     )
+    absent = list(dict.fromkeys(e for s in specs if not s.installed for e in extras_of(s.requires)))
+    for extra in absent:
+        info(escape(f"entries whose extra is marked ✗ are not installed: {extra.install}"))
 
 
 def _costs(

@@ -6,7 +6,7 @@ import json
 import math
 import re
 import sys
-from collections.abc import Iterable, Sequence
+from collections.abc import Collection, Iterable, Sequence
 from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
@@ -67,12 +67,23 @@ def table(
     rows: Iterable[Sequence[Any]],
     *,
     justify: Sequence[str] | None = None,
+    whole: Collection[str] = (),
 ) -> None:
+    """Print a table; the first two columns and those named in ``whole`` are never wrapped
+    nor cut."""
+    cells = [[format_cell(value) for value in row] for row in rows]
     out = Table(title=title, title_justify="left", header_style="bold")
     for i, column in enumerate(columns):
-        out.add_column(column, justify=(justify[i] if justify else "left"), no_wrap=i < 2)  # type: ignore[arg-type]
-    for row in rows:
-        out.add_row(*(format_cell(value) for value in row))
+        out.add_column(
+            column,
+            justify=(justify[i] if justify else "left"),  # type: ignore[arg-type]
+            no_wrap=i < 2 or column in whole,
+            min_width=max([len(column), *(len(row[i]) for row in cells)])
+            if column in whole
+            else None,
+        )
+    for row in cells:
+        out.add_row(*row)
     console.print(out)
 
 

@@ -18,6 +18,7 @@ from touchbench.app.store.exports import load_export, save_export
 from touchbench.app.store.models import ModelInfo, get_model
 from touchbench.benchmark.dataset import Schema
 from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.extras import MissingExtraError, is_installed
 from touchbench.benchmark.model import Predictor
 from touchbench.benchmark.problem import restrict_targets
 
@@ -55,6 +56,8 @@ def export_model(store: Store, request: ExportRequest) -> tuple[ExportSchema, by
     X = align_features(model.schema, data, source=info.name)
     try:
         graph = export_onnx(model, X)
+    except MissingExtraError:
+        raise
     except ConfigurationError as error:
         raise FieldError("model", str(error)) from None
     saved = save_export(store, info.id, request.format, graph)
@@ -93,8 +96,12 @@ def load_predictor(
     ------
     FieldError
         ``engine`` is ``onnx`` and the model has no twin (for ``engine``).
+    MissingExtraError
+        ``engine`` is ``onnx`` and ONNX Runtime is not installed.
     """
-    if engine == "native" or (engine == "auto" and not AUTO_PREFERS_ONNX):
+    if engine == "native" or (
+        engine == "auto" and not (AUTO_PREFERS_ONNX and is_installed("onnxruntime"))
+    ):
         return load_model(store, ref)
     info = get_model(store, ref)
     graph = load_export(store, info.id, "onnx")

@@ -123,7 +123,8 @@ def parse_weka_command(text: str) -> ClassifierSpec:
 
 
 def suite(name: str) -> list[str]:
-    """The ids of a suite, in catalogue order.
+    """The ids of a suite, in catalogue order; entries whose extra is not installed
+    (:mod:`benchmark.extras`) are left out.
 
     Parameters
     ----------
@@ -133,7 +134,7 @@ def suite(name: str) -> list[str]:
     """
     if name not in SUITES:
         raise ConfigurationError(f"unknown suite '{name}' (suites: {', '.join(SUITES)})")
-    return [spec.id for spec in SPECS if name == "all" or name in spec.suites]
+    return [spec.id for spec in SPECS if (name == "all" or name in spec.suites) and spec.installed]
 
 
 def build_pipeline(

@@ -19,6 +19,8 @@ from sklearn.utils import Tags
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from touchbench.benchmark.extras import require
+
 
 class _NominalBooster(ClassifierMixin, BaseEstimator):
     """Shared fit/predict of the wrappers: label encoding and the single-class case."""
@@ -82,6 +84,9 @@ class LightGBMClassifier(_NominalBooster):
         The fitted booster (None when training saw a single class).
     """
 
+    #: The optional modules it needs (:mod:`benchmark.extras`).
+    REQUIRES = ("lightgbm",)
+
     def __init__(
         self,
         n_estimators: int = 300,
@@ -111,6 +116,7 @@ class LightGBMClassifier(_NominalBooster):
         self.nominal_features = nominal_features
 
     def _fit_model(self, X: np.ndarray, codes: np.ndarray) -> Any:
+        require(self.REQUIRES, "LightGBM")
         from lightgbm import LGBMClassifier
 
         params = self.get_params()
@@ -135,6 +141,9 @@ class CatBoostNominalClassifier(_NominalBooster):
     classes_ : ndarray of shape (n_classes,)
     model_ : catboost.CatBoostClassifier or None
     """
+
+    #: The optional modules it needs (:mod:`benchmark.extras`).
+    REQUIRES = ("catboost",)
 
     def __init__(
         self,
@@ -165,6 +174,7 @@ class CatBoostNominalClassifier(_NominalBooster):
         return out
 
     def _fit_model(self, X: np.ndarray, codes: np.ndarray) -> Any:
+        require(self.REQUIRES, "CatBoost")
         from catboost import CatBoostClassifier
 
         model = CatBoostClassifier(

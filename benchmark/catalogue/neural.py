@@ -58,6 +58,7 @@ from sklearn.base import BaseEstimator, ClassifierMixin, RegressorMixin
 from sklearn.model_selection import GroupShuffleSplit, train_test_split
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from touchbench.benchmark.extras import require
 from touchbench.benchmark.sequence import panel
 
 #: The networks an architecture may name.
@@ -132,6 +133,8 @@ def check_weights(weights: object) -> bytes:
 class _NeuralSequenceModel(BaseEstimator):
     """What the classifier and the regressor share: parameters, scaling, training loop."""
 
+    #: The optional modules it needs (:mod:`benchmark.extras`).
+    REQUIRES = ("torch", "safetensors")
     _loss = ""
 
     def __init__(
@@ -415,6 +418,7 @@ def _memory_limited() -> bool:
 def _torch_settings() -> Iterator[Any]:
     """PyTorch with the process's thread count and deterministic algorithms; an
     allocation it cannot make becomes a ``MemoryError``, as NumPy's does."""
+    require(_NeuralSequenceModel.REQUIRES, "the neural networks")
     try:
         import torch  # PyTorch costs seconds to import: only the processes that fit or predict
     except (ImportError, OSError, SystemError) as exc:

@@ -361,6 +361,7 @@ def regression_suite(
         if (name == "all" or name in spec.suites)
         and not (spec.id == "gp" and n_instances > GP_MAX_INSTANCES)
         and (sequences or not spec.needs_sequence)
+        and spec.installed
     ]
     if n_targets > 1 and name != "fast":
         chains = [f"rc:{i}" for i in ids] if name == "all" else list(_DEFAULT_CHAINS)

@@ -8,6 +8,8 @@ from typing import Any, Literal
 
 from sklearn.base import BaseEstimator
 
+from touchbench.benchmark.extras import missing
+
 Cost = Literal["fast", "slow"]
 Scaling = Literal["standard", "minmax"]
 
@@ -121,6 +123,22 @@ class ClassifierSpec:
     stacking: Stacking | None = None
 
     @property
+    def requires(self) -> tuple[str, ...]:
+        """The optional modules it needs (:mod:`benchmark.extras`): its factory's
+        ``REQUIRES`` and those of the entries it is made of."""
+        parts = [*getattr(self.factory, "REQUIRES", ())]
+        if self.tuning is not None:
+            parts += self.tuning.base.requires
+        for member in self.stacking.members if self.stacking is not None else ():
+            parts += member.requires
+        return tuple(dict.fromkeys(parts))
+
+    @property
+    def installed(self) -> bool:
+        """Whether every optional module it needs is installed."""
+        return not missing(self.requires)
+
+    @property
     def needs_sequence(self) -> bool:
         """Whether it only works on a sequence data set."""
         return self.min_sequence is not None
@@ -158,6 +176,8 @@ class ClassifierSpec:
             "cost": self.cost,
             "suites": sorted(self.suites | {"all"}),
             "limits": self.limits,
+            "requires": list(self.requires),
+            "installed": self.installed,
             "min_sequence": self.min_sequence,
             "search_space": None
             if self.search_space is None

@@ -31,6 +31,7 @@ from sklearn.preprocessing import StandardScaler
 from sklearn.utils.validation import check_is_fitted, validate_data
 
 from touchbench.benchmark.catalogue.intervals import RandomIntervalFeatures
+from touchbench.benchmark.extras import require
 from touchbench.benchmark.sequence import panel
 
 #: The transforms :class:`RocketClassifier` offers, by name.
@@ -112,6 +113,9 @@ class RocketClassifier(_SequenceClassifier):
         Seed of the transform's biases.
     """
 
+    #: The optional modules it needs (:mod:`benchmark.extras`).
+    REQUIRES = ("aeon",)
+
     def __init__(
         self,
         variant: str = "minirocket",
@@ -127,6 +131,7 @@ class RocketClassifier(_SequenceClassifier):
         self.random_state = random_state
 
     def _make_transform(self) -> Any:
+        require(self.REQUIRES, f"classifier '{self.variant}'")
         # aeon takes a second to import: only the processes that fit a rocket pay for it
         from aeon.transformations.collection.convolution_based import MiniRocket, MultiRocket
 

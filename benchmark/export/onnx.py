@@ -38,6 +38,7 @@ from sklearn.base import BaseEstimator
 
 from touchbench.benchmark.catalogue.spec import ClassifierSpec
 from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.extras import EXTRAS, require
 from touchbench.benchmark.model import TrainedModel
 from touchbench.benchmark.problem import feature_matrix, usable_feature_columns
 
@@ -182,7 +183,10 @@ def export_onnx(model: TrainedModel, X: np.ndarray) -> bytes:
     ConfigurationError
         No converter for the model (one line naming what is supported), or the graph
         disagrees with the model on ``X`` (naming the largest difference).
+    MissingExtraError
+        The ``onnx`` extra is not installed.
     """
+    require(EXTRAS["onnx"].modules, "exporting a model to ONNX")
     onnx_model = convert(model)
     data = onnx_model.SerializeToString()
     check_twin(model, data, X)
@@ -703,6 +707,7 @@ class OnnxModel:
     """
 
     def __init__(self, schema: Any, classifier: str, data: bytes) -> None:
+        require(("onnxruntime",), "predicting with ONNX Runtime")
         import onnxruntime
 
         options = onnxruntime.SessionOptions()
