@@ -101,9 +101,8 @@ def check_training(store: Store, request: TrainRequest) -> Training:
         classifier or one that cannot learn the targets (a multi-class classifier for
         several targets, or the reverse; a sequence classifier on flat features).
     """
-    from touchbench.benchmark.estimators import (
-        check_classifier,  # start-up time: the catalogue is big
-    )
+    # start-up time: the catalogue is big
+    from touchbench.benchmark.estimators import check_classifier
 
     if request.name is not None:
         check_model_name(request.name)  # a name taken is not refused: it gets a new version
