@@ -34,6 +34,8 @@ MIN_KEY_LENGTH = 16
 LOOPBACK_HOSTS = ("127.0.0.1", "localhost", "[::1]")
 
 _KEY_NAME = re.compile(r"[A-Za-z0-9_.-]{1,64}")
+#: What a key may hold: what an HTTP header carries unchanged (printable ASCII, no space).
+_KEY_TEXT = re.compile(r"[!-~]+")
 _HOST_NAME = re.compile(r"[a-z0-9]([a-z0-9.-]{0,251}[a-z0-9])?")
 
 
@@ -58,6 +60,10 @@ class ApiKey:
 def read_keys(api_key: str | None, api_keys: str | None) -> tuple[ApiKey, ...]:
     """Every key the service knows (none: the service needs no key).
 
+    A refusal names the key by where it is given (the variable, the entry's or the line's
+    number), never by a value: a key put in the wrong place (a bare key for the list, a key
+    and its role swapped) must not reach the terminal or a log.
+
     Parameters
     ----------
     api_key : str or None
@@ -69,21 +75,27 @@ def read_keys(api_key: str | None, api_keys: str | None) -> tuple[ApiKey, ...]:
     Raises
     ------
     TrustSettingError
-        A key is empty or short, a name or key is given twice, a role is unknown, or the
-        key file cannot be read or is readable by others than its owner.
+        A key is empty, short or cannot be sent as a header, a name or key is given twice,
+        a name or role is not one, or the key file cannot be read or is readable by others
+        than its owner.
     """
-    keys: list[ApiKey] = []
+    given: list[tuple[str, ApiKey]] = []
     if api_key is not None:
-        keys.append(_key("TOUCHBENCH_API_KEY", "default", "write", api_key))
+        where = "TOUCHBENCH_API_KEY"
+        given.append((where, _key(where, "default", "write", api_key)))
     if api_keys is not None:
-        keys.extend(_keys(api_keys))
-    names = [key.name for key in keys]
-    for name in names:
-        if names.count(name) > 1:
-            raise TrustSettingError(f"TOUCHBENCH_API_KEYS: the key name '{name}' is used twice")
-    if len({key.secret for key in keys}) < len(keys):
-        raise TrustSettingError("TOUCHBENCH_API_KEYS: two keys are the same; keys must differ")
-    return tuple(keys)
+        given.extend(_keys(api_keys))
+    for i, (where, key) in enumerate(given):
+        for other_where, other in given[:i]:
+            if key.name == other.name:
+                raise TrustSettingError(
+                    f"{where}: the key's name is also {other_where}'s; names must differ"
+                )
+            if key.secret == other.secret:
+                raise TrustSettingError(
+                    f"{where}: two keys are the same (this and {other_where}'s); keys must differ"
+                )
+    return tuple(key for _, key in given)
 
 
 def read_hosts(value: str) -> frozenset[str]:
@@ -202,28 +214,40 @@ def _listed(
 
 
 def _key(where: str, name: str, role: str, text: str) -> ApiKey:
+    """The key ``text`` named ``name`` with ``role``, given at ``where``.
+
+    Raises
+    ------
+    TrustSettingError
+        Naming ``where`` and what is wrong, never a value.
+    """
     if not _KEY_NAME.fullmatch(name):
         raise TrustSettingError(
-            f"{where}: the key name '{name[:64]}' must be letters, digits, '_', '.' or '-'"
+            f"{where}: a key's name is 1 to 64 letters, digits, '_', '.' or '-' "
+            "(name:role:key, in this order)"
         )
     if role not in ROLES:
         raise TrustSettingError(
-            f"{where}: key '{name}' has the role '{role[:32]}'; roles are {', '.join(ROLES)}"
+            f"{where}: not a role; roles are {', '.join(ROLES)} (name:role:key, in this order)"
         )
     if not text:
+        raise TrustSettingError(f"{where}: the key is empty; give a key of at least 16 characters")
+    if not _KEY_TEXT.fullmatch(text):
         raise TrustSettingError(
-            f"{where}: key '{name}' is empty; give a key of at least 16 characters"
+            f"{where}: the key holds a space, a control or a non-ASCII character; a key is "
+            "sent as the X-API-Key header: printable ASCII characters only"
         )
-    if len(text) < MIN_KEY_LENGTH or any(character.isspace() for character in text):
+    if len(text) < MIN_KEY_LENGTH:
         raise TrustSettingError(
-            f"{where}: key '{name}' is {len(text)} characters long or holds spaces; a key "
-            f"is at least {MIN_KEY_LENGTH} characters without spaces"
+            f"{where}: the key is {len(text)} characters long; a key is at least "
+            f"{MIN_KEY_LENGTH} characters"
         )
     return ApiKey(name, cast(Role, role), text.encode())
 
 
-def _keys(value: str) -> list[ApiKey]:
-    """The keys of ``TOUCHBENCH_API_KEYS``: ``name:role:key`` entries or a key file."""
+def _keys(value: str) -> list[tuple[str, ApiKey]]:
+    """The keys of ``TOUCHBENCH_API_KEYS`` (``name:role:key`` entries or a key file), each
+    with where it is given."""
     where = "TOUCHBENCH_API_KEYS"
     if not value.strip():
         raise TrustSettingError(f"{where}: empty; give name:role:key entries or a key file")
@@ -231,17 +255,26 @@ def _keys(value: str) -> list[ApiKey]:
         return _key_file(Path(value.strip()).expanduser())
     keys = []
     for number, entry in enumerate(_entries(value), 1):
+        at = f"{where} entry {number}"
         parts = entry.split(":", 2)
         if len(parts) != 3:
-            raise TrustSettingError(f"{where}: entry {number} is not name:role:key")
-        keys.append(_key(where, *parts))
+            raise TrustSettingError(f"{at}: not name:role:key")
+        keys.append((at, _key(at, *parts)))
     return keys
 
 
-def _key_file(path: Path) -> list[ApiKey]:
-    where = f"TOUCHBENCH_API_KEYS file {path.name}"
+def _key_file(path: Path) -> list[tuple[str, ApiKey]]:
     try:
         mode = path.stat().st_mode
+    except (OSError, ValueError) as error:
+        # the value is not shown: a bare key given for the list lands here
+        reason = error.strerror if isinstance(error, OSError) else "not a path"
+        raise TrustSettingError(
+            f"TOUCHBENCH_API_KEYS: not name:role:key entries, and the key file it would name "
+            f"cannot be read ({reason})"
+        ) from None
+    where = f"TOUCHBENCH_API_KEYS file {path.name}"
+    try:
         if not stat.S_ISREG(mode):
             raise TrustSettingError(f"{where}: not a file")
         if mode & 0o077:
@@ -259,9 +292,10 @@ def _key_file(path: Path) -> list[ApiKey]:
         words = line.split()
         if not words or words[0].startswith("#"):
             continue
+        at = f"{where} line {number}"
         if len(words) != 3:
-            raise TrustSettingError(f"{where}:{number}: expected 'name role key'")
-        keys.append(_key(f"{where}:{number}", *words))
+            raise TrustSettingError(f"{at}: expected 'name role key'")
+        keys.append((at, _key(at, *words)))
     if not keys:
         raise TrustSettingError(f"{where}: holds no key")
     return keys
