@@ -18,6 +18,7 @@ from touchbench.app.api.deps import ModelCache, Service, require_api_key
 from touchbench.app.api.stopping import CutByStop
 from touchbench.app.api.trust import Cors, Trust
 from touchbench.app.jobs.dispatcher import Dispatcher
+from touchbench.app.redaction import install as hide_keys_in_logs
 from touchbench.app.settings import Settings, get_settings
 from touchbench.app.store.database import Store
 from touchbench.app.store.jobs import mark_lost_jobs
@@ -42,6 +43,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     """
     settings = settings or get_settings()
     settings.check_trust()
+    hide_keys_in_logs(key.secret.decode() for key in settings.keyring)
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:

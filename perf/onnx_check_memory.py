@@ -1,5 +1,5 @@
 """Peak memory of the ONNX export's check (the graph against the model on every training
-instance), whole against in chunks of :data:`benchmark.export.onnx.CHECK_ROWS` rows.
+instance), whole against in chunks of :data:`benchmark.export.check.CHECK_ROWS` rows.
 
 Run from the repository root::
 
@@ -38,12 +38,12 @@ CHECK = (
     + """
 import sys, time
 import numpy as np
-from touchbench.benchmark.export import onnx as export
+from touchbench.benchmark.export import check, onnx as export
 from touchbench.benchmark.model import loads_model, model_digest
 data = open(sys.argv[1], "rb").read()
 model = loads_model(data, sha256=model_digest(data))
 X = np.tile(np.load(sys.argv[2]), (int(sys.argv[3]), 1))
-export.CHECK_ROWS = int(sys.argv[4])
+check.CHECK_ROWS = int(sys.argv[4])
 graph = export.convert(model).SerializeToString()
 before = peak_mib()
 start = time.perf_counter()
@@ -72,7 +72,7 @@ def main() -> None:
             np.save(Path(folder) / "X.npy", data.X)
             for repeat in args.repeat:
                 for rows, how in ((10**9, "whole"), (0, "chunked")):
-                    from touchbench.benchmark.export.onnx import CHECK_ROWS
+                    from touchbench.benchmark.export.check import CHECK_ROWS
 
                     chunk = rows or CHECK_ROWS
                     started = time.perf_counter()

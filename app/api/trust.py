@@ -22,7 +22,7 @@ from starlette.responses import JSONResponse, Response
 from starlette.types import ASGIApp, Receive, Scope, Send
 
 from touchbench.app.api.errors import error_body
-from touchbench.app.settings import host_name, origin
+from touchbench.app.trust import host_name, origin
 
 #: Methods that do not change state (browsers send them cross-origin as they please; the
 #: answers stay unreadable to other origins without CORS).
@@ -38,9 +38,9 @@ class Trust:
     app : ASGIApp
         The application behind it.
     hosts : Collection[str]
-        Host names answered, as :func:`app.settings.host_name` writes them.
+        Host names answered, as :func:`app.trust.host_name` writes them.
     origins : Collection[str]
-        Other origins allowed, as :func:`app.settings.origin` writes them.
+        Other origins allowed, as :func:`app.trust.origin` writes them.
     """
 
     def __init__(self, app: ASGIApp, hosts: Collection[str], origins: Collection[str]) -> None:

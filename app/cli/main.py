@@ -5,6 +5,7 @@ Exit status: 0 success, 2 bad input or usage (one line on stderr), 1 anything un
 
 from __future__ import annotations
 
+import contextvars
 import errno
 import gc
 import os
@@ -19,7 +20,12 @@ from touchbench.app.cli.exits import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_USAGE, 
 from touchbench.app.cli.lazy import LazyGroup, Subcommand
 from touchbench.app.cli.signals import interrupted_status, interrupts
 from touchbench.app.cli.state import CliState
-from touchbench.app.environment import database_url
+from touchbench.app.environment import (
+    DATABASE_URL_VARIABLE,
+    DEFAULT_DATABASE_URL,
+    database_url,
+    debug,
+)
 
 EXIT_UNEXPECTED = EXIT_FAILED
 
@@ -291,9 +297,9 @@ def root(
             "--db",
             metavar="URL",
             help=(
-                "SQLAlchemy URL of the store, e.g. sqlite:///touchbench.db or "
-                "postgresql://user@host/db. Default: $TOUCHBENCH_DATABASE_URL, else "
-                "sqlite:///touchbench.db in the current directory."
+                f"SQLAlchemy URL of the store, e.g. {DEFAULT_DATABASE_URL} or "
+                f"postgresql://user@host/db. Default: ${DATABASE_URL_VARIABLE}, else "
+                f"{DEFAULT_DATABASE_URL} in the current directory."
             ),
             show_default=False,
         ),
@@ -319,9 +325,16 @@ gc.freeze()
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the CLI; returns (and, as a console script, exits with) the status."""
+    """Run the CLI; returns (and, as a console script, exits with) the status.
+
+    Each call runs in a context of its own, so that what a command leaves in context
+    variables (the options of its request, :mod:`app.cli.requests`) ends with it.
+    """
+    return contextvars.copy_context().run(_main, argv)
+
+
+def _main(argv: list[str] | None) -> int:
     command = typer.main.get_command(app)
-    _forget_options()
     try:
         with interrupts():
             returned = command.main(args=argv, prog_name="touchbench", standalone_mode=False)
@@ -369,7 +382,7 @@ def _failed(error: Exception) -> int:
         message = describe(error) if isinstance(error, FieldError) else str(error)
         print(f"touchbench: error: {message}", file=sys.stderr)
         return EXIT_USAGE
-    if os.environ.get("TOUCHBENCH_DEBUG"):
+    if debug():
         traceback.print_exc()
     # the first line only: a driver's error adds the statement and its parameters below it
     message = next(iter(str(error).strip().splitlines()), "")
@@ -402,17 +415,6 @@ def _discard_output() -> None:
         os.close(devnull)
     except (OSError, ValueError):  # no real standard output (a test's captured one)
         pass
-
-
-def _forget_options() -> None:
-    """Forget the options of the command run before in this process (tests run many).
-
-    Only a command that built a request (:mod:`app.cli.requests`) can have left them, so a
-    process that has not imported that module has nothing to forget.
-    """
-    requests = sys.modules.get("touchbench.app.cli.requests")
-    if requests is not None:
-        requests.reset()
 
 
 def _exit(code: int | None) -> int:

@@ -4,12 +4,18 @@ A command builds its use case's request type (:class:`app.schemas.base.Request`)
 options with :func:`build_request`, naming the option that sets each field.  A field the
 request refuses, when it is built or later in the service (:class:`app.errors.FieldError`),
 is shown as that option: ``touchbench: error: --max-memory: must be ...``.
+
+The options named by the last request built belong to the command being run: they are kept
+in a context variable, which :func:`app.cli.main.main` gives each call of the CLI afresh,
+so that nothing of one call reaches the next (tests run many in one process).
 """
 
 from __future__ import annotations
 
 import re
 from collections.abc import Mapping
+from contextvars import ContextVar
+from types import MappingProxyType
 from typing import Any, TypeVar
 
 from pydantic import ValidationError
@@ -23,7 +29,7 @@ RequestType = TypeVar("RequestType", bound=Request)
 _NAMED_FIELD = re.compile(r"`([a-z][a-z0-9_.]*)`")
 
 #: The options of the command being run, by the field each sets (see :func:`option_of`).
-_options: dict[str, str] = {}
+_options: ContextVar[Mapping[str, str]] = ContextVar("options", default=MappingProxyType({}))
 
 
 def build_request(
@@ -42,8 +48,7 @@ def build_request(
     FieldError
         The first field the request refuses.
     """
-    _options.clear()
-    _options.update(options or {})
+    _options.set(MappingProxyType(dict(options or {})))
     try:
         return kind(**{field: value for field, value in values.items() if value is not None})
     except ValidationError as error:
@@ -61,7 +66,8 @@ def field_error(error: ValidationError) -> FieldError:
 def option_of(field: str) -> str:
     """How the command line spells a request's field: its option or argument."""
     top = field.split(".", 1)[0]
-    return _options.get(field) or _options.get(top) or "--" + top.replace("_", "-")
+    options = _options.get()
+    return options.get(field) or options.get(top) or "--" + top.replace("_", "-")
 
 
 def describe(error: FieldError) -> str:
@@ -69,8 +75,3 @@ def describe(error: FieldError) -> str:
     fields the message names in backquotes are shown as their options too."""
     message = _NAMED_FIELD.sub(lambda named: option_of(named.group(1)), error.message)
     return f"{option_of(error.field)}: {message}"
-
-
-def reset() -> None:
-    """Forget the last command's options (each call of the CLI starts afresh)."""
-    _options.clear()

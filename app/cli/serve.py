@@ -5,7 +5,6 @@ from __future__ import annotations
 # Imports inside functions: start-up time: uvicorn, the settings and threadpoolctl load
 # when the service starts, not when another command of the CLI runs.
 import copy
-import ipaddress
 import os
 import socket
 from typing import Annotated, Any
@@ -13,6 +12,8 @@ from typing import Annotated, Any
 import typer
 
 from touchbench.app.cli.state import get_state
+from touchbench.app.environment import put_setting
+from touchbench.app.trust import is_loopback
 
 
 def register(app: typer.Typer) -> None:
@@ -61,17 +62,19 @@ def serve_command(
     from touchbench.app.settings import get_settings
 
     state = get_state(ctx)
-    os.environ["TOUCHBENCH_DATABASE_URL"] = state.database_url
+    # The service's processes (uvicorn's workers, the job processes) read their settings
+    # from the environment: the store the CLI was given goes there.
+    put_setting("database_url", state.database_url)
     get_settings.cache_clear()
-    settings = get_settings()
+    settings = get_settings()  # a value a setting refuses: one line, exit 2
     settings.check_trust()  # a bad key, host or origin: one line, exit 2
-    if not settings.keyring and not _loopback(host) and not insecure:
+    if not settings.keyring and not is_loopback(host) and not insecure:
         raise typer.BadParameter(
             f"{host} is reachable from other machines and TOUCHBENCH_API_KEY is not set: set "
             "a key, listen on 127.0.0.1, or pass --insecure",
             param_hint="--host",
         )
-    if not settings.allowed_hosts.strip() and not _loopback(host):
+    if not settings.allowed_hosts.strip() and not is_loopback(host):
         raise typer.BadParameter(
             f"{host} is reachable from other machines and TOUCHBENCH_ALLOWED_HOSTS is not set: "
             "name the host names or addresses clients reach the service by "
@@ -158,12 +161,3 @@ def _check_port(host: str, port: int) -> None:
                 "there: stop it or choose another port)",
                 param_hint="--port",
             ) from None
-
-
-def _loopback(host: str) -> bool:
-    if host == "localhost":
-        return True
-    try:
-        return ipaddress.ip_address(host).is_loopback
-    except ValueError:
-        return False

@@ -10,6 +10,11 @@ job and worker processes all inherit the environment) has ``CLASSIFIERS``, a seq
 :class:`~benchmark.catalogue.spec.ClassifierSpec` whose factories are module-level classes
 or functions, so that they pickle by reference into the worker processes.  Their entries
 belong to the ``all`` suite and to the suites they name.
+
+This module is where the variable is read: the catalogue is built when it is imported, in
+every process that names classifiers (the CLI, the service, job, engine and Dask worker
+processes), and the environment is what reaches them all.  The app's settings declare the
+variable with its help (:attr:`app.settings.Settings.plugins`) and read it the same way.
 """
 
 from __future__ import annotations
@@ -25,8 +30,16 @@ from touchbench.benchmark.errors import ConfigurationError
 PLUGINS_VARIABLE = "TOUCHBENCH_PLUGINS"
 
 
+def configured_modules() -> str:
+    """:data:`PLUGINS_VARIABLE`'s value (empty when unset), its name matched in any case
+    and the later of two spellings winning, as the app's settings read it."""
+    wanted = PLUGINS_VARIABLE.lower()
+    found = [value for name, value in os.environ.items() if name.lower() == wanted]
+    return found[-1] if found else ""
+
+
 def plugin_specs(known: Iterable[str], modules: str | None = None) -> tuple[ClassifierSpec, ...]:
-    """The specs of the plugin modules ``modules`` (default: ``$TOUCHBENCH_PLUGINS``).
+    """The specs of the plugin modules ``modules`` (default: :func:`configured_modules`).
 
     Parameters
     ----------
@@ -41,7 +54,7 @@ def plugin_specs(known: Iterable[str], modules: str | None = None) -> tuple[Clas
         A module that cannot be imported, has no ``CLASSIFIERS``, or gives an id that is
         taken or a value that is not a spec.
     """
-    names = os.environ.get(PLUGINS_VARIABLE, "") if modules is None else modules
+    names = configured_modules() if modules is None else modules
     taken = set(known)
     specs: list[ClassifierSpec] = []
     for name in (part.strip() for part in names.split(",")):

@@ -1,6 +1,6 @@
 """A multi-target model as one ONNX graph: one sub-graph per base classifier, joined.
 
-The input is the single-target graph's (``features``, see :mod:`benchmark.export.onnx`).
+The input is the single-target graph's (``features``, see :mod:`benchmark.export.graph`).
 Each target ``t`` has two outputs: ``label_<t>``, int64 of shape (n_instances,), the index
 of the predicted label in the target's labels, and ``probabilities_<t>``, float32 of shape
 (n_instances, n_labels[t]); the metadata key ``touchbench.targets`` lists the targets, their
@@ -27,15 +27,15 @@ from typing import Any
 import numpy as np
 
 from touchbench.benchmark.errors import ConfigurationError
-from touchbench.benchmark.export.onnx import (
+from touchbench.benchmark.export.convert import convert_pipeline
+from touchbench.benchmark.export.graph import (
     INPUT,
     LABEL,
     PROBABILITIES,
     add_metadata,
-    convert_pipeline,
     output_names,
-    refuse,
 )
+from touchbench.benchmark.export.supported import refuse
 from touchbench.benchmark.model import TrainedModel
 from touchbench.benchmark.multitarget._target_classifier import TargetClassifier
 from touchbench.benchmark.multitarget.bayesian_chain import BayesianClassifierChain

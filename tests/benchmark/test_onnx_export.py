@@ -14,14 +14,8 @@ from touchbench.benchmark.catalogue import SPECS
 from touchbench.benchmark.dataset import Attribute, Dataset, Schema
 from touchbench.benchmark.errors import ConfigurationError
 from touchbench.benchmark.estimators import build_estimator
-from touchbench.benchmark.export.onnx import (
-    LABEL,
-    PROBABILITIES,
-    TOLERANCE,
-    OnnxModel,
-    export_onnx,
-    exports_onnx,
-)
+from touchbench.benchmark.export.graph import LABEL, PROBABILITIES
+from touchbench.benchmark.export.onnx import TOLERANCE, OnnxModel, export_onnx, exports_onnx
 from touchbench.benchmark.model import TrainedModel, fit_model
 from touchbench.benchmark.problem import problem_from_dataset
 

@@ -13,7 +13,7 @@ from tests.benchmark.test_model import dataset as nominal_dataset
 from touchbench.benchmark.dataset import Dataset
 from touchbench.benchmark.errors import ConfigurationError
 from touchbench.benchmark.estimators import build_estimator
-from touchbench.benchmark.export import onnx as onnx_export
+from touchbench.benchmark.export import check
 from touchbench.benchmark.export.onnx import TOLERANCE, OnnxModel, check_twin, export_onnx
 from touchbench.benchmark.model import TrainedModel, fit_model
 from touchbench.benchmark.problem import problem_from_dataset
@@ -109,7 +109,7 @@ def test_a_target_that_differs_is_named_with_its_instance_beyond_the_first_chunk
         return codes, probabilities
 
     monkeypatch.setattr(model, "predict_with_proba", one_place_flipped)
-    monkeypatch.setattr(onnx_export, "CHECK_ROWS", 4)
+    monkeypatch.setattr(check, "CHECK_ROWS", 4)
     with pytest.raises(ConfigurationError) as refused:
         check_twin(model, graph, data.X)
     message = str(refused.value)

@@ -4,6 +4,7 @@ the key of every change of state and never shows a key."""
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -49,8 +50,8 @@ def _serve(tmp_path: Path, *arguments: str, **settings: str) -> subprocess.Compl
     )
 
 
-def _key_file(tmp_path: Path, mode: int, text: str) -> Path:
-    path = tmp_path / "keys"
+def _key_file(tmp_path: Path, mode: int, text: str, name: str = "keys") -> Path:
+    path = tmp_path / name
     path.write_text(text)
     path.chmod(mode)
     return path
@@ -59,9 +60,9 @@ def _key_file(tmp_path: Path, mode: int, text: str) -> Path:
 def test_bad_keys_and_hosts_stop_the_service_in_one_line(tmp_path: Path) -> None:
     good = f"robot read {READ}\n"
     cases: list[tuple[tuple[str, ...], dict[str, str], str, str | None]] = [
-        ((), {"api_key": ""}, "TOUCHBENCH_API_KEY: key 'default' is empty", None),
-        ((), {"api_key": "tiny-key-1"}, "TOUCHBENCH_API_KEY: key 'default' is 10", "tiny-key-1"),
-        ((), {"api_keys": "robot:read:short-key-2"}, "key 'robot' is 11", "short-key-2"),
+        ((), {"api_key": ""}, "TOUCHBENCH_API_KEY: the key is empty", None),
+        ((), {"api_key": "tiny-key-1"}, "TOUCHBENCH_API_KEY: the key is 10", "tiny-key-1"),
+        ((), {"api_keys": "robot:read:short-key-2"}, "KEYS entry 1: the key is 11", "short-key-2"),
         ((), {"api_keys": f"robot:admin:{READ}"}, "roles are read, predict, write", READ),
         ((), {"api_key": WRITE, "api_keys": f"lab:read:{WRITE}"}, "two keys are the same", WRITE),
         (
@@ -72,13 +73,38 @@ def test_bad_keys_and_hosts_stop_the_service_in_one_line(tmp_path: Path) -> None
         ),
         (
             (),
-            {"api_keys": str(_key_file(tmp_path, 0o640, good))},
+            {"api_keys": str(_key_file(tmp_path, 0o640, good, "keys-640"))},
             "(mode 640); make it private with chmod 600",
             READ,
         ),
         ((), {"api_keys": str(tmp_path / "absent")}, "cannot be read", None),
         ((), {"api_keys": " "}, "TOUCHBENCH_API_KEYS: empty", None),
-        ((), {"api_keys": f"robot:read:{READ},robot:write:{WRITE}"}, "'robot' is used twice", READ),
+        (
+            (),
+            {"api_keys": f"robot:read:{READ},robot:write:{WRITE}"},
+            "TOUCHBENCH_API_KEYS entry 2: the key's name is also TOUCHBENCH_API_KEYS entry 1's",
+            READ,
+        ),
+        # a key given in the wrong place is refused without being shown
+        ((), {"api_keys": READ}, "TOUCHBENCH_API_KEYS: not name:role:key entries", READ),
+        ((), {"api_keys": f"robot:{READ}:read"}, "KEYS entry 1: not a role; roles are", READ),
+        ((), {"api_keys": f"{READ}:read:robot"}, "KEYS entry 1: the key is 5 characters", READ),
+        (
+            (),
+            {"api_keys": f"lab:write:{WRITE},{READ}"},
+            "TOUCHBENCH_API_KEYS entry 2: not name:role:key",
+            READ,
+        ),
+        (
+            (),
+            {"api_keys": str(_key_file(tmp_path, 0o600, f"robot {READ} read\n", "swapped"))},
+            "TOUCHBENCH_API_KEYS file swapped line 1: not a role",
+            READ,
+        ),
+        # a key that cannot be sent as a header: it would start and refuse every request
+        ((), {"api_key": "clé-du-laboratoire-1"}, "printable ASCII characters only", "clé"),
+        ((), {"api_key": "key-of-the-lab\x7f-12345"}, "a control or a non-ASCII", "key-of"),
+        ((), {"api_keys": "lab:write:key of the lab 1234"}, "KEYS entry 1: the key holds", "lab 1"),
         ((), {"allowed_hosts": "http://lab.example"}, "TOUCHBENCH_ALLOWED_HOSTS:", None),
         ((), {"allowed_origins": "lab.example"}, "TOUCHBENCH_ALLOWED_ORIGINS:", None),
         (
@@ -90,7 +116,7 @@ def test_bad_keys_and_hosts_stop_the_service_in_one_line(tmp_path: Path) -> None
         (  # the empty key no longer passes the guard beyond loopback
             ("--host", "0.0.0.0"),
             {"api_key": "", "allowed_hosts": "lab.example"},
-            "TOUCHBENCH_API_KEY: key 'default' is empty",
+            "TOUCHBENCH_API_KEY: the key is empty",
             None,
         ),
     ]
@@ -217,6 +243,58 @@ def test_roles_read_predict_and_write(
     assert "by key 'robot1'" not in log  # its changes were refused; its reads are not logged
     for secret in (READ, PREDICT, WRITE, DEFAULT):
         assert secret not in log
+
+
+def _fragments(secret: str, length: int = 10) -> set[str]:
+    """Every run of ``length`` characters of ``secret``: what a cut-short log line shows."""
+    return {secret[i : i + length] for i in range(len(secret) - length + 1)}
+
+
+@pytest.mark.parametrize("level", ["debug", "info", "warning"])
+def test_no_key_reaches_the_log_at_any_level(
+    level: str, make_sqlite_server: Callable[..., Server]
+) -> None:
+    """Keys sent every way a client may send one (the X-API-Key header of a request and of
+    a WebSocket handshake, a query parameter, a JSON body, the live header message), right
+    and wrong, appear in no line of the service's log, whatever its level."""
+    wrong = "wrong-key-nobody-was-given-1"
+    server = make_sqlite_server(
+        arguments=("--log-level", level), api_key=DEFAULT, api_keys=f"arm2:predict:{PREDICT}"
+    )
+    assert server.client.get("/api/runs").status_code == 200
+    assert httpx.get(f"{server.url}/api/runs", headers={"X-API-Key": wrong}).status_code == 403
+    assert httpx.get(f"{server.url}/api/runs", params={"api_key": DEFAULT}).status_code == 401
+    sent = server.client.post("/api/runs", json={"api_key": DEFAULT, "dataset": wrong})
+    assert sent.status_code in (404, 422), sent.text
+    live = server.url.replace("http://", "ws://") + "/api/models/nope/live"
+    for handshake, message, words in (
+        (PREDICT, PREDICT, "no model 'nope'"),
+        (None, DEFAULT, "no model 'nope'"),
+        (None, wrong, "wrong API key"),
+        (wrong, None, "wrong API key"),
+    ):
+        headers = {"X-API-Key": handshake} if handshake else {}
+        header = {"samplerate": 44100, "channels": 1}
+        if message:
+            header["api_key"] = message
+        with connect(live, additional_headers=headers, open_timeout=30) as socket:
+            socket.send(json.dumps(header))
+            with pytest.raises(Exception, match=words):
+                socket.recv(timeout=30)
+    server.stop()
+    assert server.log is not None
+    log = server.log.read_text()
+    for secret in (DEFAULT, PREDICT, wrong):
+        shown = {fragment for fragment in _fragments(secret) if fragment in log}
+        assert not shown, (level, shown)
+    # the log did say what was sent, without the keys
+    if level == "debug":
+        assert "< x-api-key: ***" in log and "with a key: not shown" in log
+    if level in ("debug", "info"):
+        assert '"GET /api/runs?api_key=*** HTTP/1.1" 401' in log
+        assert "POST /api/runs by key 'default'" in log
+    else:
+        assert "INFO:" not in log and "DEBUG:" not in log
 
 
 def test_without_keys_changes_are_logged_as_keyless(
