@@ -10,14 +10,20 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
-__all__ = ["Drop", "DropReason", "Status", "TaskKey", "TaskResult"]
+if TYPE_CHECKING:  # a type only: numpy stays out of the records' import
+    from touchbench.benchmark.predictions import FoldPredictions
+
+__all__ = ["Drop", "DropReason", "Origin", "OriginKind", "Status", "TaskKey", "TaskResult"]
 
 Status = Literal["ok", "error", "timeout"]
 #: Why an entry stopped before its last fold: the race found it significantly worse than
 #: the leader, or the run's total budget left no time for its next task.
 DropReason = Literal["race", "budget", "not started"]
+#: Where an entry's folds come from, when not from fitting it as the run asked: computed
+#: from its members' fold predictions, or fitted as a member no one asked for.
+OriginKind = Literal["from fold predictions", "helper"]
 
 
 @dataclass(frozen=True, order=True)
@@ -64,6 +70,16 @@ class TaskResult:
         confidence (``count``, ``confidence``, ``correct``, lists of equal length; see
         :mod:`benchmark.evaluation.calibration`); multi-target with probabilities:
         ``{"targets": {name: bins}}``, the same per target; ``None`` otherwise.
+    predictions : FoldPredictions or None
+        What the model predicted for the test fold's rows (:mod:`benchmark.predictions`):
+        :func:`benchmark.evaluation.fold_scores.score_fold` re-scores them to ``metrics``
+        exactly, and the run's ensembles are computed from them.  ``None`` unless ``ok``,
+        and for results read back without them (:meth:`to_json` leaves them out: they are
+        stored as :func:`benchmark.predictions.encode` blobs).
+    inner_predictions : FoldPredictions or None
+        Out-of-fold predictions of the training fold's rows, from the run's inner folds
+        (:mod:`benchmark.catalogue.inner`), for a run whose stacks or ensemble selection
+        choose among its entries; ``None`` otherwise.
     """
 
     key: TaskKey
@@ -77,6 +93,8 @@ class TaskResult:
     per_target: dict[str, dict[str, float]] | None = None
     params: dict[str, Any] | None = None
     calibration: dict[str, Any] | None = None
+    predictions: FoldPredictions | None = field(default=None, repr=False, compare=False)
+    inner_predictions: FoldPredictions | None = field(default=None, repr=False, compare=False)
 
     @property
     def ok(self) -> bool:
@@ -179,6 +197,34 @@ class Drop:
             "mean": self.mean,
             "note": self.describe(),
         }
+
+
+@dataclass(frozen=True)
+class Origin:
+    """How a run came by an entry's folds, when not by fitting an entry it asked for.
+
+    Parameters
+    ----------
+    kind : {"from fold predictions", "helper"}
+        ``from fold predictions``: an ensemble, stack or selection computed from its
+        members' predictions (it fits nothing itself); ``helper``: a member of such an
+        entry that the run did not ask for, fitted once per fold for them.
+    entries : tuple of str
+        Its members (``from fold predictions``) or the entries it serves (``helper``).
+    """
+
+    kind: OriginKind
+    entries: tuple[str, ...]
+
+    def describe(self) -> str:
+        """``from fold predictions of xgb, hgb`` or ``helper of voting``: what views say."""
+        joined = ", ".join(self.entries)
+        return (
+            f"from fold predictions of {joined}" if self.kind != "helper" else f"helper of {joined}"
+        )
+
+    def to_json(self) -> dict[str, Any]:
+        return {"kind": self.kind, "entries": list(self.entries), "note": self.describe()}
 
 
 def _json_number(value: float) -> float | None:

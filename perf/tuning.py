@@ -37,11 +37,11 @@ from sklearn.model_selection import GridSearchCV, ParameterGrid, StratifiedKFold
 from threadpoolctl import threadpool_limits
 
 from touchbench.benchmark.catalogue import build_pipeline, get_spec
+from touchbench.benchmark.catalogue.inner import inner_folds
 from touchbench.benchmark.catalogue.tuning import (
     CLASSIFIER_STEP,
     TunedClassifier,
     as_grid,
-    inner_folds,
     tuned_spec,
 )
 from touchbench.benchmark.io.arff import read_arff

@@ -155,6 +155,21 @@ class EntryDropRow(Base):
     mean: Mapped[float | None] = mapped_column(Float)
 
 
+class FoldPredictionsRow(Base):
+    """What a task's model predicted (:mod:`benchmark.predictions`): its test fold's rows
+    (``part`` ``test``), or its training fold's out of fold (``inner``), as one encoded
+    blob; never pickled."""
+
+    __tablename__ = "fold_predictions"
+
+    run_id: Mapped[int] = mapped_column(ForeignKey("runs.id", ondelete="CASCADE"), primary_key=True)
+    classifier: Mapped[str] = mapped_column(String(100), primary_key=True)
+    repeat: Mapped[int] = mapped_column(Integer, primary_key=True)
+    fold: Mapped[int] = mapped_column(Integer, primary_key=True)
+    part: Mapped[str] = mapped_column(String(10), primary_key=True)
+    data: Mapped[bytes] = mapped_column(LargeBinary)
+
+
 #: The constraint that keeps two models of one name from taking the same version.
 MODEL_VERSION_KEY = "uq_models_name_version"
 

@@ -92,8 +92,11 @@ def estimate_seconds(spec: ClassifierSpec, shape: Shape) -> float:
     (k / k0) ** c`` with the family's powers ``(a, b, c)`` and weight ``w`` of
     :data:`FAMILY_COSTS`, times
     the targets a multi-target configuration fits one model for each; at least
-    :data:`MIN_SECONDS`.
+    :data:`MIN_SECONDS`.  A vote costs its members' sum (what it costs on its own; a run
+    computes it from the members' folds, which are its only cost there).
     """
+    if spec.ensemble is not None and spec.ensemble.combine != "selection":
+        return sum(estimate_seconds(member, shape) for member in spec.ensemble.members)
     a, b, c, weight = FAMILY_COSTS.get(spec.family, (1.0, 1.0, 1.0, 1.0))
     scale = (
         (max(shape.n_instances, 1) / REFERENCE_INSTANCES) ** a

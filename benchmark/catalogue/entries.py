@@ -24,8 +24,6 @@ from sklearn.ensemble import (
     GradientBoostingClassifier,
     HistGradientBoostingClassifier,
     RandomForestClassifier,
-    StackingClassifier,
-    VotingClassifier,
 )
 from sklearn.gaussian_process import GaussianProcessClassifier
 from sklearn.gaussian_process.kernels import RBF, ConstantKernel
@@ -46,11 +44,13 @@ from sklearn.svm import SVC, LinearSVC, NuSVC
 from sklearn.tree import DecisionTreeClassifier, ExtraTreeClassifier
 
 from touchbench.benchmark.catalogue.boosters import CatBoostNominalClassifier, LightGBMClassifier
+from touchbench.benchmark.catalogue.ensembles import describe_members, voting_classifier
 from touchbench.benchmark.catalogue.estimators import LabelEncodedClassifier, OneRuleClassifier
 from touchbench.benchmark.catalogue.model_trees import LogisticModelTree
 from touchbench.benchmark.catalogue.neural import NeuralSequenceClassifier
 from touchbench.benchmark.catalogue.rules import OrderedRuleClassifier
-from touchbench.benchmark.catalogue.spec import ClassifierSpec, make_spec
+from touchbench.benchmark.catalogue.spec import ClassifierSpec, Combine, Ensemble, make_spec
+from touchbench.benchmark.catalogue.stacking import stacked_spec
 from touchbench.benchmark.catalogue.time_series import IntervalForestClassifier, RocketClassifier
 from touchbench.benchmark.catalogue.weka_schemes import weka_command
 from touchbench.benchmark.weka import (
@@ -168,45 +168,8 @@ def gaussian_process(length_scale: float = 10.0, optimize: bool = False) -> Base
     return GaussianProcessClassifier(kernel=kernel, optimizer="fmin_l_bfgs_b" if optimize else None)
 
 
-def soft_voting() -> BaseEstimator:
-    """Average of the probabilities of XGBoost, histogram boosting and a calibrated RBF SVM."""
-    return VotingClassifier(
-        [
-            ("xgb", xgboost_classifier(**XGB_PARAMS)),
-            ("hgb", HistGradientBoostingClassifier(**HGB_PARAMS)),
-            ("svm", CalibratedClassifierCV(_rbf_svm(), cv=3, ensemble=False)),
-        ],
-        voting="soft",
-    )
-
-
-def hard_voting() -> BaseEstimator:
-    """Majority vote of logistic regression, random forest and an RBF SVM."""
-    return VotingClassifier(
-        [("logistic", _logistic()), ("rf", _forest()), ("svm", SVC(C=10.0))], voting="hard"
-    )
-
-
-def stacking(cv: int = 5) -> BaseEstimator:
-    """Random forest, extra trees, RBF SVM and logistic regression, stacked by logistic."""
-    return StackingClassifier(
-        [
-            ("rf", _forest()),
-            ("extra_trees", ExtraTreesClassifier(n_estimators=200)),
-            ("svm", SVC(C=10.0)),
-            ("logistic", _logistic()),
-        ],
-        final_estimator=LogisticRegression(max_iter=1000),
-        cv=cv,
-    )
-
-
 def _logistic() -> BaseEstimator:
     return LogisticRegression(C=10.0, max_iter=2000)
-
-
-def _forest() -> BaseEstimator:
-    return RandomForestClassifier(n_estimators=200)
 
 
 def _entropy_tree() -> BaseEstimator:
@@ -287,7 +250,7 @@ NEURAL_LIMITS = (
 )
 
 
-SPECS: tuple[ClassifierSpec, ...] = (
+_SINGLE: tuple[ClassifierSpec, ...] = (
     # Baselines and rules
     _spec(
         "zeror",
@@ -474,6 +437,15 @@ SPECS: tuple[ClassifierSpec, ...] = (
         suites=FAST,
     ),
     _spec(
+        "rf-200",
+        RandomForestClassifier,
+        {"n_estimators": 200},
+        family="forests",
+        description="Random forest, 200 trees (a member of voting-hard and stacking)",
+        missing=True,
+        suites=ALL_ONLY,
+    ),
+    _spec(
         "rf-500",
         RandomForestClassifier,
         {"n_estimators": 500},
@@ -507,6 +479,15 @@ SPECS: tuple[ClassifierSpec, ...] = (
         family="forests",
         description="Extremely randomised trees, 300 trees",
         missing=True,
+    ),
+    _spec(
+        "extra-trees-200",
+        ExtraTreesClassifier,
+        {"n_estimators": 200},
+        family="forests",
+        description="Extremely randomised trees, 200 trees (a member of stacking)",
+        missing=True,
+        suites=ALL_ONLY,
     ),
     _spec(
         "extra-trees-entropy",
@@ -1222,33 +1203,42 @@ SPECS: tuple[ClassifierSpec, ...] = (
         probabilities=False,
         scaling="standard",
     ),
-    # Voting and stacking
-    _spec(
-        "voting",
-        soft_voting,
-        {},
+)
+
+_BY_ID = {spec.id: spec for spec in _SINGLE}
+
+
+def _ensemble(id: str, combine: Combine, members: tuple[str, ...], **fields: Any) -> ClassifierSpec:
+    """An ensemble of the entries ``members`` (ids above), its description naming them."""
+    specs = tuple(_BY_ID[member] for member in members)
+    return make_spec(
+        id,
+        voting_classifier,
+        {"voting": combine},
         family="voting",
-        description="Soft vote of XGBoost, histogram boosting and calibrated RBF SVM",
-        scaling="standard",
-        cost="slow",
-    ),
-    _spec(
-        "voting-hard",
-        hard_voting,
-        {},
-        family="voting",
-        description="Majority vote of logistic regression, random forest and RBF SVM",
-        probabilities=False,
-        scaling="standard",
-    ),
-    _spec(
-        "stacking",
-        stacking,
-        {"cv": 5},
-        family="stacking",
-        description="RF, extra trees, RBF SVM and logistic stacked by logistic regression",
-        scaling="standard",
-        cost="slow",
+        description=describe_members(combine, specs),
+        probabilities=combine == "soft",
+        missing=True,
+        nominal=True,
+        ensemble=Ensemble(specs, combine),
+        **fields,
+    )
+
+
+_STACKED = ("rf-200", "extra-trees-200", "svm-rbf", "logistic")
+
+SPECS: tuple[ClassifierSpec, ...] = (
+    *_SINGLE,
+    # Ensembles of the entries above: a run computes them from their members' fold
+    # predictions, fitting each member once per fold
+    _ensemble("voting", "soft", ("xgb", "hgb", "calibrated-svm-rbf"), cost="slow"),
+    _ensemble("voting-hard", "hard", ("logistic", "rf-200", "svm-rbf")),
+    stacked_spec(
+        [_BY_ID[member] for member in _STACKED],
+        len(_STACKED),
+        id="stacking",
+        description=describe_members("stack", [_BY_ID[member] for member in _STACKED])
+        + ", all kept, on their inner out-of-fold class scores",
         suites=ALL_ONLY,  # 17 s a fold on Mini, below soft voting: the default suite's 5 min
     ),
     # Time series: the windows of a sequence data set (benchmark.sequence)

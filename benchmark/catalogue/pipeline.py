@@ -57,8 +57,8 @@ def pipeline_for_spec(
         "random_state": random_state,
         "sequence": sequence,
     }
-    if spec.tuning is not None or spec.stacking is not None:
-        # the preprocessing lives inside each candidate, learnt on inner training folds
+    if spec.tuning is not None or spec.stacking is not None or spec.ensemble is not None:
+        # the preprocessing lives inside each candidate (each member), learnt on its own
         return Pipeline([("preprocess", "passthrough"), ("classifier", _composite(spec, options))])
     nominal = dict(nominal_features or {})
     estimator = spec.make_estimator()
@@ -96,7 +96,7 @@ def pipeline_for_spec(
 
 
 def _composite(spec: ClassifierSpec, options: dict[str, Any]) -> BaseEstimator:
-    """The tuned twin's search, or the stack, over whole member pipelines."""
+    """The tuned twin's search, the stack or the ensemble, over whole member pipelines."""
     from touchbench.benchmark.catalogue.stacking import SelectedStack
     from touchbench.benchmark.catalogue.tuning import CLASSIFIER_STEP, TunedClassifier, as_grid
 
@@ -110,8 +110,13 @@ def _composite(spec: ClassifierSpec, options: dict[str, Any]) -> BaseEstimator:
             budget=None if budget is None else budget * 60.0,
             random_state=options["random_state"],
         )
+    members = [(m.id, pipeline_for_spec(m, **options)) for m in spec.members]
+    if spec.ensemble is not None:
+        ensemble = spec.factory(members=members, **spec.params)
+        if "random_state" in ensemble.get_params(deep=False):  # a selection's inner folds
+            ensemble.set_params(random_state=options["random_state"])
+        return ensemble
     assert spec.stacking is not None
-    members = [(m.id, pipeline_for_spec(m, **options)) for m in spec.stacking.members]
     return SelectedStack(members, spec.stacking.top_n, random_state=options["random_state"])
 
 

@@ -12,6 +12,10 @@ from touchbench.benchmark.extras import missing
 
 Cost = Literal["fast", "slow"]
 Scaling = Literal["standard", "minmax"]
+#: How an ensemble's members' predictions make its own: ``soft`` the mean of their class
+#: probabilities, ``hard`` the majority of their labels (scikit-learn's VotingClassifier
+#: either way), ``selection`` Caruana's greedy ensemble selection with replacement.
+Combine = Literal["soft", "hard", "selection"]
 
 #: Estimator parameter (as ``get_params(deep=True)`` names it) to the values to try.
 SearchSpace = Mapping[str, tuple[Any, ...]]
@@ -50,6 +54,38 @@ class Stacking:
 
 
 @dataclass(frozen=True)
+class Ensemble:
+    """How an ensemble of catalogue entries is made: the entries it combines, and how.
+
+    In a run, an ensemble is computed from its members' fold predictions (each member
+    fitted once per fold, and shared with the run's other entries and ensembles); on its
+    own (a model trained on all the data, a multi-target base) it fits its members itself.
+
+    Parameters
+    ----------
+    members : tuple of ClassifierSpec
+        The entries combined, each with its own preprocessing.
+    combine : {"soft", "hard", "selection"}
+        ``soft``: the mean of the members' class probabilities, its most probable class the
+        prediction; ``hard``: the most frequent of their labels (ties: the lowest code);
+        ``selection``: in each training fold, ``rounds`` rounds of Caruana's greedy
+        selection with replacement on the members' inner out-of-fold predictions
+        (:mod:`benchmark.catalogue.ensembles`), a weighted mean of the chosen.
+    rounds : int
+        ``selection`` only: rounds of the greedy selection.
+    """
+
+    members: tuple[ClassifierSpec, ...]
+    combine: Combine
+    rounds: int = 0
+
+    @property
+    def ids(self) -> tuple[str, ...]:
+        """The members' ids, in order."""
+        return tuple(member.id for member in self.members)
+
+
+@dataclass(frozen=True)
 class ClassifierSpec:
     """One classifier configuration, as data.
 
@@ -66,8 +102,9 @@ class ClassifierSpec:
     description : str
         One line for listings.
     factory : callable
-        Builds the unfitted estimator from ``params``; a class or a module-level function,
-        so that the spec pickles by reference into worker processes.
+        Builds the unfitted estimator from ``params`` (and, for an ensemble, its members'
+        estimators); a class or a module-level function, so that the spec pickles by
+        reference into worker processes.
     params : mapping of str to Any
         Keyword arguments of ``factory``.
     probabilities : bool
@@ -100,7 +137,11 @@ class ClassifierSpec:
     tuning : Tuning or None
         Set on a tuned twin (``rf+tuned``): the pipeline searches ``tuning.base``'s space.
     stacking : Stacking or None
-        Set on a stack (``stack-top3``): the pipeline stacks the best of its members.
+        Set on a stack (``stack-top3``, ``stacking``): the pipeline stacks the best of its
+        members.
+    ensemble : Ensemble or None
+        Set on an ensemble of entries (``voting``, ``voting-hard``, ``ensemble-5``): the
+        entries it combines, and how.
     """
 
     id: str
@@ -121,6 +162,14 @@ class ClassifierSpec:
     search_space: SearchSpace | None = None
     tuning: Tuning | None = None
     stacking: Stacking | None = None
+    ensemble: Ensemble | None = None
+
+    @property
+    def members(self) -> tuple[ClassifierSpec, ...]:
+        """The entries a stack or an ensemble combines (none for any other entry)."""
+        if self.stacking is not None:
+            return self.stacking.members
+        return self.ensemble.members if self.ensemble is not None else ()
 
     @property
     def requires(self) -> tuple[str, ...]:
@@ -129,7 +178,7 @@ class ClassifierSpec:
         parts = [*getattr(self.factory, "REQUIRES", ())]
         if self.tuning is not None:
             parts += self.tuning.base.requires
-        for member in self.stacking.members if self.stacking is not None else ():
+        for member in self.members:
             parts += member.requires
         return tuple(dict.fromkeys(parts))
 
@@ -155,7 +204,11 @@ class ClassifierSpec:
         return parts[1] if len(parts) > 1 else ""
 
     def make_estimator(self) -> BaseEstimator:
-        """A new unfitted estimator built from ``factory(**params)``."""
+        """A new unfitted estimator built from ``factory(**params)``; an ensemble's factory
+        takes its members' (name, estimator) pairs as ``members`` too."""
+        if self.ensemble is not None:
+            members = [(member.id, member.make_estimator()) for member in self.ensemble.members]
+            return self.factory(members=members, **self.params)
         return self.factory(**self.params)
 
     def to_json(self) -> dict[str, Any]:
@@ -182,7 +235,18 @@ class ClassifierSpec:
             "search_space": None
             if self.search_space is None
             else {name: jsonable(values) for name, values in self.search_space.items()},
+            "members": [member.id for member in self.members] or None,
+            "combine": self.combine,
         }
+
+    @property
+    def combine(self) -> str | None:
+        """How a stack or an ensemble combines its members: ``"stack"`` (a logistic
+        regression over their inner out-of-fold class scores), ``"soft"``, ``"hard"`` or
+        ``"selection"``; ``None`` for any other entry."""
+        if self.stacking is not None:
+            return "stack"
+        return self.ensemble.combine if self.ensemble is not None else None
 
 
 def make_spec(
@@ -201,6 +265,7 @@ def make_spec(
     suites: frozenset[str] = frozenset({"default"}),
     limits: str = "",
     min_sequence: int | None = None,
+    ensemble: Ensemble | None = None,
 ) -> ClassifierSpec:
     """A :class:`ClassifierSpec` as catalogues declare it: ``scaling`` names the scaler
     (``None``: no scaling), ``missing`` and ``nominal`` what the estimator takes itself."""
@@ -220,6 +285,7 @@ def make_spec(
         limits=limits,
         scaling=scaling or "standard",  # type: ignore[arg-type]
         min_sequence=min_sequence,
+        ensemble=ensemble,
     )
 
 

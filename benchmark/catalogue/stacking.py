@@ -1,33 +1,36 @@
 """Stacking over the best of a run, chosen inside each training fold.
 
-``stack-top3`` is a classifier like any other of a run: in each outer training fold it
-cross-validates every member on that fold only (an inner k-fold), keeps the ``top_n``
-best by the inner weighted F1, fits a logistic regression on their out-of-fold class
-scores, and refits the kept members on the whole training fold. The outer test fold
-chooses nothing. The inner predictions that choose the members are the ones the
-logistic regression learns from, so the cost is ``cv`` fits of every member on
-(cv - 1)/cv of the rows, then ``top_n`` refits: about ``(cv - 1) * M + top_n`` fits on
-all the rows per outer fold for M members (``2 M + top_n`` with :data:`INNER_FOLDS` 3),
-each member at its own cost (a tuned member brings its search along).
+``stack-top3``: in each outer training fold, every member's out-of-fold class scores on
+that fold's inner folds (:mod:`benchmark.catalogue.inner`; its probabilities, or its labels
+one-hot) choose the ``top_n`` best by the inner weighted F1, a logistic regression learns
+from the kept members' scores, and the kept members fitted on the whole training fold
+give it their scores of the test rows. The outer test fold chooses nothing. The fixed
+entry ``stacking`` is the same over four given entries, all kept.
+
+In a run, the engine computes a stack from its members' fold predictions
+(:mod:`benchmark.run.combine`): each member's inner predictions are computed once per outer
+fold, in the member's own task, and serve every stack and the ensemble selection of the run;
+the members' fits on the whole training fold are their own tasks'. Alone (a model trained
+on all the data), :class:`SelectedStack` does the same itself: ``cv`` fits of every member
+on (cv - 1)/cv of the rows, then ``top_n`` refits, each member at its own cost (a tuned
+member brings its search along).  Both go through :func:`choose_and_stack`.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
-from sklearn.base import BaseEstimator, ClassifierMixin, clone
+from sklearn.base import clone
 from sklearn.linear_model import LogisticRegression
 from sklearn.metrics import f1_score
-from sklearn.model_selection import cross_val_predict
 
+from touchbench.benchmark.catalogue.ensembles import InnerChoice, member_scores
+from touchbench.benchmark.catalogue.inner import INNER_FOLDS
 from touchbench.benchmark.catalogue.spec import ClassifierSpec, Stacking
-from touchbench.benchmark.catalogue.tuning import inner_folds
 from touchbench.benchmark.errors import ConfigurationError
 
-#: Inner folds of the member selection and of the stacked class scores.
-INNER_FOLDS = 3
 #: Most members a stack may keep.
 MAX_TOP_N = 20
 
@@ -37,8 +40,17 @@ def stack_id(top_n: int) -> str:
     return f"stack-top{top_n}"
 
 
-def stacked_spec(members: Sequence[ClassifierSpec], top_n: int) -> ClassifierSpec:
+def stacked_spec(
+    members: Sequence[ClassifierSpec],
+    top_n: int,
+    *,
+    id: str | None = None,
+    description: str | None = None,
+    suites: frozenset[str] = frozenset(),
+) -> ClassifierSpec:
     """The spec of a stack over ``members`` that keeps the ``top_n`` best per fold.
+
+    ``id`` (default ``stack-topN``), ``description`` and ``suites`` name a catalogue entry.
 
     Raises
     ------
@@ -47,10 +59,11 @@ def stacked_spec(members: Sequence[ClassifierSpec], top_n: int) -> ClassifierSpe
     """
     check_top_n(top_n, len(members))
     return ClassifierSpec(
-        id=stack_id(top_n),
+        id=id or stack_id(top_n),
         weka_command=None,
         family="stacking",
-        description=f"Logistic regression over the {top_n} best of {len(members)} members, "
+        description=description
+        or f"Logistic regression over the {top_n} best of {len(members)} members, "
         "chosen by inner cross-validation in each training fold",
         factory=LogisticRegression,
         params={},
@@ -59,7 +72,7 @@ def stacked_spec(members: Sequence[ClassifierSpec], top_n: int) -> ClassifierSpe
         handles_missing=True,
         handles_nominal=True,
         cost="slow",
-        suites=frozenset(),
+        suites=suites,
         stacking=Stacking(tuple(members), top_n),
     )
 
@@ -75,7 +88,7 @@ def check_top_n(top_n: int, n_members: int) -> None:
         )
 
 
-class SelectedStack(ClassifierMixin, BaseEstimator):
+class SelectedStack(InnerChoice):
     """Stack the ``top_n`` members that score best in an inner cross-validation.
 
     Parameters
@@ -85,7 +98,7 @@ class SelectedStack(ClassifierMixin, BaseEstimator):
     top_n : int
         Members kept.
     cv : int
-        Inner folds (stratified when every class has as many rows).
+        Inner folds (:func:`benchmark.catalogue.inner.inner_folds`).
     random_state : int or None
         Seed of the inner folds and of the final logistic regression.
 
@@ -99,10 +112,9 @@ class SelectedStack(ClassifierMixin, BaseEstimator):
         The kept members refitted on all the training rows.
     final_estimator_ : LogisticRegression
         Fitted on the kept members' out-of-fold class scores, shape
-        (n_samples, sum of their score columns).
+        (n_samples, n_kept * n_classes).
     best_params_ : dict
         ``{"members": chosen_}``, for the run's per-fold record.
-    classes_ : ndarray of shape (n_classes,)
     """
 
     def __init__(
@@ -117,50 +129,15 @@ class SelectedStack(ClassifierMixin, BaseEstimator):
         self.cv = cv
         self.random_state = random_state
 
-    def fit(self, X: np.ndarray, y: np.ndarray) -> SelectedStack:
-        """Choose, stack and refit the members on ``(X, y)`` alone.
-
-        Parameters
-        ----------
-        X : ndarray of shape (n_samples, n_features)
-        y : ndarray of shape (n_samples,)
-        """
-        y = np.asarray(y)
-        self.classes_ = np.unique(y)
-        folds = inner_folds(y, self.cv, self.random_state)
-        scores: dict[str, np.ndarray] = {}
-        self.inner_scores_ = {}
-        for name, member in self.members:
-            method = _score_method(member)
-            out_of_fold = cross_val_predict(clone(member), X, y, cv=folds, method=method)
-            block = self._as_block(out_of_fold, method)
-            scores[name] = block
-            predicted = self.classes_[np.argmax(block, axis=1)]
-            self.inner_scores_[name] = float(f1_score(y, predicted, average="weighted"))
-        ranked = sorted(self.inner_scores_, key=lambda n: -self.inner_scores_[n])
-        self.chosen_ = ranked[: self.top_n]
+    def _choose(self, blocks: dict[str, np.ndarray], X: np.ndarray, y: np.ndarray) -> None:
+        choice = choose_and_stack(blocks, y, self.classes_, self.top_n, self.random_state)
+        self.chosen_, self.inner_scores_, self.final_estimator_ = choice
         by_name = dict(self.members)
         self.estimators_ = [clone(by_name[name]).fit(X, y) for name in self.chosen_]
-        self.final_estimator_ = LogisticRegression(max_iter=2000, random_state=self.random_state)
-        self.final_estimator_.fit(np.hstack([scores[name] for name in self.chosen_]), y)
         self.best_params_ = {"members": list(self.chosen_)}
-        return self
-
-    def _as_block(self, values: np.ndarray, method: str) -> np.ndarray:
-        """Class scores of shape (n_samples, n_classes) whatever the member gives."""
-        values = np.asarray(values)
-        if method == "predict":
-            return (values[:, None] == self.classes_[None, :]).astype(np.float64)
-        if values.ndim == 1:  # a binary decision function
-            return np.column_stack([-values, values]).astype(np.float64)
-        return values.astype(np.float64)
 
     def _features(self, X: np.ndarray) -> np.ndarray:
-        blocks = []
-        for member in self.estimators_:
-            method = _score_method(member)
-            blocks.append(self._as_block(getattr(member, method)(X), method))
-        return np.hstack(blocks)
+        return np.hstack([member_scores(member, X, self.classes_) for member in self.estimators_])
 
     def predict(self, X: np.ndarray) -> np.ndarray:
         """Predictions, shape (n_samples,)."""
@@ -171,8 +148,42 @@ class SelectedStack(ClassifierMixin, BaseEstimator):
         return np.asarray(self.final_estimator_.predict_proba(self._features(X)))
 
 
-def _score_method(estimator: Any) -> str:
-    for method in ("predict_proba", "decision_function"):
-        if hasattr(estimator, method):
-            return method
-    return "predict"
+def choose_and_stack(
+    blocks: Mapping[str, np.ndarray],
+    y: np.ndarray,
+    classes: np.ndarray,
+    top_n: int,
+    seed: int | None,
+) -> tuple[list[str], dict[str, float], LogisticRegression]:
+    """Keep the ``top_n`` members of best inner weighted F1 and fit the logistic regression
+    over their out-of-fold class scores.
+
+    Parameters
+    ----------
+    blocks : mapping of str to ndarray of shape (n, len(classes))
+        Each member's out-of-fold class scores of the training rows (probabilities, or
+        labels one-hot), in the members' order.
+    y : ndarray of shape (n,)
+    classes : ndarray
+        The label codes of the columns (the training rows' classes).
+    top_n : int
+    seed : int or None
+        Seed of the logistic regression.
+
+    Returns
+    -------
+    chosen : list of str
+        Best first (ties: the members' order).
+    inner_scores : dict of str to float
+        Every member's inner weighted F1.
+    final : LogisticRegression
+        Fitted on the chosen members' blocks side by side, best first.
+    """
+    inner_scores = {
+        name: float(f1_score(y, classes[np.argmax(block, axis=1)], average="weighted"))
+        for name, block in blocks.items()
+    }
+    chosen = sorted(inner_scores, key=lambda n: -inner_scores[n])[:top_n]
+    final = LogisticRegression(max_iter=2000, random_state=seed)
+    final.fit(np.hstack([blocks[name] for name in chosen]), y)
+    return chosen, inner_scores, final

@@ -35,12 +35,12 @@ from sklearn.experimental import enable_halving_search_cv  # noqa: F401 (enables
 from sklearn.model_selection import (
     HalvingGridSearchCV,
     HalvingRandomSearchCV,
-    KFold,
     ParameterGrid,
     StratifiedKFold,
 )
 from sklearn.utils.metaestimators import available_if
 
+from touchbench.benchmark.catalogue.inner import INNER_FOLDS, inner_folds
 from touchbench.benchmark.catalogue.spec import ClassifierSpec, SearchSpace, Tuning
 from touchbench.benchmark.errors import ConfigurationError
 
@@ -156,7 +156,8 @@ class TunedClassifier(ClassifierMixin, BaseEstimator):
     budget : float or None
         Seconds the search may plan for; ``None`` for :data:`DEFAULT_FITS` default fits.
     cv : int
-        Inner folds (stratified when every class has as many rows).
+        Inner folds (:func:`benchmark.catalogue.inner.inner_folds`, the plan stacks and
+        ensemble selection share).
     factor : int
         Halving factor: each round keeps a 1/factor of the candidates on factor x the rows.
     scoring : str
@@ -183,7 +184,7 @@ class TunedClassifier(ClassifierMixin, BaseEstimator):
         estimator: Any = None,
         space: Mapping[str, Any] | None = None,
         budget: float | None = None,
-        cv: int = 3,
+        cv: int = INNER_FOLDS,
         factor: int = 3,
         scoring: str = "f1_weighted",
         random_state: int | None = None,
@@ -294,14 +295,6 @@ class TunedClassifier(ClassifierMixin, BaseEstimator):
     def decision_function(self, X: np.ndarray) -> np.ndarray:
         """Decision values of the refitted best setting."""
         return np.asarray(self.best_estimator_.decision_function(X))
-
-
-def inner_folds(y: np.ndarray, cv: int, seed: int | None) -> KFold | StratifiedKFold:
-    """Shuffled inner folds of a training fold, stratified when every class has ``cv`` rows."""
-    _, counts = np.unique(y, return_counts=True)
-    if counts.min() >= cv:
-        return StratifiedKFold(cv, shuffle=True, random_state=seed)
-    return KFold(cv, shuffle=True, random_state=seed)
 
 
 _OVERHEAD: list[float] = []

@@ -19,7 +19,7 @@ import numpy as np
 from touchbench.benchmark.errors import ConfigurationError
 from touchbench.benchmark.evaluation.metrics import LOWER_IS_BETTER
 from touchbench.benchmark.evaluation.significance import corrected_resampled_ttest
-from touchbench.benchmark.results import Drop, TaskResult
+from touchbench.benchmark.results import Drop, Origin, TaskResult
 
 Mark = Literal["v", "*", ""]
 
@@ -54,6 +54,9 @@ class LeaderboardRow:
         two paired folds).
     dropped : Drop or None
         Why the classifier stopped before its last fold (a raced or budgeted run).
+    origin : Origin or None
+        An ensemble computed from its members' fold predictions, or a helper (a member
+        the run did not ask for); ``None`` for an entry fitted as asked.
     """
 
     rank: int
@@ -66,9 +69,12 @@ class LeaderboardRow:
     tested: bool = False
     p_value: float = math.nan
     dropped: Drop | None = None
+    origin: Origin | None = None
 
     def to_json(self) -> dict[str, Any]:
-        return {
+        """JSON-ready data; ``origin`` only for a row that has one (a computed ensemble,
+        a helper)."""
+        data = {
             "rank": self.rank,
             "classifier": self.classifier,
             "mark": self.mark,
@@ -83,6 +89,9 @@ class LeaderboardRow:
             "p_value": finite(self.p_value),
             "dropped": None if self.dropped is None else self.dropped.to_json(),
         }
+        if self.origin is not None:
+            data["origin"] = self.origin.to_json()
+        return data
 
 
 @dataclass
@@ -145,6 +154,7 @@ def build_leaderboard(
     alpha: float = 0.05,
     groups: Mapping[str, str] | None = None,
     drops: Mapping[str, Drop] | None = None,
+    origins: Mapping[str, Origin] | None = None,
 ) -> Leaderboard:
     """Rank the classifiers of a run and mark significant differences from a baseline.
 
@@ -166,6 +176,9 @@ def build_leaderboard(
         Classifiers that stopped early (a raced or budgeted run) or never started (a
         cancelled run): their rows say so, and the default baseline is the best classifier
         that did not stop.
+    origins : mapping of str to Origin, optional
+        Entries computed from fold predictions and helpers (the engine's
+        :meth:`~benchmark.run.members.RunPlan.origins`): their rows say so.
 
     Raises
     ------
@@ -189,6 +202,7 @@ def build_leaderboard(
         for position, row in enumerate(failed, start=1):
             row.rank = position
             row.dropped = (drops or {}).get(row.classifier)
+            row.origin = (origins or {}).get(row.classifier)
         return Leaderboard(metric, None, failed, (0, 0, 0), alpha)
     available = sorted({name for r in results if r.ok for name in r.metrics})
     if metric not in available:
@@ -204,6 +218,7 @@ def build_leaderboard(
     _assign_ranks(rows, metric)
     for row in rows:
         row.dropped = (drops or {}).get(row.classifier)
+        row.origin = (origins or {}).get(row.classifier)
     ranked = [row for row in rows if not math.isnan(row.metrics[metric][0])]
     finished = [row for row in ranked if row.dropped is None]
     if baseline is None and finished:

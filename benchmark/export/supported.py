@@ -19,7 +19,7 @@ SUPPORTED = (
 
 def exports_onnx(spec: ClassifierSpec) -> bool:
     """Whether models of this catalogue entry export to ONNX (without fitting one)."""
-    if spec.min_sequence is not None or spec.tuning is not None or spec.stacking is not None:
+    if spec.min_sequence is not None or spec.tuning is not None or spec.members:
         return False
     try:
         estimator = spec.make_estimator()

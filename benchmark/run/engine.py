@@ -10,6 +10,14 @@ Every finished task is reported at once through ``on_result`` (in the calling pr
 so that the caller can store it; ``skip`` resumes a run without repeating what is done.
 A plain run hands the tasks out classifier-major; a raced run or one with a total budget
 runs them fold-major, cheap first (:mod:`benchmark.run.schedule`).
+
+Each task keeps its test fold's predictions (:mod:`benchmark.predictions`).  The run's
+ensembles of entries, stacks and ensemble selection have no tasks: their folds are computed
+here from their members' predictions as these arrive (:mod:`benchmark.run.members` plans
+which entries need which, :mod:`benchmark.run.combine` computes), each member fitted once
+per fold whichever ensembles name it.  A run whose stacks or selection read inner
+predictions runs fold-major, so that a fold's predictions are let go once its ensembles are
+computed.
 """
 
 from __future__ import annotations
@@ -23,13 +31,15 @@ from collections.abc import Callable, Collection, Mapping, Sequence
 from touchbench.benchmark.catalogue import ClassifierSpec
 from touchbench.benchmark.catalogue.costs import Shape, estimate_seconds
 from touchbench.benchmark.errors import ConfigurationError
-from touchbench.benchmark.estimators import check_classifier, classifier_spec, is_multitarget_id
+from touchbench.benchmark.estimators import classifier_spec, is_multitarget_id
 from touchbench.benchmark.problem import Problem
 from touchbench.benchmark.results import Drop, TaskKey, TaskResult
 from touchbench.benchmark.run.backend import Backend, RunStopped, StartCallback, StopCheck
+from touchbench.benchmark.run.combine import Combiner
 from touchbench.benchmark.run.dask_backend import DaskBackend
 from touchbench.benchmark.run.folds import Fold
 from touchbench.benchmark.run.local_backend import LocalBackend
+from touchbench.benchmark.run.members import RunPlan, plan_run
 from touchbench.benchmark.run.racing import RaceRule
 from touchbench.benchmark.run.schedule import RoundSchedule, TaskList, TaskSource, test_train_ratio
 from touchbench.benchmark.run.task import TaskContext
@@ -41,6 +51,7 @@ __all__ = [
     "TaskKey",
     "TaskResult",
     "available_cores",
+    "plan_run",
     "plan_tasks",
     "run_tasks",
 ]
@@ -71,6 +82,7 @@ def run_tasks(
     on_drop: Callable[[Drop], None] | None = None,
     clock: Callable[[], float] = time.monotonic,
     by_recording: bool = False,
+    ensemble: int | None = None,
 ) -> list[TaskResult]:
     """Cross-validate classifiers on a problem.
 
@@ -129,14 +141,19 @@ def run_tasks(
         Score each test recording (``problem.groups``) as one prediction pooled over its
         windows (:mod:`benchmark.evaluation.recordings`); the caller checks that the
         problem has groups and one label per recording.
+    ensemble : int, optional
+        Add ``ensemble-N``: in each training fold, N rounds of Caruana's greedy ensemble
+        selection over the run's entries, on their inner out-of-fold predictions
+        (:mod:`benchmark.catalogue.ensembles`).  Multi-class runs only.
 
     Returns
     -------
     list of TaskResult
-        One per task run, classifier-major in the order of ``classifiers`` and ``folds``.
-        Classifiers that raise, run out of memory, crash or time out give results with
-        status ``error`` or ``timeout``; the run goes on.  A raced classifier's results
-        stop at the fold after which it was dropped.
+        One per task run and per derived fold computed, classifier-major in the order of
+        ``classifiers`` (then the helpers, :attr:`RunPlan.helpers`) and ``folds``, each
+        with its fold predictions.  Classifiers that raise, run out of memory, crash or
+        time out give results with status ``error`` or ``timeout``; the run goes on.  A
+        raced classifier's results stop at the fold after which it was dropped.
 
     Raises
     ------
@@ -152,13 +169,15 @@ def run_tasks(
             f"budget must be a positive, finite number of seconds, got {budget}"
         )
     skip = set(skip) | {r.key for r in previous}
-    specs, tasks = plan_tasks(problem, classifiers, folds, skip=skip, extra_specs=extra_specs)
-    if not tasks:
+    plan, tasks = _plan(problem, classifiers, folds, skip, extra_specs, ensemble)
+    rounds = [(f.repeat, f.fold) for f in folds]
+    rerun = plan.reruns(rounds, skip, {r.key: r for r in previous})
+    context = TaskContext(problem, plan.specs, list(folds), random_state, by_recording, plan.inner)
+    combiner = Combiner(plan, context, done=skip)
+    # derived folds whose members an earlier execution left at hand
+    early = [derived for result in previous for derived in combiner.add(result)]
+    if not tasks and not rerun and not early:
         return []
-    context = pickle.dumps(
-        TaskContext(problem, specs, list(folds), random_state, by_recording),
-        protocol=pickle.HIGHEST_PROTOCOL,
-    )
     sizes = {(f.repeat, f.fold): (int(f.train.size), int(f.test.size)) for f in folds}
     results: dict[TaskKey, TaskResult] = {}
 
@@ -170,6 +189,13 @@ def run_tasks(
                     f"exceeded the memory limit of {max_memory / 2**20:g} MB per task "
                     f"({result.error})"
                 )
+        derived = combiner.add(result)
+        if result.key not in rerun:  # a task run again for its predictions was stored
+            arrive(result)
+        for computed in derived:
+            arrive(computed)
+
+    def arrive(result: TaskResult) -> None:
         if isinstance(source, RoundSchedule):
             source.arrived(result)  # it hands the result on, or holds it for its race
         else:
@@ -179,18 +205,23 @@ def run_tasks(
         results[result.key] = result
         if on_result is not None:
             on_result(result)
+        result.inner_predictions = None  # read by the combiner, which keeps its own
 
-    source: TaskSource = TaskList(tasks)
-    if race is not None or budget is not None:
+    def started(key: TaskKey) -> None:
+        if on_start is not None and key not in rerun:
+            on_start(key)
+
+    source: TaskSource = TaskList(sorted(rerun) + tasks)
+    if race is not None or budget is not None or plan.inner:
         if race is not None and len(folds) < race.first_round:
             raise ConfigurationError(
                 f"a race needs at least {race.first_round} folds, got {len(folds)}"
             )
         source = RoundSchedule(
-            list(dict.fromkeys(classifiers)),
-            [(f.repeat, f.fold) for f in folds],
+            plan.entries,
+            rounds,
             hand_on,
-            hints=cost_hints(problem, classifiers, specs, folds),
+            hints=cost_hints(problem, plan.workers, plan.specs, folds),
             previous=previous,
             done=skip,
             race=race,
@@ -198,17 +229,25 @@ def run_tasks(
             budget=budget,
             on_drop=on_drop,
             clock=clock,
+            derived={entry: plan.uses(entry) for entry in plan.derived},
+            helpers=plan.helpers,
+            rerun=rerun,
         )
+    for computed in early:
+        arrive(computed)
+    pickled = pickle.dumps(context, protocol=pickle.HIGHEST_PROTOCOL)
     backend: Backend
     if scheduler:
-        backend = DaskBackend(scheduler, context, timeout=timeout, max_memory=max_memory)
+        backend = DaskBackend(scheduler, pickled, timeout=timeout, max_memory=max_memory)
     else:
         workers = available_cores() if jobs == -1 else jobs
-        backend = LocalBackend(context, workers=workers, timeout=timeout, max_memory=max_memory)
-    backend.run(source, on_start or _ignore, deliver, stop or _never)
+        backend = LocalBackend(pickled, workers=workers, timeout=timeout, max_memory=max_memory)
+    if not source.exhausted:
+        backend.run(source, started, deliver, stop or _never)
     if isinstance(source, RoundSchedule):
         source.finish()
-    return [results[key] for key in tasks if key in results]
+    order = [TaskKey(entry, *round_) for entry in plan.entries for round_ in rounds]
+    return [results[key] for key in order if key in results]
 
 
 def cost_hints(
@@ -272,36 +311,41 @@ def plan_tasks(
     *,
     skip: Collection[TaskKey] = (),
     extra_specs: Mapping[str, ClassifierSpec] | None = None,
+    ensemble: int | None = None,
 ) -> tuple[dict[str, ClassifierSpec], list[TaskKey]]:
     """Check the classifier ids and list the tasks still to run.
 
     Returns
     -------
     specs : dict of str to ClassifierSpec
-        The multi-class specs the workers need: the run's multi-class classifiers and
-        every extra spec.
+        The multi-class specs the workers need: the run's multi-class classifiers, the
+        members of its ensembles and every extra spec.
     tasks : list of TaskKey
-        Classifier-major, without the keys in ``skip``.
+        Classifier-major, without the keys in ``skip``: the entries that are fitted (the
+        run's, then the helpers; an ensemble of entries has no task).
     """
-    ids = list(dict.fromkeys(classifiers))
-    if not ids:
-        raise ConfigurationError("no classifiers to run")
+    plan, tasks = _plan(problem, classifiers, folds, set(skip), extra_specs, ensemble)
+    return plan.specs, tasks
+
+
+def _plan(
+    problem: Problem,
+    classifiers: Sequence[str],
+    folds: Sequence[Fold],
+    skip: Collection[TaskKey],
+    extra_specs: Mapping[str, ClassifierSpec] | None,
+    ensemble: int | None,
+) -> tuple[RunPlan, list[TaskKey]]:
+    plan = plan_run(problem, classifiers, extra_specs=extra_specs, ensemble=ensemble)
     if not folds:
         raise ConfigurationError("no folds to run the classifiers on")
-    # extra specs travel too: a multi-target configuration may take one as its base
-    specs: dict[str, ClassifierSpec] = dict(extra_specs or {})
-    for classifier in ids:
-        spec = check_classifier(classifier, problem, extra_specs)
-        if spec is not None:
-            specs[classifier] = spec
-    done = set(skip)
     tasks = [
         key
-        for classifier in ids
+        for classifier in plan.workers
         for fold in folds
-        if (key := TaskKey(classifier, fold.repeat, fold.fold)) not in done
+        if (key := TaskKey(classifier, fold.repeat, fold.fold)) not in skip
     ]
-    return specs, tasks
+    return plan, tasks
 
 
 def available_cores() -> int:

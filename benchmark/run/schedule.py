@@ -16,6 +16,13 @@ A race's decisions depend on the scores alone: a result of round ``r + 1`` of an
 held back until the decision after round ``r`` is made, and dropped with its entry, so that
 the results handed on (and stored) are the same whatever the timing, and a resumed race
 replays the decisions of the stored results and goes on where it stopped.
+
+Entries computed from others' folds (an ensemble of entries, a stack: ``derived``) have no
+task of their own: their results arrive when their members' have (the engine computes them)
+and race like any other's.  A member runs while it is live or while a live derived entry
+needs it: a member the race dropped still runs for a live ensemble, its later results only
+feeding the ensemble; a helper (a member the run did not ask for) is not raced, and its
+results are handed on for the rounds where an entry that needs it was live.
 """
 
 from __future__ import annotations
@@ -102,6 +109,14 @@ class RoundSchedule:
         :meth:`finish`).
     clock : callable
         Monotonic seconds (tests give their own).
+    derived : mapping of str to collection of str
+        Entries computed from others' folds, with every entry (among ``entries``) whose
+        folds they are computed from, their members' members included.
+    helpers : collection of str
+        Entries the run did not ask for, members of derived ones: not raced.
+    rerun : collection of TaskKey
+        Tasks of ``done`` to run again (their predictions are needed and not at hand);
+        their results do not come back here.
     """
 
     def __init__(
@@ -118,8 +133,13 @@ class RoundSchedule:
         budget: float | None = None,
         on_drop: Callable[[Drop], None] | None = None,
         clock: Callable[[], float] = time.monotonic,
+        derived: Mapping[str, Collection[str]] | None = None,
+        helpers: Collection[str] = (),
+        rerun: Collection[TaskKey] = (),
     ) -> None:
         self._entries = list(dict.fromkeys(entries))
+        self._derived = {entry: frozenset(needs) for entry, needs in (derived or {}).items()}
+        self._helpers = frozenset(helpers)
         self._rounds = {key: index for index, key in enumerate(rounds)}
         self._n_rounds = len(rounds)
         self._round_keys = list(rounds)
@@ -130,7 +150,7 @@ class RoundSchedule:
         self._on_drop = on_drop or (lambda drop: None)
         self._clock = clock
         self._deadline = None if budget is None else clock() + budget
-        self._live = list(self._entries)
+        self._live = [e for e in self._entries if e not in self._helpers]
         self._arrived: dict[str, set[int]] = {e: set() for e in self._entries}
         self._started: dict[str, set[int]] = {e: set() for e in self._entries}
         self._scores: dict[str, dict[int, float]] = {e: {} for e in self._entries}
@@ -152,6 +172,9 @@ class RoundSchedule:
                 self._arrived[key.classifier].add(self._rounds[(key.repeat, key.fold)])
         for entry in self._entries:
             self._started[entry] = set(self._arrived[entry])
+        for key in rerun:
+            if key.classifier in self._started and (key.repeat, key.fold) in self._rounds:
+                self._started[key.classifier].discard(self._rounds[(key.repeat, key.fold)])
         self._make_decisions()
 
     # the backend's side -------------------------------------------------------------
@@ -159,16 +182,16 @@ class RoundSchedule:
     def next_task(self) -> TaskKey | None:
         """The next fold of the live entry that is furthest behind and may start, if any.
 
-        Ties within a round: a race without a budget starts the dear entries first (the
-        round's decision waits for its last task: a long one started last leaves the other
-        workers idle at the end of the round); a budget starts the cheap ones first (more
-        entries complete before it runs out).
+        Ties within a round: without a budget the dear entries start first (a race's
+        decision waits for the round's last task, and a derived entry for its members': a
+        long one started last leaves the other workers idle at the end of the round); a
+        budget starts the cheap ones first (more entries complete before it runs out).
         """
         now = self._clock()
         calibration = self._calibration()  # once per call: it reads every timed entry
-        order = -1.0 if self._race is not None and self._deadline is None else 1.0
+        order = -1.0 if self._deadline is None else 1.0
         waiting = []
-        for position, entry in enumerate(self._live):
+        for position, entry in enumerate(self._active()):
             index = next(
                 (i for i in range(self._horizon(entry) + 1) if i not in self._started[entry]),
                 None,
@@ -177,7 +200,7 @@ class RoundSchedule:
                 cost = self._cost(entry, calibration)
                 waiting.append((index, order * cost, position, entry, cost))
         for index, _, _, entry, cost in sorted(waiting):  # ties: the run's order
-            if entry not in self._live:
+            if entry not in self._active():
                 continue  # a budget's cut below let the race decide and drop it
             if self._deadline is not None and now + cost > self._deadline:
                 self._cut_entry(entry)
@@ -196,8 +219,14 @@ class RoundSchedule:
         An entry the last decision found far from a drop (the leader, the protected ones,
         p-value against the leader above :data:`SAFE_P`) may run further ahead: a worker
         that would wait for the slowest entry of the round works on a fold the race will
-        most probably keep.  Only the timing depends on it, not what is stored.
+        most probably keep.  Only the timing depends on it, not what is stored.  An entry a
+        live derived entry needs may go as far as that entry may.
         """
+        users = [e for e in self._live if e == entry or entry in self._derived.get(e, ())]
+        return max((self._own_horizon(e) for e in users), default=-1)
+
+    def _own_horizon(self, entry: str) -> int:
+        """The last round a live entry's folds may start (see :meth:`_horizon`)."""
         last = self._n_rounds - 1
         if self._race is None or self._deadline is not None:
             return last if self._race is None else min(self._decided + 2, last)
@@ -208,16 +237,26 @@ class RoundSchedule:
             return last
         return min(self._decided + 2, last)
 
+    def _active(self) -> list[str]:
+        """The entries with tasks to start: the live ones, and those a live derived entry
+        needs (a helper, a member the race dropped), in the run's order."""
+        needed = set().union(*(self._derived.get(e, ()) for e in self._live))
+        return [
+            e
+            for e in self._entries
+            if e not in self._derived and e not in self._cut and (e in self._live or e in needed)
+        ]
+
     @property
     def exhausted(self) -> bool:
         return self.remaining() == 0
 
     def remaining(self) -> int:
         if self._deadline is not None and self._clock() >= self._deadline:
-            for entry in list(self._live):  # nothing fits any more: no worker need start
-                if entry in self._live and len(self._started[entry]) < self._n_rounds:
+            for entry in self._active():  # nothing fits any more: no worker need start
+                if entry not in self._cut and len(self._started[entry]) < self._n_rounds:
                     self._cut_entry(entry)
-        return sum(self._n_rounds - len(self._started[e]) for e in self._live)
+        return sum(self._n_rounds - len(self._started[e]) for e in self._active())
 
     def arrived(self, result: TaskResult) -> None:
         """Take a result: hand it on (or hold it back), and decide the rounds it completes."""
@@ -225,13 +264,24 @@ class RoundSchedule:
         if began is not None:
             self._seconds.setdefault(result.key.classifier, []).append(self._clock() - began)
         if result.key.classifier in self.dropped:
-            return  # started ahead of the decision that dropped its entry
+            return  # started ahead of the decision that dropped it, or run for an ensemble
         index = self._note(result)
         if index > self._decided + 1:
             self._held.append(result)
         else:
-            self._deliver(result)
+            self._hand_on(result, index)
         self._make_decisions()
+
+    def _hand_on(self, result: TaskResult, index: int) -> None:
+        """Deliver a result, but a helper's only for a round where an entry that needs it
+        was live (the decisions up to the round before it are made)."""
+        entry = result.key.classifier
+        if entry in self._helpers and not any(
+            entry in needs and (d not in self.dropped or self.dropped[d].after_fold > index)
+            for d, needs in self._derived.items()
+        ):
+            return
+        self._deliver(result)
 
     def cost(self, entry: str) -> float:
         """Predicted seconds of one more fold of ``entry``."""
@@ -242,6 +292,8 @@ class RoundSchedule:
     def _note(self, result: TaskResult) -> int:
         entry, index = result.key.classifier, self._rounds[(result.key.repeat, result.key.fold)]
         self._arrived.setdefault(entry, set()).add(index)
+        if entry in self._derived:  # it has no task: it started when it arrived
+            self._started.setdefault(entry, set()).add(index)
         metric = self._race.metric if self._race is not None else None
         value = result.metrics.get(metric) if metric is not None and result.ok else None
         if value is not None and value == value:  # not NaN
@@ -280,7 +332,7 @@ class RoundSchedule:
             elif index > self._decided + 1:
                 self._held.append(result)
             else:
-                self._deliver(result)
+                self._hand_on(result, index)
 
     # the budget ------------------------------------------------------------------------
 
@@ -299,8 +351,12 @@ class RoundSchedule:
         return max(statistics.median(ratios), MIN_CALIBRATION) if ratios else 1.0
 
     def _cut_entry(self, entry: str) -> None:
-        self._cut.add(entry)
-        self._live.remove(entry)
+        """Start no more of ``entry``'s tasks, nor the folds of the live entries made of it."""
+        users = [d for d in self._live if entry in self._derived.get(d, ())]
+        for cut in [entry, *users]:
+            self._cut.add(cut)
+            if cut in self._live:
+                self._live.remove(cut)
         self._make_decisions()
 
     def cut_tasks(self) -> int:
@@ -314,9 +370,9 @@ class RoundSchedule:
         held, self._held = self._held, []
         for result in held:
             if result.key.classifier not in self.dropped:
-                self._deliver(result)
+                self._hand_on(result, self._rounds[(result.key.repeat, result.key.fold)])
         for entry in self._entries:
-            if entry in self._cut:
+            if entry in self._cut and entry not in self.dropped:
                 self._on_drop(Drop(entry, "budget", len(self._arrived[entry])))
 
 

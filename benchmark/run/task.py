@@ -19,14 +19,11 @@ from typing import Any
 import numpy as np
 
 from touchbench.benchmark.catalogue import ClassifierSpec
+from touchbench.benchmark.catalogue.inner import inner_splits, out_of_fold
 from touchbench.benchmark.estimators import build_estimator, group_fit_params
-from touchbench.benchmark.evaluation.calibration import PER_TARGET, reliability
-from touchbench.benchmark.evaluation.metrics import (
-    confusion_matrix,
-    expand_proba,
-    multiclass_scores,
-)
-from touchbench.benchmark.evaluation.recordings import Recordings
+from touchbench.benchmark.evaluation.fold_scores import score_fold
+from touchbench.benchmark.evaluation.metrics import expand_proba
+from touchbench.benchmark.predictions import FoldPredictions
 from touchbench.benchmark.problem import Problem
 from touchbench.benchmark.results import Status, TaskKey, TaskResult
 from touchbench.benchmark.run.choices import chosen_params
@@ -51,6 +48,9 @@ class TaskContext:
     by_recording : bool
         Score each test recording (``problem.groups``) as one prediction, pooled over its
         windows (:mod:`benchmark.evaluation.recordings`), rather than each window.
+    inner : frozenset of str
+        Entries whose tasks also predict their training fold out of fold, on the run's
+        inner folds (for the run's stacks and ensemble selection).
     """
 
     problem: Problem
@@ -58,12 +58,7 @@ class TaskContext:
     folds: Sequence[Fold]
     random_state: int = 0
     by_recording: bool = False
-
-    def recordings(self, fold: Fold) -> Recordings | None:
-        """The recordings of ``fold``'s test windows when scored per recording."""
-        if not self.by_recording or self.problem.groups is None:
-            return None
-        return Recordings.of(self.problem.groups[fold.test])
+    inner: frozenset[str] = frozenset()
 
     def fold(self, repeat: int, fold: int) -> Fold:
         for candidate in self.folds:
@@ -123,78 +118,98 @@ def _run_multiclass(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResul
     )
     y = problem.Y[:, 0]
     timer = _Timer()
-    model.fit(problem.X[fold.train], y[fold.train], **_groups(model, problem, fold))
+    model.fit(problem.X[fold.train], y[fold.train], **_groups(model, problem, fold.train))
     fit_time, fit_cpu = timer.lap()
     X_test = problem.X[fold.test]
     y_pred = np.asarray(model.predict(X_test), dtype=np.int64)
     proba = None
-    if context.specs[key.classifier].probabilities:
+    probabilities = context.specs[key.classifier].probabilities
+    if probabilities:
         proba = expand_proba(model.predict_proba(X_test), model.classes_, n_classes=n_classes)
     predict_time, predict_cpu = timer.lap()
-    y_test = y[fold.test]
-    recordings = context.recordings(fold)
-    if recordings is not None:
-        y_test = recordings.truth(y_test)
-        y_pred, proba = recordings.classes(y_pred, proba, n_classes)
-    scores, confusion = multiclass_scores(y_test, y_pred, proba, n_classes=n_classes)
-    scores.update(_costs(fit_time, fit_cpu, predict_time, predict_cpu, model))
+    costs = _costs(fit_time, fit_cpu, predict_time, predict_cpu, model)
+    result = scored_result(
+        context,
+        key,
+        fold,
+        FoldPredictions.of_classes(fold.test, y_pred, proba),
+        costs,
+        params=chosen_params(model),
+    )
+    if key.classifier in context.inner:
+        result.inner_predictions = _inner_predictions(context, model, fold, probabilities)
+        inner_time, inner_cpu = timer.lap()
+        result.metrics.update({"inner_time": inner_time, "inner_cpu_time": inner_cpu})
+    return result
+
+
+def scored_result(
+    context: TaskContext,
+    key: TaskKey,
+    fold: Fold,
+    predictions: FoldPredictions,
+    costs: dict[str, float],
+    *,
+    params: dict[str, Any] | None = None,
+) -> TaskResult:
+    """The ``ok`` result of a task whose model predicted ``predictions`` of the test fold,
+    scored as the run scores (:func:`benchmark.evaluation.fold_scores.score_fold`)."""
+    scores = score_fold(context.problem, predictions, by_recording=context.by_recording)
     return TaskResult(
         key,
         "ok",
         None,
-        scores,
-        confusion,
+        {**scores.metrics, **costs},
+        scores.confusion,
         int(fold.train.size),
         int(fold.test.size),
-        params=chosen_params(model),
-        # the bins, not the probabilities: they add up over folds, 30 numbers a fold
-        calibration=None if proba is None else reliability(y_test, proba).to_json(),
+        per_target=scores.per_target,
+        params=params,
+        calibration=scores.calibration,
+        predictions=predictions,
     )
 
 
-def _groups(model: Any, problem: Problem, fold: Fold) -> dict[str, np.ndarray]:
-    """The training fold's groups for a model whose fit takes them (:func:`group_fit_params`)."""
-    groups = None if problem.groups is None else problem.groups[fold.train]
+def _inner_predictions(
+    context: TaskContext, model: Any, fold: Fold, probabilities: bool
+) -> FoldPredictions:
+    """The model's out-of-fold predictions of the training fold's rows, on the run's inner
+    folds of it (:mod:`benchmark.catalogue.inner`), rows in the training fold's order."""
+    problem = context.problem
+    y = problem.Y[fold.train, 0]
+    labels, proba = out_of_fold(
+        model,
+        problem.X[fold.train],
+        y,
+        inner_splits(y, context.random_state),
+        classes=np.arange(problem.n_classes[0]),
+        probabilities=probabilities,
+        fit_params=lambda rows: _groups(model, problem, fold.train[rows]),
+    )
+    return FoldPredictions.of_classes(fold.train, labels, proba)
+
+
+def _groups(model: Any, problem: Problem, rows: np.ndarray) -> dict[str, np.ndarray]:
+    """The training rows' groups for a model whose fit takes them (:func:`group_fit_params`)."""
+    groups = None if problem.groups is None else problem.groups[rows]
     return group_fit_params(model, groups)
 
 
 def _run_regression(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResult:
-    from touchbench.benchmark.evaluation.regression import regression_scores
-
     problem = context.problem
     model = build_estimator(key.classifier, problem, random_state=context.random_state)
     Y = problem.Y if problem.n_targets > 1 else problem.Y[:, 0]
     timer = _Timer()
-    model.fit(problem.X[fold.train], Y[fold.train], **_groups(model, problem, fold))
+    model.fit(problem.X[fold.train], Y[fold.train], **_groups(model, problem, fold.train))
     fit_time, fit_cpu = timer.lap()
     Y_pred = np.asarray(model.predict(problem.X[fold.test]), dtype=np.float64)
     predict_time, predict_cpu = timer.lap()
-    Y_test, Y_pred = problem.Y[fold.test], Y_pred.reshape(len(fold.test), -1)
-    recordings = context.recordings(fold)
-    if recordings is not None:
-        Y_test, Y_pred = recordings.truth(Y_test), recordings.mean(Y_pred)
-    metrics, per_target = regression_scores(
-        Y_test,
-        Y_pred,
-        target_names=problem.target_names,
-        coordinates=problem.coordinates,
-    )
-    metrics.update(_costs(fit_time, fit_cpu, predict_time, predict_cpu, model))
-    return TaskResult(
-        key,
-        "ok",
-        None,
-        metrics,
-        None,
-        int(fold.train.size),
-        int(fold.test.size),
-        per_target=per_target,
-    )
+    predictions = FoldPredictions(fold.test, values=Y_pred.reshape(len(fold.test), -1))
+    costs = _costs(fit_time, fit_cpu, predict_time, predict_cpu, model)
+    return scored_result(context, key, fold, predictions, costs)
 
 
 def _run_multitarget(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResult:
-    from touchbench.benchmark.multitarget import multitarget_scores
-
     problem = context.problem
     model = build_estimator(
         key.classifier, problem, random_state=context.random_state, extra_specs=context.specs
@@ -207,69 +222,19 @@ def _run_multitarget(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResu
     probas = None
     if hasattr(model, "predict_proba"):
         try:
-            probas = [np.asarray(p, dtype=np.float64) for p in model.predict_proba(X_test)]
+            probas = tuple(np.asarray(p, dtype=np.float64) for p in model.predict_proba(X_test))
         except (AttributeError, NotImplementedError):
             probas = None
     predict_time, predict_cpu = timer.lap()
-    Y_test = problem.Y[fold.test]
-    recordings = context.recordings(fold)
-    if recordings is not None:
-        Y_test, Y_pred, probas = _pooled_targets(recordings, Y_test, Y_pred, probas, problem)
-    scores = dict(
-        multitarget_scores(
-            Y_test,
-            Y_pred,
-            probas,
-            n_classes=problem.n_classes,
-            target_names=problem.target_names,
-        )
-    )
-    per_target = scores.pop("per_target", None)
-    metrics = {name: float(v) for name, v in scores.items() if isinstance(v, int | float)}
-    metrics.update(_costs(fit_time, fit_cpu, predict_time, predict_cpu, model))
-    confusion = [
-        confusion_matrix(Y_test[:, t], Y_pred[:, t], n_classes=k).tolist()
-        for t, k in enumerate(problem.n_classes)
-    ]
-    return TaskResult(
+    costs = _costs(fit_time, fit_cpu, predict_time, predict_cpu, model)
+    return scored_result(
+        context,
         key,
-        "ok",
-        None,
-        metrics,
-        confusion,
-        int(fold.train.size),
-        int(fold.test.size),
-        per_target=per_target,
+        fold,
+        FoldPredictions(fold.test, Y_pred, probas),
+        costs,
         params=chosen_params(model, problem.target_names),
-        # per target, the bins of its top label's confidence (as a multi-class fold keeps)
-        calibration=None
-        if probas is None
-        else {
-            PER_TARGET: {
-                name: reliability(Y_test[:, t], probas[t]).to_json()
-                for t, name in enumerate(problem.target_names)
-            }
-        },
     )
-
-
-def _pooled_targets(
-    recordings: Recordings,
-    Y_test: np.ndarray,
-    Y_pred: np.ndarray,
-    probas: list[np.ndarray] | None,
-    problem: Problem,
-) -> tuple[np.ndarray, np.ndarray, list[np.ndarray] | None]:
-    """Each target's windows pooled per recording: truth, predictions and probabilities
-    (shapes (n_recordings, n_targets) and n_targets x (n_recordings, n_classes))."""
-    pooled = [
-        recordings.classes(Y_pred[:, t], None if probas is None else probas[t], k)
-        for t, k in enumerate(problem.n_classes)
-    ]
-    labels = np.stack([p[0] for p in pooled], axis=1)
-    means = [p[1] for p in pooled]
-    kept = None if any(m is None for m in means) else [m for m in means if m is not None]
-    return recordings.truth(Y_test), labels, kept
 
 
 class _Timer:
