@@ -104,11 +104,17 @@ class Schema:
         All attributes in file order.
     target_indices : tuple of int
         Positions of the target attributes in ``attributes`` (ascending).
+    group_column : str or None
+        The column of the source file that named each instance's group (the object
+        grasped, the subject, the session), set aside as :attr:`Dataset.groups` rather
+        than kept as an attribute; ``None`` when no column did (extracted data sets have
+        groups all the same: the recording of each instance).
     """
 
     relation: str
     attributes: tuple[Attribute, ...]
     target_indices: tuple[int, ...]
+    group_column: str | None = None
 
     @property
     def n_attributes(self) -> int:
@@ -141,18 +147,21 @@ class Schema:
             if attribute.name == name:
                 return i
         raise ConfigurationError(
-            f"no attribute named '{name}' (attributes: {_shortlist(self.attributes)})"
+            f"no attribute named '{name}' (attributes: {shortlist(self.attributes)})"
         )
 
     def with_targets(self, target_indices: Sequence[int]) -> Schema:
         return replace(self, target_indices=tuple(sorted(target_indices)))
 
     def to_json(self) -> dict[str, Any]:
-        return {
+        out: dict[str, Any] = {
             "relation": self.relation,
             "attributes": [a.to_json() for a in self.attributes],
             "target_indices": list(self.target_indices),
         }
+        if self.group_column is not None:  # absent otherwise: schemas stored before it read alike
+            out["group_column"] = self.group_column
+        return out
 
     @classmethod
     def from_json(cls, data: Mapping[str, Any]) -> Schema:
@@ -160,6 +169,7 @@ class Schema:
             relation=data["relation"],
             attributes=tuple(Attribute.from_json(a) for a in data["attributes"]),
             target_indices=tuple(data["target_indices"]),
+            group_column=data.get("group_column"),
         )
 
 
@@ -384,7 +394,7 @@ def resolve_targets(
         if name not in attribute_names:
             raise ConfigurationError(
                 f"no attribute named '{name}' to use as a target "
-                f"(attributes: {_shortlist(attribute_names)})"
+                f"(attributes: {shortlist(attribute_names)})"
             )
         positions.append(list(attribute_names).index(name))
     if len(set(positions)) != len(positions):
@@ -394,7 +404,9 @@ def resolve_targets(
     return tuple(sorted(positions))
 
 
-def _shortlist(items: Sequence[Any], limit: int = 8) -> str:
+def shortlist(items: Sequence[Any], limit: int = 8) -> str:
+    """The names of ``items`` (attributes, or names themselves) for a message: the first
+    ``limit``, and how many there are in all when there are more."""
     names = [getattr(item, "name", item) for item in items]
     shown = ", ".join(str(n) for n in names[:limit])
     return shown + (f", ... ({len(names)} in all)" if len(names) > limit else "")

@@ -14,6 +14,7 @@ from typing import Annotated
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, DownloadColumn, Progress, TextColumn, TimeRemainingColumn
 
 from touchbench.app.cli.output import JsonOption, info, print_json, table
@@ -72,6 +73,21 @@ def import_command(
             "--format", metavar="arff|csv", help="File format (default: by the file's ending)."
         ),
     ] = None,
+    groups: Annotated[
+        str | None,
+        typer.Option(
+            "--groups",
+            metavar="COLUMN",
+            help=(
+                "The column naming each instance's group (object, subject, session): kept "
+                "as the instances' groups for grouped folds, never as a feature."
+            ),
+        ),
+    ] = None,
+    ignore: Annotated[
+        str | None,
+        typer.Option("--ignore", metavar="COLUMNS", help="Comma-separated columns to leave out."),
+    ] = None,
     as_json: JsonOption = False,
 ) -> None:
     """Import an ARFF or CSV file as a data set, named after the file.
@@ -88,6 +104,8 @@ def import_command(
         name=name,
         targets=targets,
         format=file_format,
+        groups=groups,
+        ignore=ignore,
     )
     store = get_state(ctx).store
     with _import_progress(enabled=not as_json and sys.stderr.isatty()) as progress:
@@ -98,6 +116,7 @@ def import_command(
     for note in result.notes:
         info(f"note: {note}")
     _print_summary(result)
+    _print_groups(result)
 
 
 @contextmanager
@@ -130,6 +149,7 @@ def show_command(ctx: typer.Context, dataset: DatasetArgument, as_json: JsonOpti
         print_json(description.to_json())
         return
     _print_summary(description)
+    _print_groups(description)
     table(
         "attributes",
         ["#", "name", "role", "type", "labels / range", "missing"],
@@ -223,6 +243,15 @@ def _print_summary(result: ImportResult | DatasetDescription) -> None:
         ],
         justify=["right", "left", "right", "right", "left"],
     )
+
+
+def _print_groups(result: ImportResult | DatasetDescription) -> None:
+    """One line saying how many groups the instances fall into, and what named them."""
+    groups = result.groups
+    if groups is None:
+        return
+    named = f"column '{escape(groups.column)}'" if groups.column else "the recordings"
+    info(f"groups: {groups.count}, from {named}")
 
 
 def _labels_or_range(attribute: AttributeDescription) -> str:

@@ -25,6 +25,12 @@ def parse_targets(text: str | None) -> int | list[str] | None:
     return [name.strip() for name in stripped.split(",") if name.strip()]
 
 
+def parse_names(text: str) -> list[str]:
+    """``"trial, time"`` -> ``["trial", "time"]``: comma-separated column names (a name of
+    digits stays a name)."""
+    return [name.strip() for name in text.split(",") if name.strip()]
+
+
 class ImportRequest(Request):
     """The CLI's ``import`` and ``POST /api/datasets``: an ARFF or CSV file to a data set."""
 
@@ -46,6 +52,18 @@ class ImportRequest(Request):
         description="The name the user knows the file by (an upload's file name): it names "
         "the data set, is kept as its source and is what messages call the file.",
     )
+    groups: str | None = Field(
+        default=None,
+        min_length=1,
+        max_length=200,
+        description="The column that names each instance's group (the object grasped, the "
+        "subject, the session): kept as the instances' groups, never as a feature.",
+    )
+    ignore: list[str] = Field(
+        default_factory=list,
+        max_length=10_000,
+        description="Columns left out of the data set (comma-separated as text).",
+    )
 
     @field_validator("targets", mode="before")
     @classmethod
@@ -53,6 +71,13 @@ class ImportRequest(Request):
         """Targets written as text (``"2"``, ``"-2"``, ``"a,b"``), as an option or a form
         field gives them."""
         return parse_targets(value) if isinstance(value, str) else value
+
+    @field_validator("ignore", mode="before")
+    @classmethod
+    def _ignore_text(cls, value: Any) -> Any:
+        """Ignored columns written as text (``"trial,time"``), as an option or a form field
+        gives them."""
+        return parse_names(value) if isinstance(value, str) else value
 
 
 class DatasetSummary(Schema):
@@ -75,13 +100,24 @@ class DatasetList(Schema):
     datasets: list[DatasetSummary]
 
 
+class GroupsDescription(Schema):
+    """The groups of a data set's instances: folds grouped by them keep each group on one
+    side, and leave-one-group-out tests one group at a time."""
+
+    count: int = Field(description="How many distinct groups the instances fall into.")
+    column: str | None = Field(
+        description="The column of the imported file that named them; null for an extracted "
+        "data set, whose groups are the recordings its instances come from."
+    )
+
+
 class ImportResult(Schema):
     """What ``touchbench import`` did.
 
     ``created`` is ``False`` when the file's content was stored before (``action`` is then
     ``"already stored"`` and the fields describe that data set); ``notes`` say what a user
     should know: targets that are numeric (regression), CSV columns typed as nominal
-    because of a few words among numbers.
+    because of a few words among numbers, columns left out.
     """
 
     id: int
@@ -92,6 +128,7 @@ class ImportResult(Schema):
     created: bool
     action: Literal["imported", "already stored"]
     notes: list[str]
+    groups: GroupsDescription | None = None
 
 
 class AttributeDescription(Schema):
@@ -120,6 +157,7 @@ class DatasetDescription(Schema):
     class_distribution: dict[str, dict[str, int]]
     missing_values: int
     notes: list[str]
+    groups: GroupsDescription | None = None
 
 
 class RenameRequest(Request):

@@ -8,11 +8,19 @@ whatever the file's size.  A file whose content is stored already is not stored 
 importing it answers "already stored", and refuses (saying how to rename) when another
 ``name`` or other ``targets`` were asked for.  A new data set is named after the file's
 stem (``mini.arff`` -> ``mini``); the ARFF relation stays in its metadata and exports.
+
+A table from another lab may name each row's group in a column (the object grasped, the
+subject) and hold columns that are neither features nor targets: the request's ``groups``
+and ``ignore`` set them aside as the file is read (:mod:`benchmark.io.columns`), the group
+column's cells stored as the instances' groups.  The same file read with other columns set
+aside is another data set: its key in the store is the file's digest and the columns'.
 """
 
 from __future__ import annotations
 
 import contextlib
+import hashlib
+import json
 import os
 import queue
 import stat
@@ -32,6 +40,7 @@ from touchbench.app.schemas.datasets import (
     DatasetDescription,
     DatasetSummary,
     FileFormat,
+    GroupsDescription,
     ImportRequest,
     ImportResult,
     RenameRequest,
@@ -46,6 +55,7 @@ from touchbench.app.store.naming import default_name
 from touchbench.benchmark.dataset import Dataset, InstanceBlock, Schema
 from touchbench.benchmark.errors import DataFormatError, DataWarning
 from touchbench.benchmark.io.arff import ArffWriter, open_arff, read_arff
+from touchbench.benchmark.io.columns import ColumnChoice, ColumnError
 from touchbench.benchmark.io.csv import read_csv
 from touchbench.benchmark.io.textfile import FileScan, check_regular_file, open_binary, scan_file
 
@@ -73,9 +83,10 @@ def import_file(
         The file (a regular file), and optionally the data set's name (by default the stem
         of its ``source_name`` or of the file, made unique with a numeric suffix), its
         targets (by default MEKA's ``-C`` in the relation, else the last attribute), its
-        format (by default from the file name's ending) and the name the user knows the
+        format (by default from the file name's ending), the name the user knows the
         file by (an upload's file name, when ``file`` is a temporary copy: it names the
-        data set, is kept as its source, and is what error messages call the file).
+        data set, is kept as its source, and is what error messages call the file), the
+        column that names each instance's group and the columns left out.
     progress : callable, optional
         Called with (what is being done, bytes done, bytes in all).
 
@@ -87,38 +98,55 @@ def import_file(
     ------
     DataFormatError
         If the file is not a regular file, not text, or not valid ARFF/CSV; if it holds
-        no instances or infinite values; if it leaves no feature, or has more targets or
-        attributes than :mod:`app.services.limits` allows.  Nothing is stored.
+        no instances, infinite values or an instance without a group; if it leaves no
+        feature, or has more targets or attributes than :mod:`app.services.limits`
+        allows.  Nothing is stored.
     FieldError
-        If the name is invalid.
+        If the name is invalid; if ``groups`` or ``ignore`` name a column the file does
+        not have, a target, or each other's column, or leave no feature.  Nothing is
+        stored.
     ConflictError
         If the name is taken, or the content is stored already and another name or other
         targets were asked for.
     """
     path, name, targets = request.file, request.name, request.targets
+    columns = ColumnChoice(groups=request.groups, ignore=tuple(request.ignore))
     shown = request.source_name or path.name
     if name is not None:  # a name taken by the same content answers "already stored"
         stored.valid_dataset_name(name)
     chosen = request.format or guess_format(Path(shown))
     notes: list[str] = []
     label = request.source_name or str(path)  # what messages call the file
-    with _open_data(path, label, chosen, targets, Path(shown).stem, progress, notes) as data:
+    opened = _open_data(path, label, chosen, targets, columns, Path(shown).stem, progress, notes)
+    with opened as data:
         _check_schema(data.schema, label, notes)
-        existing = stored.stored_digest(store, data.scan.sha256)
+        key = import_key(data.scan.sha256, columns)
+        existing = stored.stored_digest(store, key)
         if existing is None:
             checked = _CheckedInstances(data, label, progress)
             info, created = stored.add_dataset_stream(
                 store,
                 checked,
-                sha256=data.scan.sha256,
+                sha256=key,
                 name=name,
                 default=default_name(Path(shown).stem),
                 source_name=shown,
             )
             if created:
-                return _result(info, True, notes)
+                if columns.ignore:
+                    notes.append(f"columns left out: {', '.join(columns.ignore)}")
+                return _result(store, info, data.schema, True, notes)
             existing = info  # the same content was stored meanwhile by another process
-        return _already_stored(existing, shown, name, targets, data.schema, notes)
+        return _already_stored(store, existing, shown, name, targets, data.schema, notes)
+
+
+def import_key(sha256: str, columns: ColumnChoice) -> str:
+    """The key that recognises a data set imported before: the file's digest, or with
+    columns set aside a digest of it and of them (the order of ignored columns aside)."""
+    if not columns:
+        return sha256
+    chosen = {"file": sha256, "groups": columns.groups, "ignore": sorted(columns.ignore)}
+    return hashlib.sha256(json.dumps(chosen, sort_keys=True).encode()).hexdigest()
 
 
 @dataclass
@@ -150,6 +178,7 @@ def _open_data(
     label: str,
     file_format: FileFormat,
     targets: int | Sequence[str] | None,
+    columns: ColumnChoice,
     stem: str,
     progress: ImportProgress | None,
     notes: list[str],
@@ -158,17 +187,29 @@ def _open_data(
         if progress is not None:
             progress("checking", done, total)
 
-    if file_format == "arff":
-        with open_arff(path, targets=targets, progress=scanned, source=label) as reader:
-            yield _Opened(reader.scan, reader)
-        return
-    with open_binary(check_regular_file(path)) as stream:
-        scan = scan_file(stream, source=label, size=os.fstat(stream.fileno()).st_size)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", DataWarning)
-        dataset = read_csv(path, targets=targets, relation=stem, source=label)
-    notes += [str(w.message) for w in caught if issubclass(w.category, DataWarning)]
-    yield _Opened(scan, DatasetInMemory(dataset))
+    with _columns_as_fields():
+        if file_format == "arff":
+            with open_arff(
+                path, targets=targets, progress=scanned, source=label, columns=columns
+            ) as reader:
+                yield _Opened(reader.scan, reader)
+            return
+        with open_binary(check_regular_file(path)) as stream:
+            scan = scan_file(stream, source=label, size=os.fstat(stream.fileno()).st_size)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", DataWarning)
+            dataset = read_csv(path, targets=targets, relation=stem, source=label, columns=columns)
+        notes += [str(w.message) for w in caught if issubclass(w.category, DataWarning)]
+        yield _Opened(scan, DatasetInMemory(dataset))
+
+
+@contextlib.contextmanager
+def _columns_as_fields() -> Iterator[None]:
+    """A column choice the file refuses, as the request's field (``groups``, ``ignore``)."""
+    try:
+        yield
+    except ColumnError as error:
+        raise FieldError(error.field, error.message) from None
 
 
 def _check_schema(schema: Schema, source: str, notes: list[str]) -> None:
@@ -289,6 +330,7 @@ def _refuse_infinite(block: InstanceBlock, schema: Schema, source: str, offset: 
 
 
 def _already_stored(
+    store: Store,
     existing: DatasetInfo,
     shown: str,
     name: str | None,
@@ -306,10 +348,14 @@ def _already_stored(
             f"{stored_as} with targets {', '.join(existing.targets)}; nothing imported "
             "(a run chooses its own targets among the attributes)"
         )
-    return _result(existing, False, [*notes, f"{stored_as}; nothing imported"])
+    _, stored_schema, _ = stored.load_schema(store, existing.id)
+    notes = [*notes, f"{stored_as}; nothing imported"]
+    return _result(store, existing, stored_schema, False, notes)
 
 
-def _result(info: DatasetInfo, created: bool, notes: list[str]) -> ImportResult:
+def _result(
+    store: Store, info: DatasetInfo, schema: Schema, created: bool, notes: list[str]
+) -> ImportResult:
     return ImportResult(
         id=info.id,
         name=info.name,
@@ -319,7 +365,14 @@ def _result(info: DatasetInfo, created: bool, notes: list[str]) -> ImportResult:
         created=created,
         action="imported" if created else "already stored",
         notes=notes,
+        groups=_groups(store, info.id, schema),
     )
+
+
+def _groups(store: Store, dataset_id: int, schema: Schema) -> GroupsDescription | None:
+    """How many groups a stored data set's instances fall into and what named them."""
+    count = stored.count_groups(store, dataset_id)
+    return GroupsDescription(count=count, column=schema.group_column) if count else None
 
 
 # -------------------------------------------------------------------------------- describe
@@ -383,6 +436,7 @@ def describe_dataset(store: Store, ref: str | int) -> DatasetDescription:
         },
         missing_values=int(missing.sum()),
         notes=target_notes(schema),
+        groups=_groups(store, info.id, schema),
     )
 
 

@@ -15,10 +15,10 @@ import json
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Any, Protocol, cast
 
 import numpy as np
-from sqlalchemy import delete, insert, select, update
+from sqlalchemy import Table, delete, distinct, func, insert, select, update
 from sqlalchemy.exc import IntegrityError, OperationalError
 from sqlalchemy.orm import Session
 
@@ -330,7 +330,22 @@ def _write_block(session: Session, dataset_id: int, start: int, block: InstanceB
         session.execute(insert(InstanceBlockRow), stored)
     extras = _extras(dataset_id, start, block)
     if extras:
-        session.execute(insert(InstanceRow), extras)
+        _insert_extras(session, extras)
+
+
+def _insert_extras(session: Session, rows: list[dict[str, Any]]) -> None:
+    """Insert rows of ``instances``.  An imported table's groups are a row per instance:
+    PostgreSQL copies groups alone in (a statement per row costs a round trip each), and
+    SQLite takes them through the table rather than the ORM class (whose bulk insert
+    spends several times the driver's own time on each row)."""
+    if "meta" not in rows[0] and session.connection().dialect.driver == "psycopg":
+        columns = ("dataset_id", "position", "group_id")
+        statement = f"COPY instances ({', '.join(columns)}) FROM STDIN"
+        with _dbapi(session).cursor() as cursor, cursor.copy(statement) as copy:
+            for row in rows:
+                copy.write_row([row[column] for column in columns])
+        return
+    session.execute(insert(cast(Table, InstanceRow.__table__)), rows)
 
 
 def _bytes_of(array: np.ndarray) -> memoryview:
@@ -348,6 +363,13 @@ def _extras(dataset_id: int, start: int, block: InstanceBlock) -> list[dict[str,
     groups, metas = block.groups, block.meta
     if groups is None and metas is None:
         return []
+    if metas is None:  # groups alone (an imported table's group column)
+        assert groups is not None
+        return [
+            {"dataset_id": dataset_id, "position": start + i, "group_id": str(group)}
+            for i, group in enumerate(groups.tolist())
+            if group is not None
+        ]
     rows = []
     for i in range(block.n_instances):
         group = None if groups is None or groups[i] is None else str(groups[i])
@@ -512,6 +534,17 @@ def _instance_extras(
                 meta = [{} for _ in range(n)]
             meta[position] = extra
     return groups, meta
+
+
+def count_groups(store: Store, dataset_id: int) -> int:
+    """How many distinct groups the instances of a stored data set fall into (0: none)."""
+    with store.session() as session:
+        count = session.scalar(
+            select(func.count(distinct(InstanceRow.group_id))).where(
+                InstanceRow.dataset_id == dataset_id
+            )
+        )
+    return int(count or 0)
 
 
 def rename_dataset(store: Store, ref: str | int, new_name: str) -> tuple[DatasetInfo, str]:

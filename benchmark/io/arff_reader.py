@@ -11,6 +11,9 @@ size.  Each block of lines is read the fastest way that is exact for it:
 3. everything else (sparse rows, weights, escapes, comments) by WEKA's tokenizer
    (:mod:`benchmark.io.tokens`), which also locates every error by line and attribute.
 
+Columns set aside (:mod:`benchmark.io.columns`: the group column, ignored columns) are
+read like the others and then taken out of each block.
+
 All three give the same values, bit for bit: ``parser="tokenizer"`` reads every row the
 third way, the reference the others are tested against.  Arrow reads plain blocks in
 threads, a few blocks ahead of the one handed on (:mod:`benchmark.io.read_ahead`); the
@@ -29,16 +32,19 @@ from typing import BinaryIO, Literal
 import numpy as np
 
 from touchbench.benchmark.dataset import (
+    Attribute,
     Dataset,
     InstanceBlock,
     Schema,
     join_blocks,
+    meka_target_count,
     resolve_targets,
 )
 from touchbench.benchmark.errors import ConfigurationError, DataFormatError
 from touchbench.benchmark.io.arff_data import DataSection
 from touchbench.benchmark.io.arff_fast import plain_plan, read_plain_block
 from touchbench.benchmark.io.arff_header import Header, HeaderParser
+from touchbench.benchmark.io.columns import ColumnChoice, plan_columns
 from touchbench.benchmark.io.read_ahead import ordered_ahead
 from touchbench.benchmark.io.textfile import (
     BLOCK_BYTES,
@@ -86,11 +92,16 @@ class ArffReader:
         About how many bytes of the file each block of instances comes from.
     errors : str
         How undecodable bytes are handled (``"surrogatepass"`` for text given as str).
+    columns : ColumnChoice, optional
+        The attribute naming each instance's group and the attributes left out; the
+        targets are chosen among all the file's attributes, and may be neither.
 
     Raises
     ------
     DataFormatError
         If the header is wrong or the targets do not exist.
+    ColumnError
+        A column choice that does not fit the file (see :func:`plan_columns`).
     """
 
     def __init__(
@@ -103,6 +114,7 @@ class ArffReader:
         parser: Parser = "auto",
         block_bytes: int = BLOCK_BYTES,
         errors: str = "strict",
+        columns: ColumnChoice | None = None,
     ) -> None:
         self.scan = scan
         self.source = source
@@ -116,16 +128,24 @@ class ArffReader:
         except ConfigurationError as error:
             line = self.header.relation_line if targets is None else None
             raise DataFormatError(f"targets: {error}", source=source, line=line) from None
+        self.columns = plan_columns(
+            names,
+            self.target_indices,
+            columns,
+            source=source,
+            targets_by=None if targets is not None else _targets_by(self.header.relation),
+        )
         self._data = DataSection(self.header.attributes, source)
         self._plan = plain_plan(self.header.attributes) if parser != "tokenizer" else None
         self._finished = False
 
     @property
     def schema(self) -> Schema:
-        """The schema; string tables are complete once :meth:`blocks` is exhausted."""
+        """The data set's schema (without the columns set aside); string tables are
+        complete once :meth:`blocks` is exhausted."""
         assert self.header.relation is not None
         attributes = self._data.finish() if self._finished else self._data.attributes()
-        return Schema(self.header.relation, attributes, self.target_indices)
+        return self.columns.schema(self.header.relation, attributes)
 
     @property
     def sparse(self) -> bool:
@@ -143,8 +163,10 @@ class ArffReader:
         Yields
         ------
         InstanceBlock
-            ``values`` of shape (n, n_attributes), ``weights`` (``None`` unless a row of
-            the block has one) and ``lines``, the line each instance was read from.
+            ``values`` of shape (n, n_attributes) (the data set's attributes: the columns
+            set aside taken out), ``weights`` (``None`` unless a row of the block has
+            one), ``groups`` (the group column's values as text, if there is one) and
+            ``lines``, the line each instance was read from.
 
         Raises
         ------
@@ -154,8 +176,14 @@ class ArffReader:
         for (block, first_line), parsed in ordered_ahead(
             self._lines.blocks(), self._read_plain, self._is_for_arrow
         ):
-            yield self._read_block(block, first_line, None if parsed is None else parsed.result())
+            read = self._read_block(block, first_line, None if parsed is None else parsed.result())
+            yield self.columns.block(read, self._group_attribute(), source=self.source)
         self._finished = True
+
+    def _group_attribute(self) -> Attribute | None:
+        """The group column's attribute as read so far (a string table grows as rows come)."""
+        group = self.columns.group
+        return None if group is None else self._data.columns[group].attribute()
 
     def read(self) -> Dataset:
         """The whole data set (reads the blocks that are left)."""
@@ -211,6 +239,7 @@ def open_arff(
     block_bytes: int = BLOCK_BYTES,
     progress: Progress | None = None,
     source: str | None = None,
+    columns: ColumnChoice | None = None,
 ) -> Iterator[ArffReader]:
     """An ARFF file opened for reading in blocks.
 
@@ -222,7 +251,7 @@ def open_arff(
     ----------
     path : str or path-like
         The file.
-    targets, parser, block_bytes
+    targets, parser, block_bytes, columns
         As in :class:`ArffReader`.
     progress : callable, optional
         Called with (bytes read, file size) while the file is scanned.
@@ -257,8 +286,25 @@ def open_arff(
                 f"cannot read the file: {error.strerror}", source=source
             ) from None
         yield ArffReader(
-            stream, scan, source=source, targets=targets, parser=parser, block_bytes=block_bytes
+            stream,
+            scan,
+            source=source,
+            targets=targets,
+            parser=parser,
+            block_bytes=block_bytes,
+            columns=columns,
         )
+
+
+def _targets_by(relation: str) -> str:
+    """How the targets of a file whose user named none were chosen, for messages."""
+    try:
+        count = meka_target_count(relation)
+    except ConfigurationError:
+        count = None  # refused already when the targets were resolved
+    if count is None:
+        return "the last attribute, by default"
+    return f"MEKA's -C {count} in the @relation"
 
 
 def _check_header_start(head: bytes, source: str) -> None:
@@ -278,6 +324,7 @@ def loads_arff(
     source: str = "<string>",
     targets: TargetSpec = None,
     parser: Parser = "auto",
+    columns: ColumnChoice | None = None,
 ) -> Dataset:
     """Parse ARFF text.
 
@@ -293,12 +340,15 @@ def loads_arff(
         the first N attributes; ``-N``: the last N; names: those attributes.
     parser : {"auto", "vectorised", "tokenizer"}
         As in :class:`ArffReader`.
+    columns : ColumnChoice, optional
+        As in :class:`ArffReader`.
 
     Returns
     -------
     Dataset
         ``values`` has shape (n_instances, n_attributes); ``weights`` is ``None`` unless
-        some row has an instance weight; ``sparse`` tells whether rows were sparse.
+        some row has an instance weight; ``groups`` is ``None`` unless ``columns`` names
+        a group column; ``sparse`` tells whether rows were sparse.
 
     Raises
     ------
@@ -315,6 +365,7 @@ def loads_arff(
         targets=targets,
         parser=parser,
         errors="surrogatepass",
+        columns=columns,
     )
     return reader.read()
 
@@ -325,6 +376,7 @@ def read_arff(
     targets: TargetSpec = None,
     parser: Parser = "auto",
     source: str | None = None,
+    columns: ColumnChoice | None = None,
 ) -> Dataset:
     """Read an ARFF file.
 
@@ -339,6 +391,8 @@ def read_arff(
     source : str, optional
         The name messages give the file (an upload's name when ``path`` is a temporary
         copy); ``path`` by default.
+    columns : ColumnChoice, optional
+        As in :class:`ArffReader`.
 
     Returns
     -------
@@ -350,5 +404,5 @@ def read_arff(
     DataFormatError
         If the file does not exist, cannot be read, or is not valid ARFF.
     """
-    with open_arff(path, targets=targets, parser=parser, source=source) as reader:
+    with open_arff(path, targets=targets, parser=parser, source=source, columns=columns) as reader:
         return reader.read()

@@ -11,6 +11,9 @@ labels in order of first appearance; when most of a nominal column's cells are n
 in a column of measurements is more likely a typo than a label).  One exception makes
 class labels usable: a target column whose cells are all integers (``0``, ``1``, ``2``...)
 is nominal, with its labels sorted by value, since a classifier needs a nominal target.
+
+Columns set aside (:mod:`benchmark.io.columns`) are not typed: ignored ones are dropped
+unread, and the group column's cells, as written, are the instances' groups.
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ import numpy as np
 
 from touchbench.benchmark.dataset import Attribute, Dataset, Schema, resolve_targets
 from touchbench.benchmark.errors import ConfigurationError, DataFormatError, DataWarning
+from touchbench.benchmark.io.columns import ColumnChoice, plan_columns
 from touchbench.benchmark.io.textfile import read_text_file
 
 MISSING = frozenset({"", "?", "NA", "NaN", "nan"})
@@ -164,6 +168,7 @@ def read_csv(
     targets: int | Sequence[str] | None = None,
     relation: str | None = None,
     source: str | None = None,
+    columns: ColumnChoice | None = None,
 ) -> Dataset:
     """Read a CSV file whose first row names the columns.
 
@@ -179,18 +184,25 @@ def read_csv(
     source : str, optional
         The name messages give the file (an upload's name when ``path`` is a temporary
         copy); ``path`` by default.
+    columns : ColumnChoice, optional
+        The column naming each row's group and the columns left out; targets are chosen
+        among all the file's columns, and may be neither.
 
     Returns
     -------
     Dataset
-        ``values`` of shape (n_rows, n_columns), numeric and nominal attributes.
+        ``values`` of shape (n_rows, n_kept), numeric and nominal attributes: every
+        column but the group column and the ignored ones; ``groups`` of shape (n_rows,),
+        the group column's cells as text, when there is one.
 
     Raises
     ------
     DataFormatError
         If the file is missing, empty, has no header, duplicate or empty column names,
-        rows with another number of cells than the header, or unknown targets; the
-        error names the file and the line.
+        rows with another number of cells than the header, unknown targets, or a row
+        without a group; the error names the file and the line.
+    ColumnError
+        A column choice that does not fit the file (see :func:`plan_columns`).
 
     Warns
     -----
@@ -208,6 +220,8 @@ def read_csv(
         target_indices = resolve_targets(-1 if targets is None else targets, names)
     except ConfigurationError as error:
         raise DataFormatError(f"targets: {error}", source=source, line=header_line) from None
+    by_default = "the last column, by default" if targets is None else None
+    plan = plan_columns(names, target_indices, columns, source=source, targets_by=by_default)
     rows = records[1:]
     for line, cells in rows:
         if len(cells) != len(names):
@@ -218,11 +232,35 @@ def read_csv(
             )
     attributes = []
     lines = [line for line, _ in rows]
-    values = np.empty((len(rows), len(names)))
-    for j, name in enumerate(names):
+    values = np.empty((len(rows), len(plan.kept)))
+    for position, j in enumerate(plan.kept):
         cells = [row[j] for _, row in rows]
-        attribute, codes = _column(name, cells, lines, is_target=j in target_indices, source=source)
+        is_target = j in target_indices
+        attribute, codes = _column(names[j], cells, lines, is_target=is_target, source=source)
         attributes.append(attribute)
-        values[:, j] = codes
+        values[:, position] = codes
+    groups = None
+    if plan.group is not None:
+        cells_of = [(line, row[plan.group]) for line, row in rows]
+        groups = _group_cells(names[plan.group], cells_of, source)
     name = Path(source).stem if relation is None else relation
-    return Dataset(Schema(name, tuple(attributes), target_indices), values)
+    schema = Schema(
+        name,
+        tuple(attributes),
+        plan.target_indices,
+        group_column=None if plan.group is None else names[plan.group],
+    )
+    return Dataset(schema, values, groups=groups)
+
+
+def _group_cells(name: str, cells: list[tuple[int, str]], source: str) -> np.ndarray:
+    """The group column's cells as written, shape (n_rows,), object; each row needs one."""
+    for line, cell in cells:
+        if cell in MISSING:
+            raise DataFormatError(
+                "no group: every row needs a value in the group column",
+                source=source,
+                line=line,
+                attribute=name,
+            )
+    return np.array([cell for _, cell in cells], dtype=object)

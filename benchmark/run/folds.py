@@ -7,6 +7,11 @@ recording/session groups, a group never straddles training and test (group k-fol
 scheme used is named in :attr:`FoldPlan.scheme`, for leaderboards to say.  When the data
 cannot support the requested number of folds, the largest feasible number is used and a
 warning line says so.
+
+Leave-one-group-out (``split="leave-one-group-out"``) asks how a classifier does on a group
+it never saw (an object never grasped, a subject never recorded): as many folds as groups,
+each group the test side of one fold, in the groups' sorted order; it is deterministic, so
+it is made once, whatever the seed.
 """
 
 from __future__ import annotations
@@ -14,11 +19,17 @@ from __future__ import annotations
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 from sklearn.model_selection import GroupKFold, KFold, StratifiedGroupKFold, StratifiedKFold
 
 from touchbench.benchmark.errors import ConfigurationError
+
+#: How the instances are split: ``k-fold`` (stratified and group-aware where it can be) or
+#: one fold per group.
+Split = Literal["k-fold", "leave-one-group-out"]
+LEAVE_ONE_GROUP_OUT: Split = "leave-one-group-out"
 
 
 @dataclass(frozen=True)
@@ -52,13 +63,17 @@ class FoldPlan:
     notes : list of str
         One line per adjustment made (fewer folds, unstratified splits...).
     scheme : str
-        ``"stratified k-fold"``, ``"k-fold"`` (shuffled), ``"stratified group k-fold"``
-        or ``"group k-fold"``.
+        ``"stratified k-fold"``, ``"k-fold"`` (shuffled), ``"stratified group k-fold"``,
+        ``"group k-fold"`` or ``"leave-one-group-out over N groups"``.
+    test_groups : tuple of str or None
+        Leave-one-group-out: the group each fold tests (fold ``k`` tests
+        ``test_groups[k]``); ``None`` for k-fold.
     """
 
     folds: list[Fold]
     notes: list[str]
     scheme: str
+    test_groups: tuple[str, ...] | None = None
 
 
 def make_folds(
@@ -70,9 +85,10 @@ def make_folds(
     groups: np.ndarray | None = None,
     target_names: Sequence[str] | None = None,
     regression: bool = False,
+    split: Split = "k-fold",
 ) -> tuple[list[Fold], list[str]]:
-    """Repeated (stratified, group-aware) k-fold splits: :func:`make_fold_plan`'s folds and
-    notes."""
+    """Repeated (stratified, group-aware) k-fold splits, or leave-one-group-out:
+    :func:`make_fold_plan`'s folds and notes."""
     plan = make_fold_plan(
         Y,
         n_folds=n_folds,
@@ -81,6 +97,7 @@ def make_folds(
         groups=groups,
         target_names=target_names,
         regression=regression,
+        split=split,
     )
     return plan.folds, plan.notes
 
@@ -94,25 +111,30 @@ def make_fold_plan(
     groups: np.ndarray | None = None,
     target_names: Sequence[str] | None = None,
     regression: bool = False,
+    split: Split = "k-fold",
 ) -> FoldPlan:
-    """Repeated (stratified, group-aware) k-fold splits.
+    """Repeated (stratified, group-aware) k-fold splits, or leave-one-group-out.
 
     Parameters
     ----------
     Y : ndarray of shape (n_instances, n_targets) or (n_instances,)
         Integer target codes, or target values with ``regression``.
     n_folds : int
-        Requested number of folds (at least 2).
+        Requested number of folds (at least 2); leave-one-group-out makes one per group.
     n_repeats : int
-        Number of repetitions, each shuffled with seed ``seed + repeat``.
+        Number of repetitions, each shuffled with seed ``seed + repeat``; leave-one-group-out
+        makes one partition only.
     seed : int
         Base random seed.
     groups : ndarray of shape (n_instances,), optional
-        Recording/session id per instance; instances of a group stay together.
+        Group per instance (its recording, session, object or subject); instances of a
+        group stay together.  Leave-one-group-out needs them.
     target_names : sequence of str, optional
         Names used in messages (default ``target 1``, ``target 2``...).
     regression : bool
         Numeric targets: shuffled (group) k-fold, never stratified.
+    split : {"k-fold", "leave-one-group-out"}
+        k-fold, or one fold per group with that group on the test side.
 
     Returns
     -------
@@ -121,8 +143,8 @@ def make_fold_plan(
     Raises
     ------
     ConfigurationError
-        Empty data, a target with a single class, fewer than two instances or groups, or
-        impossible parameters.
+        Empty data, a target with a single class, fewer than two instances or groups,
+        instances without a group, or impossible parameters.
     """
     Y = np.asarray(Y)
     if Y.ndim == 1:
@@ -131,13 +153,10 @@ def make_fold_plan(
         raise ConfigurationError(f"targets must be a 2-D array, got shape {Y.shape}")
     n_instances, n_targets = Y.shape
     names = list(target_names or [f"target {t + 1}" for t in range(n_targets)])
+    if split == LEAVE_ONE_GROUP_OUT:
+        return _leave_one_group_out(Y, n_repeats, groups, names, regression=regression)
     _check_parameters(n_folds, n_repeats, n_instances, n_targets)
-    if groups is not None:
-        groups = np.asarray(groups)
-        if groups.shape != (n_instances,):
-            raise ConfigurationError(
-                f"groups must have one entry per instance ({n_instances}), got {groups.shape}"
-            )
+    groups = _checked_groups(groups, n_instances)
     notes: list[str] = []
     if regression:
         strata, stratified = np.zeros(n_instances, dtype=np.int64), False
@@ -157,6 +176,65 @@ def make_fold_plan(
     ]
     scheme = ("stratified " if stratified else "") + ("group " if groups is not None else "")
     return FoldPlan(folds, notes, scheme + "k-fold")
+
+
+def _leave_one_group_out(
+    Y: np.ndarray,
+    n_repeats: int,
+    groups: np.ndarray | None,
+    names: Sequence[str],
+    *,
+    regression: bool,
+) -> FoldPlan:
+    """One fold per group, that group on its test side, groups in sorted order."""
+    n_instances, n_targets = Y.shape
+    if groups is None:
+        raise ConfigurationError(
+            "leave-one-group-out needs groups, and the data set has none (a group column "
+            "named on import, or the recordings of an extracted data set, give them)"
+        )
+    _check_parameters(2, 1, n_instances, n_targets)  # the folds and repeats are checked below
+    if n_repeats != 1:
+        raise ConfigurationError(
+            "leave-one-group-out makes one partition, the same every time: the number of "
+            f"repeats must be 1, got {n_repeats}"
+        )
+    groups = _checked_groups(groups, n_instances)
+    assert groups is not None
+    if not regression:
+        _check_classes(Y, names)
+    labels, which = np.unique(groups, return_inverse=True)
+    if labels.size < 2:
+        raise ConfigurationError(
+            f"leave-one-group-out needs at least 2 groups; every instance is in group '{labels[0]}'"
+        )
+    everything = np.arange(n_instances, dtype=np.int64)
+    folds = [Fold(0, k, everything[which != k], everything[which == k]) for k in range(labels.size)]
+    return FoldPlan(
+        folds,
+        [],
+        f"leave-one-group-out over {labels.size} groups",
+        test_groups=tuple(str(label) for label in labels),
+    )
+
+
+def _checked_groups(groups: np.ndarray | None, n_instances: int) -> np.ndarray | None:
+    """``groups`` as an array of one group per instance, each instance with one."""
+    if groups is None:
+        return None
+    groups = np.asarray(groups)
+    if groups.shape != (n_instances,):
+        raise ConfigurationError(
+            f"groups must have one entry per instance ({n_instances}), got {groups.shape}"
+        )
+    if groups.dtype == object:
+        without = np.flatnonzero(np.array([group is None for group in groups.tolist()]))
+        if without.size:
+            raise ConfigurationError(
+                f"{without.size} instance(s) have no group (the first: instance "
+                f"{int(without[0]) + 1}); group-aware folds need one for every instance"
+            )
+    return groups
 
 
 def _check_classes(Y: np.ndarray, names: Sequence[str]) -> None:

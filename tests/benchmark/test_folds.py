@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from touchbench.benchmark.errors import ConfigurationError
-from touchbench.benchmark.run.folds import make_folds
+from touchbench.benchmark.run.folds import make_fold_plan, make_folds
 
 
 def check_partition(folds: list, n: int, n_repeats: int = 1) -> None:
@@ -65,6 +65,31 @@ def test_a_singleton_class_still_gives_two_folds_and_says_why() -> None:
         (np.array([[0], [1]]), {"n_repeats": 0}, "number of repeats must be at least 1"),
         (np.array([[0], [1], [0], [1]]), {"groups": np.zeros(4)}, "all instances belong to one"),
         (np.array([[0], [1], [0], [1]]), {"groups": np.zeros(3)}, "groups must have one entry"),
+        (
+            np.array([[0], [1], [0], [1]]),
+            {"groups": np.array(["a", None, "b", "b"], dtype=object)},
+            r"1 instance\(s\) have no group \(the first: instance 2\)",
+        ),
+        (
+            np.array([[0], [1], [0], [1]]),
+            {"split": "leave-one-group-out"},
+            "leave-one-group-out needs groups, and the data set has none",
+        ),
+        (
+            np.array([[0], [1], [0], [1]]),
+            {"split": "leave-one-group-out", "groups": np.array(["mug"] * 4)},
+            "leave-one-group-out needs at least 2 groups; every instance is in group 'mug'",
+        ),
+        (
+            np.array([[0], [1], [0], [1]]),
+            {"split": "leave-one-group-out", "groups": np.arange(4), "n_repeats": 3},
+            "the number of repeats must be 1, got 3",
+        ),
+        (
+            np.zeros((4, 1), int),
+            {"split": "leave-one-group-out", "groups": np.arange(4)},
+            "target 'target 1' has a single class",
+        ),
     ],
 )
 def test_impossible_requests_are_configuration_errors(Y, kwargs, message) -> None:
@@ -111,3 +136,29 @@ def test_multi_target_folds_fall_back_to_plain_k_fold_for_rare_combinations() ->
         "than 10 instances (plain shuffled k-fold)"
     ]
     check_partition(folds, 60)
+
+
+def test_leave_one_group_out_makes_one_fold_per_group_each_tested_once() -> None:
+    rng = np.random.default_rng(1)
+    groups = rng.permutation(np.repeat([f"subject{i:02d}" for i in range(12)], 7))
+    y = rng.integers(0, 3, size=groups.size)
+    plan = make_fold_plan(y, groups=groups, split="leave-one-group-out", n_folds=5, seed=9)
+    assert plan.scheme == "leave-one-group-out over 12 groups" and plan.notes == []
+    assert [(f.repeat, f.fold) for f in plan.folds] == [(0, k) for k in range(12)]
+    assert plan.test_groups == tuple(f"subject{i:02d}" for i in range(12))
+    check_partition(plan.folds, groups.size)
+    for fold, held_out in zip(plan.folds, plan.test_groups, strict=True):
+        assert set(groups[fold.test]) == {held_out}
+        assert held_out not in set(groups[fold.train])
+    again = make_fold_plan(y, groups=groups, split="leave-one-group-out", seed=1)
+    for a, b in zip(plan.folds, again.folds, strict=True):  # the seed changes nothing
+        np.testing.assert_array_equal(a.test, b.test)
+
+
+def test_leave_one_group_out_also_splits_numeric_targets() -> None:
+    values = np.linspace(0.0, 1.0, 20)
+    plan = make_fold_plan(
+        values, groups=np.arange(20) // 5, regression=True, split="leave-one-group-out"
+    )
+    assert plan.scheme == "leave-one-group-out over 4 groups" and len(plan.folds) == 4
+    assert plan.test_groups == ("0", "1", "2", "3")

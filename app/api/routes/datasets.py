@@ -60,12 +60,22 @@ def upload(
         ),
     ] = None,
     format: Annotated[str | None, Form(description="arff or csv (default: by the ending).")] = None,
+    groups: Annotated[
+        str | None, Form(description="The column naming each instance's group.")
+    ] = None,
+    ignore: Annotated[str | None, Form(description="Comma-separated columns to leave out.")] = None,
 ) -> ImportResult:
     """Import an uploaded file as a data set (what the CLI's import prints as JSON); nothing
     is stored if the file has an error."""
     service.settings.work_dir.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=service.settings.work_dir) as folder:
-        fields = {"name": name, "targets": targets, "format": format}
+        fields = {
+            "name": name,
+            "targets": targets,
+            "format": format,
+            "groups": groups,
+            "ignore": ignore,
+        }
         form_request(ImportRequest, file=Path(folder) / "upload", **fields)  # before saving
         path = save_upload(file, Path(folder), "upload.arff")
         request = form_request(ImportRequest, file=path, source_name=path.name, **fields)
