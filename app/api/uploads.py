@@ -1,5 +1,6 @@
-"""Uploads: a body-size limit enforced while the body streams in, uploaded files saved under
-safe names, and requests built from a form's fields."""
+"""Uploads: a body-size limit enforced while the body streams in (a lower one, and a depth
+limit, for JSON bodies), uploaded files saved under safe names, and requests built from a
+form's fields."""
 
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ from fastapi.exceptions import RequestValidationError
 from pydantic import ValidationError
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
+from touchbench.app.api.counting import check_depth
 from touchbench.app.api.errors import UploadTooLarge, error_body
 from touchbench.app.errors import USER_ERRORS, AppError, client_words
 from touchbench.app.schemas.base import Request
@@ -27,38 +29,74 @@ CHUNK = 1 << 20
 _UNSAFE = re.compile(r"[^\w.+-]+")
 
 
+class JsonTooLarge(UploadTooLarge):
+    """A JSON body larger than ``TOUCHBENCH_MAX_JSON_MB`` (answered 413 as any upload)."""
+
+    def __init__(self, limit: int) -> None:
+        Exception.__init__(
+            self,
+            f"the JSON body is larger than the limit of {limit / 2**20:g} MB (the setting "
+            "TOUCHBENCH_MAX_JSON_MB raises the limit)",
+        )
+
+
 class BodyLimit:
-    """ASGI middleware: a request body over ``limit`` bytes is refused with 413.
+    """ASGI middleware: a request body over ``limit`` bytes (``json_limit`` for a JSON
+    body) is refused with 413, and a JSON body nested too deep with 422
+    (:func:`app.api.counting.check_depth`).
 
     A declared ``Content-Length`` over the limit is refused before any byte is read; a
     body without one is counted as it arrives and refused as soon as it passes the limit,
-    so that nothing larger is ever spooled to memory or disk.
+    so that nothing larger is ever spooled to memory or disk.  A JSON body is gathered
+    here (the route reads it whole anyway) and its depth checked before the route parses
+    it.
     """
 
-    def __init__(self, app: ASGIApp, limit: int) -> None:
+    def __init__(self, app: ASGIApp, limit: int, json_limit: int | None = None) -> None:
         self.app = app
         self.limit = limit
+        self.json_limit = limit if json_limit is None else min(limit, json_limit)
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] != "http":
             await self.app(scope, receive, send)
             return
+        json_body = _is_json(scope)
+        limit = self.json_limit if json_body else self.limit
+        too_large = JsonTooLarge if json_body else UploadTooLarge
         declared = _content_length(scope)
-        if declared is not None and declared > self.limit:
-            await _refuse(send, self.limit)
+        if declared is not None and declared > limit:
+            await _refuse(send, too_large(limit))
             return
         seen = 0
+        gathered = False
 
         async def counted() -> Message:
             nonlocal seen
             message = await receive()
             if message["type"] == "http.request":
                 seen += len(message.get("body", b""))
-                if seen > self.limit:
-                    raise UploadTooLarge(self.limit)
+                if seen > limit:
+                    raise too_large(limit)
             return message
 
-        await self.app(scope, counted, send)
+        async def checked() -> Message:
+            nonlocal gathered
+            if gathered:
+                return await receive()
+            gathered = True
+            message = await counted()
+            chunks = [message.get("body", b"")]
+            while message["type"] == "http.request" and message.get("more_body", False):
+                message = await counted()
+                chunks.append(message.get("body", b""))
+            if message["type"] != "http.request":
+                return message  # the client went away
+            body = b"".join(chunks)
+            check_depth(body)
+            return {"type": "http.request", "body": body, "more_body": False}
+
+        await self.app(scope, checked if json_body else counted, send)
 
 
 def safe_name(name: str | None, fallback: str) -> str:
@@ -121,6 +159,17 @@ def form_request(kind: type[RequestType], **fields: Any) -> RequestType:
         ) from None
 
 
+def _is_json(scope: Scope) -> bool:
+    """Whether the request says its body is JSON (``application/json``, ``.../x+json``)."""
+    for key, value in scope.get("headers", ()):
+        if key == b"content-type":
+            kind = value.split(b";", 1)[0].strip().lower()
+            return kind == b"application/json" or (
+                kind.startswith(b"application/") and kind.endswith(b"+json")
+            )
+    return False
+
+
 def _content_length(scope: Scope) -> int | None:
     for key, value in scope.get("headers", ()):
         if key == b"content-length":
@@ -131,9 +180,8 @@ def _content_length(scope: Scope) -> int | None:
     return None
 
 
-async def _refuse(send: Send, limit: int) -> None:
-
-    body: Any = json.dumps(error_body("UploadTooLarge", str(UploadTooLarge(limit)), "body"))
+async def _refuse(send: Send, error: UploadTooLarge) -> None:
+    body: Any = json.dumps(error_body("UploadTooLarge", str(error), "body"))
     await send(
         {
             "type": "http.response.start",
