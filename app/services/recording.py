@@ -110,7 +110,7 @@ def _check_header(labels_path: Path, targets: list[str]) -> list[str]:
         try:
             with labels_path.open(newline="", encoding="utf-8") as handle:
                 lines = bounded_lines(handle, limit=LINE_CHARS, source=str(labels_path))
-                found = next(csv.reader(lines), [])  # type: ignore[arg-type]
+                found = next(csv.reader(lines), [])
         except csv.Error as error:
             raise AppError(f"{labels_path}: {csv_problem(error)} on its first line") from None
         except LineTooLongError as error:
