@@ -14,18 +14,22 @@ out, with one note counting them (a session's labels used for some of its takes)
 values stay declared.
 
 A labels file is read as recordings are (:mod:`drivers.limits`): row by row, a line too
-long refused as it streams in, and at most ``TOUCHBENCH_MAX_LABEL_ROWS`` rows, so that its
-work and memory follow the rows a session can have, not the file's size.
+long refused as it streams in, and at most ``TOUCHBENCH_MAX_LABEL_ROWS`` rows (its lines
+are counted first, in C, so that a file of millions of rows is refused before one is
+parsed), so that its work and memory follow the rows a session can have, not the file's
+size.
 """
 
 from __future__ import annotations
 
 import csv
+import functools
 import itertools
 import math
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -39,9 +43,9 @@ _MISSING = frozenset({"", "?"})
 _SPECIAL = frozenset({"file", "start", "end"})
 
 
-@dataclass(frozen=True)
-class LabelRow:
-    """One row of a labels file: an interval (or the whole file) and its target values."""
+class LabelRow(NamedTuple):
+    """One row of a labels file: an interval (or the whole file) and its target values (a
+    named tuple: made once per row, it is much cheaper than a frozen dataclass)."""
 
     line: int
     start: float
@@ -95,6 +99,7 @@ def read_labels(path: Path, *, max_rows: int | None = None) -> LabelTable:
     source = str(path)
     line = 0
     try:
+        _check_lines(Path(path), max_rows, source)
         with Path(path).open(newline="", encoding="utf-8-sig") as handle:
             rows = _rows(handle, source)
             first = next(rows, None)
@@ -105,12 +110,7 @@ def read_labels(path: Path, *, max_rows: int | None = None) -> LabelTable:
             by_file: dict[str, list[LabelRow]] = {}
             for count, (line, row) in enumerate(rows, 1):
                 if count > max_rows:
-                    raise DataFormatError(
-                        f"more than {max_rows:,} rows, the most a labels file may have"
-                        + raised_by("label_rows"),
-                        source=source,
-                        line=line,
-                    )
+                    raise _too_many(max_rows, source, line)
                 entry = columns.row(row, source, line)
                 by_file.setdefault(entry[0], []).append(entry[1])
     except FileNotFoundError:
@@ -130,6 +130,39 @@ def read_labels(path: Path, *, max_rows: int | None = None) -> LabelTable:
     return LabelTable(
         source=source, targets=columns.targets, intervals=columns.intervals, rows=by_file
     )
+
+
+@functools.lru_cache(maxsize=4096)
+def _file_name(cell: str) -> str:
+    """The file name a cell names (folders left out); rows name few files, many times."""
+    return Path(cell.strip()).name
+
+
+def _too_many(max_rows: int, source: str, line: int | None) -> DataFormatError:
+    return DataFormatError(
+        f"more than {max_rows:,} rows, the most a labels file may have" + raised_by("label_rows"),
+        source=source,
+        line=line,
+    )
+
+
+def _check_lines(path: Path, max_rows: int, source: str) -> None:
+    """Refuse a file with more lines holding something than a header and ``max_rows``
+    rows, counted in blocks of bytes (array operations, no row parsed) before any row is
+    parsed: a file of millions of rows costs milliseconds, not a parse of its first rows
+    with the GIL held.  (A row whose quoted field holds a line break counts as two.)"""
+    lines = 0
+    before = np.frombuffer(b"\n", dtype=np.uint8)  # as if a line break came before the file
+    with path.open("rb") as handle:
+        for block in iter(lambda: handle.read(1 << 20), b""):
+            codes = np.frombuffer(block, dtype=np.uint8)
+            codes = np.concatenate([before, codes[codes != 13]])  # "\r\n" ends a line as "\n"
+            # a line break after something else than a line break ends a line that holds
+            # something
+            lines += int(np.count_nonzero((codes[1:] == 10) & (codes[:-1] != 10)))
+            before = codes[-1:]
+            if lines > max_rows + 1:
+                raise _too_many(max_rows, source, None)
 
 
 def _rows(handle: Iterator[str], source: str) -> Iterator[tuple[int, list[str]]]:
@@ -194,7 +227,7 @@ class _Columns:
             raise DataFormatError(
                 f"has {len(row)} fields, the header has {self.width}", source=source, line=line
             )
-        file_name = Path(row[self.file].strip()).name
+        file_name = _file_name(row[self.file])
         if not file_name:
             raise DataFormatError("empty file name", source=source, line=line, attribute="file")
         start, end = 0.0, math.inf

@@ -186,7 +186,7 @@ def test_a_labels_file_is_read_row_by_row_and_bounded(served: Server, tmp_path: 
     error = _refusal(
         _upload_session(served, many, take),
         400,
-        "many.csv:100002: more than 100,000 rows, the most a labels file may have",
+        "many.csv: more than 100,000 rows, the most a labels file may have",
         "TOUCHBENCH_MAX_LABEL_ROWS",
     )
     assert error["type"] == "DataFormatError"
