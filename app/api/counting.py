@@ -11,9 +11,10 @@ exactly.  A body too short to pass any limit is not scanned at all (a one-instan
 prediction pays nothing).  Anything else (a body that is not JSON, a field of the wrong
 type) is left to the validation that follows, which says what is wrong where.
 
-Before any of that, :func:`check_depth` refuses a JSON body nested deeper than
+Before any of that, :func:`depth_problem` finds a JSON body nested deeper than
 :data:`MAX_DEPTH` (a parser recurses once per level: 100,000 ``[`` are 200 KB that no
-parser should follow); the service's body limit calls it on every JSON body.
+parser should follow); the service's body limit refuses such a body (422) before any
+route parses it.
 """
 
 from __future__ import annotations
@@ -41,31 +42,26 @@ _OPENING = np.frombuffer(b"[{", dtype=np.uint8)
 _CLOSING = np.frombuffer(b"]}", dtype=np.uint8)
 
 
-def check_depth(body: bytes, *, max_depth: int = MAX_DEPTH) -> None:
-    """Refuse a JSON body whose objects and lists nest deeper than ``max_depth``.
+def depth_problem(body: bytes, *, max_depth: int = MAX_DEPTH) -> str | None:
+    """What is wrong with a JSON body whose objects and lists nest deeper than
+    ``max_depth``; None when they do not.
 
     Brackets inside strings do not count; the scan is a regular expression and array
     operations over the body's brackets, so its cost follows the body's size, and a body
     with fewer brackets than the limit is not scanned at all.
-
-    Raises
-    ------
-    RequestValidationError
-        Located at ``body``, saying the depth reached.
     """
     if body.count(b"[") + body.count(b"{") <= max_depth:
-        return
+        return None
     bare = np.frombuffer(_STRING.sub(b'""', body), dtype=np.uint8)
     brackets = np.flatnonzero(np.isin(bare, _OPENING) | np.isin(bare, _CLOSING))
     steps = np.where(np.isin(bare[brackets], _OPENING), 1, -1).astype(np.int32)
     deepest = int(np.cumsum(steps, dtype=np.int32).max())
-    if deepest > max_depth:
-        _refuse(
-            ("body",),
-            "json_depth",
-            f"JSON nested {deepest:,} levels deep, deeper than the {max_depth} allowed "
-            "(objects and lists in one another)",
-        )
+    if deepest <= max_depth:
+        return None
+    return (
+        f"JSON nested {deepest:,} levels deep, deeper than the {max_depth} allowed (objects "
+        "and lists in one another)"
+    )
 
 
 class _NotCountedError(Exception):

@@ -17,7 +17,7 @@ from fastapi.exceptions import RequestValidationError
 from pydantic import ValidationError
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from touchbench.app.api.counting import check_depth
+from touchbench.app.api.counting import depth_problem
 from touchbench.app.api.errors import UploadTooLarge, error_body
 from touchbench.app.errors import USER_ERRORS, AppError, client_words
 from touchbench.app.schemas.base import Request
@@ -43,13 +43,13 @@ class JsonTooLarge(UploadTooLarge):
 class BodyLimit:
     """ASGI middleware: a request body over ``limit`` bytes (``json_limit`` for a JSON
     body) is refused with 413, and a JSON body nested too deep with 422
-    (:func:`app.api.counting.check_depth`).
+    (:func:`app.api.counting.depth_problem`).
 
     A declared ``Content-Length`` over the limit is refused before any byte is read; a
     body without one is counted as it arrives and refused as soon as it passes the limit,
     so that nothing larger is ever spooled to memory or disk.  A JSON body is gathered
-    here (the route reads it whole anyway) and its depth checked before the route parses
-    it.
+    here (the route reads it whole anyway), and answered here when refused: a route's
+    body parser would turn any error met reading the body into a 400.
     """
 
     def __init__(self, app: ASGIApp, limit: int, json_limit: int | None = None) -> None:
@@ -66,10 +66,12 @@ class BodyLimit:
         too_large = JsonTooLarge if json_body else UploadTooLarge
         declared = _content_length(scope)
         if declared is not None and declared > limit:
-            await _refuse(send, too_large(limit))
+            await _answer(send, 413, "UploadTooLarge", str(too_large(limit)))
+            return
+        if json_body:
+            await self._json(scope, receive, send)
             return
         seen = 0
-        gathered = False
 
         async def counted() -> Message:
             nonlocal seen
@@ -80,23 +82,45 @@ class BodyLimit:
                     raise too_large(limit)
             return message
 
-        async def checked() -> Message:
-            nonlocal gathered
-            if gathered:
-                return await receive()
-            gathered = True
-            message = await counted()
-            chunks = [message.get("body", b"")]
-            while message["type"] == "http.request" and message.get("more_body", False):
-                message = await counted()
-                chunks.append(message.get("body", b""))
-            if message["type"] != "http.request":
-                return message  # the client went away
-            body = b"".join(chunks)
-            check_depth(body)
-            return {"type": "http.request", "body": body, "more_body": False}
+        await self.app(scope, counted, send)
 
-        await self.app(scope, checked if json_body else counted, send)
+    async def _json(self, scope: Scope, receive: Receive, send: Send) -> None:
+        """Gather a JSON body, refuse it when too large or too deep, else hand it on."""
+        chunks: list[bytes] = []
+        size = 0
+        while True:
+            message = await receive()
+            if message["type"] != "http.request":  # the client went away: say so onwards
+                await self.app(scope, _replayed(message, receive), send)
+                return
+            chunks.append(message.get("body", b""))
+            size += len(chunks[-1])
+            if size > self.json_limit:
+                await _answer(send, 413, "UploadTooLarge", str(JsonTooLarge(self.json_limit)))
+                return
+            if not message.get("more_body", False):
+                break
+        body = b"".join(chunks)
+        problem = depth_problem(body)
+        if problem is not None:
+            await _answer(send, 422, "ValidationError", f"body: {problem}")
+            return
+        whole = {"type": "http.request", "body": body, "more_body": False}
+        await self.app(scope, _replayed(whole, receive), send)
+
+
+def _replayed(first: Message, receive: Receive) -> Receive:
+    """``receive`` that gives ``first`` before the messages still to come."""
+    given = False
+
+    async def replay() -> Message:
+        nonlocal given
+        if given:
+            return await receive()
+        given = True
+        return first
+
+    return replay
 
 
 def safe_name(name: str | None, fallback: str) -> str:
@@ -180,12 +204,14 @@ def _content_length(scope: Scope) -> int | None:
     return None
 
 
-async def _refuse(send: Send, error: UploadTooLarge) -> None:
-    body: Any = json.dumps(error_body("UploadTooLarge", str(error), "body"))
+async def _answer(send: Send, status: int, kind: str, message: str) -> None:
+    """Answer the request here, in the service's error body, and close the connection
+    (the rest of a refused body is not read)."""
+    body: Any = json.dumps(error_body(kind, message, "body"))
     await send(
         {
             "type": "http.response.start",
-            "status": 413,
+            "status": status,
             "headers": [(b"content-type", b"application/json"), (b"connection", b"close")],
         }
     )

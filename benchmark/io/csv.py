@@ -38,8 +38,9 @@ _DELIMITERS = (",", ";", "\t")
 _SNIFF_LINES = 20
 _INTEGER = re.compile(r"[+-]?\d+")
 #: The longest line of a CSV file, in characters: a file of one long line (no line break)
-#: would otherwise be parsed into millions of cells of one header row.
-MAX_LINE = 1 << 20
+#: would otherwise be parsed into millions of cells of one header row.  Rows of sequence
+#: data sets are long (44 channels x 800 steps are about 700 KB), hence the room.
+MAX_LINE = 8 << 20
 _LONG_LINE = re.compile(rf"[^\n]{{{MAX_LINE + 1}}}")
 
 Record = tuple[int, list[str]]

@@ -160,7 +160,14 @@ def test_a_20_mb_csv_of_one_line_is_refused_as_it_streams_in(
     )
     with path.open("rb") as handle:
         imported = served.client.post("/api/datasets", files={"file": (path.name, handle)})
-    _refusal(imported, 400, "one-line.csv:1: a line longer than 1,048,576 characters")
+    _refusal(imported, 400, "one-line.csv:1: a line longer than 8,388,608 characters")
+    arff = tmp_path / "one-line.arff"
+    arff.write_bytes(b"@relation r\n@attribute a numeric\n@attribute c {x,y}\n@data\n")
+    with arff.open("ab") as out:
+        out.write(path.read_bytes())
+    with arff.open("rb") as handle:
+        imported = served.client.post("/api/datasets", files={"file": (arff.name, handle)})
+    _refusal(imported, 400, "one-line.arff:5: a line longer than 8,388,608 bytes")
     _within_bound(served)
 
 
