@@ -31,6 +31,7 @@ from touchbench.app.trust import (
     read_keys,
     read_origins,
 )
+from touchbench.drivers.limits import CELLS, GAP_SAMPLES
 
 __all__ = ["ApiKey", "Role", "Settings", "SettingsError", "get_settings", "variable"]
 
@@ -105,13 +106,13 @@ class Settings(BaseSettings):
         "among them counts as its channels.",
     )
     max_cells: int = Field(
-        default=2**25,
+        default=CELLS,
         ge=1000,
         description="Most values a data set (instances x attributes) or one recording "
         "(samples x channels, as read, resampled or padded) may hold.",
     )
     max_gap_samples: int = Field(
-        default=100_000,
+        default=GAP_SAMPLES,
         ge=1,
         description="Most samples resampling may put between two consecutive time stamps.",
     )

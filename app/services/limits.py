@@ -44,7 +44,7 @@ class DatasetLimits:
 
     targets: int
     attributes: int
-    cells: int = 2**25
+    cells: int
 
     @classmethod
     def configured(cls) -> DatasetLimits:
