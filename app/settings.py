@@ -31,6 +31,7 @@ from touchbench.app.trust import (
     read_keys,
     read_origins,
 )
+from touchbench.drivers.limits import CELLS, GAP_SAMPLES
 
 __all__ = ["ApiKey", "Role", "Settings", "SettingsError", "get_settings", "variable"]
 
@@ -101,7 +102,25 @@ class Settings(BaseSettings):
     max_attributes: int = Field(
         default=20000,
         ge=2,
-        description="Most attributes (targets and features) a data set may have.",
+        description="Most attributes (targets and features) a data set may have; a sequence "
+        "among them counts as its channels.",
+    )
+    max_cells: int = Field(
+        default=CELLS,
+        ge=1000,
+        description="Most values a data set (instances x attributes) or one recording "
+        "(samples x channels, as read, resampled or padded) may hold.",
+    )
+    max_gap_samples: int = Field(
+        default=GAP_SAMPLES,
+        ge=1,
+        description="Most samples resampling may put between two consecutive time stamps.",
+    )
+    max_label_rows: int = Field(default=100_000, ge=1, description="Most rows of a labels file.")
+    max_json_mb: float = Field(
+        default=16.0,
+        gt=0,
+        description="Largest JSON body, enforced while it streams in.",
     )
     job_workers: int = Field(
         default=1,
@@ -149,6 +168,10 @@ class Settings(BaseSettings):
     @property
     def max_upload_bytes(self) -> int:
         return int(self.max_upload_mb * 2**20)
+
+    @property
+    def max_json_bytes(self) -> int:
+        return int(self.max_json_mb * 2**20)
 
     @cached_property
     def keyring(self) -> tuple[ApiKey, ...]:

@@ -28,7 +28,8 @@ import numpy as np
 
 from touchbench.drivers.bag_reader import close_bag, field_specs, raw_messages, reason
 from touchbench.drivers.errors import DriverError
-from touchbench.drivers.resample import EvenResampler, jitter_note, median_rate
+from touchbench.drivers.limits import ReadLimits
+from touchbench.drivers.resample import EvenResampler, check_grid, jitter_note, median_rate
 from touchbench.drivers.source import Block, Source
 
 #: ROS base types read as numbers.
@@ -195,6 +196,7 @@ class BagFieldsSource(Source):
         name: str,
         fields: Sequence[str] | None = None,
         samplerate: float | None = None,
+        limits: ReadLimits | None = None,
     ) -> None:
         self._reader = reader
         self._connection = connection
@@ -218,6 +220,15 @@ class BagFieldsSource(Source):
             self.resampled = not samplerate
             self.start_time = float(times[0])
             self._times = times
+            numbers = np.flatnonzero(self._keep) + 1
+            check_grid(
+                times,
+                self.samplerate,
+                self.n_channels,
+                limits or ReadLimits(),
+                at=lambda i: f"{where}: message {numbers[i]}'s stamp jumps",
+                before="the message before",
+            )
             note = jitter_note(times, self.samplerate, what=f"stamps of '{connection.topic}'")
             self.notes += [note] if note else []
         except BaseException:

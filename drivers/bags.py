@@ -38,6 +38,7 @@ from touchbench.drivers.bag_reader import (
     topic_listing,
 )
 from touchbench.drivers.errors import DriverError
+from touchbench.drivers.limits import ReadLimits
 from touchbench.drivers.mp3 import Mp3Decoder, looks_like_mp3
 from touchbench.drivers.pcm import SAMPLE_FORMATS, decode_pcm
 from touchbench.drivers.source import Block, Source
@@ -62,6 +63,7 @@ def open_bag_source(
     samplerate: float | None = None,
     channels: int | None = None,
     sample_format: str | None = None,
+    limits: ReadLimits | None = None,
 ) -> Source:
     """The source a bag holds: audio, or the numeric fields of a topic.
 
@@ -81,6 +83,8 @@ def open_bag_source(
         Fields: the even grid's rate (default: the median rate of the stamps).
     channels, sample_format : optional
         Raw PCM without ``AudioInfo``: channels per frame, ``S16LE``/``S32LE``/``F32LE``.
+    limits : ReadLimits, optional
+        The bounds of putting fields on an even grid (:func:`drivers.resample.check_grid`).
     """
     name = str(path)
     reader = open_bag(Path(path))
@@ -120,7 +124,9 @@ def open_bag_source(
                 f"{name}: `{given[0]}` applies to audio, and topic '{topic}' is read for its "
                 "numeric fields"
             )
-        return BagFieldsSource(reader, chosen[0], name=name, fields=fields, samplerate=samplerate)
+        return BagFieldsSource(
+            reader, chosen[0], name=name, fields=fields, samplerate=samplerate, limits=limits
+        )
     except BaseException:
         close_bag(reader)
         raise

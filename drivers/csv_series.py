@@ -13,6 +13,10 @@
 * With a time column, a row equal to the one before in every column (a sample logged
   twice) is left out with a note; the same stamp with other values is refused.
 * ``channels`` picks columns by name (or 1-based number among the channels).
+* Work follows the file's size, not what its values say (:class:`drivers.limits.ReadLimits`):
+  a line too long is refused as it streams in, the values read or resampled are bounded,
+  and a gap between stamps that resampling would fill with too many samples is refused,
+  naming its line; so are stamps that are NaN, infinite or do not rise.
 
 Every problem is a :class:`~drivers.errors.DriverError` naming the file, and the line
 and column where there is one.
@@ -29,7 +33,8 @@ from pathlib import Path
 import numpy as np
 
 from touchbench.drivers.errors import DriverError
-from touchbench.drivers.resample import jitter_of, resample_even
+from touchbench.drivers.limits import ReadLimits, bounded_lines
+from touchbench.drivers.resample import check_grid, jitter_of, resample_even
 
 #: Names of a time column, lower case: the common ones and those ROS tools write
 #: (``rostopic echo -p`` writes ``%time`` and ``field.header.stamp``, in nanoseconds).
@@ -97,6 +102,7 @@ def read_csv_series(
     time_column: str | None = None,
     time_unit: str = "auto",
     channels: Sequence[str] | None = None,
+    limits: ReadLimits | None = None,
 ) -> CsvSeries:
     """Read a CSV time series (see the module docstring).
 
@@ -113,8 +119,16 @@ def read_csv_series(
         The time column's unit; ``auto``: seconds or nanoseconds, by magnitude.
     channels : sequence of str, optional
         The columns to keep as channels, by name or 1-based number; all by default.
+    limits : ReadLimits, optional
+        The bounds of the work (by default :class:`~drivers.limits.ReadLimits`'s).
+
+    Raises
+    ------
+    DriverError
+        Naming the file, and the line where there is one.
     """
-    header, values, lines = _read_table(path)
+    limits = limits or ReadLimits()
+    header, values, lines = _read_table(path, limits)
     names = header if header is not None else [f"column {i + 1}" for i in range(values.shape[1])]
     time = _time_column(path, header, time_column)
     signal = [i for i in range(len(names)) if i != time]
@@ -133,8 +147,11 @@ def read_csv_series(
             f"{int(lines[repeats][0])}): left out as logged twice"
         )
         values, samples, lines = values[~repeats], samples[~repeats], lines[~repeats]
+    _check_stamps(path, names[time], values[:, time], lines)
     times, unit = stamps_in_seconds(values[:, time], time_unit)
-    rate, samples, notes = _on_even_grid(path, names[time], times, lines, samples, samplerate)
+    rate, samples, notes = _on_even_grid(
+        path, names[time], times, lines, samples, samplerate, limits
+    )
     resampled = samplerate is None and bool(notes)  # the grid's notes only
     if repeated is not None:
         notes.insert(0, repeated)
@@ -172,21 +189,22 @@ def stamps_in_seconds(stamps: np.ndarray, unit: str = "auto") -> tuple[np.ndarra
 ROWS_PER_BLOCK = 4096
 
 
-def _read_table(path: Path) -> tuple[list[str] | None, np.ndarray, np.ndarray]:
+def _read_table(path: Path, limits: ReadLimits) -> tuple[list[str] | None, np.ndarray, np.ndarray]:
     """The header (None if the first row is numbers), every cell as a float of shape
     (n_rows, n_columns), and each row's line number, shape (n_rows,).
 
     A trailing empty field (a delimiter at the end of the row) is removed.  Rows are
-    converted as they are read, so memory holds the numbers, not the text.
+    converted as they are read, so memory holds the numbers, not the text; a line longer
+    than ``limits.line_chars``, or more values than ``limits.cells``, is refused there.
     """
+    numbers: list[int] = []
     try:
         with path.open(newline="", encoding="utf-8-sig") as handle:
             dialect = csv.excel_tab if path.suffix.lower() == ".tsv" else csv.excel
-            rows = (
-                (number, row)
-                for number, row in enumerate(csv.reader(handle, dialect), 1)
-                if any(cell.strip() for cell in row)
+            reader = csv.reader(
+                bounded_lines(handle, limit=limits.line_chars, source=str(path)), dialect
             )
+            rows = ((reader.line_num, row) for row in reader if any(cell.strip() for cell in row))
             first = next(rows, None)
             if first is None:
                 raise DriverError(f"{path}: the recording has no samples")
@@ -199,10 +217,12 @@ def _read_table(path: Path) -> tuple[list[str] | None, np.ndarray, np.ndarray]:
                 header = header[:-1]
             width = len(header) if header is not None else len(_trimmed(first[1]))
             names = header or [f"column {i + 1}" for i in range(width)]
-            blocks, numbers, block = [], [], []
+            blocks, block = [], []
             for number, row in itertools.chain(pending, rows):
                 block.append(_row_values(path, names, number, _trimmed(row, width)))
                 numbers.append(number)
+                if len(numbers) * width > limits.cells:
+                    limits.check_cells(len(numbers), width, what=f"{path}:{number}")
                 if len(block) == ROWS_PER_BLOCK:
                     blocks.append(np.array(block))
                     block = []
@@ -290,6 +310,17 @@ def _repeated_rows(values: np.ndarray) -> np.ndarray:
     return repeats
 
 
+def _check_stamps(path: Path, name: str, stamps: np.ndarray, lines: np.ndarray) -> None:
+    """Refuse a stamp of shape (n,) that is NaN or infinite, naming its line."""
+    bad = ~np.isfinite(stamps)
+    if bad.any():
+        index = int(np.flatnonzero(bad)[0])
+        raise DriverError(
+            f"{path}:{lines[index]}: column '{name}': {float(stamps[index])} is not a time "
+            "(NaN or infinite)"
+        )
+
+
 def _on_even_grid(
     path: Path,
     name: str,
@@ -297,13 +328,14 @@ def _on_even_grid(
     lines: np.ndarray,
     samples: np.ndarray,
     samplerate: float | None,
+    limits: ReadLimits,
 ) -> tuple[float, np.ndarray, list[str]]:
     """The rate and the samples of shape (n, n_channels) on an even grid, and notes."""
     if times.size < 2:
         raise DriverError(f"{path}: column '{name}' needs at least two times to give a rate")
     steps = np.diff(times)
     if not (steps > 0).all():
-        index = int(np.flatnonzero(steps <= 0)[0]) + 1
+        index = int(np.flatnonzero(~(steps > 0))[0]) + 1
         raise DriverError(
             f"{path}:{lines[index]}: column '{name}': the time does not rise over the line before"
         )
@@ -315,6 +347,14 @@ def _on_even_grid(
         return samplerate, samples, []
     jitter = jitter_of(times)
     rate = samplerate if samplerate is not None else jitter.rate
+    check_grid(
+        times,
+        rate,
+        samples.shape[1],
+        limits,
+        at=lambda index: f"{path}:{lines[index]}: column '{name}' jumps",
+        before="the line before",
+    )
     resampled = resample_even(times, samples.T, rate).T
     note = (
         f"column '{name}': {jitter.describe()}; {times.size} samples resampled to "

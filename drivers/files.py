@@ -23,6 +23,7 @@ import soundfile
 
 from touchbench.drivers.csv_series import read_csv_series
 from touchbench.drivers.errors import DriverError
+from touchbench.drivers.limits import ReadLimits
 from touchbench.drivers.recording import Recording
 
 _CSV_SUFFIXES = frozenset({".csv", ".tsv", ".txt"})
@@ -35,6 +36,7 @@ def read_recording(
     time_column: str | None = None,
     time_unit: str = "auto",
     fields: Sequence[str] | None = None,
+    limits: ReadLimits | None = None,
 ) -> Recording:
     """Read one recording, choosing the reader by the file's suffix.
 
@@ -52,6 +54,8 @@ def read_recording(
         The unit of a CSV file's time column (``auto``: seconds or nanoseconds).
     fields : sequence of str, optional
         The CSV columns to keep as channels (names, or 1-based numbers); all by default.
+    limits : ReadLimits, optional
+        The bounds of reading a CSV file (:mod:`drivers.limits`).
 
     Returns
     -------
@@ -85,6 +89,7 @@ def read_recording(
             time_column=time_column,
             time_unit=time_unit,
             channels=fields,
+            limits=limits,
         )
         samples, rate, names, notes = (
             series.samples,

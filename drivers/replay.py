@@ -20,6 +20,7 @@ import soundfile
 
 from touchbench.drivers.errors import DriverError
 from touchbench.drivers.files import check_rate, no_sample_rate, open_npy, read_recording
+from touchbench.drivers.limits import ReadLimits
 from touchbench.drivers.source import Block, RecordingSource, Source, check_finite, paced
 
 CSV_SUFFIXES = frozenset({".csv", ".tsv", ".txt"})
@@ -56,6 +57,9 @@ class FileReplaySource(Source):
     channels, sample_format : optional
         Raw PCM audio of a bag without ``AudioInfo``: channels per frame and
         ``S16LE``/``S32LE``/``F32LE``.
+    limits : ReadLimits, optional
+        The bounds of reading (:mod:`drivers.limits`): a CSV file's lines and values, and
+        the gaps resampling fills (CSV files and bag fields).
     """
 
     def __init__(
@@ -71,6 +75,7 @@ class FileReplaySource(Source):
         sample_format: str | None = None,
         time_column: str | None = None,
         time_unit: str = "auto",
+        limits: ReadLimits | None = None,
     ) -> None:
         self.path = Path(path)
         self.name = str(path)
@@ -109,6 +114,7 @@ class FileReplaySource(Source):
                 samplerate=samplerate,
                 channels=channels,
                 sample_format=sample_format,
+                limits=limits,
             )
             self._inner, self._start = bag, float(getattr(bag, "start_time", 0.0))
             rate: float | None = bag.samplerate
@@ -123,6 +129,7 @@ class FileReplaySource(Source):
                 time_column=time_column,
                 time_unit=time_unit,
                 fields=fields,
+                limits=limits,
             )
             inner = RecordingSource(recording, block_length=block_length)
             self._inner, self.channel_names, self.notes = inner, inner.channel_names, inner.notes

@@ -12,11 +12,13 @@ precise mean rate, the jitter, the gaps).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from touchbench.drivers.errors import DriverError
+from touchbench.drivers.limits import ReadLimits
 
 #: Steps within this fraction of the median step count as even (no note).
 EVEN = 0.01
@@ -64,6 +66,60 @@ def resample_even(times: np.ndarray, values: np.ndarray, rate: float) -> np.ndar
     if times.size == 0:
         return np.zeros((values.shape[0], 0))
     return EvenResampler(float(times[0]), rate).feed(times, values)
+
+
+def check_grid(
+    times: np.ndarray,
+    rate: float,
+    n_channels: int,
+    limits: ReadLimits,
+    *,
+    at: Callable[[int], str],
+    before: str,
+) -> None:
+    """Refuse to put rising ``times`` onto a grid at ``rate`` when it would fill one gap
+    with more than ``limits.gap_samples`` samples or hold more than ``limits.cells``
+    values: checked before any of it is made, so that the work follows the number of
+    stamps, not what they say.
+
+    Parameters
+    ----------
+    times : ndarray of shape (n,)
+        Seconds, strictly rising.
+    rate : float
+        The grid's samples per second.
+    n_channels : int
+    limits : ReadLimits
+    at : callable
+        ``at(index)``: where the stamp ``times[index]`` is, as the message's start
+        (``"take.csv:4: column 'time' jumps"``).
+    before : str
+        What the stamp before it is called (``"the line before"``).
+
+    Raises
+    ------
+    DriverError
+        One line naming the longest gap, where it is and how many samples it would make.
+    """
+    if times.size < 2:
+        return
+    steps = np.diff(times)
+    index = int(np.argmax(steps))
+    gap = float(steps[index])
+    where = f"{at(index + 1)} {gap:.6g} s over {before}: resampling at {rate:.6g} Hz"
+    if gap * rate > limits.gap_samples:
+        raise DriverError(
+            f"{where} would fill that gap with {gap * rate:,.0f} samples, more than the "
+            f"{limits.gap_samples:,} allowed{limits.raised_by('gap_samples')}; split the "
+            "recording at the gap"
+        )
+    total = int(np.floor((times[-1] - times[0]) * rate + 1e-9)) + 1
+    if total * n_channels > limits.cells:
+        raise DriverError(
+            f"{where} would make {total:,} samples x {n_channels:,} channel(s) of "
+            f"{times.size:,} stamps, more than the {limits.cells:,} values a recording may "
+            f"hold{limits.raised_by('cells')}"
+        )
 
 
 class EvenResampler:

@@ -10,6 +10,11 @@ allowed, or another kind of item, is decoded (the standard library's C decoder) 
 exactly.  A body too short to pass any limit is not scanned at all (a one-instance
 prediction pays nothing).  Anything else (a body that is not JSON, a field of the wrong
 type) is left to the validation that follows, which says what is wrong where.
+
+Before any of that, :func:`depth_problem` finds a JSON body nested deeper than
+:data:`MAX_DEPTH` (a parser recurses once per level: 100,000 ``[`` are 200 KB that no
+parser should follow); the service's body limit refuses such a body (422) before any
+route parses it.
 """
 
 from __future__ import annotations
@@ -18,6 +23,7 @@ import json
 import re
 from typing import Any
 
+import numpy as np
 from annotated_types import MaxLen
 from fastapi.exceptions import RequestValidationError
 from pydantic import BaseModel
@@ -26,6 +32,36 @@ _SPACE = re.compile(r"[ \t\n\r]*")
 _DECODER = json.JSONDecoder()
 #: An object whose values are strings, numbers, booleans or null (no nested object or list).
 _FLAT_OBJECT = re.compile(r'\{(?:[^"{}\[\]]++|"(?:[^"\\]++|\\.)*+")*+\}')
+
+
+#: The deepest nesting of objects and lists a JSON body may have.
+MAX_DEPTH = 64
+#: A JSON string, escapes included (possessive: a long string is one step of the engine).
+_STRING = re.compile(rb'"(?:[^"\\]++|\\.)*+"')
+_OPENING = np.frombuffer(b"[{", dtype=np.uint8)
+_CLOSING = np.frombuffer(b"]}", dtype=np.uint8)
+
+
+def depth_problem(body: bytes, *, max_depth: int = MAX_DEPTH) -> str | None:
+    """What is wrong with a JSON body whose objects and lists nest deeper than
+    ``max_depth``; None when they do not.
+
+    Brackets inside strings do not count; the scan is a regular expression and array
+    operations over the body's brackets, so its cost follows the body's size, and a body
+    with fewer brackets than the limit is not scanned at all.
+    """
+    if body.count(b"[") + body.count(b"{") <= max_depth:
+        return None
+    bare = np.frombuffer(_STRING.sub(b'""', body), dtype=np.uint8)
+    brackets = np.flatnonzero(np.isin(bare, _OPENING) | np.isin(bare, _CLOSING))
+    steps = np.where(np.isin(bare[brackets], _OPENING), 1, -1).astype(np.int32)
+    deepest = int(np.cumsum(steps, dtype=np.int32).max())
+    if deepest <= max_depth:
+        return None
+    return (
+        f"JSON nested {deepest:,} levels deep, deeper than the {max_depth} allowed (objects "
+        "and lists in one another)"
+    )
 
 
 class _NotCountedError(Exception):
@@ -66,7 +102,13 @@ def check_counts(body: bytes, lists: dict[str, int], *, max_keys: int) -> None:
         return
     try:
         _scan(body.decode("utf-8"), lists, max_keys)
-    except (_NotCountedError, UnicodeDecodeError, json.JSONDecodeError, IndexError):
+    except (
+        _NotCountedError,
+        UnicodeDecodeError,
+        json.JSONDecodeError,
+        IndexError,
+        RecursionError,
+    ):
         return  # not the object expected: the validation says what is wrong
 
 

@@ -27,7 +27,9 @@ def install(app: FastAPI, settings: Settings) -> None:
     """Add the API's routes (behind the API key but for health and the live WebSocket, which
     checks it itself), its error handlers and the upload limit to ``app``."""
     errors.install(app)
-    app.add_middleware(BodyLimit, limit=settings.max_upload_bytes)
+    app.add_middleware(
+        BodyLimit, limit=settings.max_upload_bytes, json_limit=settings.max_json_bytes
+    )
     protected = [Depends(require_api_key)]
     app.include_router(health.router)
     app.include_router(live.router)  # checks the API key itself: see its module

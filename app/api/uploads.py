@@ -1,5 +1,6 @@
-"""Uploads: a body-size limit enforced while the body streams in, uploaded files saved under
-safe names, and requests built from a form's fields."""
+"""Uploads: a body-size limit enforced while the body streams in (a lower one, and a depth
+limit, for JSON bodies), uploaded files saved under safe names, and requests built from a
+form's fields."""
 
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ from fastapi.exceptions import RequestValidationError
 from pydantic import ValidationError
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
+from touchbench.app.api.counting import depth_problem
 from touchbench.app.api.errors import UploadTooLarge, error_body
 from touchbench.app.errors import USER_ERRORS, AppError, client_words
 from touchbench.app.schemas.base import Request
@@ -27,25 +29,47 @@ CHUNK = 1 << 20
 _UNSAFE = re.compile(r"[^\w.+-]+")
 
 
+class JsonTooLarge(UploadTooLarge):
+    """A JSON body larger than ``TOUCHBENCH_MAX_JSON_MB`` (answered 413 as any upload)."""
+
+    def __init__(self, limit: int) -> None:
+        Exception.__init__(
+            self,
+            f"the JSON body is larger than the limit of {limit / 2**20:g} MB (the setting "
+            "TOUCHBENCH_MAX_JSON_MB raises the limit)",
+        )
+
+
 class BodyLimit:
-    """ASGI middleware: a request body over ``limit`` bytes is refused with 413.
+    """ASGI middleware: a request body over ``limit`` bytes (``json_limit`` for a JSON
+    body) is refused with 413, and a JSON body nested too deep with 422
+    (:func:`app.api.counting.depth_problem`).
 
     A declared ``Content-Length`` over the limit is refused before any byte is read; a
     body without one is counted as it arrives and refused as soon as it passes the limit,
-    so that nothing larger is ever spooled to memory or disk.
+    so that nothing larger is ever spooled to memory or disk.  A JSON body is gathered
+    here (the route reads it whole anyway), and answered here when refused: a route's
+    body parser would turn any error met reading the body into a 400.
     """
 
-    def __init__(self, app: ASGIApp, limit: int) -> None:
+    def __init__(self, app: ASGIApp, limit: int, json_limit: int | None = None) -> None:
         self.app = app
         self.limit = limit
+        self.json_limit = limit if json_limit is None else min(limit, json_limit)
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] != "http":
             await self.app(scope, receive, send)
             return
+        json_body = _is_json(scope)
+        limit = self.json_limit if json_body else self.limit
+        too_large = JsonTooLarge if json_body else UploadTooLarge
         declared = _content_length(scope)
-        if declared is not None and declared > self.limit:
-            await _refuse(send, self.limit)
+        if declared is not None and declared > limit:
+            await _answer(send, 413, "UploadTooLarge", str(too_large(limit)))
+            return
+        if json_body:
+            await self._json(scope, receive, send)
             return
         seen = 0
 
@@ -54,11 +78,49 @@ class BodyLimit:
             message = await receive()
             if message["type"] == "http.request":
                 seen += len(message.get("body", b""))
-                if seen > self.limit:
-                    raise UploadTooLarge(self.limit)
+                if seen > limit:
+                    raise too_large(limit)
             return message
 
         await self.app(scope, counted, send)
+
+    async def _json(self, scope: Scope, receive: Receive, send: Send) -> None:
+        """Gather a JSON body, refuse it when too large or too deep, else hand it on."""
+        chunks: list[bytes] = []
+        size = 0
+        while True:
+            message = await receive()
+            if message["type"] != "http.request":  # the client went away: say so onwards
+                await self.app(scope, _replayed(message, receive), send)
+                return
+            chunks.append(message.get("body", b""))
+            size += len(chunks[-1])
+            if size > self.json_limit:
+                await _answer(send, 413, "UploadTooLarge", str(JsonTooLarge(self.json_limit)))
+                return
+            if not message.get("more_body", False):
+                break
+        body = b"".join(chunks)
+        problem = depth_problem(body)
+        if problem is not None:
+            await _answer(send, 422, "ValidationError", f"body: {problem}")
+            return
+        whole = {"type": "http.request", "body": body, "more_body": False}
+        await self.app(scope, _replayed(whole, receive), send)
+
+
+def _replayed(first: Message, receive: Receive) -> Receive:
+    """``receive`` that gives ``first`` before the messages still to come."""
+    given = False
+
+    async def replay() -> Message:
+        nonlocal given
+        if given:
+            return await receive()
+        given = True
+        return first
+
+    return replay
 
 
 def safe_name(name: str | None, fallback: str) -> str:
@@ -121,6 +183,17 @@ def form_request(kind: type[RequestType], **fields: Any) -> RequestType:
         ) from None
 
 
+def _is_json(scope: Scope) -> bool:
+    """Whether the request says its body is JSON (``application/json``, ``.../x+json``)."""
+    for key, value in scope.get("headers", ()):
+        if key == b"content-type":
+            kind = value.split(b";", 1)[0].strip().lower()
+            return kind == b"application/json" or (
+                kind.startswith(b"application/") and kind.endswith(b"+json")
+            )
+    return False
+
+
 def _content_length(scope: Scope) -> int | None:
     for key, value in scope.get("headers", ()):
         if key == b"content-length":
@@ -131,13 +204,14 @@ def _content_length(scope: Scope) -> int | None:
     return None
 
 
-async def _refuse(send: Send, limit: int) -> None:
-
-    body: Any = json.dumps(error_body("UploadTooLarge", str(UploadTooLarge(limit)), "body"))
+async def _answer(send: Send, status: int, kind: str, message: str) -> None:
+    """Answer the request here, in the service's error body, and close the connection
+    (the rest of a refused body is not read)."""
+    body: Any = json.dumps(error_body(kind, message, "body"))
     await send(
         {
             "type": "http.response.start",
-            "status": 413,
+            "status": status,
             "headers": [(b"content-type", b"application/json"), (b"connection", b"close")],
         }
     )

@@ -2,7 +2,8 @@
 of the others ("and 19,980 more").
 
 A data set may have hundreds of targets and thousands of attributes, a target thousands of
-classes, and the store thousands of runs.  Whatever it holds, a fragment or a plot shows at
+classes, a run thousands of classifiers (an imported results file), and the store
+thousands of runs.  Whatever it holds, a fragment or a plot shows at
 most these many of each, so that drawing and rendering cost a bounded time and memory (a
 plot with a panel per target grew faster than the square of the targets); the JSON API and
 the CLI give everything.
@@ -28,6 +29,10 @@ CLASSES = 30
 ATTRIBUTES = 200
 #: Rows of a listing (data sets, runs, models).
 ROWS = 500
+#: Classifiers in a run's leaderboard fragment (rows of its table and of each table below).
+CLASSIFIERS = 100
+#: Classifiers drawn in a plot (one row or one dot each), the best first.
+DRAWN = 30
 
 
 @dataclass(frozen=True)

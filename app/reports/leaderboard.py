@@ -44,6 +44,7 @@ def leaderboard_rows(
     beside, a classifier that only compares by its mean has ``=`` (means only) where a
     mark would be."""
     origins = row_runs(besides)
+    notes = _has_notes(board)  # once: each row asking made the table quadratic
     out = []
     for row in board.rows:
         cells: list[Any] = [row.rank, row.classifier]
@@ -53,7 +54,7 @@ def leaderboard_rows(
         for column in columns:
             value = row.metrics.get(column)
             cells.append(mean_std(value) if isinstance(value, tuple) else "-")
-        if _has_notes(board):
+        if notes:
             cells.append(row_note(row))
         out.append(tuple(cells))
     return out

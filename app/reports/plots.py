@@ -30,7 +30,7 @@ from matplotlib.figure import Figure
 from numpy.typing import ArrayLike
 
 from touchbench.app.errors import AppError
-from touchbench.app.reports.bounds import CLASSES, PANELS, first, of_all
+from touchbench.app.reports.bounds import CLASSES, DRAWN, PANELS, first, of_all
 
 #: Output formats of :func:`save_figure`, by file suffix.
 FORMATS = ("svg", "png")
@@ -171,7 +171,8 @@ def fold_strip_plot(
     -------
     Figure
         Dots for folds (spread vertically so that equal scores stay visible), a bar for the
-        mean.
+        mean; the best :data:`~app.reports.bounds.DRAWN` classifiers, the title saying so
+        when there are more.
     """
     if not scores:
         raise AppError("no classifier to plot")
@@ -184,7 +185,10 @@ def fold_strip_plot(
         mean = float(finite.mean())
         return (False, mean if lower_is_better else -mean, name)
 
-    names = sorted(columns, key=key)
+    best = first(sorted(columns, key=key), DRAWN)
+    names = best.items
+    if best.more:
+        title = f"{title}\n(the best: {of_all(best, 'classifiers')})"
     figure = Figure(figsize=(7.5, 1.1 + 0.3 * len(names)), layout="constrained")
     ax = figure.add_subplot()
     jitter = np.random.default_rng(0)
@@ -327,9 +331,11 @@ def per_target_figure(
     -------
     Figure
         A dot per classifier at its mean, classifiers in the order given (a
-        leaderboard's), error bars one standard deviation.
+        leaderboard's; the first :data:`~app.reports.bounds.DRAWN`), error bars one
+        standard deviation.
     """
-    classifiers = list(summary)
+    drawn = first(list(summary), DRAWN)
+    classifiers = drawn.items
     shown = first(dict.fromkeys(t for by_target in summary.values() for t in by_target), PANELS)
     targets = shown.items
     if not classifiers or not targets:
@@ -360,7 +366,8 @@ def per_target_figure(
         ax.set_axisbelow(True)
     axes[0].set_yticks(rows, classifiers)
     axes[0].set_ylim(len(classifiers) - 0.5, -0.5)
-    _suptitle(figure, title, of_all(shown, "targets"))
+    left_out = [of_all(shown, "targets"), of_all(drawn, "classifiers")]
+    _suptitle(figure, title, "; ".join(text for text in left_out if text))
     return figure
 
 

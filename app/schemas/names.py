@@ -3,10 +3,11 @@ one (import, extraction, training, rename) and for the store that keeps it.
 
 A name is how a user finds a row again, on the command line and in a URL path
 (``/api/datasets/{name}``), so it must survive both: not empty, at most :data:`MAX_NAME`
-characters, no control characters, no spaces at its ends, no ``/`` (a path segment
-cannot hold one: ``a/b`` would be stored and never reached by name again), and not a
-number (a number is read as an id).  A model's name holds no ``@`` either: ``NAME@VERSION``
-and ``NAME@ALIAS`` name one of its versions.
+characters, no control characters nor bidirectional formatting ones (a right-to-left
+override makes ``abc\u202edcba`` list as another name), no spaces at its ends, no ``/``
+(a path segment cannot hold one: ``a/b`` would be stored and never reached by name
+again), and not a number (a number is read as an id).  A model's name holds no ``@``
+either: ``NAME@VERSION`` and ``NAME@ALIAS`` name one of its versions.
 
 An alias (``champion``) starts with a letter, so that it is never read as a version number.
 """
@@ -25,6 +26,10 @@ from touchbench.app.errors import AppError, FieldError
 MAX_NAME = 200
 #: Control characters (C0, DEL and C1).
 CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]")
+#: Characters that change how the text around them is shown rather than being shown:
+#: control characters, the bidirectional marks, embeddings, overrides and isolates, and
+#: the line and paragraph separators.
+INVISIBLE = re.compile(r"[\x00-\x1f\x7f-\x9f\u061c\u200e\u200f\u2028-\u202e\u2066-\u2069]")
 #: Characters of a name a message shows.
 _SHOWN = 40
 
@@ -50,11 +55,11 @@ def check_name(name: str, *, kind: str) -> str:
         raise AppError(
             f"a {kind} name has at most {MAX_NAME} characters; '{shown(name)}' has {len(name)}"
         )
-    control = CONTROL.search(name)
+    control = INVISIBLE.search(name)
     if control is not None:
         raise AppError(
-            f"a {kind} name cannot hold control characters: '{shown(name)}' has "
-            f"{control.group()!r} at position {control.start() + 1}"
+            f"a {kind} name cannot hold control characters, nor bidirectional formatting ones: "
+            f"'{shown(name)}' has U+{ord(control.group()):04X} at position {control.start() + 1}"
         )
     if name != name.strip():
         raise AppError(f"a {kind} name cannot start or end with spaces: '{shown(name)}'")
@@ -100,8 +105,9 @@ def check_alias(alias: str) -> str:
 
 
 def shown(text: str, limit: int = _SHOWN) -> str:
-    """``text`` for a message: control characters as ``?``, cut to ``limit`` characters."""
-    text = CONTROL.sub("?", text)
+    """``text`` for a message: control and bidirectional formatting characters as ``?``,
+    cut to ``limit`` characters."""
+    text = INVISIBLE.sub("?", text)
     return text if len(text) <= limit else text[: limit - 1] + "…"
 
 

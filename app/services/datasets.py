@@ -46,7 +46,7 @@ from touchbench.app.schemas.datasets import (
     RenameRequest,
     RenameResult,
 )
-from touchbench.app.services.limits import check_dataset_size
+from touchbench.app.services.limits import check_dataset_size, sequence_of
 from touchbench.app.services.listing import summary
 from touchbench.app.store import datasets as stored
 from touchbench.app.store.database import Store
@@ -214,7 +214,10 @@ def _columns_as_fields() -> Iterator[None]:
 
 def _check_schema(schema: Schema, source: str, notes: list[str]) -> None:
     check_dataset_size(
-        n_targets=len(schema.target_indices), n_attributes=schema.n_attributes, source=source
+        n_targets=len(schema.target_indices),
+        n_attributes=schema.n_attributes,
+        source=source,
+        sequence=sequence_of(schema.feature_names),
     )
     if not schema.feature_indices:
         raise DataFormatError(

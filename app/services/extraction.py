@@ -10,25 +10,15 @@ returned: :class:`~benchmark.errors.DataFormatError` for the labels file (with i
 line), :class:`~drivers.errors.DriverError` for a recording,
 :class:`~features.errors.FeatureError` for what the extractor or detector cannot use.
 
-Labels CSV (a header row, then one row per interval or per file)::
-
-    file,start,end,gesture,place        file,gesture,place
-    s1.wav,0.5,1.9,tap,head             s1.wav,tap,head
-
-``file`` is a recording's file name; ``start``/``end`` are seconds (for a ROS bag,
-seconds from its first message).  An instance takes
-the targets of the interval of its file it overlaps most (the earlier one on a tie);
-one that overlaps none is dropped and counted.  Without ``start``/``end``, every
-instance of a file takes that file's targets.  An empty cell or ``?`` is a missing
-target value.  Rows of recordings not given are left out, with one note counting them
-(a session's labels used for some of its takes); their values stay declared.
+The labels CSV is :mod:`app.services.labels`'s.  The data set's size is bounded
+(:mod:`app.services.limits`) before the values are made: its targets when the labels file
+is read, its attributes (a sequence counted as its channels) when the first recording
+says its channels, and its values as the instances come, each refusal naming the input
+that broke the bound.
 """
 
 from __future__ import annotations
 
-import csv
-import itertools
-import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -37,18 +27,27 @@ from typing import Any
 import numpy as np
 
 from touchbench.app.schemas.extraction import ExtractionSummary, ExtractRequest
-from touchbench.app.services.limits import check_dataset_size
+from touchbench.app.services.labels import (
+    count_label_targets,
+    few,
+    label_instances,
+    other_recordings,
+    read_labels,
+)
+from touchbench.app.services.limits import (
+    DatasetLimits,
+    check_cells,
+    check_dataset_size,
+    read_limits,
+)
 from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import add_dataset, check_dataset_name, dataset_digest
 from touchbench.benchmark.dataset import Attribute, Dataset, Schema
 from touchbench.benchmark.errors import DataFormatError
-from touchbench.benchmark.io.csv import csv_problem
 from touchbench.drivers.replay import CSV_SUFFIXES, FileReplaySource
 from touchbench.features.errors import FeatureError
 from touchbench.features.extractors import Instances
 from touchbench.features.recipe import Recipe
-
-_MISSING = frozenset({"", "?"})
 
 
 @dataclass
@@ -84,26 +83,6 @@ class ExtractionResult:
     warnings: list[str] = field(default_factory=list)
     recipe: dict[str, Any] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
-
-
-@dataclass(frozen=True)
-class LabelRow:
-    """One row of a labels file: an interval (or the whole file) and its target values."""
-
-    line: int
-    start: float
-    end: float
-    values: tuple[str | None, ...]
-
-
-@dataclass(frozen=True)
-class LabelTable:
-    """A parsed labels file: target names and rows per recording file name."""
-
-    source: str
-    targets: tuple[str, ...]
-    intervals: bool
-    rows: dict[str, list[LabelRow]]
 
 
 def extract_dataset(
@@ -177,9 +156,13 @@ def extract_dataset(
     paths = [Path(path) for path in recordings]
     by_name = _unique_names(paths)
     table = read_labels(labels) if labels is not None else None
+    limits = DatasetLimits.configured()
+    n_targets = 0 if table is None else len(table.targets)
+    if labels is not None:
+        check_dataset_size(n_targets=n_targets, source=labels.name, limits=limits)
     notes: list[str] = []
     if table is not None:
-        other = _other_recordings(table, by_name)
+        other = other_recordings(table, by_name)
         if other:
             notes.append(other)
     dataset_name = name or (labels.stem if labels is not None else paths[0].stem)
@@ -191,6 +174,8 @@ def extract_dataset(
     shape: tuple[float, int] | None = None
     names: tuple[str, ...] | None = None
     grid = samplerate
+    reading = read_limits()
+    values: _Values | None = None
 
     def open_source(path: Path) -> FileReplaySource:
         return FileReplaySource(
@@ -202,6 +187,7 @@ def extract_dataset(
             sample_format=sample_format,
             time_column=time_column,
             time_unit=time_unit,
+            limits=reading,
         )
 
     for index, path in enumerate(paths):
@@ -217,7 +203,9 @@ def extract_dataset(
                     longest = _longest(paths, open_source)
                 recipe, filled = _at_rate(recipe, source.samplerate, longest, path)
                 notes += filled
-            parts = _extract_one(recipe, source, path, on_progress)
+                values = _Values(recipe, n_targets, source.n_channels, path, limits)
+            assert values is not None
+            parts = _extract_one(recipe, source, path, on_progress, values)
             origin, rate = source.start_time, source.samplerate
         notes += [f"{path.name}: {text}" for text in source.notes]
         # Kept as the parts the stream gave, joined once into the data set itself (which
@@ -238,18 +226,13 @@ def extract_dataset(
         target_attributes: list[Attribute] = []
         codes = np.zeros((n_events, 0))
     else:
-        keep, target_attributes, codes, label_warnings = _label(table, spans, by_name)
+        keep, target_attributes, codes, label_warnings = label_instances(table, spans, by_name)
         warnings += label_warnings
         if not keep.any():
             raise DataFormatError(
                 f"none of the {n_events} instance(s) found falls inside a labelled interval",
                 source=table.source,
             )
-    check_dataset_size(
-        n_targets=len(target_attributes),
-        n_attributes=len(target_attributes) + len(feature_names),
-        source=labels.name if labels is not None else paths[0].name,
-    )
     schema = Schema(
         relation=(
             f"{dataset_name}: -C {len(target_attributes)}" if target_attributes else dataset_name
@@ -469,19 +452,81 @@ def _extract_one(
     source: FileReplaySource,
     path: Path,
     on_progress: Callable[[str, float], None] | None,
+    values: _Values,
 ) -> list[Instances]:
-    """The instances of one recording, read block by block, as the stream gave them."""
+    """The instances of one recording, read block by block, as the stream gave them;
+    refused as soon as the data set's values pass the limit."""
     try:
         stream = recipe.open(samplerate=source.samplerate, n_channels=source.n_channels)
         parts = []
         for block in source.blocks():
             parts.append(stream.feed(block.samples))
+            values.add(parts[-1].values.shape[0], path)
             if on_progress is not None:
                 on_progress(path.name, stream.position / source.samplerate)
         parts.append(stream.finish())
+        values.add(parts[-1].values.shape[0], path)
     except FeatureError as error:
         raise FeatureError(f"{path}: {error}") from None
     return parts
+
+
+@dataclass
+class _Values:
+    """The data set's size as its instances come: its attributes and one instance's values
+    checked when the first recording says its channels (before any value is made), then
+    every instance counted.
+
+    Parameters
+    ----------
+    recipe : Recipe
+        With the options that depend on the recordings filled in.
+    n_targets, n_channels : int
+    path : Path
+        The first recording.
+    limits : DatasetLimits
+
+    Raises
+    ------
+    DataFormatError
+        Naming the recording and the extractor that make too many.
+    """
+
+    recipe: Recipe
+    n_targets: int
+    n_channels: int
+    path: Path
+    limits: DatasetLimits
+    n_instances: int = 0
+
+    def __post_init__(self) -> None:
+        extractor = self.recipe.make_extractor()
+        self.width = self.n_targets + extractor.n_features(self.n_channels)
+        self.sequence = extractor.sequence_shape(self.n_channels)
+        check_dataset_size(
+            n_targets=self.n_targets,
+            n_attributes=self.width,
+            source=f"{self.path.name} ({self.n_channels} channel(s), {self._made_by})",
+            limits=self.limits,
+            sequence=self.sequence,
+        )
+        self.add(1, self.path)
+        self.n_instances = 0
+
+    @property
+    def _made_by(self) -> str:
+        return f"extractor '{self.recipe.extractor}'"
+
+    def add(self, count: int, path: Path) -> None:
+        """Count ``count`` more instances (of ``path``), refused past the values limit."""
+        self.n_instances += count
+        check_cells(
+            n_instances=self.n_instances,
+            n_attributes=self.width,
+            source=f"{path.name} ({self._made_by})",
+            limits=self.limits,
+            sequence=self.sequence,
+        )
 
 
 def _unique_names(paths: Sequence[Path]) -> dict[str, Path]:
@@ -520,8 +565,8 @@ def _same_names(
     names = None if found is None else tuple(found)
     if not first and names != expected:
         raise FeatureError(
-            f"{path}: has channels {_few(names or ('unnamed',))} but the recordings before it "
-            f"{_few(expected or ('unnamed',))}; one data set needs the same channels"
+            f"{path}: has channels {few(names or ('unnamed',))} but the recordings before it "
+            f"{few(expected or ('unnamed',))}; one data set needs the same channels"
         )
     return names
 
@@ -529,214 +574,3 @@ def _same_names(
 def _more(lines: Sequence[str]) -> str:
     """`` and N more`` for the lines after the first ("" for one)."""
     return f" and {len(lines) - 1} more" if len(lines) > 1 else ""
-
-
-def _few(names: Sequence[str], shown: int = 3) -> str:
-    """At most ``shown`` names, then how many more: messages stay one short line."""
-    text = ", ".join(str(name) for name in names[:shown])
-    return text + (f" and {len(names) - shown} more" if len(names) > shown else "")
-
-
-def count_label_targets(path: Path) -> int:
-    """How many target columns the header of a labels CSV names (the file is read up to
-    its first non-empty row only; a file that cannot be read counts 0, and
-    :func:`read_labels` says what is wrong with it)."""
-    try:
-        with Path(path).open(newline="", encoding="utf-8-sig") as handle:
-            for row in csv.reader(handle):
-                if any(cell.strip() for cell in row):
-                    special = {"file", "start", "end"}
-                    return sum(1 for cell in row if cell.strip().lower() not in special)
-    except (OSError, UnicodeDecodeError, csv.Error):
-        pass
-    return 0
-
-
-def read_labels(path: Path) -> LabelTable:
-    """Parse a labels CSV (see the module docstring).
-
-    Raises
-    ------
-    DataFormatError
-        Missing file or columns, a row of the wrong width, a bad time, a file labelled
-        twice, or overlapping intervals of one file; with the line number.
-    """
-    source = str(path)
-    lines: list[tuple[int, list[str]]] = []
-    try:
-        with Path(path).open(newline="", encoding="utf-8-sig") as handle:
-            lines.extend(enumerate(csv.reader(handle), 1))
-    except FileNotFoundError:
-        raise DataFormatError("no such labels file", source=source) from None
-    except (OSError, UnicodeDecodeError) as error:
-        raise DataFormatError(f"cannot read the labels file: {error}", source=source) from None
-    except csv.Error as error:
-        raise DataFormatError(csv_problem(error), source=source, line=len(lines) + 1) from None
-    lines = [(number, row) for number, row in lines if any(cell.strip() for cell in row)]
-    if not lines:
-        raise DataFormatError("the labels file is empty", source=source)
-    header_line, header = lines[0][0], [cell.strip() for cell in lines[0][1]]
-    columns = {cell.lower(): i for i, cell in enumerate(header)}
-    if len(columns) != len(header):
-        raise DataFormatError("a column name appears twice", source=source, line=header_line)
-    if "file" not in columns:
-        raise DataFormatError(
-            "no 'file' column (expected file,start,end,TARGET... or file,TARGET...)",
-            source=source,
-            line=header_line,
-        )
-    if ("start" in columns) != ("end" in columns):
-        missing = "end" if "start" in columns else "start"
-        raise DataFormatError(
-            f"has one of start/end but no '{missing}' column", source=source, line=header_line
-        )
-    intervals = "start" in columns
-    special = {columns["file"], *((columns["start"], columns["end"]) if intervals else ())}
-    target_columns = [i for i in range(len(header)) if i not in special]
-    if not target_columns:
-        raise DataFormatError(
-            "no target column after file" + (",start,end" if intervals else ""),
-            source=source,
-            line=header_line,
-        )
-    rows: dict[str, list[LabelRow]] = {}
-    for number, row in lines[1:]:
-        if len(row) != len(header):
-            raise DataFormatError(
-                f"has {len(row)} fields, the header has {len(header)}", source=source, line=number
-            )
-        file_name = Path(row[columns["file"]].strip()).name
-        if not file_name:
-            raise DataFormatError("empty file name", source=source, line=number, attribute="file")
-        start, end = 0.0, math.inf
-        if intervals:
-            start = _seconds(row[columns["start"]], source, number, "start")
-            end = _seconds(row[columns["end"]], source, number, "end")
-            if end <= start:
-                raise DataFormatError(
-                    f"end ({end:g}) must be after start ({start:g})", source=source, line=number
-                )
-        values = tuple(
-            None if row[i].strip() in _MISSING else row[i].strip() for i in target_columns
-        )
-        rows.setdefault(file_name, []).append(LabelRow(number, start, end, values))
-    if not rows:
-        raise DataFormatError("the labels file has a header but no rows", source=source)
-    for file_name, entries in rows.items():
-        _check_overlaps(file_name, entries, intervals, source)
-    return LabelTable(
-        source=source,
-        targets=tuple(header[i] for i in target_columns),
-        intervals=intervals,
-        rows=rows,
-    )
-
-
-def _seconds(text: str, source: str, line: int, column: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise DataFormatError(
-            f"{text.strip()!r} is not a number of seconds",
-            source=source,
-            line=line,
-            attribute=column,
-        ) from None
-    if not math.isfinite(value) or value < 0:
-        raise DataFormatError(
-            f"{text.strip()!r} is not a time of at least 0 s",
-            source=source,
-            line=line,
-            attribute=column,
-        )
-    return value
-
-
-def _check_overlaps(file_name: str, entries: list[LabelRow], intervals: bool, source: str) -> None:
-    if not intervals:
-        if len(entries) > 1:
-            raise DataFormatError(
-                f"'{file_name}' is labelled again (first on line {entries[0].line})",
-                source=source,
-                line=entries[1].line,
-            )
-        return
-    ordered = sorted(entries, key=lambda entry: entry.start)
-    for before, after in itertools.pairwise(ordered):
-        if after.start < before.end:
-            first, second = sorted((before.line, after.line))
-            raise DataFormatError(
-                f"interval of '{file_name}' overlaps the one on line {first} "
-                f"({before.start:g}-{before.end:g} s and {after.start:g}-{after.end:g} s)",
-                source=source,
-                line=second,
-            )
-
-
-def _other_recordings(table: LabelTable, recordings: Mapping[str, Path]) -> str:
-    """A note counting the rows of recordings not given ("" if there are none): a
-    session's labels used for a subset of its takes.  Those rows label nothing, but their
-    target values stay declared, so that the data sets of a session's subsets agree.
-
-    Raises
-    ------
-    DataFormatError
-        When no row names a recording given: the labels are for other recordings.
-    """
-    other = sorted(name for name in table.rows if name not in recordings)
-    if not other:
-        return ""
-    count = sum(len(table.rows[name]) for name in other)
-    if len(other) == len(table.rows):
-        raise DataFormatError(
-            f"names none of the {len(recordings)} recording(s) given "
-            f"({_few(sorted(recordings))}); it names {_few(other)}",
-            source=table.source,
-            attribute="file",
-        )
-    return (
-        f"{Path(table.source).name}: {count} row(s) of {len(other)} recording(s) not given "
-        f"were left out ({_few(other)})"
-    )
-
-
-def _label(
-    table: LabelTable,
-    spans: Sequence[tuple[str, float, float]],
-    recordings: Mapping[str, Path],
-) -> tuple[np.ndarray, list[Attribute], np.ndarray, list[str]]:
-    """Which instances are kept, the target attributes, their codes, and warnings."""
-    chosen: list[LabelRow | None] = []
-    for file_name, start, end in spans:
-        best, best_overlap = None, 0.0
-        for row in table.rows.get(file_name, ()):
-            overlap = min(end, row.end) - max(start, row.start)
-            if overlap > best_overlap:
-                best, best_overlap = row, overlap
-        chosen.append(best)
-    labels_in_order: list[list[str]] = [[] for _ in table.targets]
-    for rows in table.rows.values():
-        for row in sorted(rows, key=lambda r: r.line):
-            for values, value in zip(labels_in_order, row.values, strict=True):
-                if value is not None and value not in values:
-                    values.append(value)
-    attributes = [
-        Attribute(target, "nominal", values=tuple(values), declared_type="nominal")
-        for target, values in zip(table.targets, labels_in_order, strict=True)
-    ]
-    codes = np.full((len(spans), len(attributes)), np.nan)
-    for i, match in enumerate(chosen):
-        if match is None:
-            continue
-        for j, value in enumerate(match.values):
-            if value is not None:
-                codes[i, j] = attributes[j].values.index(value)
-    keep = np.array([row is not None for row in chosen], dtype=bool)
-    unlabelled = [file_name for file_name in recordings if file_name not in table.rows]
-    warnings = []
-    if unlabelled:
-        warnings.append(
-            f"{len(unlabelled)} recording(s) have no labels; their instances were dropped "
-            f"({_few(unlabelled)})"
-        )
-    return keep, attributes, codes, warnings

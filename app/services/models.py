@@ -48,6 +48,7 @@ from touchbench.benchmark.dataset import Attribute, Dataset, Schema
 from touchbench.benchmark.errors import ConfigurationError, DataFormatError
 from touchbench.benchmark.model import Predictor, TrainedModel, dumps_model, fit_model, loads_model
 from touchbench.benchmark.problem import Problem, problem_from_dataset, restrict_targets
+from touchbench.drivers.limits import LINE_CHARS, LineTooLongError, bounded_lines
 
 #: Labels quoted in one warning at most.
 MAX_QUOTED = 5
@@ -384,8 +385,11 @@ def is_recording(path: Path, schema: Schema) -> bool:
         return True
     try:
         with path.open(newline="", encoding="utf-8-sig") as handle:
-            header = {cell.strip() for cell in next(csv.reader(handle), [])}
-    except (OSError, UnicodeDecodeError):
+            lines = bounded_lines(handle, limit=LINE_CHARS, source=str(path))
+            header = {cell.strip() for cell in next(csv.reader(lines), [])}
+    except LineTooLongError:
+        return True  # no header of features: the recording's reader refuses its line
+    except (OSError, UnicodeDecodeError, csv.Error):
         return False  # the data reader says what is wrong with it
     return not header & {attribute.name for attribute in schema.features}
 

@@ -4,7 +4,9 @@ A session folder holds one WAV file per take (``take-001.wav``, ...) and ``label
 (``file,TARGET...``: every touch of a take has the take's labels), which is what
 ``touchbench extract`` reads.  A take is written to ``take-NNN.wav.part`` and renamed
 when it ends, and the labels file is replaced whole, so a Ctrl-C keeps the audio so far
-and a kill at any moment leaves the labels file valid (at worst a ``.part`` file).
+and a kill at any moment leaves the labels file valid (at worst a ``.part`` file).  The
+labels file is read as a stream (its header line bounded, its rows copied block by
+block), never whole.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from __future__ import annotations
 import csv
 import io
 import os
+import shutil
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,6 +24,7 @@ import soundfile
 from touchbench.app.errors import AppError
 from touchbench.benchmark.io.csv import csv_problem
 from touchbench.drivers.errors import DriverError
+from touchbench.drivers.limits import LINE_CHARS, LineTooLongError, bounded_lines
 from touchbench.drivers.sound import SoundDeviceSource
 from touchbench.features.event_streams import open_event_stream
 
@@ -105,9 +109,12 @@ def _check_header(labels_path: Path, targets: list[str]) -> list[str]:
     if labels_path.exists():
         try:
             with labels_path.open(newline="", encoding="utf-8") as handle:
-                found = next(csv.reader(handle), [])
+                lines = bounded_lines(handle, limit=LINE_CHARS, source=str(labels_path))
+                found = next(csv.reader(lines), [])
         except csv.Error as error:
             raise AppError(f"{labels_path}: {csv_problem(error)} on its first line") from None
+        except LineTooLongError as error:
+            raise AppError(str(error)) from None
         if found != header:
             raise AppError(
                 f"{labels_path} labels takes with {','.join(found[1:]) or 'no target'}; "
@@ -125,13 +132,25 @@ def _next_take(folder: Path) -> Path:
 
 
 def _append_row(labels_path: Path, header: list[str], row: list[str]) -> None:
-    """Add a row to the labels file by replacing it whole (never half-written)."""
-    text = labels_path.read_text(encoding="utf-8") if labels_path.exists() else ""
+    """Add a row to the labels file by replacing it (never half-written): its rows are
+    copied block by block into a new file, the new row written after them."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
-    if not text:
-        writer.writerow(header)
-    writer.writerow(row)
     temporary = labels_path.with_name(labels_path.name + ".tmp")
-    temporary.write_text(text + buffer.getvalue(), encoding="utf-8")
+    with temporary.open("wb") as out:
+        if labels_path.exists():
+            with labels_path.open("rb") as old:
+                shutil.copyfileobj(old, out)
+                if out.tell() and not _ends_a_line(old):
+                    out.write(b"\n")
+        if out.tell() == 0:
+            writer.writerow(header)
+        writer.writerow(row)
+        out.write(buffer.getvalue().encode("utf-8"))
     os.replace(temporary, labels_path)
+
+
+def _ends_a_line(handle: io.BufferedReader) -> bool:
+    """Whether the file read to its end by ``handle`` ends with a line break."""
+    handle.seek(-1, os.SEEK_END)
+    return handle.read(1) in (b"\n", b"\r")

@@ -123,15 +123,12 @@ class RunView(RunLeaderboard):
         fold of repeat 1.
         """
         first = {r.key.fold for r in self.results if r.key.repeat == 0}
+        by_classifier: dict[str, list[TaskResult]] = {}  # once: not a pass per classifier
+        for r in self.results:
+            if r.key.repeat == 0 and r.ok and r.confusion is not None:
+                by_classifier.setdefault(r.key.classifier, []).append(r)
         for row in self.board.rows:
-            done = [
-                r
-                for r in self.results
-                if r.key.classifier == row.classifier
-                and r.key.repeat == 0
-                and r.ok
-                and r.confusion is not None
-            ]
+            done = by_classifier.get(row.classifier, [])
             if {r.key.fold for r in done} == first:
                 matrices = _sum_confusions(self.run, done)
                 return {

@@ -119,7 +119,9 @@ class ArffReader:
         self.scan = scan
         self.source = source
         self.parser = parser
-        self._lines = LineBlocks(stream, scan.encoding, block_bytes=block_bytes, errors=errors)
+        self._lines = LineBlocks(
+            stream, scan.encoding, block_bytes=block_bytes, errors=errors, source=source
+        )
         self.header = self._read_header()
         assert self.header.relation is not None
         names = [attribute.name for attribute in self.header.attributes]

@@ -37,6 +37,11 @@ MISSING = frozenset({"", "?", "NA", "NaN", "nan"})
 _DELIMITERS = (",", ";", "\t")
 _SNIFF_LINES = 20
 _INTEGER = re.compile(r"[+-]?\d+")
+#: The longest line of a CSV file, in characters: a file of one long line (no line break)
+#: would otherwise be parsed into millions of cells of one header row.  Rows of sequence
+#: data sets are long (44 channels x 800 steps are about 700 KB), hence the room.
+MAX_LINE = 8 << 20
+_LONG_LINE = re.compile(rf"[^\n]{{{MAX_LINE + 1}}}")
 
 Record = tuple[int, list[str]]
 
@@ -211,6 +216,13 @@ def read_csv(
     """
     text, named = read_text_file(path)
     source = source or named
+    long_line = _LONG_LINE.search(text)  # one pass in C before any cell is made
+    if long_line is not None:
+        raise DataFormatError(
+            f"a line longer than {MAX_LINE:,} characters (a file of one line?)",
+            source=source,
+            line=text.count("\n", 0, long_line.start()) + 1,
+        )
     records = _records(text, sniff_delimiter(text), source)
     if not records:
         raise DataFormatError("empty file", source=source)

@@ -31,6 +31,10 @@ from touchbench.benchmark.errors import DataFormatError
 SNIFF_BYTES = 65536
 #: Default size of the blocks of lines handed to the parsers.
 BLOCK_BYTES = 4 << 20
+#: The longest line :class:`LineBlocks` reads, in bytes: a file of one line (no line break)
+#: would otherwise be held, and then split, whole.  Rows of sequence data sets are long
+#: (44 channels x 800 steps are about 700 KB of text), hence the room.
+MAX_LINE_BYTES = 8 << 20
 _UTF16_BOMS = (b"\xff\xfe", b"\xfe\xff")
 _UTF8_BOM = b"\xef\xbb\xbf"
 _CONTROL = re.compile(r"[\x00-\x08\x0e-\x1f\x7f]")
@@ -297,6 +301,9 @@ class LineBlocks:
     errors : str
         How bytes that do not decode are handled by :meth:`decode` (``"strict"`` for
         files; text given as ``str`` comes as UTF-8 with ``"surrogatepass"``).
+    source : str, optional
+        The file's name, for the error of a line longer than :data:`MAX_LINE_BYTES`
+        (refused as soon as that many bytes hold no line break).
     """
 
     def __init__(
@@ -306,7 +313,9 @@ class LineBlocks:
         *,
         block_bytes: int = BLOCK_BYTES,
         errors: str = "strict",
+        source: str | None = None,
     ) -> None:
+        self._source = source
         self._stream = stream
         self._block_bytes = block_bytes
         self._utf16 = encoding == "utf-16"
@@ -355,6 +364,7 @@ class LineBlocks:
                 self._position = match.end()
                 self.lines_read += 1
                 return line
+            self._check_line(self._buffer, self._position)
             if not self._read():
                 if self._position >= len(self._buffer):
                     return None
@@ -379,6 +389,7 @@ class LineBlocks:
             rest = self._buffer[self._position :]
             cut = self._cut(rest)
             while cut == 0 and rest:
+                self._check_line(rest, 0)
                 self._read()
                 rest = self._buffer[self._position :]
                 cut = self._cut(rest)
@@ -389,6 +400,16 @@ class LineBlocks:
             first_line = self.lines_read + 1
             self.lines_read += count_line_ends(block)
             yield block, first_line
+
+    def _check_line(self, data: bytes, start: int) -> None:
+        """Refuse the line from ``start`` when it is longer than :data:`MAX_LINE_BYTES`
+        and has no line break yet."""
+        if len(data) - start > MAX_LINE_BYTES:
+            raise DataFormatError(
+                f"a line longer than {MAX_LINE_BYTES:,} bytes (a file of one line?)",
+                source=self._source,
+                line=self.lines_read + 1,
+            )
 
     def _cut(self, data: bytes) -> int:
         """Length of the longest prefix of whole lines (0 if there is none yet)."""

@@ -190,6 +190,16 @@ class Extractor(ABC):
         """Attribute names of the features, in order, for ``n_channels`` channels (named
         ``channels`` when the recording names them: ``t0_pac1``, ``pac1[0]``)."""
 
+    def n_features(self, n_channels: int) -> int:
+        """How many features :meth:`feature_names` names, without naming them (a window
+        padded to a long ``length`` has millions)."""
+        return len(self.feature_names(n_channels))
+
+    def sequence_shape(self, n_channels: int) -> tuple[int, int] | None:
+        """``(channels, steps)`` when each instance is a sequence (features named by
+        :func:`sequence_names`), else None."""
+        return None
+
     @abstractmethod
     def extract(self, y: np.ndarray, *, samplerate: float, detection: Detection) -> Instances:
         """Instances of the events of one recording.

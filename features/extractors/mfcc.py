@@ -76,6 +76,11 @@ class Mfcc(Extractor):
         names += [f"mfcc{q}_std" for q in range(1, count + 1)]
         return channel_suffixed(names, n_channels, channels)
 
+    def sequence_shape(self, n_channels: int) -> tuple[int, int] | None:
+        if self.params["frames"] is None:
+            return None
+        return n_channels * int(self.params["n_mfcc"]), int(self.params["frames"])
+
     def extract(self, y: np.ndarray, *, samplerate: float, detection: Detection) -> Instances:
         n_channels = y.shape[0]
         frame_length, hop_length = self.frame_length(samplerate), self.hop_length(samplerate)

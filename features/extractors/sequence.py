@@ -139,6 +139,9 @@ class Sequence(Window):
         labels = channel_labels(n_channels, channels, prefix="ch")
         return sequence_names(labels, self.params["length"])
 
+    def sequence_shape(self, n_channels: int) -> tuple[int, int] | None:
+        return n_channels, int(self.params["length"])
+
     def extract(self, y: np.ndarray, *, samplerate: float, detection: Detection) -> Instances:
         if not self.resampled:
             return super().extract(y, samplerate=samplerate, detection=detection)

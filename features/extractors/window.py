@@ -45,6 +45,11 @@ class Window(Extractor):
         names = [f"t{i}" for i in range(self.params["length"])]
         return channel_suffixed(names, n_channels, channels)
 
+    def n_features(self, n_channels: int) -> int:
+        if self.params["length"] is None:  # a sequence's, not filled in yet: say so
+            return super().n_features(n_channels)
+        return n_channels * int(self.params["length"])
+
     def pads(self) -> bool:
         """Whether an event too close to the end is padded with the last sample (else it
         is left out)."""

@@ -1,11 +1,17 @@
 """Fragments of runs: the list, a run's progress, its leaderboard (ranked by any metric,
 marked against any baseline), its plots, one classifier's confusion matrix and folds, and
-the form that starts a run."""
+the form that starts a run.
+
+A run may have thousands of classifiers (an imported results file): its fragments show the
+first of them and a count, as data set pages do (:mod:`app.reports.bounds`), and its
+plots draw the best of them with a note; the JSON API and the CLI give every one.
+"""
 
 from __future__ import annotations
 
 # Imports inside functions: start-up time: matplotlib, the catalogue and the reports load
 # when a fragment that draws or lists them is first asked for, not when the service starts.
+from dataclasses import replace
 from functools import partial
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -13,8 +19,9 @@ from fastapi import APIRouter, Query
 from fastapi.responses import HTMLResponse
 
 from touchbench.app.errors import NotFoundError
+from touchbench.app.reports import bounds
 from touchbench.app.reports.answer_tables import run_answer_tables
-from touchbench.app.reports.run_tables import run_tables
+from touchbench.app.reports.run_tables import RunTable, run_tables
 from touchbench.app.schemas.runs import FINAL_STATUSES
 from touchbench.app.services.answers import run_answers
 from touchbench.app.services.listing import list_datasets
@@ -100,7 +107,7 @@ def leaderboard(
         run=ranked.run,
         board=ranked.board,
         table=_table(ranked, chosen_baseline=baseline or None),
-        tables=run_tables(ranked.report()),
+        tables=[_first_rows(table) for table in run_tables(ranked.report())],
         answers=run_answer_tables(run_answers(store, run_id)),
         notes=ranked.notes(),
     )
@@ -136,7 +143,7 @@ def classifier(
     if classifier not in view.run.classifiers:
         raise NotFoundError(
             f"run {view.run.id} has no classifier '{classifier}' "
-            f"(classifiers: {', '.join(view.run.classifiers)})"
+            f"(classifiers: {bounds.names(view.run.classifiers)})"
         )
     row = view.board.row(classifier)
     reference = view.board.baseline or classifier
@@ -212,16 +219,44 @@ def _table(ranked: RunLeaderboard, *, chosen_baseline: str | None) -> dict[str, 
     run, board, besides = ranked.run, ranked.board, ranked.besides
     columns = metric_columns(run, board)
     metrics = sorted({name for row in board.rows for name in row.metrics})
+    rows = _first_and_baseline(leaderboard_rows(board, columns, besides), board.baseline)
+    baselines = [row.classifier for row in board.rows if row.n_ok]
     return {
         "header": leaderboard_header(board, columns, besides),
         "columns": columns,
-        "rows": leaderboard_rows(board, columns, besides),
+        "rows": rows.items,
+        "more": rows.more,
         "mark_column": 4 if besides else 3,
         "beside_notes": beside_notes(besides),
         "beside": [b.run.id for b in besides],
         "metrics": metrics,
-        "baselines": [row.classifier for row in board.rows if row.n_ok],
+        # the picker offers the classifiers shown (and the one chosen, wherever it ranks)
+        "baselines": _first_and_baseline(baselines, chosen_baseline, at=None).items,
         "dropped": [row.classifier for row in board.rows if row.dropped is not None],
         "chosen_baseline": chosen_baseline,
         "direction": "lower is better" if board.metric in LOWER_IS_BETTER else "higher is better",
     }
+
+
+def _first_and_baseline(
+    rows: list[Any], baseline: str | None, *, at: int | None = 1
+) -> bounds.Shown[Any]:
+    """The first :data:`~app.reports.bounds.CLASSIFIERS` of ``rows`` (classifiers, or
+    table rows naming one in cell ``at``), and the baseline's after them when it ranks
+    lower: the row every mark is against stays on the page."""
+    shown = bounds.first(rows, bounds.CLASSIFIERS)
+    named = (lambda row: row) if at is None else (lambda row: row[at])
+    if baseline is not None and shown.more and all(named(r) != baseline for r in shown.items):
+        extra = [row for row in rows[bounds.CLASSIFIERS :] if named(row) == baseline]
+        return bounds.Shown(shown.items + extra, shown.more - len(extra))
+    return shown
+
+
+def _first_rows(table: RunTable) -> RunTable:
+    """``table`` with its first :data:`~app.reports.bounds.CLASSIFIERS` rows, its title
+    saying how many there are."""
+    shown = bounds.first(table.rows, bounds.CLASSIFIERS)
+    if not shown.more:
+        return table
+    title = f"{table.title}; {bounds.of_all(shown, 'rows')}"
+    return replace(table, title=title, rows=shown.items)
