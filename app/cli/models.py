@@ -288,6 +288,7 @@ def alias_command(
     as_json: JsonOption = False,
 ) -> None:
     """Point an alias of a model (NAME@ALIAS) at one of its versions."""
+    from touchbench.app.schemas.references import parse_model_ref
     from touchbench.app.services.models import move_alias, remove_alias
 
     request = _alias_request(model_ref, alias)
@@ -298,7 +299,7 @@ def alias_command(
     if as_json:
         print_json(gone.to_json())
         return
-    name = gone.model.rpartition("@")[0]
+    name = parse_model_ref(gone.model).name
     info(f"deleted {name}@{gone.alias} (it pointed at version {gone.version})")
 
 

@@ -12,9 +12,10 @@ from pydantic import ConfigDict, Field, model_validator
 from touchbench.app.errors import FieldError
 from touchbench.app.schemas.base import Request, Schema
 from touchbench.app.schemas.names import AliasName, ModelName
+from touchbench.app.schemas.references import MAX_ROW_ID
 
 #: The largest id or seed (the store's integer columns are 32-bit on PostgreSQL).
-MAX_ID = 2**31 - 1
+MAX_ID = MAX_ROW_ID
 
 
 class ModelSchema(Schema):

@@ -10,23 +10,16 @@ graph of operators, not code, so loading them runs nothing of the writer's.
 from __future__ import annotations
 
 from touchbench.app.errors import ConflictError, FieldError
-from touchbench.app.schemas.models import Engine, ExportRequest, ExportSchema
-from touchbench.app.services.models import align_features, load_model
+from touchbench.app.schemas.models import ExportRequest, ExportSchema
+from touchbench.app.services.loading import load_model
+from touchbench.app.services.models import align_features
 from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import load_dataset
 from touchbench.app.store.exports import load_export, save_export
 from touchbench.app.store.models import ModelInfo, get_model
-from touchbench.benchmark.dataset import Schema
 from touchbench.benchmark.errors import ConfigurationError
-from touchbench.benchmark.extras import MissingExtraError, is_installed
-from touchbench.benchmark.model import Predictor
+from touchbench.benchmark.extras import MissingExtraError
 from touchbench.benchmark.problem import restrict_targets
-
-#: What ``auto`` picks when the model has an ONNX twin: ONNX Runtime answers one row sooner
-#: than the model's own estimator for every entry measured (perf/live_latency.py part 3,
-#: p50 of one row, native vs ONNX: rf 68 vs 0.24 ms, xgb 53 vs 0.22, logistic 34 vs 0.23,
-#: svm-rbf 34 vs 0.23; scikit-learn's per-call validation is what a row pays for).
-AUTO_PREFERS_ONNX = True
 
 
 def export_model(store: Store, request: ExportRequest) -> tuple[ExportSchema, bytes]:
@@ -83,36 +76,3 @@ def stored_export(store: Store, ref: str | int) -> tuple[ModelInfo, bytes, bool]
         return info, graph, False
     _, graph = export_model(store, ExportRequest(model=info.id))
     return info, graph, True
-
-
-def load_predictor(
-    store: Store, ref: str | int, engine: Engine = "auto"
-) -> tuple[ModelInfo, Predictor]:
-    """A stored model ready to predict with ``engine``: the model itself, or its ONNX
-    twin (:class:`benchmark.export.onnx.OnnxModel`, the same interface; the model's own
-    artifact is then not read).
-
-    Raises
-    ------
-    FieldError
-        ``engine`` is ``onnx`` and the model has no twin (for ``engine``).
-    MissingExtraError
-        ``engine`` is ``onnx`` and ONNX Runtime is not installed.
-    """
-    if engine == "native" or (
-        engine == "auto" and not (AUTO_PREFERS_ONNX and is_installed("onnxruntime"))
-    ):
-        return load_model(store, ref)
-    info = get_model(store, ref)
-    graph = load_export(store, info.id, "onnx")
-    if graph is None:
-        if engine == "onnx":
-            raise FieldError(
-                "engine",
-                f"model '{info.name}' has no ONNX twin yet; export it to ONNX first, or "
-                "predict with the native engine",
-            )
-        return load_model(store, info.id)
-    from touchbench.benchmark.export.onnx import OnnxModel  # start-up time: onnxruntime
-
-    return info, OnnxModel(Schema.from_json(info.schema), info.classifier, graph)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import csv
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -22,7 +22,6 @@ from touchbench.app.errors import ConflictError, FieldError
 from touchbench.app.schemas.models import (
     AliasDeleted,
     AliasRequest,
-    Engine,
     MissingPolicy,
     PredictFileRequest,
     PredictionReport,
@@ -30,6 +29,7 @@ from touchbench.app.schemas.models import (
     TrainRequest,
 )
 from touchbench.app.services.datasets import read_data_file
+from touchbench.app.services.loading import PredictorLoader, load_model, load_predictor
 from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import find_dataset, load_dataset
 from touchbench.app.store.models import (
@@ -37,7 +37,6 @@ from touchbench.app.store.models import (
     ModelInfo,
     check_model_name,
     delete_alias,
-    load_artifact,
     rollback_alias,
     save_model,
     set_alias,
@@ -46,7 +45,7 @@ from touchbench.app.store.naming import shorten
 from touchbench.app.store.runs import RunInfo, get_run, load_results
 from touchbench.benchmark.dataset import Attribute, Dataset, Schema
 from touchbench.benchmark.errors import ConfigurationError, DataFormatError
-from touchbench.benchmark.model import Predictor, TrainedModel, dumps_model, fit_model, loads_model
+from touchbench.benchmark.model import Predictor, dumps_model, fit_model
 from touchbench.benchmark.problem import Problem, problem_from_dataset, restrict_targets
 from touchbench.drivers.limits import LINE_CHARS, LineTooLongError, bounded_lines
 
@@ -168,14 +167,6 @@ def _best_of_run(store: Store, run_ref: int) -> tuple[RunInfo, str]:
     if board.baseline is None:
         raise ConflictError(f"run {run.id} has no successful classifier to train")
     return run, board.rows[0].classifier
-
-
-def load_model(store: Store, ref: str | int) -> tuple[ModelInfo, TrainedModel]:
-    """A stored model (an id, ``NAME``: its newest version, ``NAME@VERSION``, ``NAME@ALIAS``);
-    its bytes are checked against their sha256 and loaded only as an artifact that cannot
-    run code (:mod:`benchmark.artifacts`)."""
-    info, artifact = load_artifact(store, ref)
-    return info, loads_model(artifact, sha256=info.sha256)
 
 
 def move_alias(store: Store, request: AliasRequest) -> AliasMove:
@@ -322,11 +313,6 @@ def _predict_values(
     )
 
 
-#: How a stored model is loaded to predict: :func:`app.services.export.load_predictor`'s
-#: signature (the service passes its cache of loaded models).
-PredictorLoader = Callable[[Store, str | int, Engine], tuple[ModelInfo, Predictor]]
-
-
 def predict_file(
     store: Store, request: PredictFileRequest, *, loader: PredictorLoader | None = None
 ) -> PredictionReport:
@@ -335,13 +321,9 @@ def predict_file(
     Parameters
     ----------
     loader : callable, optional
-        Loads the model (default: :func:`app.services.export.load_predictor`).
+        Loads the model (default: :func:`app.services.loading.load_predictor`).
     """
-    if loader is None:
-        from touchbench.app.services.export import load_predictor  # it builds on this module
-
-        loader = load_predictor
-    info, model = loader(store, request.model, request.engine)
+    info, model = (loader or load_predictor)(store, request.model, request.engine)
     return predict_path(info, model, request.file, source=request.source_name)
 
 

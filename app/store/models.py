@@ -27,9 +27,15 @@ from sqlalchemy.orm import Session
 from touchbench.app.errors import AppError, ConflictError, FieldError, NotFoundError
 from touchbench.app.schemas.listing import Page
 from touchbench.app.schemas.models import AliasMoved, ModelSchema
-from touchbench.app.schemas.names import LATEST, check_alias, check_name
+from touchbench.app.schemas.names import check_alias, check_name
+from touchbench.app.schemas.references import (
+    SEPARATOR,
+    ModelRef,
+    parse_model_ref,
+    version_label,
+)
 from touchbench.app.store.database import Store
-from touchbench.app.store.naming import find_row, is_decimal, is_row_id, may_be_name, shorten
+from touchbench.app.store.naming import find_row, may_be_name, shorten
 from touchbench.app.store.paging import count_rows, paged
 from touchbench.app.store.tables import (
     MODEL_VERSION_KEY,
@@ -71,7 +77,7 @@ class ModelInfo:
     @property
     def label(self) -> str:
         """``NAME@VERSION``: the one version this is, as answers name it."""
-        return f"{self.name}@{self.version}"
+        return version_label(self.name, self.version)
 
     @property
     def feature_names(self) -> list[str]:
@@ -163,7 +169,7 @@ def save_model(
 
 def default_model_name(dataset: DatasetRow | None, classifier: str) -> str:
     """``DATASET-CLASSIFIER`` (``@`` folded to ``_``: it would read as a version)."""
-    base = f"{dataset.name if dataset else 'model'}-{classifier}".replace("@", "_")
+    base = f"{dataset.name if dataset else 'model'}-{classifier}".replace(SEPARATOR, "_")
     return base[:200]
 
 
@@ -226,25 +232,24 @@ def model_version(store: Store, ref: str | int) -> tuple[int, str, str]:
     NotFoundError
         As :func:`get_model` does.
     """
-    text = str(ref)
-    found = None
+    parsed = parse_model_ref(ref)
+    text, found = parsed.text, None
     if may_be_name(text):
-        if "@" in text:  # one query for NAME@champion; a name stored with '@' next
-            name, _, suffix = text.rpartition("@")
-            if is_row_id(suffix):
-                found = store.first_row(_VERSION_BY_NUMBER, ref=name, number=int(suffix))
-            elif suffix == LATEST:
-                found = store.first_row(_VERSION_BY_NAME, ref=name)
-            else:
-                found = store.first_row(_VERSION_BY_ALIAS, ref=name, alias=suffix)
+        # one query for NAME@champion; a name stored with '@' next
+        if parsed.version is not None:
+            found = store.first_row(_VERSION_BY_NUMBER, ref=parsed.name, number=parsed.version)
+        elif parsed.kind == "latest":
+            found = store.first_row(_VERSION_BY_NAME, ref=parsed.name)
+        elif parsed.alias is not None:
+            found = store.first_row(_VERSION_BY_ALIAS, ref=parsed.name, alias=parsed.alias)
         if found is None:
             found = store.first_row(_VERSION_BY_NAME, ref=text)
-    if found is None and is_row_id(text):
-        found = store.first_row(_VERSION_BY_ID, ref=int(text))
+    if found is None and parsed.id is not None:
+        found = store.first_row(_VERSION_BY_ID, ref=parsed.id)
     if found is None:
-        get_model(store, ref)  # raises NotFoundError naming the known models
+        get_model(store, text)  # raises NotFoundError naming the known models
         raise AssertionError("get_model found a model the version query did not")
-    return int(found[0]), str(found[1]), f"{found[2]}@{found[3]}"
+    return int(found[0]), str(found[1]), version_label(found[2], found[3])
 
 
 _VERSION = select(ModelRow.id, ModelRow.sha256, ModelRow.name, ModelRow.version)
@@ -259,13 +264,6 @@ _VERSION_BY_ALIAS = _VERSION.join(
     and_(ModelAliasRow.name == ModelRow.name, ModelAliasRow.version == ModelRow.version),
 ).where(ModelAliasRow.name == bindparam("ref"), ModelAliasRow.alias == bindparam("alias"))
 _VERSION_BY_ID = _VERSION.where(ModelRow.id == bindparam("ref"))
-
-
-def is_pinned(ref: str | int) -> bool:
-    """Whether ``ref`` names one version for good (an id, ``NAME@VERSION``), rather than
-    whatever version a name's newest or an alias is now."""
-    text = str(ref)
-    return is_row_id(text) or ("@" in text and is_row_id(text.rpartition("@")[2]))
 
 
 def load_artifact(store: Store, ref: str | int) -> tuple[ModelInfo, bytes]:
@@ -452,7 +450,7 @@ def delete_alias(store: Store, ref: str | int, alias: str) -> AliasMove:
                 f"model '{shorten(row.name)}' has no alias '{alias}' (aliases: "
                 f"{', '.join(names) or 'none'})"
             )
-        if is_pinned(ref) and current.version != row.version:
+        if parse_model_ref(ref).pinned and current.version != row.version:
             raise ConflictError(
                 f"'{shorten(row.name)}@{alias}' points at version {current.version}, not "
                 f"{row.version}: not deleted (name the model without a version to delete it "
@@ -516,20 +514,22 @@ def _row(session: Session, ref: str | int) -> ModelRow:
     NotFoundError
         Naming the known models, or the known versions and aliases of ``NAME``.
     """
-    text = str(ref)
-    if may_be_name(text):
-        if "@" in text:
+    parsed = parse_model_ref(ref)
+    if may_be_name(parsed.text):
+        if parsed.suffix is not None:
             try:
-                return _version_of(session, *text.rpartition("@")[::2])
+                return _version_of(session, parsed)
             except NotFoundError:
-                row = _newest(session, text)
+                row = _newest(session, parsed.text)
                 if row is None:
                     raise
                 return row
-        row = _newest(session, text)
+        row = _newest(session, parsed.text)
         if row is not None:
             return row
-    return find_row(session, ModelRow, ref, kind="model", hint="none yet; training makes one")
+    return find_row(
+        session, ModelRow, parsed.text, kind="model", hint="none yet; training makes one"
+    )
 
 
 def _newest(session: Session, name: str) -> ModelRow | None:
@@ -538,8 +538,9 @@ def _newest(session: Session, name: str) -> ModelRow | None:
     ).first()
 
 
-def _version_of(session: Session, name: str, suffix: str) -> ModelRow:
-    """Version ``suffix`` (a number, ``latest`` or an alias) of the model ``name``."""
+def _version_of(session: Session, ref: ModelRef) -> ModelRow:
+    """The version of ``NAME@VERSION``, ``NAME@latest`` or ``NAME@ALIAS``."""
+    name, suffix = ref.name, str(ref.suffix)
     versions = list(
         session.scalars(
             select(ModelRow).where(ModelRow.name == name).order_by(ModelRow.version.desc())
@@ -548,11 +549,11 @@ def _version_of(session: Session, name: str, suffix: str) -> ModelRow:
     if not versions:
         find_row(session, ModelRow, name, kind="model", hint="none yet; training makes one")
         raise AssertionError("find_row found a name the query did not")
-    if suffix == LATEST:
+    if ref.kind == "latest":
         return versions[0]
-    if is_decimal(suffix):
+    if ref.kind == "version":
         for row in versions:
-            if str(row.version) == suffix.lstrip("0"):
+            if row.version == ref.version:
                 return row
         known = ", ".join(str(row.version) for row in reversed(versions[:20]))
         raise NotFoundError(

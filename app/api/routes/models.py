@@ -77,7 +77,7 @@ def onnx_graph(model_ref: str, service: ServiceDep) -> Response:
 
     info, graph, exported = stored_export(service.store, model_ref)
     if exported:
-        service.models.forget(info.id)  # predictions with engine auto take the twin now
+        service.forget(info.id)  # predictions with engine auto take the twin now
     return Response(
         graph,
         media_type="application/octet-stream",
@@ -88,7 +88,7 @@ def onnx_graph(model_ref: str, service: ServiceDep) -> Response:
 @router.delete("/{model_ref}", response_model=ModelSchema)
 def remove(model_ref: str, service: ServiceDep) -> ModelSchema:
     gone = delete_model(service.store, model_ref)
-    service.models.forget(gone.id)
+    service.forget(gone.id)
     return gone.to_schema()
 
 
@@ -134,7 +134,7 @@ async def predict_instances(model_ref: str, body: PredictRequest, service: Servi
     """Predict instances given as ``{attribute: value}`` (matched to the model by name):
     per instance and target the predicted label and the class probabilities."""
     size = request_size(body.instances)
-    content = await service.models.run(
+    content = await service.placement.run(
         model_ref,
         size,
         functools.partial(_predict_records, service, model_ref, body, size),
@@ -150,7 +150,7 @@ def _predict_records(service: Service, model_ref: str, body: PredictRequest, siz
     info, trained = service.models.get(service.store, model_ref, body.engine)
     start = time.thread_time()
     report = records_report(info, trained, body.instances, missing=body.missing)
-    service.models.record(info.id, time.thread_time() - start, size)
+    service.placement.record(info.id, time.thread_time() - start, size)
     return report.model_dump_json().encode()
 
 
