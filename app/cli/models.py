@@ -16,7 +16,7 @@ from touchbench.app.cli.state import get_state
 
 if TYPE_CHECKING:
     from touchbench.app.schemas.models import AliasRequest
-    from touchbench.app.store.models import AliasMove
+    from touchbench.app.store.aliases import AliasMove
 
 
 def register(app: typer.Typer) -> None:

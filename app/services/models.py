@@ -30,17 +30,10 @@ from touchbench.app.schemas.models import (
 )
 from touchbench.app.services.datasets import read_data_file
 from touchbench.app.services.loading import PredictorLoader, load_model, load_predictor
+from touchbench.app.store.aliases import AliasMove, delete_alias, rollback_alias, set_alias
 from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import find_dataset, load_dataset
-from touchbench.app.store.models import (
-    AliasMove,
-    ModelInfo,
-    check_model_name,
-    delete_alias,
-    rollback_alias,
-    save_model,
-    set_alias,
-)
+from touchbench.app.store.models import ModelInfo, check_model_name, save_model
 from touchbench.app.store.naming import shorten
 from touchbench.app.store.runs import RunInfo, get_run, load_results
 from touchbench.benchmark.dataset import Attribute, Dataset, Schema

@@ -1,33 +1,37 @@
-"""Trained models in the store: the artifact's bytes with their sha256 and format, the schema
-the model expects, the classifier and its parameters, the data set and run it came from,
-and how that data set was extracted from recordings.
+"""Trained models in the store, as a registry: a registered model per name
+(``registered_models``), its versions (``models``: the artifact's sha256 and format, the
+schema the model expects, the classifier and its parameters, the data set and run it came
+from, and how that data set was extracted from recordings).
 
 Artifacts live in a table of their own (``model_artifacts``), so listings and the version
 check of every served prediction never read one; :func:`load_artifact` reads one, and
 only a format that cannot run code when loaded (``skops``) is handed out.
 
 Models stored under one name are its versions 1, 2, ... (training again under a name adds
-one).  A reference to a model is its id, ``NAME`` (the newest version), ``NAME@VERSION``,
-``NAME@latest`` or ``NAME@ALIAS`` (an alias such as ``champion`` points at one version;
-:func:`set_alias` moves it and keeps its history, :func:`rollback_alias` steps back).
+one).  A number is taken from the registered model's counter, which only grows, and ids
+are never given twice either: ``NAME@VERSION`` and an id name one model for good, even
+after it is deleted.  A reference to a model is read by
+:func:`app.schemas.references.parse_model_ref` (an id, ``NAME``: the newest version,
+``NAME@VERSION``, ``NAME@latest``, ``NAME@ALIAS``) and resolved here; aliases are
+:mod:`app.store.aliases`' business.
 """
 
 from __future__ import annotations
 
 import hashlib
-from collections.abc import Iterator, Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 from datetime import datetime
 from typing import Any
 
-from sqlalchemy import and_, bindparam, delete, func, select, update
+from sqlalchemy import and_, bindparam, delete, exists, func, select, update
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session
 
 from touchbench.app.errors import AppError, ConflictError, FieldError, NotFoundError
 from touchbench.app.schemas.listing import Page
-from touchbench.app.schemas.models import AliasMoved, ModelSchema
-from touchbench.app.schemas.names import check_alias, check_name
+from touchbench.app.schemas.models import ModelSchema
+from touchbench.app.schemas.names import check_name
 from touchbench.app.schemas.references import (
     SEPARATOR,
     ModelRef,
@@ -35,24 +39,24 @@ from touchbench.app.schemas.references import (
     version_label,
 )
 from touchbench.app.store.database import Store
-from touchbench.app.store.naming import find_row, may_be_name, shorten
+from touchbench.app.store.naming import may_be_name, shorten
 from touchbench.app.store.paging import count_rows, paged
 from touchbench.app.store.tables import (
-    MODEL_VERSION_KEY,
     DatasetRow,
-    ModelAliasEventRow,
     ModelAliasRow,
     ModelArtifactRow,
     ModelRow,
-    utcnow,
+    RegisteredModelRow,
 )
 
 #: The only artifact format that is loaded (see :mod:`benchmark.artifacts`).
 SAFE_FORMAT = "skops"
-#: The alias ``promote`` sets and ``rollback`` steps back.
-CHAMPION = "champion"
-#: Attempts at a free version number when other processes store versions of the same name.
+#: Attempts at storing the first version of a name that other processes store at once.
 VERSION_ATTEMPTS = 20
+#: Names listed in a "no such model" message.
+_NAMES_SHOWN = 10
+#: Versions listed in a "no such version" message (the newest).
+_VERSIONS_SHOWN = 20
 
 
 @dataclass(frozen=True)
@@ -128,9 +132,11 @@ def save_model(
     new version of that model, not another model).
 
     The data set's extraction recipe (if it was extracted from recordings) is copied to
-    the model, so that live prediction extracts features as training did.  Processes that
-    store versions of one name at once each get their own: the store's unique ``(name,
-    version)`` refuses a taken one, and the next free number is tried.
+    the model, so that live prediction extracts features as training did.  The version's
+    number is taken from the registered model's counter in the same statement that raises
+    it, so processes storing versions of one name at once each get their own; two that
+    register a new name at once are told apart by its unique key, and the second tries
+    again.
     """
     if name is not None:
         check_model_name(name)
@@ -140,8 +146,8 @@ def save_model(
                 dataset = session.get(DatasetRow, dataset_id) if dataset_id is not None else None
                 chosen = name if name is not None else default_model_name(dataset, classifier)
                 row = ModelRow(
-                    name=chosen,
-                    version=_next_version(session, chosen),
+                    registered_model_id=(parent := _register(session, chosen)),
+                    version=take_version(session, parent),
                     dataset_id=dataset_id,
                     run_id=run_id,
                     classifier=classifier,
@@ -154,34 +160,48 @@ def save_model(
                     extraction=dataset.extraction if dataset is not None else None,
                 )
                 session.add(row)
-                session.flush()  # waits for a concurrent insert of the same version to end
+                session.flush()
                 session.add(ModelArtifactRow(model_id=row.id, artifact=artifact))
-                return _info(session, row)
+                return version_info(session, row)
         except IntegrityError as error:
-            if not _version_taken(error):
+            if "registered_models" not in str(error.orig):
                 raise
-            # another process stored this version meanwhile: take the next one
+            # another process registered the name meanwhile: its row is there now
     raise ConflictError(
-        f"could not find a free version of model '{shorten(str(name))}' after "
-        f"{VERSION_ATTEMPTS} attempts (busy store); try again"
+        f"could not register model '{shorten(str(name))}' after {VERSION_ATTEMPTS} attempts "
+        "(busy store); try again"
     )
+
+
+def _register(session: Session, name: str) -> int:
+    """The id of the registered model ``name``, registered now if it is new."""
+    found = session.scalar(select(RegisteredModelRow.id).where(RegisteredModelRow.name == name))
+    if found is not None:
+        return int(found)
+    parent = RegisteredModelRow(name=name, last_version=0)
+    session.add(parent)
+    session.flush()  # a concurrent registration of the name fails here
+    return parent.id
+
+
+def take_version(session: Session, parent: int) -> int:
+    """Raise the registered model's counter and return it: the number of its next version
+    (one UPDATE: another process raising it meanwhile waits for this transaction's end,
+    then raises what this one left)."""
+    raised = session.execute(
+        update(RegisteredModelRow)
+        .where(RegisteredModelRow.id == parent)
+        .values(last_version=RegisteredModelRow.last_version + 1)
+        .returning(RegisteredModelRow.last_version)
+        .execution_options(synchronize_session=False)
+    ).scalar_one()
+    return int(raised)
 
 
 def default_model_name(dataset: DatasetRow | None, classifier: str) -> str:
     """``DATASET-CLASSIFIER`` (``@`` folded to ``_``: it would read as a version)."""
     base = f"{dataset.name if dataset else 'model'}-{classifier}".replace(SEPARATOR, "_")
     return base[:200]
-
-
-def _next_version(session: Session, name: str) -> int:
-    top = session.scalar(select(func.max(ModelRow.version)).where(ModelRow.name == name))
-    return int(top or 0) + 1
-
-
-def _version_taken(error: IntegrityError) -> bool:
-    """Whether ``error`` is the unique ``(name, version)`` refusing a taken version."""
-    text = str(error.orig)
-    return MODEL_VERSION_KEY in text or "models.version" in text
 
 
 def check_model_name(name: str) -> None:
@@ -205,27 +225,27 @@ def list_models(store: Store, *, page: Page | None = None) -> list[ModelInfo]:
     with store.session() as session:
         rows = list(session.scalars(paged(select(ModelRow).order_by(ModelRow.id), page)))
         names = _dataset_names(session, rows)
-        aliases = _aliases(session, {row.name for row in rows})
-        return [_info(session, row, names, aliases) for row in rows]
+        aliases = _aliases(session, {row.registered_model_id for row in rows})
+        return [version_info(session, row, names, aliases) for row in rows]
 
 
 def count_models(store: Store) -> int:
+    """How many model versions the store holds."""
     return count_rows(store, ModelRow)
 
 
 def get_model(store: Store, ref: str | int) -> ModelInfo:
     """A model's description (its artifact is not read)."""
     with store.session() as session:
-        return _info(session, _row(session, ref))
+        return version_info(session, version_row(session, ref))
 
 
 def model_version(store: Store, ref: str | int) -> tuple[int, str, str]:
     """The id, artifact sha256 and ``NAME@VERSION`` of the model ``ref`` names now: one
     or two indexed queries on the driver's cursor.
 
-    The service's model cache asks this on every prediction to know whether the model it
-    holds is still the stored one (and the one an alias points at), and a live session
-    to follow ``NAME@champion``.
+    The model cache (:mod:`app.services.model_cache`) asks this to know whether a model it
+    holds is still the one ``ref`` names (a version deleted, an alias moved).
 
     Raises
     ------
@@ -240,7 +260,7 @@ def model_version(store: Store, ref: str | int) -> tuple[int, str, str]:
             found = store.first_row(_VERSION_BY_NUMBER, ref=parsed.name, number=parsed.version)
         elif parsed.kind == "latest":
             found = store.first_row(_VERSION_BY_NAME, ref=parsed.name)
-        elif parsed.alias is not None:
+        elif parsed.alias is not None and may_be_name(parsed.alias):
             found = store.first_row(_VERSION_BY_ALIAS, ref=parsed.name, alias=parsed.alias)
         if found is None:
             found = store.first_row(_VERSION_BY_NAME, ref=text)
@@ -252,17 +272,24 @@ def model_version(store: Store, ref: str | int) -> tuple[int, str, str]:
     return int(found[0]), str(found[1]), version_label(found[2], found[3])
 
 
-_VERSION = select(ModelRow.id, ModelRow.sha256, ModelRow.name, ModelRow.version)
+_VERSION = select(ModelRow.id, ModelRow.sha256, RegisteredModelRow.name, ModelRow.version).join(
+    RegisteredModelRow, RegisteredModelRow.id == ModelRow.registered_model_id
+)
 _VERSION_BY_NAME = (
-    _VERSION.where(ModelRow.name == bindparam("ref")).order_by(ModelRow.version.desc()).limit(1)
+    _VERSION.where(RegisteredModelRow.name == bindparam("ref"))
+    .order_by(ModelRow.version.desc())
+    .limit(1)
 )
 _VERSION_BY_NUMBER = _VERSION.where(
-    ModelRow.name == bindparam("ref"), ModelRow.version == bindparam("number")
+    RegisteredModelRow.name == bindparam("ref"), ModelRow.version == bindparam("number")
 )
 _VERSION_BY_ALIAS = _VERSION.join(
     ModelAliasRow,
-    and_(ModelAliasRow.name == ModelRow.name, ModelAliasRow.version == ModelRow.version),
-).where(ModelAliasRow.name == bindparam("ref"), ModelAliasRow.alias == bindparam("alias"))
+    and_(
+        ModelAliasRow.registered_model_id == ModelRow.registered_model_id,
+        ModelAliasRow.version == ModelRow.version,
+    ),
+).where(RegisteredModelRow.name == bindparam("ref"), ModelAliasRow.alias == bindparam("alias"))
 _VERSION_BY_ID = _VERSION.where(ModelRow.id == bindparam("ref"))
 
 
@@ -276,8 +303,8 @@ def load_artifact(store: Store, ref: str | int) -> tuple[ModelInfo, bytes]:
         touchbench before 0.2 were pickles).
     """
     with store.session() as session:
-        row = _row(session, ref)
-        info = _info(session, row)
+        row = version_row(session, ref)
+        info = version_info(session, row)
         if row.format != SAFE_FORMAT:
             raise AppError(
                 f"model '{row.name}' is stored as a {row.format}, a format that can run code "
@@ -288,223 +315,49 @@ def load_artifact(store: Store, ref: str | int) -> tuple[ModelInfo, bytes]:
 
 
 def delete_model(store: Store, ref: str | int) -> ModelInfo:
-    """Delete the version ``ref`` names (``NAME``: the newest); aliases that pointed at it
-    go with it (their history stays, and ``rollback`` skips versions that are gone)."""
+    """Delete the version ``ref`` names (``NAME``: the newest): one DELETE, its artifact,
+    twins and the aliases that pointed at it going with it by cascade (their history
+    stays, and ``rollback`` skips versions that are gone).  Its number and id are not given
+    again."""
     with store.session() as session:
-        row = _row(session, ref)
-        info = _info(session, row)
-        session.execute(
-            delete(ModelAliasRow).where(
-                ModelAliasRow.name == row.name, ModelAliasRow.version == row.version
-            )
-        )
+        row = version_row(session, ref)
+        info = version_info(session, row)
         session.execute(delete(ModelRow).where(ModelRow.id == row.id))
         return info
 
 
 def rename_model(store: Store, ref: str | int, new_name: str) -> ModelInfo:
-    """Give every version of the model ``ref`` names another name, with its aliases and
-    their history; returns the version ``ref`` named.
+    """Give the model ``ref`` names (every version, its aliases and their history) another
+    name: one UPDATE of its registered model; returns the version ``ref`` named.
 
     Raises
     ------
     ConflictError
-        Another model has the name.
+        Another model has the name, or had it (its numbers are not given again).
     """
     check_model_name(new_name)
     try:
         with store.session() as session:
-            row = _row(session, ref)
-            old, version = row.name, row.version
-            if new_name != old:
-                if session.scalars(select(ModelRow.id).where(ModelRow.name == new_name)).first():
-                    raise ConflictError(_taken(new_name))
-                for table in (ModelRow, ModelAliasRow, ModelAliasEventRow):
-                    session.execute(update(table).where(table.name == old).values(name=new_name))
+            row = version_row(session, ref)
+            version = row.version
+            if new_name != row.name:
+                session.execute(
+                    update(RegisteredModelRow)
+                    .where(RegisteredModelRow.id == row.registered_model_id)
+                    .values(name=new_name)
+                    .execution_options(synchronize_session=False)
+                )
     except IntegrityError:
-        raise ConflictError(_taken(new_name)) from None
-    return get_model(store, f"{new_name}@{version}")
-
-
-def _taken(name: str) -> str:
-    return f"a model named '{shorten(name)}' already exists; choose another name"
-
-
-@dataclass(frozen=True)
-class AliasMove:
-    """An alias set or stepped back: the version it points at now, and before (None: it
-    pointed at none)."""
-
-    alias: str
-    model: ModelInfo
-    previous: int | None
-
-    def to_schema(self) -> AliasMoved:
-        return AliasMoved(
-            alias=self.alias,
-            model=self.model.label,
-            version=self.model.version,
-            previous=self.previous,
-        )
-
-    def to_json(self) -> dict[str, Any]:
-        return self.to_schema().to_json()
-
-
-def set_alias(store: Store, ref: str | int, alias: str) -> AliasMove:
-    """Point ``NAME@alias`` at the version ``ref`` names, and note it in the alias's history.
-
-    Raises
-    ------
-    FieldError
-        An invalid alias (``alias``).
-    NotFoundError
-        No such model or version.
-    """
-    try:
-        check_alias(alias)
-    except AppError as error:
-        raise FieldError("alias", str(error)) from None
-    for _attempt in range(VERSION_ATTEMPTS):
-        try:
-            with store.session() as session:
-                row = _row(session, ref)
-                current = _alias_row(session, row.name, alias)
-                previous = None if current is None else current.version
-                if current is None:
-                    session.add(ModelAliasRow(name=row.name, alias=alias, version=row.version))
-                else:
-                    current.version = row.version
-                    current.set_at = utcnow()
-                session.add(ModelAliasEventRow(name=row.name, alias=alias, version=row.version))
-                session.flush()  # a concurrent first setting of the alias: try again
-                return AliasMove(alias, _info(session, row), previous)
-        except IntegrityError:
-            continue
-    raise ConflictError(f"could not set alias '{alias}' (busy store); try again")
-
-
-def rollback_alias(store: Store, ref: str | int, alias: str = CHAMPION) -> AliasMove:
-    """Point ``NAME@alias`` back at the version it pointed at before its last move (a
-    second rollback goes one step further back); versions deleted since are skipped.
-
-    Raises
-    ------
-    NotFoundError
-        No such model.
-    ConflictError
-        The alias points at nothing, or at the only version it ever pointed at.
-    """
-    with store.session() as session:
-        name = _row(session, ref).name
-        current = _alias_row(session, name, alias)
-        if current is None:
-            raise ConflictError(
-                f"model '{shorten(name)}' has no alias '{alias}' to roll back (set it with "
-                f"`promote` or `alias` first)"
-            )
-        for step in _alias_steps(session, name, alias):
-            target = (
-                _version_row(session, name, step.version)
-                if step.version != current.version
-                else None
-            )
-            if target is not None:
-                previous, current.version, current.set_at = current.version, step.version, utcnow()
-                return AliasMove(alias, _info(session, target), previous)
-            step.undone = True  # the move being undone, or a version deleted since
         raise ConflictError(
-            f"'{shorten(name)}@{alias}' has pointed at no other version that still exists "
-            f"(now version {current.version}): nothing to roll back to"
-        )
+            f"a model named '{shorten(new_name)}' exists or existed (a name keeps its version "
+            "numbers, which are not given again); choose another name"
+        ) from None
+    return get_model(store, version_label(new_name, version))
 
 
-def delete_alias(store: Store, ref: str | int, alias: str) -> AliasMove:
-    """Remove ``NAME@alias``; returns the version it pointed at (``model``, and
-    ``previous``).  Its history is marked undone, so that the alias set again later starts
-    afresh (``rollback`` does not step back past its deletion).
-
-    A ``ref`` that names one version (an id, ``NAME@VERSION``) deletes the alias only while
-    it points at that version: an alias another client moved since is not removed unseen.
-
-    Raises
-    ------
-    FieldError
-        An invalid alias (``alias``).
-    NotFoundError
-        No such model, or the model has no such alias.
-    ConflictError
-        ``ref`` names a version the alias does not point at.
-    """
-    try:
-        check_alias(alias)
-    except AppError as error:
-        raise FieldError("alias", str(error)) from None
-    with store.session() as session:
-        row = _row(session, ref)
-        current = _alias_row(session, row.name, alias)
-        if current is None:
-            known = _aliases(session, {row.name})
-            names = sorted(a for aliases in known.values() for a in aliases)
-            raise NotFoundError(
-                f"model '{shorten(row.name)}' has no alias '{alias}' (aliases: "
-                f"{', '.join(names) or 'none'})"
-            )
-        if parse_model_ref(ref).pinned and current.version != row.version:
-            raise ConflictError(
-                f"'{shorten(row.name)}@{alias}' points at version {current.version}, not "
-                f"{row.version}: not deleted (name the model without a version to delete it "
-                "whatever it points at)"
-            )
-        target = _version_row(session, row.name, current.version)
-        assert target is not None  # deleting a version deletes the aliases on it
-        session.execute(
-            update(ModelAliasEventRow)
-            .where(ModelAliasEventRow.name == row.name, ModelAliasEventRow.alias == alias)
-            .values(undone=True)
-        )
-        session.delete(current)
-        return AliasMove(alias, _info(session, target), current.version)
-
-
-#: History steps read per query by :func:`_alias_steps`.
-ALIAS_STEPS_PAGE = 16
-
-
-def _alias_steps(session: Session, name: str, alias: str) -> Iterator[ModelAliasEventRow]:
-    """The alias's moves not undone, newest first, read a page at a time: a rollback
-    usually stops at the second, and an alias moved 20,000 times took 0.9 s to read whole."""
-    before: int | None = None
-    while True:
-        query = select(ModelAliasEventRow).where(
-            ModelAliasEventRow.name == name,
-            ModelAliasEventRow.alias == alias,
-            ModelAliasEventRow.undone.is_(False),
-        )
-        if before is not None:
-            query = query.where(ModelAliasEventRow.id < before)
-        page = session.scalars(
-            query.order_by(ModelAliasEventRow.id.desc()).limit(ALIAS_STEPS_PAGE)
-        ).all()
-        yield from page
-        if len(page) < ALIAS_STEPS_PAGE:
-            return
-        before = page[-1].id
-
-
-def _alias_row(session: Session, name: str, alias: str) -> ModelAliasRow | None:
-    return session.get(ModelAliasRow, (name, alias))
-
-
-def _version_row(session: Session, name: str, version: int) -> ModelRow | None:
-    return session.scalars(
-        select(ModelRow).where(ModelRow.name == name, ModelRow.version == version)
-    ).first()
-
-
-def _row(session: Session, ref: str | int) -> ModelRow:
-    """The model version ``ref`` names: a name (its newest version), an id, or
-    ``NAME@VERSION``, ``NAME@latest``, ``NAME@ALIAS``.
+def version_row(session: Session, ref: str | int) -> ModelRow:
+    """The model version ``ref`` names (:func:`app.schemas.references.parse_model_ref`): a
+    name (its newest version), an id, or ``NAME@VERSION``, ``NAME@latest``, ``NAME@ALIAS``.
 
     A name with ``@`` in it that names no version is looked up whole, so that a model
     stored with ``@`` in its name before names refused it is still found.
@@ -520,60 +373,120 @@ def _row(session: Session, ref: str | int) -> ModelRow:
             try:
                 return _version_of(session, parsed)
             except NotFoundError:
-                row = _newest(session, parsed.text)
-                if row is None:
+                if registered(session, parsed.text) is None:
                     raise
-                return row
-        row = _newest(session, parsed.text)
+        parent = registered(session, parsed.text)
+        if parent is not None and (parsed.id is None or _has_versions(session, parent.id)):
+            return _newest(session, parent)
+    if parsed.id is not None:
+        row = session.get(ModelRow, parsed.id)
         if row is not None:
             return row
-    return find_row(
-        session, ModelRow, parsed.text, kind="model", hint="none yet; training makes one"
-    )
+    raise _unknown(session, parsed.text)
 
 
-def _newest(session: Session, name: str) -> ModelRow | None:
+def registered(session: Session, name: str) -> RegisteredModelRow | None:
+    """The registered model called ``name``, whether or not it has versions left."""
     return session.scalars(
-        select(ModelRow).where(ModelRow.name == name).order_by(ModelRow.version.desc())
+        select(RegisteredModelRow).where(RegisteredModelRow.name == name)
     ).first()
+
+
+def _has_versions(session: Session, parent: int) -> bool:
+    return bool(session.scalar(select(exists().where(ModelRow.registered_model_id == parent))))
+
+
+def _newest(session: Session, parent: RegisteredModelRow) -> ModelRow:
+    """The newest version of ``parent``.
+
+    Raises
+    ------
+    NotFoundError
+        Every version of it was deleted.
+    """
+    row = session.scalars(
+        select(ModelRow)
+        .where(ModelRow.registered_model_id == parent.id)
+        .order_by(ModelRow.version.desc())
+        .limit(1)
+    ).first()
+    if row is None:
+        raise NotFoundError(
+            f"model '{shorten(parent.name)}' has no versions left (versions up to "
+            f"{parent.last_version} were deleted; training under its name makes version "
+            f"{parent.last_version + 1})"
+        )
+    return row
 
 
 def _version_of(session: Session, ref: ModelRef) -> ModelRow:
     """The version of ``NAME@VERSION``, ``NAME@latest`` or ``NAME@ALIAS``."""
-    name, suffix = ref.name, str(ref.suffix)
-    versions = list(
-        session.scalars(
-            select(ModelRow).where(ModelRow.name == name).order_by(ModelRow.version.desc())
-        )
-    )
-    if not versions:
-        find_row(session, ModelRow, name, kind="model", hint="none yet; training makes one")
-        raise AssertionError("find_row found a name the query did not")
+    parent = registered(session, ref.name)
+    if parent is None:
+        raise _unknown(session, ref.name)
     if ref.kind == "latest":
-        return versions[0]
+        return _newest(session, parent)
+    suffix = str(ref.suffix)
     if ref.kind == "version":
-        for row in versions:
-            if row.version == ref.version:
-                return row
-        known = ", ".join(str(row.version) for row in reversed(versions[:20]))
+        row = None
+        if ref.version is not None:
+            row = session.scalars(
+                select(ModelRow).where(
+                    ModelRow.registered_model_id == parent.id, ModelRow.version == ref.version
+                )
+            ).first()
+        if row is not None:
+            return row
+        newest = session.scalars(
+            select(ModelRow.version)
+            .where(ModelRow.registered_model_id == parent.id)
+            .order_by(ModelRow.version.desc())
+            .limit(_VERSIONS_SHOWN)
+        ).all()
+        known = ", ".join(str(version) for version in reversed(newest)) or "none left"
         raise NotFoundError(
-            f"model '{shorten(name)}' has no version {suffix[:12]} (versions: {known})"
+            f"model '{shorten(parent.name)}' has no version {suffix[:12]} (versions: {known})"
         )
-    alias = _alias_row(session, name, suffix) if may_be_name(suffix) else None
+    alias = session.get(ModelAliasRow, (parent.id, suffix)) if may_be_name(suffix) else None
     if alias is not None:
-        for row in versions:
-            if row.version == alias.version:
-                return row
+        return session.scalars(
+            select(ModelRow).where(
+                ModelRow.registered_model_id == parent.id, ModelRow.version == alias.version
+            )
+        ).one()  # an alias goes with its version (a foreign key)
     known = ", ".join(
         f"{a}->{v}"
         for a, v in session.execute(
-            select(ModelAliasRow.alias, ModelAliasRow.version).where(ModelAliasRow.name == name)
+            select(ModelAliasRow.alias, ModelAliasRow.version).where(
+                ModelAliasRow.registered_model_id == parent.id
+            )
         ).all()
     )
     raise NotFoundError(
-        f"model '{shorten(name)}' has no alias '{shorten(suffix)}' (aliases: "
+        f"model '{shorten(parent.name)}' has no alias '{shorten(suffix)}' (aliases: "
         f"{known or 'none; `promote NAME@VERSION` sets champion'})"
     )
+
+
+def _unknown(session: Session, text: str) -> NotFoundError:
+    """No model is ``text``: the error, naming the first models that have versions."""
+    with_versions = exists().where(ModelRow.registered_model_id == RegisteredModelRow.id)
+    names = session.scalars(
+        select(RegisteredModelRow.name)
+        .where(with_versions)
+        .order_by(RegisteredModelRow.id)
+        .limit(_NAMES_SHOWN)
+    ).all()
+    if names:
+        known = ", ".join(shorten(name) for name in names)
+        total = session.scalar(
+            select(func.count()).select_from(RegisteredModelRow).where(with_versions)
+        )
+        if (total or 0) > len(names):
+            known += f", ... ({total} in all)"
+    else:
+        known = "none yet; training makes one"
+    return NotFoundError(f"no model '{shorten(text)}' (models: {known})")
 
 
 def _dataset_names(session: Session, rows: Sequence[ModelRow]) -> dict[int, str]:
@@ -585,36 +498,38 @@ def _dataset_names(session: Session, rows: Sequence[ModelRow]) -> dict[int, str]
     )
 
 
-def _aliases(session: Session, names: set[str]) -> dict[tuple[str, int], tuple[str, ...]]:
-    """(name, version) -> the aliases that point at it, sorted."""
-    if not names:
+def _aliases(session: Session, parents: Collection[int]) -> dict[tuple[int, int], tuple[str, ...]]:
+    """(registered model id, version) -> the aliases that point at it, sorted."""
+    if not parents:
         return {}
-    found: dict[tuple[str, int], list[str]] = {}
+    found: dict[tuple[int, int], list[str]] = {}
     rows = session.execute(
-        select(ModelAliasRow.name, ModelAliasRow.version, ModelAliasRow.alias)
-        .where(ModelAliasRow.name.in_(names))
+        select(ModelAliasRow.registered_model_id, ModelAliasRow.version, ModelAliasRow.alias)
+        .where(ModelAliasRow.registered_model_id.in_(parents))
         .order_by(ModelAliasRow.alias)
     )
-    for name, version, alias in rows:
-        found.setdefault((name, version), []).append(alias)
+    for parent, version, alias in rows:
+        found.setdefault((parent, version), []).append(alias)
     return {key: tuple(aliases) for key, aliases in found.items()}
 
 
-def _info(
+def version_info(
     session: Session,
     row: ModelRow,
     names: dict[int, str] | None = None,
-    aliases: dict[tuple[str, int], tuple[str, ...]] | None = None,
+    aliases: dict[tuple[int, int], tuple[str, ...]] | None = None,
 ) -> ModelInfo:
+    """The description of the version ``row`` (``names``: data set names by id, and
+    ``aliases``, when a listing read them for many rows at once)."""
     if names is None:
         names = _dataset_names(session, [row])
     if aliases is None:
-        aliases = _aliases(session, {row.name})
+        aliases = _aliases(session, {row.registered_model_id})
     return ModelInfo(
         id=row.id,
         name=row.name,
         version=row.version,
-        aliases=aliases.get((row.name, row.version), ()),
+        aliases=aliases.get((row.registered_model_id, row.version), ()),
         classifier=row.classifier,
         params=dict(row.params),
         targets=list(row.targets),

@@ -16,8 +16,9 @@ from touchbench.app.schemas.references import parse_model_ref
 from touchbench.app.services.datasets import import_file
 from touchbench.app.services.model_cache import ModelCache
 from touchbench.app.services.models import train
+from touchbench.app.store.aliases import set_alias
 from touchbench.app.store.database import Store
-from touchbench.app.store.models import delete_model, set_alias
+from touchbench.app.store.models import delete_model
 
 
 class Clock:
