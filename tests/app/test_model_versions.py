@@ -165,6 +165,38 @@ def test_a_rollback_reads_the_history_a_page_at_a_time(
     assert rollback_alias(store, "mic").model.label == "mic@1"
 
 
+def test_a_deleted_version_and_its_id_never_come_back(store: Store) -> None:
+    """Issue 36: delete ``pin@2`` (the newest), train ``pin`` again with another
+    classifier: it is ``pin@3`` with an id of its own, and ``rollback`` does not move the
+    champion onto it (nobody promoted it)."""
+    assert [_save(store, "pin"), _save(store, "pin")] == [1, 2]
+    set_alias(store, "pin@2", "champion")
+    set_alias(store, "pin@1", "champion")
+    gone = delete_model(store, "pin")
+    assert gone.label == "pin@2"
+    again = _saved(store, "pin", classifier="j48")
+    assert again.label == "pin@3" and again.id > gone.id
+    with pytest.raises(NotFoundError, match=r"model 'pin' has no version 2 \(versions: 1, 3\)"):
+        get_model(store, "pin@2")
+    with pytest.raises(NotFoundError):
+        get_model(store, gone.id)
+    with pytest.raises(ConflictError, match="nothing to roll back to"):
+        rollback_alias(store, "pin")
+    assert model_version(store, "pin@champion")[2] == "pin@1"
+
+    # every version deleted: the name keeps its count, and so do the ids
+    newest = again.id
+    for ref in ("pin@3", "pin@1"):
+        delete_model(store, ref)
+    with pytest.raises(NotFoundError, match=r"'pin' has no versions left \(versions up to 3"):
+        get_model(store, "pin")
+    with pytest.raises(NotFoundError, match=r"'pin' has no version 1 \(versions: none left\)"):
+        get_model(store, "pin@1")
+    fresh = _saved(store, "pin")
+    assert fresh.label == "pin@4" and fresh.id > newest
+    assert [m.label for m in list_models(store)] == ["pin@4"]
+
+
 def test_aliases_that_would_read_otherwise_are_refused(store: Store) -> None:
     _save(store)
     for alias in ["3", "latest", "", "with space", "x" * 101]:
