@@ -2,15 +2,18 @@
 :func:`set_alias` moves it and keeps its history, :func:`rollback_alias` steps back,
 :func:`delete_alias` removes it.  An alias goes with the version it points at (a foreign
 key), and its history with the registered model.
+
+Each change holds the registered model while it reads and writes (as deleting and storing
+versions do), so that changes from many clients at once are made one after the other.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
-from sqlalchemy import select, update
+from sqlalchemy import delete, insert, select, update
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session
 
@@ -19,13 +22,13 @@ from touchbench.app.schemas.models import AliasMoved
 from touchbench.app.schemas.names import check_alias
 from touchbench.app.schemas.references import parse_model_ref
 from touchbench.app.store.database import Store
-from touchbench.app.store.models import ModelInfo, version_info, version_row
+from touchbench.app.store.models import ModelInfo, held_version, version_info
 from touchbench.app.store.naming import shorten
 from touchbench.app.store.tables import ModelAliasEventRow, ModelAliasRow, ModelRow, utcnow
 
 #: The alias ``promote`` sets and ``rollback`` steps back.
 CHAMPION = "champion"
-#: Attempts at setting an alias that other processes set at once.
+#: Attempts at a change of aliases that the store refused for a change made at once.
 ALIAS_ATTEMPTS = 20
 #: History steps read per query by :func:`_alias_steps`.
 ALIAS_STEPS_PAGE = 16
@@ -67,38 +70,35 @@ def set_alias(store: Store, ref: str | int, alias: str) -> AliasMove:
     FieldError
         An invalid alias (``alias``).
     NotFoundError
-        No such model or version.
+        No such model or version (deleted by a change made meanwhile, too).
+    ConflictError
+        ``ref`` was renamed meanwhile, or the store stayed too busy.
     """
     _checked(alias)
-    for _attempt in range(ALIAS_ATTEMPTS):
-        try:
-            with store.session() as session:
-                row = version_row(session, ref)
-                current = _alias_row(session, row.registered_model_id, alias)
-                previous = None if current is None else current.version
-                if current is None:
-                    session.add(
-                        ModelAliasRow(
-                            registered_model_id=row.registered_model_id,
-                            alias=alias,
-                            version=row.version,
-                        )
-                    )
-                else:
-                    current.version = row.version
-                    current.set_at = utcnow()
-                session.add(
-                    ModelAliasEventRow(
-                        registered_model_id=row.registered_model_id,
-                        alias=alias,
-                        version=row.version,
-                    )
+
+    def change(session: Session, row: ModelRow) -> AliasMove:
+        parent = row.registered_model_id
+        previous = _pointed_at(session, parent, alias)
+        if previous is None:
+            session.execute(
+                insert(ModelAliasRow).values(
+                    registered_model_id=parent, alias=alias, version=row.version, set_at=utcnow()
                 )
-                session.flush()  # a concurrent first setting of the alias: try again
-                return AliasMove(alias, version_info(session, row), previous)
-        except IntegrityError:
-            continue
-    raise ConflictError(f"could not set alias '{alias}' (busy store); try again")
+            )
+        else:
+            _point(session, parent, alias, row.version)
+        session.execute(
+            insert(ModelAliasEventRow).values(
+                registered_model_id=parent,
+                alias=alias,
+                version=row.version,
+                set_at=utcnow(),
+                undone=False,
+            )
+        )
+        return AliasMove(alias, version_info(session, row), previous)
+
+    return _changed(store, ref, change)
 
 
 def rollback_alias(store: Store, ref: str | int, alias: str = CHAMPION) -> AliasMove:
@@ -112,27 +112,29 @@ def rollback_alias(store: Store, ref: str | int, alias: str = CHAMPION) -> Alias
     ConflictError
         The alias points at nothing, or at the only version it ever pointed at.
     """
-    with store.session() as session:
-        row = version_row(session, ref)
+
+    def change(session: Session, row: ModelRow) -> AliasMove:
         parent, name = row.registered_model_id, row.name
-        current = _alias_row(session, parent, alias)
+        current = _pointed_at(session, parent, alias)
         if current is None:
             raise ConflictError(
                 f"model '{shorten(name)}' has no alias '{alias}' to roll back (set it with "
                 f"`promote` or `alias` first)"
             )
+        undone: list[int] = []
         for step in _alias_steps(session, parent, alias):
-            target = (
-                _version(session, parent, step.version) if step.version != current.version else None
-            )
+            target = _version(session, parent, step.version) if step.version != current else None
             if target is not None:
-                previous, current.version, current.set_at = current.version, step.version, utcnow()
-                return AliasMove(alias, version_info(session, target), previous)
-            step.undone = True  # the move being undone, or a version deleted since
+                _undo(session, undone)
+                _point(session, parent, alias, step.version)
+                return AliasMove(alias, version_info(session, target), current)
+            undone.append(step.id)  # the move being undone, or a version deleted since
         raise ConflictError(
             f"'{shorten(name)}@{alias}' has pointed at no other version that still exists "
-            f"(now version {current.version}): nothing to roll back to"
+            f"(now version {current}): nothing to roll back to"
         )
+
+    return _changed(store, ref, change)
 
 
 def delete_alias(store: Store, ref: str | int, alias: str) -> AliasMove:
@@ -148,15 +150,15 @@ def delete_alias(store: Store, ref: str | int, alias: str) -> AliasMove:
     FieldError
         An invalid alias (``alias``).
     NotFoundError
-        No such model, or the model has no such alias.
+        No such model, or the model has no such alias (deleted meanwhile, too).
     ConflictError
         ``ref`` names a version the alias does not point at.
     """
     _checked(alias)
-    with store.session() as session:
-        row = version_row(session, ref)
+
+    def change(session: Session, row: ModelRow) -> AliasMove:
         parent, name = row.registered_model_id, row.name
-        current = _alias_row(session, parent, alias)
+        current = _pointed_at(session, parent, alias)
         if current is None:
             known = session.scalars(
                 select(ModelAliasRow.alias)
@@ -167,13 +169,13 @@ def delete_alias(store: Store, ref: str | int, alias: str) -> AliasMove:
                 f"model '{shorten(name)}' has no alias '{alias}' (aliases: "
                 f"{', '.join(known) or 'none'})"
             )
-        if parse_model_ref(ref).pinned and current.version != row.version:
+        if parse_model_ref(ref).pinned and current != row.version:
             raise ConflictError(
-                f"'{shorten(name)}@{alias}' points at version {current.version}, not "
+                f"'{shorten(name)}@{alias}' points at version {current}, not "
                 f"{row.version}: not deleted (name the model without a version to delete it "
                 "whatever it points at)"
             )
-        target = _version(session, parent, current.version)
+        target = _version(session, parent, current)
         assert target is not None  # an alias goes with its version (a foreign key)
         session.execute(
             update(ModelAliasEventRow)
@@ -183,8 +185,57 @@ def delete_alias(store: Store, ref: str | int, alias: str) -> AliasMove:
             )
             .values(undone=True)
         )
-        session.delete(current)
-        return AliasMove(alias, version_info(session, target), current.version)
+        session.execute(
+            delete(ModelAliasRow).where(
+                ModelAliasRow.registered_model_id == parent, ModelAliasRow.alias == alias
+            )
+        )
+        return AliasMove(alias, version_info(session, target), current)
+
+    return _changed(store, ref, change)
+
+
+def _changed(
+    store: Store, ref: str | int, change: Callable[[Session, ModelRow], AliasMove]
+) -> AliasMove:
+    """``change`` made to the aliases of the version ``ref`` names, in one transaction that
+    holds its registered model first (:func:`app.store.models.held_version`): changes to one
+    model's aliases from many clients at once happen one after the other, each answering
+    for what the one before left (a 404 or 409, never a stale write).  A constraint the
+    store still refuses (a version deleted by a process that did not hold the model) is
+    tried again."""
+    for _attempt in range(ALIAS_ATTEMPTS):
+        try:
+            with store.session() as session:
+                return change(session, held_version(session, ref))
+        except IntegrityError:
+            continue
+    raise ConflictError("the model's aliases kept changing meanwhile (busy store); try again")
+
+
+def _pointed_at(session: Session, parent: int, alias: str) -> int | None:
+    """The version ``alias`` points at now, None if it points at none."""
+    return session.scalar(
+        select(ModelAliasRow.version).where(
+            ModelAliasRow.registered_model_id == parent, ModelAliasRow.alias == alias
+        )
+    )
+
+
+def _point(session: Session, parent: int, alias: str, version: int) -> None:
+    session.execute(
+        update(ModelAliasRow)
+        .where(ModelAliasRow.registered_model_id == parent, ModelAliasRow.alias == alias)
+        .values(version=version, set_at=utcnow())
+    )
+
+
+def _undo(session: Session, steps: list[int]) -> None:
+    """Mark the history ``steps`` (ids) undone."""
+    if steps:
+        session.execute(
+            update(ModelAliasEventRow).where(ModelAliasEventRow.id.in_(steps)).values(undone=True)
+        )
 
 
 def _alias_steps(session: Session, parent: int, alias: str) -> Iterator[ModelAliasEventRow]:
@@ -206,10 +257,6 @@ def _alias_steps(session: Session, parent: int, alias: str) -> Iterator[ModelAli
         if len(page) < ALIAS_STEPS_PAGE:
             return
         before = page[-1].id
-
-
-def _alias_row(session: Session, parent: int, alias: str) -> ModelAliasRow | None:
-    return session.get(ModelAliasRow, (parent, alias))
 
 
 def _version(session: Session, parent: int, version: int) -> ModelRow | None:

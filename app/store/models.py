@@ -198,6 +198,43 @@ def take_version(session: Session, parent: int) -> int:
     return int(raised)
 
 
+def lock_registered(session: Session, parent: int) -> None:
+    """Hold the registered model ``parent`` until the transaction ends (its row lock on
+    PostgreSQL, the write lock on SQLite), as :func:`take_version` does, without changing
+    it: every change to a model's versions and aliases takes it first, so that they happen
+    one at a time, each on what the one before it left."""
+    session.execute(
+        update(RegisteredModelRow)
+        .where(RegisteredModelRow.id == parent)
+        .values(last_version=RegisteredModelRow.last_version)
+        .execution_options(synchronize_session=False)
+    )
+
+
+def held_version(session: Session, ref: str | int) -> ModelRow:
+    """The version ``ref`` names, read once its registered model is held
+    (:func:`lock_registered`): what the changes before this one left.
+
+    Raises
+    ------
+    NotFoundError
+        ``ref`` names nothing now (another change deleted it meanwhile).
+    ConflictError
+        ``ref`` names another model now (renamed meanwhile).
+    """
+    row = version_row(session, ref)
+    parent = row.registered_model_id
+    lock_registered(session, parent)
+    session.expire_all()  # rows read before the lock may have changed since
+    row = version_row(session, ref)
+    if row.registered_model_id != parent:
+        raise ConflictError(
+            f"'{shorten(str(ref))}' names another model than it did a moment ago (renamed "
+            "meanwhile); try again"
+        )
+    return row
+
+
 def default_model_name(dataset: DatasetRow | None, classifier: str) -> str:
     """``DATASET-CLASSIFIER`` (``@`` folded to ``_``: it would read as a version)."""
     base = f"{dataset.name if dataset else 'model'}-{classifier}".replace(SEPARATOR, "_")
@@ -320,7 +357,7 @@ def delete_model(store: Store, ref: str | int) -> ModelInfo:
     stays, and ``rollback`` skips versions that are gone).  Its number and id are not given
     again."""
     with store.session() as session:
-        row = version_row(session, ref)
+        row = held_version(session, ref)
         info = version_info(session, row)
         session.execute(delete(ModelRow).where(ModelRow.id == row.id))
         return info
