@@ -5,9 +5,10 @@ Loading a model checks and rebuilds its artifact (or its ONNX twin), which costs
 than a prediction; so loaded models are kept, the least recently used dropped first.  The
 freshness rule: a loaded model answers for a reference only while the reference names that
 version now, as the store says it with one indexed query
-(:func:`app.store.models.model_version`: the id, the artifact's sha256 and ``NAME@VERSION``).
-A model deleted or renamed by another process, a new version trained under its name, or an
-alias moved (``NAME@champion``) is never served stale.
+(:func:`app.store.models.model_version`: the id, the artifact's sha256, ``NAME@VERSION``
+and the sha256 of its ONNX twin).  A model deleted or renamed by another process, a new
+version trained under its name, an alias moved (``NAME@champion``) or a twin made by a job
+is never served stale.
 
 How old that answer may be is the caller's choice (``max_age``): the service asks on every
 prediction (0 s); a live session between two blocks asks at most once a second, and
@@ -22,31 +23,26 @@ import threading
 import time
 from collections import OrderedDict
 from collections.abc import Callable
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING
 
 from touchbench.app.schemas.references import parse_model_ref
 from touchbench.app.store.database import Store
-from touchbench.app.store.models import ModelInfo, model_version
+from touchbench.app.store.models import ModelInfo, ModelVersion, model_version
 
 if TYPE_CHECKING:
     from touchbench.app.schemas.models import Engine
     from touchbench.benchmark.model import Predictor
 
 
-class ModelKey(NamedTuple):
-    """Which stored version a reference names now (:func:`app.store.models.model_version`)."""
-
-    id: int
-    sha256: str
-    label: str
-
-
+#: A stored model and what runs it (the model itself or its twin).
+Loaded = tuple[ModelInfo, "Predictor"]
 #: References remembered per cached model (clients choose them: the memory stays bounded).
 REFS_PER_MODEL = 64
 
 
 class ModelCache:
-    """Loaded models by (id, sha256, ``NAME@VERSION``) and engine; thread-safe.
+    """Loaded models by (id, sha256, ``NAME@VERSION``, twin's sha256) and engine;
+    thread-safe.
 
     Parameters
     ----------
@@ -59,12 +55,14 @@ class ModelCache:
     def __init__(self, size: int, *, clock: Callable[[], float] = time.monotonic) -> None:
         self.size = size
         self._clock = clock
-        self._models: OrderedDict[ModelKey, dict[str, tuple[ModelInfo, Predictor]]] = OrderedDict()
+        self._models: OrderedDict[ModelVersion, dict[str, tuple[ModelInfo, Predictor]]] = (
+            OrderedDict()
+        )
         # reference -> the version it named last, and when the store said so
-        self._refs: dict[str, tuple[ModelKey, float]] = {}
+        self._refs: dict[str, tuple[ModelVersion, float]] = {}
         self._lock = threading.Lock()
 
-    def version(self, store: Store, ref: str | int, *, max_age: float = 0.0) -> ModelKey:
+    def version(self, store: Store, ref: str | int, *, max_age: float = 0.0) -> ModelVersion:
         """The version ``ref`` names now: asked of the store, unless it answered for ``ref``
         less than ``max_age`` seconds ago.
 
@@ -79,7 +77,7 @@ class ModelCache:
                 known = self._refs.get(text)
             if known is not None and self._clock() - known[1] < max_age:
                 return known[0]
-        key = ModelKey(*model_version(store, text))
+        key = model_version(store, text)
         with self._lock:
             if len(self._refs) >= REFS_PER_MODEL * self.size and text not in self._refs:
                 self._refs.clear()
@@ -100,10 +98,9 @@ class ModelCache:
         from touchbench.app.services.loading import load_predictor  # start-up time: see above
 
         info, model = load_predictor(store, key.id, engine)
-        loaded_key = ModelKey(info.id, info.sha256, info.label)
         with self._lock:
-            self._models.setdefault(loaded_key, {})[engine] = (info, model)
-            self._models.move_to_end(loaded_key)
+            self._models.setdefault(key, {})[engine] = (info, model)
+            self._models.move_to_end(key)
             while len(self._models) > self.size:
                 self._models.popitem(last=False)
         return info, model

@@ -22,7 +22,7 @@ import hashlib
 from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 from datetime import datetime
-from typing import Any
+from typing import Any, NamedTuple
 
 from sqlalchemy import and_, bindparam, delete, exists, func, select, update
 from sqlalchemy.exc import IntegrityError
@@ -30,7 +30,7 @@ from sqlalchemy.orm import Session
 
 from touchbench.app.errors import AppError, ConflictError, FieldError, NotFoundError
 from touchbench.app.schemas.listing import Page
-from touchbench.app.schemas.models import ModelSchema
+from touchbench.app.schemas.models import ModelSchema, TwinSchema
 from touchbench.app.schemas.names import check_name
 from touchbench.app.schemas.references import (
     SEPARATOR,
@@ -45,18 +45,43 @@ from touchbench.app.store.tables import (
     DatasetRow,
     ModelAliasRow,
     ModelArtifactRow,
+    ModelExportRow,
     ModelRow,
     RegisteredModelRow,
 )
 
 #: The only artifact format that is loaded (see :mod:`benchmark.artifacts`).
 SAFE_FORMAT = "skops"
+#: The format of the twin that predictions may run (``engine``), and the version query reads.
+TWIN_FORMAT = "onnx"
 #: Attempts at storing the first version of a name that other processes store at once.
 VERSION_ATTEMPTS = 20
 #: Names listed in a "no such model" message.
 _NAMES_SHOWN = 10
 #: Versions listed in a "no such version" message (the newest).
 _VERSIONS_SHOWN = 20
+
+
+@dataclass(frozen=True)
+class TwinInfo:
+    """A model's twin in another format (ONNX), as the store describes it (its bytes are
+    not read); ``problem`` says why it could not be loaded, once a prediction tried."""
+
+    format: str
+    sha256: str
+    size_bytes: int
+    problem: str | None = None
+
+
+class ModelVersion(NamedTuple):
+    """What a reference names now, in one indexed query (:func:`model_version`): the
+    version's id, its artifact's sha256, ``NAME@VERSION``, and its ONNX twin's sha256 (None
+    without one)."""
+
+    id: int
+    sha256: str
+    label: str
+    twin: str | None = None
 
 
 @dataclass(frozen=True)
@@ -77,6 +102,7 @@ class ModelInfo:
     extraction: dict[str, Any] | None = None
     version: int = 1
     aliases: tuple[str, ...] = ()
+    twin: TwinInfo | None = None
 
     @property
     def label(self) -> str:
@@ -109,6 +135,13 @@ class ModelInfo:
             created_at=self.created_at,
             features=self.feature_names,
             extraction=self.extraction,
+            onnx=None
+            if self.twin is None
+            else TwinSchema(
+                sha256=self.twin.sha256,
+                size_bytes=self.twin.size_bytes,
+                problem=self.twin.problem,
+            ),
         )
 
     def to_json(self) -> dict[str, Any]:
@@ -263,7 +296,8 @@ def list_models(store: Store, *, page: Page | None = None) -> list[ModelInfo]:
         rows = list(session.scalars(paged(select(ModelRow).order_by(ModelRow.id), page)))
         names = _dataset_names(session, rows)
         aliases = _aliases(session, {row.registered_model_id for row in rows})
-        return [version_info(session, row, names, aliases) for row in rows]
+        twins = _twins(session, [row.id for row in rows])
+        return [version_info(session, row, names, aliases, twins) for row in rows]
 
 
 def count_models(store: Store) -> int:
@@ -277,12 +311,12 @@ def get_model(store: Store, ref: str | int) -> ModelInfo:
         return version_info(session, version_row(session, ref))
 
 
-def model_version(store: Store, ref: str | int) -> tuple[int, str, str]:
-    """The id, artifact sha256 and ``NAME@VERSION`` of the model ``ref`` names now: one
-    or two indexed queries on the driver's cursor.
+def model_version(store: Store, ref: str | int) -> ModelVersion:
+    """The id, artifact sha256, ``NAME@VERSION`` and ONNX twin's sha256 of the model ``ref``
+    names now: one or two indexed queries on the driver's cursor.
 
     The model cache (:mod:`app.services.model_cache`) asks this to know whether a model it
-    holds is still the one ``ref`` names (a version deleted, an alias moved).
+    holds is still the one ``ref`` names (a version deleted, an alias moved, a twin made).
 
     Raises
     ------
@@ -306,11 +340,23 @@ def model_version(store: Store, ref: str | int) -> tuple[int, str, str]:
     if found is None:
         get_model(store, text)  # raises NotFoundError naming the known models
         raise AssertionError("get_model found a model the version query did not")
-    return int(found[0]), str(found[1]), version_label(found[2], found[3])
+    model_id, sha256, name, version, twin = found
+    return ModelVersion(int(model_id), str(sha256), version_label(name, version), twin)
 
 
-_VERSION = select(ModelRow.id, ModelRow.sha256, RegisteredModelRow.name, ModelRow.version).join(
-    RegisteredModelRow, RegisteredModelRow.id == ModelRow.registered_model_id
+_VERSION = (
+    select(
+        ModelRow.id,
+        ModelRow.sha256,
+        RegisteredModelRow.name,
+        ModelRow.version,
+        ModelExportRow.sha256,
+    )
+    .join(RegisteredModelRow, RegisteredModelRow.id == ModelRow.registered_model_id)
+    .outerjoin(
+        ModelExportRow,
+        and_(ModelExportRow.model_id == ModelRow.id, ModelExportRow.format == TWIN_FORMAT),
+    )
 )
 _VERSION_BY_NAME = (
     _VERSION.where(RegisteredModelRow.name == bindparam("ref"))
@@ -550,18 +596,33 @@ def _aliases(session: Session, parents: Collection[int]) -> dict[tuple[int, int]
     return {key: tuple(aliases) for key, aliases in found.items()}
 
 
+def _twins(session: Session, ids: Collection[int]) -> dict[int, TwinInfo]:
+    """Model id -> its ONNX twin's description (the bytes are not read)."""
+    if not ids:
+        return {}
+    rows = session.execute(
+        select(ModelExportRow.model_id, ModelExportRow.sha256, ModelExportRow.size_bytes).where(
+            ModelExportRow.model_id.in_(ids), ModelExportRow.format == TWIN_FORMAT
+        )
+    )
+    return {model_id: TwinInfo(TWIN_FORMAT, sha256, size) for model_id, sha256, size in rows}
+
+
 def version_info(
     session: Session,
     row: ModelRow,
     names: dict[int, str] | None = None,
     aliases: dict[tuple[int, int], tuple[str, ...]] | None = None,
+    twins: dict[int, TwinInfo] | None = None,
 ) -> ModelInfo:
-    """The description of the version ``row`` (``names``: data set names by id, and
-    ``aliases``, when a listing read them for many rows at once)."""
+    """The description of the version ``row`` (``names``: data set names by id,
+    ``aliases`` and ``twins``, when a listing read them for many rows at once)."""
     if names is None:
         names = _dataset_names(session, [row])
     if aliases is None:
         aliases = _aliases(session, {row.registered_model_id})
+    if twins is None:
+        twins = _twins(session, [row.id])
     return ModelInfo(
         id=row.id,
         name=row.name,
@@ -579,4 +640,5 @@ def version_info(
         schema=dict(row.schema),
         format=row.format,
         extraction=row.extraction,
+        twin=twins.get(row.id),
     )

@@ -58,7 +58,7 @@ def test_references_name_versions_and_aliases(store: Store) -> None:
     ids = [model.id for model in list_models(store)]
     assert model_version(store, "mic")[2] == "mic@3"  # a name alone: the newest version
     assert model_version(store, "mic@latest")[2] == "mic@3"
-    assert model_version(store, "mic@2") == (ids[1], model_version(store, ids[1])[1], "mic@2")
+    assert model_version(store, "mic@2") == (ids[1], model_version(store, ids[1])[1], "mic@2", None)
     assert get_model(store, "mic@1").id == ids[0] and get_model(store, ids[2]).version == 3
     with pytest.raises(NotFoundError, match=r"model 'mic' has no version 7 \(versions: 1, 2, 3\)"):
         get_model(store, "mic@7")

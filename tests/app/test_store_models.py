@@ -49,11 +49,11 @@ def test_the_version_follows_renames_and_deletes_by_name_and_by_id(store: Store)
     artifact = os.urandom(3_000_000)  # far beyond a page: an artifact in overflow pages
     model_id = _add(store, "big", artifact)
     digest = hashlib.sha256(artifact).hexdigest()
-    assert model_version(store, "big") == (model_id, digest, "big@1")
-    assert model_version(store, str(model_id)) == (model_id, digest, "big@1")
-    assert model_version(store, model_id) == (model_id, digest, "big@1")
+    assert model_version(store, "big") == (model_id, digest, "big@1", None)
+    assert model_version(store, str(model_id)) == (model_id, digest, "big@1", None)
+    assert model_version(store, model_id) == (model_id, digest, "big@1", None)
     rename_model(store, "big", "large")
-    assert model_version(store, model_id) == (model_id, digest, "large@1")
+    assert model_version(store, model_id) == (model_id, digest, "large@1", None)
     with pytest.raises(NotFoundError, match="no model 'big'"):
         model_version(store, "big")
     assert load_artifact(store, "large")[1] == artifact
@@ -186,6 +186,7 @@ def test_the_registry_moves_under_registered_models_and_back(store_url: str) -> 
             8,
             hashlib.sha256(b"two").hexdigest(),
             "mic@2",
+            hashlib.sha256(b"two").hexdigest(),  # its twin, copied here from its artifact
         )
         assert rollback_alias(store, "mic").model.label == "mic@1"  # past 5, deleted
         again = _add(store, "mic", b"six")
