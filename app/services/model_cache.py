@@ -27,7 +27,8 @@ from typing import TYPE_CHECKING
 
 from touchbench.app.schemas.references import parse_model_ref
 from touchbench.app.store.database import Store
-from touchbench.app.store.models import ModelInfo, ModelVersion, model_version
+from touchbench.app.store.model_refs import ModelVersion, model_version
+from touchbench.app.store.models import ModelInfo
 
 if TYPE_CHECKING:
     from touchbench.app.schemas.models import Engine

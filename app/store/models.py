@@ -12,8 +12,8 @@ one).  A number is taken from the registered model's counter, which only grows, 
 are never given twice either: ``NAME@VERSION`` and an id name one model for good, even
 after it is deleted.  A reference to a model is read by
 :func:`app.schemas.references.parse_model_ref` (an id, ``NAME``: the newest version,
-``NAME@VERSION``, ``NAME@latest``, ``NAME@ALIAS``) and resolved here; aliases are
-:mod:`app.store.aliases`' business.
+``NAME@VERSION``, ``NAME@latest``, ``NAME@ALIAS``) and resolved by
+:mod:`app.store.model_refs`; aliases are :mod:`app.store.aliases`' business.
 """
 
 from __future__ import annotations
@@ -22,24 +22,20 @@ import hashlib
 from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 from datetime import datetime
-from typing import Any, NamedTuple
+from typing import Any
 
-from sqlalchemy import and_, bindparam, delete, exists, func, select, update
+from sqlalchemy import delete, select, update
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session
 
-from touchbench.app.errors import AppError, ConflictError, FieldError, NotFoundError
+from touchbench.app.errors import AppError, ConflictError, FieldError
 from touchbench.app.schemas.listing import Page
 from touchbench.app.schemas.models import ModelSchema, TwinSchema
 from touchbench.app.schemas.names import check_name
-from touchbench.app.schemas.references import (
-    SEPARATOR,
-    ModelRef,
-    parse_model_ref,
-    version_label,
-)
+from touchbench.app.schemas.references import SEPARATOR, version_label
 from touchbench.app.store.database import Store
-from touchbench.app.store.naming import may_be_name, shorten
+from touchbench.app.store.model_refs import TWIN_FORMAT, version_row
+from touchbench.app.store.naming import shorten
 from touchbench.app.store.paging import count_rows, paged
 from touchbench.app.store.tables import (
     DatasetRow,
@@ -52,14 +48,8 @@ from touchbench.app.store.tables import (
 
 #: The only artifact format that is loaded (see :mod:`benchmark.artifacts`).
 SAFE_FORMAT = "skops"
-#: The format of the twin that predictions may run (``engine``), and the version query reads.
-TWIN_FORMAT = "onnx"
 #: Attempts at storing the first version of a name that other processes store at once.
 VERSION_ATTEMPTS = 20
-#: Names listed in a "no such model" message.
-_NAMES_SHOWN = 10
-#: Versions listed in a "no such version" message (the newest).
-_VERSIONS_SHOWN = 20
 
 
 @dataclass(frozen=True)
@@ -71,17 +61,6 @@ class TwinInfo:
     sha256: str
     size_bytes: int
     problem: str | None = None
-
-
-class ModelVersion(NamedTuple):
-    """What a reference names now, in one indexed query (:func:`model_version`): the
-    version's id, its artifact's sha256, ``NAME@VERSION``, and its ONNX twin's sha256 (None
-    without one)."""
-
-    id: int
-    sha256: str
-    label: str
-    twin: str | None = None
 
 
 @dataclass(frozen=True)
@@ -311,71 +290,6 @@ def get_model(store: Store, ref: str | int) -> ModelInfo:
         return version_info(session, version_row(session, ref))
 
 
-def model_version(store: Store, ref: str | int) -> ModelVersion:
-    """The id, artifact sha256, ``NAME@VERSION`` and ONNX twin's sha256 of the model ``ref``
-    names now: one or two indexed queries on the driver's cursor.
-
-    The model cache (:mod:`app.services.model_cache`) asks this to know whether a model it
-    holds is still the one ``ref`` names (a version deleted, an alias moved, a twin made).
-
-    Raises
-    ------
-    NotFoundError
-        As :func:`get_model` does.
-    """
-    parsed = parse_model_ref(ref)
-    text, found = parsed.text, None
-    if may_be_name(text):
-        # one query for NAME@champion; a name stored with '@' next
-        if parsed.version is not None:
-            found = store.first_row(_VERSION_BY_NUMBER, ref=parsed.name, number=parsed.version)
-        elif parsed.kind == "latest":
-            found = store.first_row(_VERSION_BY_NAME, ref=parsed.name)
-        elif parsed.alias is not None and may_be_name(parsed.alias):
-            found = store.first_row(_VERSION_BY_ALIAS, ref=parsed.name, alias=parsed.alias)
-        if found is None:
-            found = store.first_row(_VERSION_BY_NAME, ref=text)
-    if found is None and parsed.id is not None:
-        found = store.first_row(_VERSION_BY_ID, ref=parsed.id)
-    if found is None:
-        get_model(store, text)  # raises NotFoundError naming the known models
-        raise AssertionError("get_model found a model the version query did not")
-    model_id, sha256, name, version, twin = found
-    return ModelVersion(int(model_id), str(sha256), version_label(name, version), twin)
-
-
-_VERSION = (
-    select(
-        ModelRow.id,
-        ModelRow.sha256,
-        RegisteredModelRow.name,
-        ModelRow.version,
-        ModelExportRow.sha256,
-    )
-    .join(RegisteredModelRow, RegisteredModelRow.id == ModelRow.registered_model_id)
-    .outerjoin(
-        ModelExportRow,
-        and_(ModelExportRow.model_id == ModelRow.id, ModelExportRow.format == TWIN_FORMAT),
-    )
-)
-_VERSION_BY_NAME = (
-    _VERSION.where(RegisteredModelRow.name == bindparam("ref"))
-    .order_by(ModelRow.version.desc())
-    .limit(1)
-)
-_VERSION_BY_NUMBER = _VERSION.where(
-    RegisteredModelRow.name == bindparam("ref"), ModelRow.version == bindparam("number")
-)
-_VERSION_BY_ALIAS = _VERSION.join(
-    ModelAliasRow,
-    and_(
-        ModelAliasRow.registered_model_id == ModelRow.registered_model_id,
-        ModelAliasRow.version == ModelRow.version,
-    ),
-).where(RegisteredModelRow.name == bindparam("ref"), ModelAliasRow.alias == bindparam("alias"))
-_VERSION_BY_ID = _VERSION.where(ModelRow.id == bindparam("ref"))
-
-
 def load_artifact(store: Store, ref: str | int) -> tuple[ModelInfo, bytes]:
     """A model's description and artifact bytes (check them with the sha256 before use).
 
@@ -436,140 +350,6 @@ def rename_model(store: Store, ref: str | int, new_name: str) -> ModelInfo:
             "numbers, which are not given again); choose another name"
         ) from None
     return get_model(store, version_label(new_name, version))
-
-
-def version_row(session: Session, ref: str | int) -> ModelRow:
-    """The model version ``ref`` names (:func:`app.schemas.references.parse_model_ref`): a
-    name (its newest version), an id, or ``NAME@VERSION``, ``NAME@latest``, ``NAME@ALIAS``.
-
-    A name with ``@`` in it that names no version is looked up whole, so that a model
-    stored with ``@`` in its name before names refused it is still found.
-
-    Raises
-    ------
-    NotFoundError
-        Naming the known models, or the known versions and aliases of ``NAME``.
-    """
-    parsed = parse_model_ref(ref)
-    if may_be_name(parsed.text):
-        if parsed.suffix is not None:
-            try:
-                return _version_of(session, parsed)
-            except NotFoundError:
-                if registered(session, parsed.text) is None:
-                    raise
-        parent = registered(session, parsed.text)
-        if parent is not None and (parsed.id is None or _has_versions(session, parent.id)):
-            return _newest(session, parent)
-    if parsed.id is not None:
-        row = session.get(ModelRow, parsed.id)
-        if row is not None:
-            return row
-    raise _unknown(session, parsed.text)
-
-
-def registered(session: Session, name: str) -> RegisteredModelRow | None:
-    """The registered model called ``name``, whether or not it has versions left."""
-    return session.scalars(
-        select(RegisteredModelRow).where(RegisteredModelRow.name == name)
-    ).first()
-
-
-def _has_versions(session: Session, parent: int) -> bool:
-    return bool(session.scalar(select(exists().where(ModelRow.registered_model_id == parent))))
-
-
-def _newest(session: Session, parent: RegisteredModelRow) -> ModelRow:
-    """The newest version of ``parent``.
-
-    Raises
-    ------
-    NotFoundError
-        Every version of it was deleted.
-    """
-    row = session.scalars(
-        select(ModelRow)
-        .where(ModelRow.registered_model_id == parent.id)
-        .order_by(ModelRow.version.desc())
-        .limit(1)
-    ).first()
-    if row is None:
-        raise NotFoundError(
-            f"model '{shorten(parent.name)}' has no versions left (versions up to "
-            f"{parent.last_version} were deleted; training under its name makes version "
-            f"{parent.last_version + 1})"
-        )
-    return row
-
-
-def _version_of(session: Session, ref: ModelRef) -> ModelRow:
-    """The version of ``NAME@VERSION``, ``NAME@latest`` or ``NAME@ALIAS``."""
-    parent = registered(session, ref.name)
-    if parent is None:
-        raise _unknown(session, ref.name)
-    if ref.kind == "latest":
-        return _newest(session, parent)
-    suffix = str(ref.suffix)
-    if ref.kind == "version":
-        row = None
-        if ref.version is not None:
-            row = session.scalars(
-                select(ModelRow).where(
-                    ModelRow.registered_model_id == parent.id, ModelRow.version == ref.version
-                )
-            ).first()
-        if row is not None:
-            return row
-        newest = session.scalars(
-            select(ModelRow.version)
-            .where(ModelRow.registered_model_id == parent.id)
-            .order_by(ModelRow.version.desc())
-            .limit(_VERSIONS_SHOWN)
-        ).all()
-        known = ", ".join(str(version) for version in reversed(newest)) or "none left"
-        raise NotFoundError(
-            f"model '{shorten(parent.name)}' has no version {suffix[:12]} (versions: {known})"
-        )
-    alias = session.get(ModelAliasRow, (parent.id, suffix)) if may_be_name(suffix) else None
-    if alias is not None:
-        return session.scalars(
-            select(ModelRow).where(
-                ModelRow.registered_model_id == parent.id, ModelRow.version == alias.version
-            )
-        ).one()  # an alias goes with its version (a foreign key)
-    known = ", ".join(
-        f"{a}->{v}"
-        for a, v in session.execute(
-            select(ModelAliasRow.alias, ModelAliasRow.version).where(
-                ModelAliasRow.registered_model_id == parent.id
-            )
-        ).all()
-    )
-    raise NotFoundError(
-        f"model '{shorten(parent.name)}' has no alias '{shorten(suffix)}' (aliases: "
-        f"{known or 'none; `promote NAME@VERSION` sets champion'})"
-    )
-
-
-def _unknown(session: Session, text: str) -> NotFoundError:
-    """No model is ``text``: the error, naming the first models that have versions."""
-    with_versions = exists().where(ModelRow.registered_model_id == RegisteredModelRow.id)
-    names = session.scalars(
-        select(RegisteredModelRow.name)
-        .where(with_versions)
-        .order_by(RegisteredModelRow.id)
-        .limit(_NAMES_SHOWN)
-    ).all()
-    if names:
-        known = ", ".join(shorten(name) for name in names)
-        total = session.scalar(
-            select(func.count()).select_from(RegisteredModelRow).where(with_versions)
-        )
-        if (total or 0) > len(names):
-            known += f", ... ({total} in all)"
-    else:
-        known = "none yet; training makes one"
-    return NotFoundError(f"no model '{shorten(text)}' (models: {known})")
 
 
 def _dataset_names(session: Session, rows: Sequence[ModelRow]) -> dict[int, str]:

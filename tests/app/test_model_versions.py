@@ -19,12 +19,12 @@ from touchbench.app.store import aliases as store_aliases
 from touchbench.app.store import models as store_models
 from touchbench.app.store.aliases import delete_alias, rollback_alias, set_alias
 from touchbench.app.store.database import Store
+from touchbench.app.store.model_refs import model_version
 from touchbench.app.store.models import (
     ModelInfo,
     delete_model,
     get_model,
     list_models,
-    model_version,
     save_model,
 )
 from touchbench.app.store.tables import DatasetRow, ModelRow, RegisteredModelRow

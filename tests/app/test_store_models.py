@@ -15,12 +15,12 @@ from touchbench.app.errors import NotFoundError
 from touchbench.app.store.aliases import rollback_alias
 from touchbench.app.store.database import Store
 from touchbench.app.store.exports import load_export
+from touchbench.app.store.model_refs import model_version
 from touchbench.app.store.models import (
     delete_model,
     get_model,
     list_models,
     load_artifact,
-    model_version,
     rename_model,
     save_model,
 )
