@@ -14,11 +14,12 @@ from importlib import metadata
 from fastapi import Depends, FastAPI
 
 from touchbench.app.api import main as api
-from touchbench.app.api.deps import ModelCache, Service, require_api_key
+from touchbench.app.api.deps import PredictionPlacement, Service, require_api_key
 from touchbench.app.api.stopping import CutByStop
 from touchbench.app.api.trust import Cors, Trust
 from touchbench.app.jobs.dispatcher import Dispatcher
 from touchbench.app.redaction import install as hide_keys_in_logs
+from touchbench.app.services.model_cache import ModelCache
 from touchbench.app.settings import Settings, get_settings
 from touchbench.app.store.database import Store
 from touchbench.app.store.jobs import mark_lost_jobs
@@ -56,14 +57,16 @@ def create_app(settings: Settings | None = None) -> FastAPI:
                     finish_run(store, run_id, "queued")
         settings.work_dir.mkdir(parents=True, exist_ok=True)
         dispatcher = Dispatcher(store, settings)
-        app.state.service = Service(settings, store, dispatcher, ModelCache(settings.model_cache))
+        models = ModelCache(settings.model_cache)
+        placement = PredictionPlacement(models.known)
+        app.state.service = Service(settings, store, dispatcher, models, placement)
         dispatcher.start()
         threading.Thread(target=_warm_up, daemon=True, name="warm-up").start()
         try:
             yield
         finally:
             dispatcher.stop()
-            app.state.service.models.close()
+            app.state.service.placement.close()
             store.dispose()
 
     app = FastAPI(

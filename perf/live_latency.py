@@ -100,7 +100,8 @@ def networks(store: Store, here: Path, recordings: list[Path], labels: Path, ses
     from touchbench.app.schemas.models import TrainRequest
     from touchbench.app.services.extraction import extract_and_store
     from touchbench.app.services.live import open_live
-    from touchbench.app.services.models import load_model, train
+    from touchbench.app.services.loading import load_model
+    from touchbench.app.services.models import train
     from touchbench.app.services.simulation import write_session
     from touchbench.drivers.replay import FileReplaySource
     from touchbench.drivers.source import LIVE_BLOCK
@@ -153,7 +154,8 @@ def networks(store: Store, here: Path, recordings: list[Path], labels: Path, ses
 def engines(store: Store, repeats: int) -> None:
     """Per-row latency of each entry's own estimator and of its ONNX twin, alternately."""
     from touchbench.app.schemas.models import ExportRequest, TrainRequest
-    from touchbench.app.services.export import export_model, load_predictor
+    from touchbench.app.services.export import export_model
+    from touchbench.app.services.loading import load_predictor
     from touchbench.app.services.models import train
     from touchbench.app.store.datasets import load_dataset
 
@@ -188,7 +190,8 @@ def main() -> None:
     from touchbench.app.schemas.models import TrainRequest
     from touchbench.app.services.extraction import extract_and_store
     from touchbench.app.services.live import open_live
-    from touchbench.app.services.models import load_model, train
+    from touchbench.app.services.loading import load_model
+    from touchbench.app.services.models import train
     from touchbench.app.services.simulation import write_labels, write_session
     from touchbench.app.store.database import Store
     from touchbench.drivers.replay import FileReplaySource

@@ -329,9 +329,11 @@ def main() -> None:
 
     from touchbench.app.schemas.datasets import ImportRequest
     from touchbench.app.schemas.models import ExportRequest, TrainRequest
+    from touchbench.app.services.alignment import align_features
     from touchbench.app.services.datasets import import_file
-    from touchbench.app.services.export import export_model, load_predictor
-    from touchbench.app.services.models import align_features, train
+    from touchbench.app.services.export import export_model
+    from touchbench.app.services.loading import load_predictor
+    from touchbench.app.services.models import train
     from touchbench.app.store.database import Store
     from touchbench.benchmark.io import read_arff
 

@@ -1,5 +1,5 @@
-"""What routes depend on: the service's state (settings, store, dispatcher, model cache), the
-API key check with the keys' roles, and a cache of loaded models for fast predictions."""
+"""What routes depend on: the service's state (settings, store, dispatcher, the cache of loaded
+models), the API key check with the keys' roles, and where a served prediction runs."""
 
 from __future__ import annotations
 
@@ -7,35 +7,25 @@ import asyncio
 import hmac
 import logging
 import threading
-from collections import OrderedDict
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Annotated, TypeVar
+from typing import Annotated, TypeVar
 
 from fastapi import Depends, Header, HTTPException, Query, Request, Response
 
 from touchbench.app.jobs.dispatcher import Dispatcher
 from touchbench.app.schemas.listing import Page
+from touchbench.app.services.model_cache import ModelCache
 from touchbench.app.settings import Role, Settings
 from touchbench.app.store.database import Store
-from touchbench.app.store.models import ModelInfo, model_version
-
-if TYPE_CHECKING:  # scikit-learn loads on the first prediction, not at start-up
-    from touchbench.app.schemas.models import Engine
-    from touchbench.benchmark.model import Predictor
-
-
-#: A stored model's id, artifact sha256 and ``NAME@VERSION``
-#: (:func:`app.store.models.model_version`).
-ModelKey = tuple[int, str, str]
 
 log = logging.getLogger("touchbench.api")
 
 
 #: A prediction expected to take at most this many seconds of CPU time may run on the event
-#: loop (see :meth:`ModelCache.run`). Slower ones (large ensembles, many instances) go to a
-#: worker thread.
+#: loop (see :meth:`PredictionPlacement.run`). Slower ones (large ensembles, many instances)
+#: go to a worker thread.
 INLINE_SECONDS = 0.005
 
 Result = TypeVar("Result")
@@ -49,24 +39,21 @@ def request_size(instances: Sequence[Mapping[str, object]]) -> int:
     return len(instances) + sum(len(instance) for instance in instances)
 
 
-class ModelCache:
-    """Loaded models by (id, sha256, ``NAME@VERSION``), least recently used dropped first;
-    thread-safe.
+class PredictionPlacement:
+    """Where a served prediction runs: on the event loop, or in this process's one
+    prediction thread; it keeps how long each model's predictions take (:meth:`record`),
+    which decides where the next one runs (:meth:`runs_inline`).
 
-    Loading a model checks and rebuilds its artifact (tens to hundreds of milliseconds);
-    a prediction on a cached model costs one indexed query for the id, sha256 and version
-    its reference names now, so a model deleted or renamed by another process, a new
-    version trained under its name, or an alias moved (``NAME@champion``) is never served
-    stale. The cache also keeps how long each model's predictions take
-    (:meth:`record`), which decides where the next one runs (:meth:`runs_inline`).
+    Parameters
+    ----------
+    known : callable
+        ``known(ref)``: the id of the model ``ref`` named last, without asking the store
+        (:meth:`app.services.model_cache.ModelCache.known`), None if not loaded.
     """
 
-    def __init__(self, size: int) -> None:
-        self.size = size
-        # per model version, per engine asked for: the model or its ONNX twin
-        self._models: OrderedDict[ModelKey, dict[str, tuple[ModelInfo, Predictor]]] = OrderedDict()
+    def __init__(self, known: Callable[[str], int | None]) -> None:
+        self._known = known
         self._seconds: dict[int, float] = {}  # model id -> seconds per unit of size
-        self._refs: dict[str, int] = {}  # reference -> the model id it named last
         self._lock = threading.Lock()
         self._in_flight = 0  # predictions under way in this process (changed on the loop only)
         self._thread = ThreadPoolExecutor(1, thread_name_prefix="predict")
@@ -80,9 +67,8 @@ class ModelCache:
         prediction (the GIL runs one of them at a time anyway). Otherwise in the one
         prediction thread, first come first served: slow models must not hold the loop up;
         predictions run back to back on the loop leave some clients waiting far longer than
-        others (p99 1.3 s against 0.45 s for 32 clients); and predictions in many threads
-        at once wait on each other for the GIL at every numpy call (a forest's hundred
-        trees: 90 answers a second in place of 370).
+        others; and predictions in many threads at once wait on each other for the GIL at
+        every numpy call (``perf/serve.py`` measures both).
         """
         self._in_flight += 1
         try:
@@ -101,13 +87,8 @@ class ModelCache:
         """Whether a prediction of ``size`` (:func:`request_size`) with the model ``ref`` is
         known to be quick: the model is loaded and its recent predictions took under
         :data:`INLINE_SECONDS` of CPU time for that size."""
+        model_id = self._known(ref)
         with self._lock:
-            model_id = self._refs.get(ref)  # what ``ref`` named last (NAME@champion...)
-            if model_id is None:
-                for loaded, _, label in self._models:
-                    if ref in (label, label.rpartition("@")[0], str(loaded)):
-                        model_id = loaded
-                        break
             seconds = None if model_id is None else self._seconds.get(model_id)
         return seconds is not None and seconds * size <= INLINE_SECONDS
 
@@ -120,40 +101,9 @@ class ModelCache:
             known = self._seconds.get(model_id)
             self._seconds[model_id] = per_unit if known is None else 0.8 * known + 0.2 * per_unit
 
-    def get(
-        self, store: Store, ref: str | int, engine: Engine = "auto"
-    ) -> tuple[ModelInfo, Predictor]:
-        """A stored model run by ``engine`` (the model, or its ONNX twin: see
-        :func:`app.services.export.load_predictor`)."""
-        key = model_version(store, ref)
-        with self._lock:
-            if len(self._refs) >= 64 * self.size and str(ref) not in self._refs:
-                self._refs.clear()  # bounded: clients choose the references
-            self._refs[str(ref)] = key[0]
-            cached = self._models.get(key, {}).get(engine)
-            if cached is not None:
-                self._models.move_to_end(key)
-                return cached
-        # loaded with the first model: start-up time (scikit-learn loads in the service's
-        # warm-up thread, not before it answers its first request)
-        from touchbench.app.services.export import load_predictor
-
-        info, model = load_predictor(store, key[0], engine)
-        with self._lock:
-            loaded = self._models.setdefault((info.id, info.sha256, info.label), {})
-            loaded[engine] = (info, model)
-            self._models.move_to_end((info.id, info.sha256, info.label))
-            while len(self._models) > self.size:
-                self._models.popitem(last=False)
-        return info, model
-
     def forget(self, model_id: int) -> None:
         with self._lock:
-            for key in [key for key in self._models if key[0] == model_id]:
-                del self._models[key]
             self._seconds.pop(model_id, None)
-            for ref in [ref for ref, known in self._refs.items() if known == model_id]:
-                del self._refs[ref]
 
 
 @dataclass
@@ -164,6 +114,12 @@ class Service:
     store: Store
     dispatcher: Dispatcher
     models: ModelCache
+    placement: PredictionPlacement
+
+    def forget(self, model_id: int) -> None:
+        """Drop what this process holds of the model ``model_id`` (deleted)."""
+        self.models.forget(model_id)
+        self.placement.forget(model_id)
 
 
 # The dependencies below are ``async`` only so that FastAPI calls them on the event loop

@@ -9,7 +9,6 @@ import json
 # is chosen).
 import sys
 from enum import StrEnum
-from functools import partial
 from pathlib import Path
 from typing import Annotated
 
@@ -264,9 +263,7 @@ def live_command(
             samplerate=source.samplerate,
             n_channels=source.n_channels,
             extraction=extraction,
-            follow=follower(
-                store, model, model_info, load=partial(load_live_model, engine=choice.engine)
-            ),
+            follow=follower(store, model, model_info, engine=choice.engine),
         )
         shown = 0
         try:

@@ -16,7 +16,7 @@ from touchbench.app.cli.state import get_state
 
 if TYPE_CHECKING:
     from touchbench.app.schemas.models import AliasRequest
-    from touchbench.app.store.models import AliasMove
+    from touchbench.app.store.aliases import AliasMove
 
 
 def register(app: typer.Typer) -> None:
@@ -62,6 +62,14 @@ def train_command(
         int | None,
         typer.Option("--seed", metavar="S", help="Seed of the classifier.", show_default="0"),
     ] = None,
+    onnx: Annotated[
+        bool,
+        typer.Option(
+            "--onnx",
+            help="Also make the model's ONNX twin, checked against it on the training "
+            "instances (predictions with --engine auto then run it).",
+        ),
+    ] = False,
     as_json: JsonOption = False,
 ) -> None:
     """Fit a classifier on every instance of a data set and store the model."""
@@ -77,14 +85,17 @@ def train_command(
         target=target,
         name=name,
         seed=seed,
+        onnx=onnx,
     )
     model = train(get_state(ctx).store, request)
     if as_json:
         print_json(model.to_json())
         return
+    twin = "" if model.twin is None else f"; its ONNX twin {model.twin.size_bytes:,} bytes"
     info(
         f"trained model {model.id} '{model.label}': {model.classifier} on {model.dataset_name} "
-        f"for {', '.join(model.targets)} ({model.size_bytes:,} bytes, sha256 {model.sha256[:12]})"
+        f"for {', '.join(model.targets)} ({model.size_bytes:,} bytes, sha256 "
+        f"{model.sha256[:12]}{twin})"
     )
 
 
@@ -251,6 +262,8 @@ def export_model_command(
     )
     if output.exists() and not force:
         raise FieldError("output", f"{output.name} exists; give --force to overwrite it")
+    if not output.parent.is_dir():  # refused before the twin is made and stored
+        raise FieldError("output", f"folder {output.parent} does not exist")
     exported, graph = export_model(get_state(ctx).store, request)
     output.write_bytes(graph)
     if as_json:
@@ -288,6 +301,7 @@ def alias_command(
     as_json: JsonOption = False,
 ) -> None:
     """Point an alias of a model (NAME@ALIAS) at one of its versions."""
+    from touchbench.app.schemas.references import parse_model_ref
     from touchbench.app.services.models import move_alias, remove_alias
 
     request = _alias_request(model_ref, alias)
@@ -298,7 +312,7 @@ def alias_command(
     if as_json:
         print_json(gone.to_json())
         return
-    name = gone.model.rpartition("@")[0]
+    name = parse_model_ref(gone.model).name
     info(f"deleted {name}@{gone.alias} (it pointed at version {gone.version})")
 
 

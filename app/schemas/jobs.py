@@ -1,6 +1,6 @@
-"""Jobs other than runs (extraction of an uploaded recording session, training a model, the
-answers after a run: ablation, permutation importance, a learning curve), as the API answers
-them."""
+"""Jobs other than runs (extraction of an uploaded recording session, training a model,
+making a model's ONNX twin, the answers after a run: ablation, permutation importance, a
+learning curve), as the API answers them."""
 
 from __future__ import annotations
 
@@ -14,13 +14,14 @@ from touchbench.app.schemas.base import Request, Schema
 from touchbench.app.schemas.extraction import ExtractRequest
 from touchbench.app.schemas.importance import ImportanceRequest
 from touchbench.app.schemas.learning import LearningCurveRequest
-from touchbench.app.schemas.models import TrainRequest
+from touchbench.app.schemas.models import ExportRequest, TrainRequest
 
-JobKind = Literal["extract", "train", "ablation", "importance", "learning-curve"]
+JobKind = Literal["extract", "train", "export", "ablation", "importance", "learning-curve"]
 #: The request each kind of job carries out (its JSON is the job's ``params``).
 JOB_REQUESTS: dict[JobKind, type[Request]] = {
     "extract": ExtractRequest,
     "train": TrainRequest,
+    "export": ExportRequest,
     "ablation": AblationRequest,
     "importance": ImportanceRequest,
     "learning-curve": LearningCurveRequest,
@@ -44,7 +45,8 @@ class JobSchema(Schema):
     )
     result: dict[str, Any] | None = Field(
         default=None,
-        description="extract: the new data set; train: the new model; ablation, importance, "
+        description="extract: the new data set; train: the new model; export: the model's "
+        "new twin; ablation, importance, "
         "learning-curve: the answer (while running, what is finished so far, `complete` "
         "false).",
     )

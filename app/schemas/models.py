@@ -12,9 +12,23 @@ from pydantic import ConfigDict, Field, model_validator
 from touchbench.app.errors import FieldError
 from touchbench.app.schemas.base import Request, Schema
 from touchbench.app.schemas.names import AliasName, ModelName
+from touchbench.app.schemas.references import MAX_ROW_ID
 
 #: The largest id or seed (the store's integer columns are 32-bit on PostgreSQL).
-MAX_ID = 2**31 - 1
+MAX_ID = MAX_ROW_ID
+
+
+class TwinSchema(Schema):
+    """A model's twin in ONNX, checked against the model when it was made."""
+
+    format: str = "onnx"
+    sha256: str = Field(description="Digest of the twin's bytes, checked before each load.")
+    size_bytes: int
+    problem: str | None = Field(
+        default=None,
+        description="Why the twin could not be loaded, once a prediction tried: predictions "
+        "with engine auto then run the model itself, and engine onnx is refused.",
+    )
 
 
 class ModelSchema(Schema):
@@ -39,6 +53,9 @@ class ModelSchema(Schema):
     extraction: dict[str, Any] | None = Field(
         default=None,
         description="How its training data was extracted from recordings (null: imported).",
+    )
+    onnx: TwinSchema | None = Field(
+        default=None, description="Its ONNX twin (null: none yet; an export job makes one)."
     )
 
 
@@ -89,9 +106,9 @@ MissingPolicy = Literal["refuse", "allow"]
 
 
 #: What runs a model's predictions: ``native`` its own estimator (scikit-learn, XGBoost...),
-#: ``onnx`` its ONNX twin in ONNX Runtime (``touchbench export-model`` writes it), ``auto``
-#: the twin where the model has one (measured faster: ``perf/serve.py``,
-#: ``perf/live_latency.py``), else the estimator.
+#: ``onnx`` its ONNX twin in ONNX Runtime (an export makes it), ``auto`` the twin where the
+#: model has a usable one (measured faster: ``perf/serve.py``, ``perf/live_latency.py``),
+#: else the estimator.
 Engine = Literal["auto", "onnx", "native"]
 
 
@@ -110,10 +127,12 @@ ExportFormat = Literal["onnx"]
 
 
 class ExportRequest(Request):
-    """``GET /api/models/{id}/onnx`` and the CLI's ``export-model``: a model's twin in a
-    format other programs run, checked against the model on its training instances."""
+    """``POST /api/models/{id}/onnx`` (a job) and the CLI's ``export-model``: a model's twin
+    in a format other programs run, checked against the model on its training instances."""
 
-    model: str | int = Field(description="Model name or id.")
+    model: str | int = Field(
+        description="Model id, NAME (its newest version), NAME@VERSION or NAME@ALIAS."
+    )
     format: ExportFormat = Field(default="onnx", description="onnx: one ONNX graph.")
 
 
@@ -183,6 +202,11 @@ class TrainRequest(Request):
         default=None, description="Model name (default: DATASET-CLASSIFIER)."
     )
     seed: int = Field(default=0, ge=0, le=MAX_ID, description="Seed of the classifier.")
+    onnx: bool = Field(
+        default=False,
+        description="Also make the model's ONNX twin, checked against the model on its "
+        "training instances (predictions with engine auto then run it).",
+    )
 
     @model_validator(mode="after")
     def _one_source(self) -> TrainRequest:

@@ -21,6 +21,7 @@ from typing import Annotated
 from pydantic import AfterValidator, ValidationInfo
 
 from touchbench.app.errors import AppError, FieldError
+from touchbench.app.schemas.references import LATEST, SEPARATOR
 
 #: The longest name the store keeps (the ``name`` columns are ``String(200)``).
 MAX_NAME = 200
@@ -69,7 +70,7 @@ def check_name(name: str, *, kind: str) -> str:
         )
     if name.isascii() and name.isdigit():
         raise AppError(f"a {kind} name cannot be a number ('{name}' would read as an id)")
-    if kind == "model" and "@" in name:
+    if kind == "model" and SEPARATOR in name:
         raise AppError(
             f"a model name cannot hold '@' (NAME@VERSION and NAME@ALIAS name a version of "
             f"model NAME): '{shown(name)}'"
@@ -80,8 +81,6 @@ def check_name(name: str, *, kind: str) -> str:
 #: The longest alias the store keeps (``model_aliases.alias`` is ``String(100)``).
 MAX_ALIAS = 100
 _ALIAS = re.compile(r"[A-Za-z][A-Za-z0-9_.-]*")
-#: ``NAME@latest`` is the newest version, whatever the aliases say.
-LATEST = "latest"
 
 
 def check_alias(alias: str) -> str:

@@ -1,37 +1,48 @@
-"""Exporting a model as ONNX, and choosing what runs its predictions (the engine).
+"""A model's twin in ONNX: made (converted, checked, stored) as a job or by the command line,
+never inside a request that reads; read back as stored.
 
 An export is checked before it is stored: the graph must give the model's labels, and its
 probabilities within :data:`benchmark.export.onnx.TOLERANCE`, on every instance of the data
 set the model was trained on.  The twin is kept in the store beside the model
 (``model_exports``) with its sha256, which is verified on every load; ONNX bytes are a
-graph of operators, not code, so loading them runs nothing of the writer's.
+graph of operators, not code, so loading them runs nothing of the writer's.  Converting a
+large model takes seconds and a great deal of memory: the service does it in a job
+(:func:`app.services.jobs.submit_export`), one per model at a time.
 """
 
 from __future__ import annotations
 
-from touchbench.app.errors import ConflictError, FieldError
-from touchbench.app.schemas.models import Engine, ExportRequest, ExportSchema
-from touchbench.app.services.models import align_features, load_model
+# Imports inside functions: start-up time: the converters (skl2onnx, onnx) and the catalogue
+# load only where a model is exported or checked for it.
+from touchbench.app.errors import ConflictError, FieldError, NotFoundError
+from touchbench.app.schemas.models import ExportRequest, ExportSchema
+from touchbench.app.services.alignment import align_features
+from touchbench.app.services.loading import load_model
 from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import load_dataset
-from touchbench.app.store.exports import load_export, save_export
+from touchbench.app.store.exports import export_under_way, load_export, save_export
 from touchbench.app.store.models import ModelInfo, get_model
 from touchbench.benchmark.dataset import Schema
 from touchbench.benchmark.errors import ConfigurationError
-from touchbench.benchmark.extras import MissingExtraError, is_installed
-from touchbench.benchmark.model import Predictor
+from touchbench.benchmark.extras import MissingExtraError
 from touchbench.benchmark.problem import restrict_targets
 
-#: What ``auto`` picks when the model has an ONNX twin: ONNX Runtime answers one row sooner
-#: than the model's own estimator for every entry measured (perf/live_latency.py part 3,
-#: p50 of one row, native vs ONNX: rf 68 vs 0.24 ms, xgb 53 vs 0.22, logistic 34 vs 0.23,
-#: svm-rbf 34 vs 0.23; scikit-learn's per-call validation is what a row pays for).
-AUTO_PREFERS_ONNX = True
+
+class TwinMissing(NotFoundError):  # noqa: N818 (a state of the model, answered 404)
+    """The model has no twin in the format, and none is being made."""
+
+
+class TwinUnderWay(ConflictError):  # noqa: N818 (a state of the model, answered 409)
+    """The model's twin is being made by a job (``job``)."""
+
+    def __init__(self, message: str, job: int) -> None:
+        super().__init__(message)
+        self.job = job
 
 
 def export_model(store: Store, request: ExportRequest) -> tuple[ExportSchema, bytes]:
     """Convert a stored model, check the graph on its training instances, store it as the
-    model's twin, and return it.
+    model's twin (replacing one it had), and return it.
 
     Raises
     ------
@@ -43,14 +54,11 @@ def export_model(store: Store, request: ExportRequest) -> tuple[ExportSchema, by
     NotFoundError
         No such model.
     """
-    from touchbench.benchmark.export.onnx import export_onnx  # start-up time: skl2onnx, onnxruntime
+    from touchbench.benchmark.export.onnx import export_onnx  # start-up time: see above
 
     info, model = load_model(store, request.model)
-    if info.dataset_id is None:
-        raise ConflictError(
-            f"model '{info.name}': the data set it was trained on was deleted, so its ONNX "
-            "graph cannot be checked against it; train the model again to export it"
-        )
+    _refuse_without_data(info)
+    assert info.dataset_id is not None  # refused above
     data = load_dataset(store, info.dataset_id)
     data = restrict_targets(data, [t.name for t in model.schema.targets])
     X = align_features(model.schema, data, source=info.name)
@@ -74,45 +82,93 @@ def export_model(store: Store, request: ExportRequest) -> tuple[ExportSchema, by
     )
 
 
-def stored_export(store: Store, ref: str | int) -> tuple[ModelInfo, bytes, bool]:
-    """A model's stored ONNX twin, exported (and stored) first if it has none; and whether
-    it was exported now."""
-    info = get_model(store, ref)
-    graph = load_export(store, info.id, "onnx")
-    if graph is not None:
-        return info, graph, False
-    _, graph = export_model(store, ExportRequest(model=info.id))
-    return info, graph, True
+def check_export(store: Store, request: ExportRequest) -> ModelInfo:
+    """The model ``request`` names, once what its export would refuse without converting
+    anything was refused: before a job is queued, or before a model is trained with a twin.
+
+    Raises
+    ------
+    NotFoundError
+        No such model.
+    ConflictError
+        The data set it was trained on is gone.
+    FieldError
+        Models of its classifier have no converter (for ``model``).
+    MissingExtraError
+        The ``onnx`` extra is not installed.
+    """
+    info = get_model(store, request.model)
+    _refuse_without_data(info)
+    refuse_unexportable(info.classifier, regression=_is_regression(info), field="model")
+    return info
 
 
-def load_predictor(
-    store: Store, ref: str | int, engine: Engine = "auto"
-) -> tuple[ModelInfo, Predictor]:
-    """A stored model ready to predict with ``engine``: the model itself, or its ONNX
-    twin (:class:`benchmark.export.onnx.OnnxModel`, the same interface; the model's own
-    artifact is then not read).
+def refuse_unexportable(classifier: str, *, regression: bool, field: str) -> None:
+    """Refuse a classifier whose models the catalogue says do not export, before one is
+    trained or converted; what the catalogue does not know of is left to the export.
 
     Raises
     ------
     FieldError
-        ``engine`` is ``onnx`` and the model has no twin (for ``engine``).
+        For ``field``, in the words of the export's own refusal.
     MissingExtraError
-        ``engine`` is ``onnx`` and ONNX Runtime is not installed.
+        The ``onnx`` extra is not installed.
     """
-    if engine == "native" or (
-        engine == "auto" and not (AUTO_PREFERS_ONNX and is_installed("onnxruntime"))
-    ):
-        return load_model(store, ref)
-    info = get_model(store, ref)
-    graph = load_export(store, info.id, "onnx")
-    if graph is None:
-        if engine == "onnx":
-            raise FieldError(
-                "engine",
-                f"model '{info.name}' has no ONNX twin yet; export it to ONNX first, or "
-                "predict with the native engine",
-            )
-        return load_model(store, info.id)
-    from touchbench.benchmark.export.onnx import OnnxModel  # start-up time: onnxruntime
+    # start-up time: see above
+    from touchbench.benchmark.catalogue import get_spec
+    from touchbench.benchmark.export.multitarget import exports_multitarget
+    from touchbench.benchmark.export.onnx import exports_onnx
+    from touchbench.benchmark.export.supported import SUPPORTED
+    from touchbench.benchmark.extras import EXTRAS, require
+    from touchbench.benchmark.multitarget import parse_config
 
-    return info, OnnxModel(Schema.from_json(info.schema), info.classifier, graph)
+    require(EXTRAS["onnx"].modules, "exporting a model to ONNX")
+    if regression:
+        return  # the catalogue's entries are classifiers; the export judges regressors
+    try:
+        if ":" in classifier:
+            meta, base = parse_config(classifier)
+            exports = exports_multitarget(meta, bool(base) and exports_onnx(get_spec(base)))
+        else:
+            exports = exports_onnx(get_spec(classifier))
+    except ConfigurationError:
+        return  # not in the catalogue (a plug-in, a WEKA command line)
+    if not exports:
+        raise FieldError(
+            field,
+            f"classifier '{classifier}' has no ONNX converter; exportable: {SUPPORTED}",
+        )
+
+
+def stored_twin(store: Store, ref: str | int, format: str = "onnx") -> tuple[ModelInfo, bytes]:
+    """A model's stored twin, as it is: never made here.
+
+    Raises
+    ------
+    TwinUnderWay
+        A job is making it (``job``).
+    TwinMissing
+        It has none, and none is being made.
+    AppError
+        Its bytes differ from their recorded digest.
+    """
+    info = get_model(store, ref)
+    graph = load_export(store, info.id, format)
+    if graph is not None:
+        return info, graph
+    job = export_under_way(store, info.id, format)
+    if job is not None:
+        raise TwinUnderWay(f"model '{info.label}': its ONNX twin is being made by job {job}", job)
+    raise TwinMissing(f"model '{info.label}' has no ONNX twin yet")
+
+
+def _refuse_without_data(info: ModelInfo) -> None:
+    if info.dataset_id is None:
+        raise ConflictError(
+            f"model '{info.name}': the data set it was trained on was deleted, so its ONNX "
+            "graph cannot be checked against it; train the model again to export it"
+        )
+
+
+def _is_regression(info: ModelInfo) -> bool:
+    return all(target.kind == "numeric" for target in Schema.from_json(info.schema).targets)

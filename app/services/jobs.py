@@ -1,7 +1,7 @@
 """Long work the service queues instead of doing in a request: benchmark runs (the runs table
-is their queue), extraction of an uploaded recording session, training a model, and the
-answers after a run (an ablation, permutation importance, a learning curve), which keep what
-they finished as the job's result while they run.
+is their queue), extraction of an uploaded recording session, training a model, making a
+model's ONNX twin, and the answers after a run (an ablation, permutation importance, a
+learning curve), which keep what they finished as the job's result while they run.
 
 The request stores what is asked (``queued``) and answers at once; a dispatcher
 (:mod:`app.jobs.dispatcher`) hands each queued item to a worker process, which claims it
@@ -29,8 +29,9 @@ from touchbench.app.schemas.extraction import ExtractRequest
 from touchbench.app.schemas.importance import ImportanceRequest
 from touchbench.app.schemas.jobs import JOB_REQUESTS, JobKind, JobSchema
 from touchbench.app.schemas.learning import LearningCurveRequest
-from touchbench.app.schemas.models import TrainRequest
+from touchbench.app.schemas.models import ExportRequest, TrainRequest
 from touchbench.app.store.database import Store
+from touchbench.app.store.exports import queue_export
 from touchbench.app.store.jobs import (
     claim_job,
     create_job,
@@ -79,6 +80,23 @@ def submit_training(store: Store, request: TrainRequest) -> JobSchema:
 
     check_training(store, request)
     return _submit(store, "train", request)
+
+
+def submit_export(store: Store, request: ExportRequest) -> tuple[JobSchema, bool]:
+    """Queue the making of a model's ONNX twin, once
+    :func:`app.services.export.check_export` found nothing to refuse; at most one such job
+    per model at a time: a request while one is under way is answered with that job.
+
+    Returns
+    -------
+    tuple of (JobSchema, bool)
+        The job, and whether it was queued now.
+    """
+    from touchbench.app.services.export import check_export
+
+    info = check_export(store, request)
+    job_id, created = queue_export(store, info.id, request.format)
+    return get_job(store, job_id), created
 
 
 def submit_answer(
@@ -307,6 +325,10 @@ def _carry_out(
 
         summary = extract_and_store(store, request).to_json()
         return {"dataset_id": summary["id"], **summary}
+    if isinstance(request, ExportRequest):
+        from touchbench.app.services.export import export_model
+
+        return export_model(store, request)[0].to_json()
     assert isinstance(request, TrainRequest)
     from touchbench.app.services.models import train
 

@@ -8,27 +8,29 @@ calls, so that a CLI loop and an async WebSocket handler (in a worker thread) sh
 
 A session opened on a reference that can name another version later (``NAME``: the
 newest version; ``NAME@champion``) follows it (:class:`ModelFollower`): between two blocks
-it asks the store, at most once per second, which version the reference names, and
-switches to a new one without dropping the stream when that version extracts its features
-the same way (same recipe, sample rate and channels); otherwise it keeps the model it has
-and says why once.  Each prediction names the version that made it.
+it asks the model cache (:mod:`app.services.model_cache`, whose freshness rule asks the
+store at most once per second) which version the reference names, and switches to a new
+one without dropping the stream when that version extracts its features the same way
+(same recipe, sample rate and channels); otherwise it keeps the model it has and says why
+once.  Each prediction names the version that made it.
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
-from functools import partial
 from typing import Any
 
 import numpy as np
 
 from touchbench.app.errors import AppError
 from touchbench.app.schemas.models import Engine
-from touchbench.app.services.export import load_predictor
+from touchbench.app.schemas.references import parse_model_ref
+from touchbench.app.services.loading import load_predictor
+from touchbench.app.services.model_cache import ModelCache
 from touchbench.app.store.database import Store
-from touchbench.app.store.models import ModelInfo, is_pinned, model_version
+from touchbench.app.store.models import ModelInfo
 from touchbench.benchmark.model import Predictor
 from touchbench.features.errors import FeatureError
 from touchbench.features.extractors import Instances
@@ -73,14 +75,15 @@ class TouchPrediction:
         }
 
 
-#: The model a reference names now, loaded: ``load(store, ref)``.
-Loader = Callable[[Store, "str | int"], "tuple[ModelInfo, Predictor]"]
 #: Seconds between two checks of which version a followed reference names.
 FOLLOW_SECONDS = 1.0
+#: Model versions a session's own cache keeps loaded (the one held, the one switched to).
+FOLLOWED_MODELS = 2
 
 
 class ModelFollower:
-    """Which version a model reference (``NAME@champion``) names now.
+    """Which version a model reference (``NAME@champion``) names now, by the freshness rule
+    of the model cache (:class:`app.services.model_cache.ModelCache`).
 
     Parameters
     ----------
@@ -89,10 +92,14 @@ class ModelFollower:
         The reference the session was opened with.
     current : ModelInfo
         The version the session holds.
-    load : callable, optional
-        ``load(store, model_id)``, the loaded model (the service passes its model cache).
+    cache : ModelCache
+        Where versions are loaded, and what ``ref`` named last (the service's own cache,
+        shared with its predictions and other sessions; the command line's, the session's).
+    engine : {"auto", "onnx", "native"}
+        What runs the versions switched to.
     interval : float
-        Seconds between two checks: a check is one indexed query, a change a model load.
+        Seconds an answer of the store on what ``ref`` names stays good: a check is one
+        indexed query, a change a model load.
     """
 
     def __init__(
@@ -101,31 +108,28 @@ class ModelFollower:
         ref: str | int,
         current: ModelInfo,
         *,
-        load: Loader | None = None,
+        cache: ModelCache,
+        engine: Engine = "auto",
         interval: float = FOLLOW_SECONDS,
     ) -> None:
         self.store = store
         self.ref = ref
-        self.load: Loader = load or load_live_model
+        self.cache = cache
+        self.engine: Engine = engine
         self.interval = interval
         self.held = (current.id, current.sha256)
         self.refused: tuple[int, str] | None = None  # a version already found unfit
-        self.checked = time.monotonic()
 
     def check(self) -> tuple[ModelInfo, Predictor] | str | None:
         """A version to switch to, a message when the reference names nothing now, or None
-        (no change, or not time to ask yet, or a version refused before)."""
-        now = time.monotonic()
-        if now - self.checked < self.interval:
-            return None
-        self.checked = now
+        (no change, or a version refused before)."""
         try:
-            model_id, sha256, _ = model_version(self.store, self.ref)
+            key = self.cache.version(self.store, self.ref, max_age=self.interval)
         except AppError as error:  # the version deleted, the alias removed: keep ours
             return self._once(("gone", str(self.ref)), f"{error}; the session keeps its model")
-        if (model_id, sha256) in (self.held, self.refused):
+        if (key.id, key.sha256) in (self.held, self.refused):
             return None
-        return self.load(self.store, model_id)
+        return self.cache.get(self.store, key.id, self.engine)
 
     def _once(self, key: tuple[Any, str], message: str) -> str | None:
         if self.refused == key:
@@ -139,14 +143,22 @@ def follower(
     ref: str | int,
     current: ModelInfo,
     *,
-    load: Loader | None = None,
+    cache: ModelCache | None = None,
+    engine: Engine = "auto",
     interval: float = FOLLOW_SECONDS,
 ) -> ModelFollower | None:
-    """A :class:`ModelFollower` of ``ref``, or None when it names one version for good (an
-    id, ``NAME@VERSION``)."""
-    if is_pinned(ref):
+    """A :class:`ModelFollower` of ``ref`` (with a cache of its own if none is given), or
+    None when it names one version for good (an id, ``NAME@VERSION``)."""
+    if parse_model_ref(ref).pinned:
         return None
-    return ModelFollower(store, ref, current, load=load, interval=interval)
+    return ModelFollower(
+        store,
+        ref,
+        current,
+        cache=cache or ModelCache(FOLLOWED_MODELS),
+        engine=engine,
+        interval=interval,
+    )
 
 
 class LiveSession:
@@ -380,7 +392,7 @@ def open_live(
     samplerate: float,
     n_channels: int,
     engine: Engine = "auto",
-    load: Loader | None = None,
+    cache: ModelCache | None = None,
     follow_seconds: float = FOLLOW_SECONDS,
 ) -> LiveSession:
     """A :class:`LiveSession` of the stored model ``ref`` (id, ``NAME``, ``NAME@VERSION``,
@@ -389,20 +401,20 @@ def open_live(
     Parameters
     ----------
     engine : {"auto", "onnx", "native"}
-        What runs the predictions (see :func:`app.services.export.load_predictor`), of
+        What runs the predictions (see :func:`app.services.loading.load_predictor`), of
         this version and of those the session switches to.
-    load : callable, optional
-        ``load(store, ref)``: the loaded model (default :func:`load_live_model` with
-        ``engine``; the service passes its model cache).
+    cache : ModelCache, optional
+        Where the versions are loaded (the service passes its own); default: one of the
+        session's own.
     follow_seconds : float
         Seconds between two checks of the version ``ref`` names.
     """
-    loader: Loader = load or partial(load_live_model, engine=engine)
-    info, model = loader(store, ref)
+    cache = cache or ModelCache(FOLLOWED_MODELS)
+    info, model = cache.get(store, ref, engine)
     return LiveSession(
         info,
         model,
         samplerate=samplerate,
         n_channels=n_channels,
-        follow=follower(store, ref, info, load=loader, interval=follow_seconds),
+        follow=follower(store, ref, info, cache=cache, engine=engine, interval=follow_seconds),
     )

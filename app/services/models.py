@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import csv
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -22,36 +22,28 @@ from touchbench.app.errors import ConflictError, FieldError
 from touchbench.app.schemas.models import (
     AliasDeleted,
     AliasRequest,
-    Engine,
+    ExportRequest,
     MissingPolicy,
     PredictFileRequest,
     PredictionReport,
     PredictionRow,
     TrainRequest,
 )
+from touchbench.app.services.alignment import align_features, lacks, quoted
 from touchbench.app.services.datasets import read_data_file
+from touchbench.app.services.export import export_model, refuse_unexportable
+from touchbench.app.services.loading import PredictorLoader, load_model, load_predictor
+from touchbench.app.store.aliases import AliasMove, delete_alias, rollback_alias, set_alias
 from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import find_dataset, load_dataset
-from touchbench.app.store.models import (
-    AliasMove,
-    ModelInfo,
-    check_model_name,
-    delete_alias,
-    load_artifact,
-    rollback_alias,
-    save_model,
-    set_alias,
-)
+from touchbench.app.store.models import ModelInfo, check_model_name, get_model, save_model
 from touchbench.app.store.naming import shorten
 from touchbench.app.store.runs import RunInfo, get_run, load_results
 from touchbench.benchmark.dataset import Attribute, Dataset, Schema
 from touchbench.benchmark.errors import ConfigurationError, DataFormatError
-from touchbench.benchmark.model import Predictor, TrainedModel, dumps_model, fit_model, loads_model
+from touchbench.benchmark.model import Predictor, dumps_model, fit_model
 from touchbench.benchmark.problem import Problem, problem_from_dataset, restrict_targets
 from touchbench.drivers.limits import LINE_CHARS, LineTooLongError, bounded_lines
-
-#: Labels quoted in one warning at most.
-MAX_QUOTED = 5
 
 
 @dataclass(frozen=True)
@@ -71,11 +63,15 @@ def train(store: Store, request: TrainRequest) -> ModelInfo:
     on the run's data set and targets) and store the model as the next version of its name
     (``request.name``, else ``DATASET-CLASSIFIER``).
 
-    Raises as :func:`check_training` does.
+    With ``request.onnx``, the model's ONNX twin is made too, checked on the training
+    instances (:func:`app.services.export.export_model`).
+
+    Raises as :func:`check_training` does; a twin whose graph disagrees with the model is
+    refused after the model was stored (it stays, without a twin).
     """
     plan = check_training(store, request)
     model = fit_model(plan.data, plan.classifier, random_state=plan.seed)
-    return save_model(
+    info = save_model(
         store,
         classifier=plan.classifier,
         params=_jsonable(model.params),
@@ -86,6 +82,15 @@ def train(store: Store, request: TrainRequest) -> ModelInfo:
         run_id=plan.run_id,
         name=request.name,
     )
+    if not request.onnx:
+        return info
+    try:
+        export_model(store, ExportRequest(model=info.id))
+    except FieldError as error:
+        raise FieldError(
+            "onnx", f"model '{info.label}' was stored without its ONNX twin: {error.message}"
+        ) from None
+    return get_model(store, info.id)
 
 
 def check_training(store: Store, request: TrainRequest) -> Training:
@@ -100,7 +105,10 @@ def check_training(store: Store, request: TrainRequest) -> Training:
     FieldError
         An invalid name; an unknown target or one without any known value; an unknown
         classifier or one that cannot learn the targets (a multi-class classifier for
-        several targets, or the reverse; a sequence classifier on flat features).
+        several targets, or the reverse; a sequence classifier on flat features); an ONNX
+        twin asked of a classifier without a converter.
+    MissingExtraError
+        An ONNX twin asked without the ``onnx`` extra.
     """
     # start-up time: the catalogue is big
     from touchbench.benchmark.estimators import check_classifier
@@ -133,6 +141,8 @@ def check_training(store: Store, request: TrainRequest) -> Training:
         check_classifier(classifier, problem)
     except ConfigurationError as error:
         raise FieldError("run" if request.run is not None else "classifier", str(error)) from None
+    if request.onnx:
+        refuse_unexportable(classifier, regression=problem.kind == "regression", field="onnx")
     return Training(data, dataset_id, classifier, seed, run_id)
 
 
@@ -168,14 +178,6 @@ def _best_of_run(store: Store, run_ref: int) -> tuple[RunInfo, str]:
     if board.baseline is None:
         raise ConflictError(f"run {run.id} has no successful classifier to train")
     return run, board.rows[0].classifier
-
-
-def load_model(store: Store, ref: str | int) -> tuple[ModelInfo, TrainedModel]:
-    """A stored model (an id, ``NAME``: its newest version, ``NAME@VERSION``, ``NAME@ALIAS``);
-    its bytes are checked against their sha256 and loaded only as an artifact that cannot
-    run code (:mod:`benchmark.artifacts`)."""
-    info, artifact = load_artifact(store, ref)
-    return info, loads_model(artifact, sha256=info.sha256)
 
 
 def move_alias(store: Store, request: AliasRequest) -> AliasMove:
@@ -229,14 +231,23 @@ class Predictions:
     mae: dict[str, float] = field(default_factory=dict)
 
     def report(self, model: ModelInfo) -> PredictionReport:
-        """The report ``predict --json`` prints and the API answers."""
+        """The report ``predict --json`` prints and the API answers (with the problem of a
+        twin that could not be loaded, when the model itself answered in its place)."""
+        unusable = (
+            []
+            if model.twin is None or model.twin.problem is None
+            else [
+                f"model '{model.label}': its ONNX twin cannot be loaded ({model.twin.problem}); "
+                "the model itself predicted"
+            ]
+        )
         return PredictionReport(
             model=model.label,
             targets=model.targets,
             predictions=[PredictionRow(**row) for row in self.to_json()],
             accuracy=self.accuracy,
             mae=self.mae,
-            warnings=self.warnings,
+            warnings=unusable + self.warnings,
         )
 
     def to_json(self) -> list[dict[str, Any]]:
@@ -284,7 +295,7 @@ def predict(model: Predictor, data: Dataset, *, source: str = "input") -> Predic
         if foreign:
             warnings.append(
                 f"{source}: target '{t.name}': {len(foreign)} instance(s) carry labels the "
-                f"model cannot predict ({_quoted(foreign)}); they count as misses in the accuracy"
+                f"model cannot predict ({quoted(foreign)}); they count as misses in the accuracy"
             )
     return Predictions(
         labels=labels,
@@ -322,11 +333,6 @@ def _predict_values(
     )
 
 
-#: How a stored model is loaded to predict: :func:`app.services.export.load_predictor`'s
-#: signature (the service passes its cache of loaded models).
-PredictorLoader = Callable[[Store, str | int, Engine], tuple[ModelInfo, Predictor]]
-
-
 def predict_file(
     store: Store, request: PredictFileRequest, *, loader: PredictorLoader | None = None
 ) -> PredictionReport:
@@ -335,13 +341,9 @@ def predict_file(
     Parameters
     ----------
     loader : callable, optional
-        Loads the model (default: :func:`app.services.export.load_predictor`).
+        Loads the model (default: :func:`app.services.loading.load_predictor`).
     """
-    if loader is None:
-        from touchbench.app.services.export import load_predictor  # it builds on this module
-
-        loader = load_predictor
-    info, model = loader(store, request.model, request.engine)
+    info, model = (loader or load_predictor)(store, request.model, request.engine)
     return predict_path(info, model, request.file, source=request.source_name)
 
 
@@ -454,8 +456,8 @@ def dataset_from_records(
     given = {key for record in records for key in record}
     if given and not given & {a.name for a in features}:
         raise DataFormatError(
-            f"none of the attributes given are the model's ({_quoted(sorted(given))}); the "
-            f"model needs {_quoted([a.name for a in features])}",
+            f"none of the attributes given are the model's ({quoted(sorted(given))}); the "
+            f"model needs {quoted([a.name for a in features])}",
             source="instances",
         )
     values = np.full((len(records), len(features)), np.nan)
@@ -470,7 +472,7 @@ def dataset_from_records(
                     continue
                 if isinstance(cell, bool) or not isinstance(cell, str | int):
                     raise DataFormatError(
-                        f"instance {i + 1}: expects a label ({_quoted(labels)}), got {cell!r}",
+                        f"instance {i + 1}: expects a label ({quoted(labels)}), got {cell!r}",
                         source="instances",
                         attribute=name,
                     )
@@ -505,16 +507,9 @@ def _refuse_left_out(features: Sequence[Attribute], records: Sequence[Mapping[st
         if left_out:
             raise FieldError(
                 f"instances.{i}",
-                f"instance {i + 1} {_lacks(left_out)} (give null for a value not known, or "
+                f"instance {i + 1} {lacks(left_out)} (give null for a value not known, or "
                 'set `missing` to "allow" to read left-out attributes as missing values)',
             )
-
-
-def _lacks(names: Sequence[str]) -> str:
-    """``lacks N attribute(s) the model needs: a, b, ...``, naming the first five."""
-    shown = ", ".join(shorten(name) for name in names[:5])
-    more = f", ... ({len(names)} in all)" if len(names) > 5 else ""
-    return f"lacks {len(names)} attribute(s) the model needs: {shown}{more}"
 
 
 def _is_finite_number(cell: object) -> bool:
@@ -527,71 +522,6 @@ def _is_finite_number(cell: object) -> bool:
         return False
 
 
-def align_features(
-    schema: Schema,
-    data: Dataset,
-    *,
-    source: str = "input",
-    warnings: list[str] | None = None,
-) -> np.ndarray:
-    """The model's feature matrix from ``data``, shape (n_instances, n_model_features).
-
-    Columns are found by name; nominal codes are translated label by label; a label the
-    model never saw becomes missing (NaN), which every pipeline imputes, and is reported
-    in ``warnings``.
-    """
-    given, wanted = data.schema.attributes, schema.features
-    if len(given) == len(wanted) and all(a is b for a, b in zip(given, wanted, strict=True)):
-        return data.values  # built from the model's own attributes (dataset_from_records)
-    by_name = {a.name: i for i, a in enumerate(given)}
-    missing = [a.name for a in schema.features if a.name not in by_name]
-    if missing:
-        raise DataFormatError(_lacks(missing), source=source)
-    X = np.empty((data.n_instances, len(schema.features)))
-    for j, attribute in enumerate(schema.features):
-        theirs = data.schema.attributes[by_name[attribute.name]]
-        column = data.values[:, by_name[attribute.name]]
-        X[:, j] = _translate(attribute, theirs, column, source, warnings)
-    return X
-
-
-def _translate(
-    mine: Attribute,
-    theirs: Attribute,
-    column: np.ndarray,
-    source: str,
-    warnings: list[str] | None,
-) -> np.ndarray:
-    if mine.kind == "nominal":
-        if theirs.kind != "nominal":
-            raise DataFormatError(
-                f"is {theirs.kind} here but nominal in the model",
-                source=source,
-                attribute=mine.name,
-            )
-        lookup = np.array(
-            [mine.values.index(v) if v in mine.values else -1.0 for v in theirs.values] or [-1.0]
-        )
-        out = np.full(column.shape, np.nan)
-        known = ~np.isnan(column)
-        out[known] = lookup[column[known].astype(int)]
-        unseen = out < 0
-        if unseen.any():
-            labels = [theirs.values[int(code)] for code in column[unseen]]
-            if warnings is not None:
-                warnings.append(
-                    f"{source}: attribute '{mine.name}': {int(unseen.sum())} instance(s) have "
-                    f"labels the model never saw ({_quoted(labels)}); treated as missing values"
-                )
-            out[unseen] = np.nan
-        return out
-    if theirs.kind not in ("numeric", "date") and mine.kind == "numeric":
-        raise DataFormatError(
-            f"is {theirs.kind} here but numeric in the model", source=source, attribute=mine.name
-        )
-    return column
-
-
 def _true_labels(target: Attribute, data: Dataset) -> list[str | None] | None:
     names = [a.name for a in data.schema.attributes]
     if target.name not in names:
@@ -601,12 +531,6 @@ def _true_labels(target: Attribute, data: Dataset) -> list[str | None] | None:
         return None
     column = data.values[:, names.index(target.name)]
     return [theirs.label(v) for v in column]
-
-
-def _quoted(labels: Sequence[str]) -> str:
-    distinct = list(dict.fromkeys(labels))
-    shown = ", ".join(f"'{label}'" for label in distinct[:MAX_QUOTED])
-    return shown + (f", ... ({len(distinct)} in all)" if len(distinct) > MAX_QUOTED else "")
 
 
 def _jsonable(params: dict[str, Any]) -> dict[str, Any]:

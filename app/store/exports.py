@@ -1,5 +1,6 @@
 """A model's twins in other formats (``model_exports``): ONNX graphs checked against the
-model before they were written, kept with their sha256 and verified on every load."""
+model before they were written, kept with their sha256 and verified on every load; and the
+jobs that make them, one per model and format at a time."""
 
 from __future__ import annotations
 
@@ -7,13 +8,18 @@ import hashlib
 from dataclasses import dataclass
 
 from sqlalchemy import delete, select
+from sqlalchemy.orm import Session
 
 from touchbench.app.errors import AppError
+from touchbench.app.schemas.runs import FINAL_STATUSES
 from touchbench.app.store.database import Store
-from touchbench.app.store.tables import ModelExportRow
+from touchbench.app.store.models import held_version
+from touchbench.app.store.tables import JobRow, ModelExportRow
 
 #: The formats a twin may have.
 FORMATS = ("onnx",)
+#: The kind of the jobs that make twins (their params: the model's id and the format).
+EXPORT_JOB = "export"
 
 
 @dataclass(frozen=True)
@@ -73,3 +79,45 @@ def load_export(store: Store, model_id: int, format: str) -> bytes | None:
             f"({recorded[:12]}..., got {actual[:12]}...); export the model again"
         )
     return data
+
+
+def queue_export(store: Store, model_id: int, format: str) -> tuple[int, bool]:
+    """The job that makes the twin of the model ``model_id`` in ``format``: the one under
+    way if there is one, else one queued now; and whether it was queued now.
+
+    The model is held while this looks and queues (:func:`app.store.models.held_version`),
+    so that requests at the same moment queue one job between them.
+
+    Raises
+    ------
+    NotFoundError
+        The model was deleted meanwhile.
+    """
+    with store.session() as session:
+        held_version(session, model_id)
+        under_way = _under_way(session, model_id, format)
+        if under_way is not None:
+            return under_way, False
+        row = JobRow(kind=EXPORT_JOB, status="queued", params={"model": model_id, "format": format})
+        session.add(row)
+        session.flush()
+        return row.id, True
+
+
+def export_under_way(store: Store, model_id: int, format: str) -> int | None:
+    """The id of the job making the model's twin in ``format`` (queued, running or being
+    cancelled), None if there is none."""
+    with store.session() as session:
+        return _under_way(session, model_id, format)
+
+
+def _under_way(session: Session, model_id: int, format: str) -> int | None:
+    unfinished = session.execute(
+        select(JobRow.id, JobRow.params)
+        .where(JobRow.kind == EXPORT_JOB, JobRow.status.not_in(FINAL_STATUSES))
+        .order_by(JobRow.id)
+    )
+    for job_id, params in unfinished:
+        if params.get("model") == model_id and params.get("format", "onnx") == format:
+            return int(job_id)
+    return None

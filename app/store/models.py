@@ -1,52 +1,66 @@
-"""Trained models in the store: the artifact's bytes with their sha256 and format, the schema
-the model expects, the classifier and its parameters, the data set and run it came from,
-and how that data set was extracted from recordings.
+"""Trained models in the store, as a registry: a registered model per name
+(``registered_models``), its versions (``models``: the artifact's sha256 and format, the
+schema the model expects, the classifier and its parameters, the data set and run it came
+from, and how that data set was extracted from recordings).
 
 Artifacts live in a table of their own (``model_artifacts``), so listings and the version
 check of every served prediction never read one; :func:`load_artifact` reads one, and
 only a format that cannot run code when loaded (``skops``) is handed out.
 
 Models stored under one name are its versions 1, 2, ... (training again under a name adds
-one).  A reference to a model is its id, ``NAME`` (the newest version), ``NAME@VERSION``,
-``NAME@latest`` or ``NAME@ALIAS`` (an alias such as ``champion`` points at one version;
-:func:`set_alias` moves it and keeps its history, :func:`rollback_alias` steps back).
+one).  A number is taken from the registered model's counter, which only grows, and ids
+are never given twice either: ``NAME@VERSION`` and an id name one model for good, even
+after it is deleted.  A reference to a model is read by
+:func:`app.schemas.references.parse_model_ref` (an id, ``NAME``: the newest version,
+``NAME@VERSION``, ``NAME@latest``, ``NAME@ALIAS``) and resolved by
+:mod:`app.store.model_refs`; aliases are :mod:`app.store.aliases`' business.
 """
 
 from __future__ import annotations
 
 import hashlib
-from collections.abc import Iterator, Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 from datetime import datetime
 from typing import Any
 
-from sqlalchemy import and_, bindparam, delete, func, select, update
+from sqlalchemy import delete, select, update
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session
 
-from touchbench.app.errors import AppError, ConflictError, FieldError, NotFoundError
+from touchbench.app.errors import AppError, ConflictError, FieldError
 from touchbench.app.schemas.listing import Page
-from touchbench.app.schemas.models import AliasMoved, ModelSchema
-from touchbench.app.schemas.names import LATEST, check_alias, check_name
+from touchbench.app.schemas.models import ModelSchema, TwinSchema
+from touchbench.app.schemas.names import check_name
+from touchbench.app.schemas.references import SEPARATOR, version_label
 from touchbench.app.store.database import Store
-from touchbench.app.store.naming import find_row, is_decimal, is_row_id, may_be_name, shorten
+from touchbench.app.store.model_refs import TWIN_FORMAT, version_row
+from touchbench.app.store.naming import shorten
 from touchbench.app.store.paging import count_rows, paged
 from touchbench.app.store.tables import (
-    MODEL_VERSION_KEY,
     DatasetRow,
-    ModelAliasEventRow,
     ModelAliasRow,
     ModelArtifactRow,
+    ModelExportRow,
     ModelRow,
-    utcnow,
+    RegisteredModelRow,
 )
 
 #: The only artifact format that is loaded (see :mod:`benchmark.artifacts`).
 SAFE_FORMAT = "skops"
-#: The alias ``promote`` sets and ``rollback`` steps back.
-CHAMPION = "champion"
-#: Attempts at a free version number when other processes store versions of the same name.
+#: Attempts at storing the first version of a name that other processes store at once.
 VERSION_ATTEMPTS = 20
+
+
+@dataclass(frozen=True)
+class TwinInfo:
+    """A model's twin in another format (ONNX), as the store describes it (its bytes are
+    not read); ``problem`` says why it could not be loaded, once a prediction tried."""
+
+    format: str
+    sha256: str
+    size_bytes: int
+    problem: str | None = None
 
 
 @dataclass(frozen=True)
@@ -67,11 +81,12 @@ class ModelInfo:
     extraction: dict[str, Any] | None = None
     version: int = 1
     aliases: tuple[str, ...] = ()
+    twin: TwinInfo | None = None
 
     @property
     def label(self) -> str:
         """``NAME@VERSION``: the one version this is, as answers name it."""
-        return f"{self.name}@{self.version}"
+        return version_label(self.name, self.version)
 
     @property
     def feature_names(self) -> list[str]:
@@ -99,6 +114,13 @@ class ModelInfo:
             created_at=self.created_at,
             features=self.feature_names,
             extraction=self.extraction,
+            onnx=None
+            if self.twin is None
+            else TwinSchema(
+                sha256=self.twin.sha256,
+                size_bytes=self.twin.size_bytes,
+                problem=self.twin.problem,
+            ),
         )
 
     def to_json(self) -> dict[str, Any]:
@@ -122,9 +144,11 @@ def save_model(
     new version of that model, not another model).
 
     The data set's extraction recipe (if it was extracted from recordings) is copied to
-    the model, so that live prediction extracts features as training did.  Processes that
-    store versions of one name at once each get their own: the store's unique ``(name,
-    version)`` refuses a taken one, and the next free number is tried.
+    the model, so that live prediction extracts features as training did.  The version's
+    number is taken from the registered model's counter in the same statement that raises
+    it, so processes storing versions of one name at once each get their own; two that
+    register a new name at once are told apart by its unique key, and the second tries
+    again.
     """
     if name is not None:
         check_model_name(name)
@@ -134,8 +158,8 @@ def save_model(
                 dataset = session.get(DatasetRow, dataset_id) if dataset_id is not None else None
                 chosen = name if name is not None else default_model_name(dataset, classifier)
                 row = ModelRow(
-                    name=chosen,
-                    version=_next_version(session, chosen),
+                    registered_model_id=(parent := _register(session, chosen)),
+                    version=take_version(session, parent),
                     dataset_id=dataset_id,
                     run_id=run_id,
                     classifier=classifier,
@@ -148,34 +172,85 @@ def save_model(
                     extraction=dataset.extraction if dataset is not None else None,
                 )
                 session.add(row)
-                session.flush()  # waits for a concurrent insert of the same version to end
+                session.flush()
                 session.add(ModelArtifactRow(model_id=row.id, artifact=artifact))
-                return _info(session, row)
+                return version_info(session, row)
         except IntegrityError as error:
-            if not _version_taken(error):
+            if "registered_models" not in str(error.orig):
                 raise
-            # another process stored this version meanwhile: take the next one
+            # another process registered the name meanwhile: its row is there now
     raise ConflictError(
-        f"could not find a free version of model '{shorten(str(name))}' after "
-        f"{VERSION_ATTEMPTS} attempts (busy store); try again"
+        f"could not register model '{shorten(str(name))}' after {VERSION_ATTEMPTS} attempts "
+        "(busy store); try again"
     )
+
+
+def _register(session: Session, name: str) -> int:
+    """The id of the registered model ``name``, registered now if it is new."""
+    found = session.scalar(select(RegisteredModelRow.id).where(RegisteredModelRow.name == name))
+    if found is not None:
+        return int(found)
+    parent = RegisteredModelRow(name=name, last_version=0)
+    session.add(parent)
+    session.flush()  # a concurrent registration of the name fails here
+    return parent.id
+
+
+def take_version(session: Session, parent: int) -> int:
+    """Raise the registered model's counter and return it: the number of its next version
+    (one UPDATE: another process raising it meanwhile waits for this transaction's end,
+    then raises what this one left)."""
+    raised = session.execute(
+        update(RegisteredModelRow)
+        .where(RegisteredModelRow.id == parent)
+        .values(last_version=RegisteredModelRow.last_version + 1)
+        .returning(RegisteredModelRow.last_version)
+        .execution_options(synchronize_session=False)
+    ).scalar_one()
+    return int(raised)
+
+
+def lock_registered(session: Session, parent: int) -> None:
+    """Hold the registered model ``parent`` until the transaction ends (its row lock on
+    PostgreSQL, the write lock on SQLite), as :func:`take_version` does, without changing
+    it: every change to a model's versions and aliases takes it first, so that they happen
+    one at a time, each on what the one before it left."""
+    session.execute(
+        update(RegisteredModelRow)
+        .where(RegisteredModelRow.id == parent)
+        .values(last_version=RegisteredModelRow.last_version)
+        .execution_options(synchronize_session=False)
+    )
+
+
+def held_version(session: Session, ref: str | int) -> ModelRow:
+    """The version ``ref`` names, read once its registered model is held
+    (:func:`lock_registered`): what the changes before this one left.
+
+    Raises
+    ------
+    NotFoundError
+        ``ref`` names nothing now (another change deleted it meanwhile).
+    ConflictError
+        ``ref`` names another model now (renamed meanwhile).
+    """
+    row = version_row(session, ref)
+    parent = row.registered_model_id
+    lock_registered(session, parent)
+    session.expire_all()  # rows read before the lock may have changed since
+    row = version_row(session, ref)
+    if row.registered_model_id != parent:
+        raise ConflictError(
+            f"'{shorten(str(ref))}' names another model than it did a moment ago (renamed "
+            "meanwhile); try again"
+        )
+    return row
 
 
 def default_model_name(dataset: DatasetRow | None, classifier: str) -> str:
     """``DATASET-CLASSIFIER`` (``@`` folded to ``_``: it would read as a version)."""
-    base = f"{dataset.name if dataset else 'model'}-{classifier}".replace("@", "_")
+    base = f"{dataset.name if dataset else 'model'}-{classifier}".replace(SEPARATOR, "_")
     return base[:200]
-
-
-def _next_version(session: Session, name: str) -> int:
-    top = session.scalar(select(func.max(ModelRow.version)).where(ModelRow.name == name))
-    return int(top or 0) + 1
-
-
-def _version_taken(error: IntegrityError) -> bool:
-    """Whether ``error`` is the unique ``(name, version)`` refusing a taken version."""
-    text = str(error.orig)
-    return MODEL_VERSION_KEY in text or "models.version" in text
 
 
 def check_model_name(name: str) -> None:
@@ -199,73 +274,20 @@ def list_models(store: Store, *, page: Page | None = None) -> list[ModelInfo]:
     with store.session() as session:
         rows = list(session.scalars(paged(select(ModelRow).order_by(ModelRow.id), page)))
         names = _dataset_names(session, rows)
-        aliases = _aliases(session, {row.name for row in rows})
-        return [_info(session, row, names, aliases) for row in rows]
+        aliases = _aliases(session, {row.registered_model_id for row in rows})
+        twins = _twins(session, [row.id for row in rows])
+        return [version_info(session, row, names, aliases, twins) for row in rows]
 
 
 def count_models(store: Store) -> int:
+    """How many model versions the store holds."""
     return count_rows(store, ModelRow)
 
 
 def get_model(store: Store, ref: str | int) -> ModelInfo:
     """A model's description (its artifact is not read)."""
     with store.session() as session:
-        return _info(session, _row(session, ref))
-
-
-def model_version(store: Store, ref: str | int) -> tuple[int, str, str]:
-    """The id, artifact sha256 and ``NAME@VERSION`` of the model ``ref`` names now: one
-    or two indexed queries on the driver's cursor.
-
-    The service's model cache asks this on every prediction to know whether the model it
-    holds is still the stored one (and the one an alias points at), and a live session
-    to follow ``NAME@champion``.
-
-    Raises
-    ------
-    NotFoundError
-        As :func:`get_model` does.
-    """
-    text = str(ref)
-    found = None
-    if may_be_name(text):
-        if "@" in text:  # one query for NAME@champion; a name stored with '@' next
-            name, _, suffix = text.rpartition("@")
-            if is_row_id(suffix):
-                found = store.first_row(_VERSION_BY_NUMBER, ref=name, number=int(suffix))
-            elif suffix == LATEST:
-                found = store.first_row(_VERSION_BY_NAME, ref=name)
-            else:
-                found = store.first_row(_VERSION_BY_ALIAS, ref=name, alias=suffix)
-        if found is None:
-            found = store.first_row(_VERSION_BY_NAME, ref=text)
-    if found is None and is_row_id(text):
-        found = store.first_row(_VERSION_BY_ID, ref=int(text))
-    if found is None:
-        get_model(store, ref)  # raises NotFoundError naming the known models
-        raise AssertionError("get_model found a model the version query did not")
-    return int(found[0]), str(found[1]), f"{found[2]}@{found[3]}"
-
-
-_VERSION = select(ModelRow.id, ModelRow.sha256, ModelRow.name, ModelRow.version)
-_VERSION_BY_NAME = (
-    _VERSION.where(ModelRow.name == bindparam("ref")).order_by(ModelRow.version.desc()).limit(1)
-)
-_VERSION_BY_NUMBER = _VERSION.where(
-    ModelRow.name == bindparam("ref"), ModelRow.version == bindparam("number")
-)
-_VERSION_BY_ALIAS = _VERSION.join(
-    ModelAliasRow,
-    and_(ModelAliasRow.name == ModelRow.name, ModelAliasRow.version == ModelRow.version),
-).where(ModelAliasRow.name == bindparam("ref"), ModelAliasRow.alias == bindparam("alias"))
-_VERSION_BY_ID = _VERSION.where(ModelRow.id == bindparam("ref"))
-
-
-def is_pinned(ref: str | int) -> bool:
-    """Whether ``ref`` names one version for good (an id, ``NAME@VERSION``), rather than
-    whatever version a name's newest or an alias is now."""
-    text = str(ref)
-    return is_row_id(text) or ("@" in text and is_row_id(text.rpartition("@")[2]))
+        return version_info(session, version_row(session, ref))
 
 
 def load_artifact(store: Store, ref: str | int) -> tuple[ModelInfo, bytes]:
@@ -278,8 +300,8 @@ def load_artifact(store: Store, ref: str | int) -> tuple[ModelInfo, bytes]:
         touchbench before 0.2 were pickles).
     """
     with store.session() as session:
-        row = _row(session, ref)
-        info = _info(session, row)
+        row = version_row(session, ref)
+        info = version_info(session, row)
         if row.format != SAFE_FORMAT:
             raise AppError(
                 f"model '{row.name}' is stored as a {row.format}, a format that can run code "
@@ -290,289 +312,44 @@ def load_artifact(store: Store, ref: str | int) -> tuple[ModelInfo, bytes]:
 
 
 def delete_model(store: Store, ref: str | int) -> ModelInfo:
-    """Delete the version ``ref`` names (``NAME``: the newest); aliases that pointed at it
-    go with it (their history stays, and ``rollback`` skips versions that are gone)."""
+    """Delete the version ``ref`` names (``NAME``: the newest): one DELETE, its artifact,
+    twins and the aliases that pointed at it going with it by cascade (their history
+    stays, and ``rollback`` skips versions that are gone).  Its number and id are not given
+    again."""
     with store.session() as session:
-        row = _row(session, ref)
-        info = _info(session, row)
-        session.execute(
-            delete(ModelAliasRow).where(
-                ModelAliasRow.name == row.name, ModelAliasRow.version == row.version
-            )
-        )
+        row = held_version(session, ref)
+        info = version_info(session, row)
         session.execute(delete(ModelRow).where(ModelRow.id == row.id))
         return info
 
 
 def rename_model(store: Store, ref: str | int, new_name: str) -> ModelInfo:
-    """Give every version of the model ``ref`` names another name, with its aliases and
-    their history; returns the version ``ref`` named.
+    """Give the model ``ref`` names (every version, its aliases and their history) another
+    name: one UPDATE of its registered model; returns the version ``ref`` named.
 
     Raises
     ------
     ConflictError
-        Another model has the name.
+        Another model has the name, or had it (its numbers are not given again).
     """
     check_model_name(new_name)
     try:
         with store.session() as session:
-            row = _row(session, ref)
-            old, version = row.name, row.version
-            if new_name != old:
-                if session.scalars(select(ModelRow.id).where(ModelRow.name == new_name)).first():
-                    raise ConflictError(_taken(new_name))
-                for table in (ModelRow, ModelAliasRow, ModelAliasEventRow):
-                    session.execute(update(table).where(table.name == old).values(name=new_name))
+            row = version_row(session, ref)
+            version = row.version
+            if new_name != row.name:
+                session.execute(
+                    update(RegisteredModelRow)
+                    .where(RegisteredModelRow.id == row.registered_model_id)
+                    .values(name=new_name)
+                    .execution_options(synchronize_session=False)
+                )
     except IntegrityError:
-        raise ConflictError(_taken(new_name)) from None
-    return get_model(store, f"{new_name}@{version}")
-
-
-def _taken(name: str) -> str:
-    return f"a model named '{shorten(name)}' already exists; choose another name"
-
-
-@dataclass(frozen=True)
-class AliasMove:
-    """An alias set or stepped back: the version it points at now, and before (None: it
-    pointed at none)."""
-
-    alias: str
-    model: ModelInfo
-    previous: int | None
-
-    def to_schema(self) -> AliasMoved:
-        return AliasMoved(
-            alias=self.alias,
-            model=self.model.label,
-            version=self.model.version,
-            previous=self.previous,
-        )
-
-    def to_json(self) -> dict[str, Any]:
-        return self.to_schema().to_json()
-
-
-def set_alias(store: Store, ref: str | int, alias: str) -> AliasMove:
-    """Point ``NAME@alias`` at the version ``ref`` names, and note it in the alias's history.
-
-    Raises
-    ------
-    FieldError
-        An invalid alias (``alias``).
-    NotFoundError
-        No such model or version.
-    """
-    try:
-        check_alias(alias)
-    except AppError as error:
-        raise FieldError("alias", str(error)) from None
-    for _attempt in range(VERSION_ATTEMPTS):
-        try:
-            with store.session() as session:
-                row = _row(session, ref)
-                current = _alias_row(session, row.name, alias)
-                previous = None if current is None else current.version
-                if current is None:
-                    session.add(ModelAliasRow(name=row.name, alias=alias, version=row.version))
-                else:
-                    current.version = row.version
-                    current.set_at = utcnow()
-                session.add(ModelAliasEventRow(name=row.name, alias=alias, version=row.version))
-                session.flush()  # a concurrent first setting of the alias: try again
-                return AliasMove(alias, _info(session, row), previous)
-        except IntegrityError:
-            continue
-    raise ConflictError(f"could not set alias '{alias}' (busy store); try again")
-
-
-def rollback_alias(store: Store, ref: str | int, alias: str = CHAMPION) -> AliasMove:
-    """Point ``NAME@alias`` back at the version it pointed at before its last move (a
-    second rollback goes one step further back); versions deleted since are skipped.
-
-    Raises
-    ------
-    NotFoundError
-        No such model.
-    ConflictError
-        The alias points at nothing, or at the only version it ever pointed at.
-    """
-    with store.session() as session:
-        name = _row(session, ref).name
-        current = _alias_row(session, name, alias)
-        if current is None:
-            raise ConflictError(
-                f"model '{shorten(name)}' has no alias '{alias}' to roll back (set it with "
-                f"`promote` or `alias` first)"
-            )
-        for step in _alias_steps(session, name, alias):
-            target = (
-                _version_row(session, name, step.version)
-                if step.version != current.version
-                else None
-            )
-            if target is not None:
-                previous, current.version, current.set_at = current.version, step.version, utcnow()
-                return AliasMove(alias, _info(session, target), previous)
-            step.undone = True  # the move being undone, or a version deleted since
         raise ConflictError(
-            f"'{shorten(name)}@{alias}' has pointed at no other version that still exists "
-            f"(now version {current.version}): nothing to roll back to"
-        )
-
-
-def delete_alias(store: Store, ref: str | int, alias: str) -> AliasMove:
-    """Remove ``NAME@alias``; returns the version it pointed at (``model``, and
-    ``previous``).  Its history is marked undone, so that the alias set again later starts
-    afresh (``rollback`` does not step back past its deletion).
-
-    A ``ref`` that names one version (an id, ``NAME@VERSION``) deletes the alias only while
-    it points at that version: an alias another client moved since is not removed unseen.
-
-    Raises
-    ------
-    FieldError
-        An invalid alias (``alias``).
-    NotFoundError
-        No such model, or the model has no such alias.
-    ConflictError
-        ``ref`` names a version the alias does not point at.
-    """
-    try:
-        check_alias(alias)
-    except AppError as error:
-        raise FieldError("alias", str(error)) from None
-    with store.session() as session:
-        row = _row(session, ref)
-        current = _alias_row(session, row.name, alias)
-        if current is None:
-            known = _aliases(session, {row.name})
-            names = sorted(a for aliases in known.values() for a in aliases)
-            raise NotFoundError(
-                f"model '{shorten(row.name)}' has no alias '{alias}' (aliases: "
-                f"{', '.join(names) or 'none'})"
-            )
-        if is_pinned(ref) and current.version != row.version:
-            raise ConflictError(
-                f"'{shorten(row.name)}@{alias}' points at version {current.version}, not "
-                f"{row.version}: not deleted (name the model without a version to delete it "
-                "whatever it points at)"
-            )
-        target = _version_row(session, row.name, current.version)
-        assert target is not None  # deleting a version deletes the aliases on it
-        session.execute(
-            update(ModelAliasEventRow)
-            .where(ModelAliasEventRow.name == row.name, ModelAliasEventRow.alias == alias)
-            .values(undone=True)
-        )
-        session.delete(current)
-        return AliasMove(alias, _info(session, target), current.version)
-
-
-#: History steps read per query by :func:`_alias_steps`.
-ALIAS_STEPS_PAGE = 16
-
-
-def _alias_steps(session: Session, name: str, alias: str) -> Iterator[ModelAliasEventRow]:
-    """The alias's moves not undone, newest first, read a page at a time: a rollback
-    usually stops at the second, and an alias moved 20,000 times took 0.9 s to read whole."""
-    before: int | None = None
-    while True:
-        query = select(ModelAliasEventRow).where(
-            ModelAliasEventRow.name == name,
-            ModelAliasEventRow.alias == alias,
-            ModelAliasEventRow.undone.is_(False),
-        )
-        if before is not None:
-            query = query.where(ModelAliasEventRow.id < before)
-        page = session.scalars(
-            query.order_by(ModelAliasEventRow.id.desc()).limit(ALIAS_STEPS_PAGE)
-        ).all()
-        yield from page
-        if len(page) < ALIAS_STEPS_PAGE:
-            return
-        before = page[-1].id
-
-
-def _alias_row(session: Session, name: str, alias: str) -> ModelAliasRow | None:
-    return session.get(ModelAliasRow, (name, alias))
-
-
-def _version_row(session: Session, name: str, version: int) -> ModelRow | None:
-    return session.scalars(
-        select(ModelRow).where(ModelRow.name == name, ModelRow.version == version)
-    ).first()
-
-
-def _row(session: Session, ref: str | int) -> ModelRow:
-    """The model version ``ref`` names: a name (its newest version), an id, or
-    ``NAME@VERSION``, ``NAME@latest``, ``NAME@ALIAS``.
-
-    A name with ``@`` in it that names no version is looked up whole, so that a model
-    stored with ``@`` in its name before names refused it is still found.
-
-    Raises
-    ------
-    NotFoundError
-        Naming the known models, or the known versions and aliases of ``NAME``.
-    """
-    text = str(ref)
-    if may_be_name(text):
-        if "@" in text:
-            try:
-                return _version_of(session, *text.rpartition("@")[::2])
-            except NotFoundError:
-                row = _newest(session, text)
-                if row is None:
-                    raise
-                return row
-        row = _newest(session, text)
-        if row is not None:
-            return row
-    return find_row(session, ModelRow, ref, kind="model", hint="none yet; training makes one")
-
-
-def _newest(session: Session, name: str) -> ModelRow | None:
-    return session.scalars(
-        select(ModelRow).where(ModelRow.name == name).order_by(ModelRow.version.desc())
-    ).first()
-
-
-def _version_of(session: Session, name: str, suffix: str) -> ModelRow:
-    """Version ``suffix`` (a number, ``latest`` or an alias) of the model ``name``."""
-    versions = list(
-        session.scalars(
-            select(ModelRow).where(ModelRow.name == name).order_by(ModelRow.version.desc())
-        )
-    )
-    if not versions:
-        find_row(session, ModelRow, name, kind="model", hint="none yet; training makes one")
-        raise AssertionError("find_row found a name the query did not")
-    if suffix == LATEST:
-        return versions[0]
-    if is_decimal(suffix):
-        for row in versions:
-            if str(row.version) == suffix.lstrip("0"):
-                return row
-        known = ", ".join(str(row.version) for row in reversed(versions[:20]))
-        raise NotFoundError(
-            f"model '{shorten(name)}' has no version {suffix[:12]} (versions: {known})"
-        )
-    alias = _alias_row(session, name, suffix) if may_be_name(suffix) else None
-    if alias is not None:
-        for row in versions:
-            if row.version == alias.version:
-                return row
-    known = ", ".join(
-        f"{a}->{v}"
-        for a, v in session.execute(
-            select(ModelAliasRow.alias, ModelAliasRow.version).where(ModelAliasRow.name == name)
-        ).all()
-    )
-    raise NotFoundError(
-        f"model '{shorten(name)}' has no alias '{shorten(suffix)}' (aliases: "
-        f"{known or 'none; `promote NAME@VERSION` sets champion'})"
-    )
+            f"a model named '{shorten(new_name)}' exists or existed (a name keeps its version "
+            "numbers, which are not given again); choose another name"
+        ) from None
+    return get_model(store, version_label(new_name, version))
 
 
 def _dataset_names(session: Session, rows: Sequence[ModelRow]) -> dict[int, str]:
@@ -584,36 +361,53 @@ def _dataset_names(session: Session, rows: Sequence[ModelRow]) -> dict[int, str]
     )
 
 
-def _aliases(session: Session, names: set[str]) -> dict[tuple[str, int], tuple[str, ...]]:
-    """(name, version) -> the aliases that point at it, sorted."""
-    if not names:
+def _aliases(session: Session, parents: Collection[int]) -> dict[tuple[int, int], tuple[str, ...]]:
+    """(registered model id, version) -> the aliases that point at it, sorted."""
+    if not parents:
         return {}
-    found: dict[tuple[str, int], list[str]] = {}
+    found: dict[tuple[int, int], list[str]] = {}
     rows = session.execute(
-        select(ModelAliasRow.name, ModelAliasRow.version, ModelAliasRow.alias)
-        .where(ModelAliasRow.name.in_(names))
+        select(ModelAliasRow.registered_model_id, ModelAliasRow.version, ModelAliasRow.alias)
+        .where(ModelAliasRow.registered_model_id.in_(parents))
         .order_by(ModelAliasRow.alias)
     )
-    for name, version, alias in rows:
-        found.setdefault((name, version), []).append(alias)
+    for parent, version, alias in rows:
+        found.setdefault((parent, version), []).append(alias)
     return {key: tuple(aliases) for key, aliases in found.items()}
 
 
-def _info(
+def _twins(session: Session, ids: Collection[int]) -> dict[int, TwinInfo]:
+    """Model id -> its ONNX twin's description (the bytes are not read)."""
+    if not ids:
+        return {}
+    rows = session.execute(
+        select(ModelExportRow.model_id, ModelExportRow.sha256, ModelExportRow.size_bytes).where(
+            ModelExportRow.model_id.in_(ids), ModelExportRow.format == TWIN_FORMAT
+        )
+    )
+    return {model_id: TwinInfo(TWIN_FORMAT, sha256, size) for model_id, sha256, size in rows}
+
+
+def version_info(
     session: Session,
     row: ModelRow,
     names: dict[int, str] | None = None,
-    aliases: dict[tuple[str, int], tuple[str, ...]] | None = None,
+    aliases: dict[tuple[int, int], tuple[str, ...]] | None = None,
+    twins: dict[int, TwinInfo] | None = None,
 ) -> ModelInfo:
+    """The description of the version ``row`` (``names``: data set names by id,
+    ``aliases`` and ``twins``, when a listing read them for many rows at once)."""
     if names is None:
         names = _dataset_names(session, [row])
     if aliases is None:
-        aliases = _aliases(session, {row.name})
+        aliases = _aliases(session, {row.registered_model_id})
+    if twins is None:
+        twins = _twins(session, [row.id])
     return ModelInfo(
         id=row.id,
         name=row.name,
         version=row.version,
-        aliases=aliases.get((row.name, row.version), ()),
+        aliases=aliases.get((row.registered_model_id, row.version), ()),
         classifier=row.classifier,
         params=dict(row.params),
         targets=list(row.targets),
@@ -626,4 +420,5 @@ def _info(
         schema=dict(row.schema),
         format=row.format,
         extraction=row.extraction,
+        twin=twins.get(row.id),
     )

@@ -14,6 +14,10 @@ from touchbench.app.schemas.names import CONTROL as _CONTROL
 from touchbench.app.schemas.names import MAX_NAME
 from touchbench.app.schemas.names import shown as shorten
 
+# re-exported: the rule of an id is the schemas' (model references read it too)
+from touchbench.app.schemas.references import is_decimal as is_decimal
+from touchbench.app.schemas.references import is_row_id as is_row_id
+
 #: Names listed in a "no such ..." message.
 _NAMES_SHOWN = 10
 _UNSAFE = re.compile(r"[^\w.-]+")
@@ -25,21 +29,6 @@ class Named(Protocol):
 
 
 RowT = TypeVar("RowT", bound=Named)
-
-
-#: The largest id a row can have (the columns are 32-bit integers on PostgreSQL).
-MAX_ROW_ID = 2**31 - 1
-
-
-def is_decimal(text: str) -> bool:
-    """Whether ``text`` is ASCII digits only (``str.isdigit`` also takes ``"²"``, which
-    ``int`` refuses, and ``int`` takes other scripts' digits, which no id is written in)."""
-    return text.isascii() and text.isdigit()
-
-
-def is_row_id(text: str) -> bool:
-    """Whether ``text`` can be the id of a row (so that looking it up cannot fail)."""
-    return is_decimal(text) and len(text) <= 10 and 0 < int(text) <= MAX_ROW_ID
 
 
 def may_be_name(text: str) -> bool:

@@ -1,5 +1,5 @@
 """ORM models of the store: data sets and their instances, benchmark runs and their
-per-fold results, trained models.
+per-fold results, the registry of trained models.
 
 Instances keep WEKA's encoding (see :mod:`benchmark.dataset`) in blocks of consecutive
 instances: each row of ``instance_blocks`` holds a block's values as little-endian float64
@@ -19,6 +19,8 @@ from sqlalchemy import (
     DateTime,
     Float,
     ForeignKey,
+    ForeignKeyConstraint,
+    Index,
     Integer,
     LargeBinary,
     String,
@@ -170,25 +172,49 @@ class FoldPredictionsRow(Base):
     data: Mapped[bytes] = mapped_column(LargeBinary)
 
 
-#: The constraint that keeps two models of one name from taking the same version.
-MODEL_VERSION_KEY = "uq_models_name_version"
+# The model registry, as MLflow's (``mlflow/store/model_registry/dbmodels/models.py``): a
+# parent row per registered name; its versions, their aliases and the aliases' history tied
+# to it by foreign keys, so that renaming a model is one UPDATE of its parent and deleting a
+# version one DELETE (its artifact, twins and aliases go by cascade).  Ids come from
+# AUTOINCREMENT on SQLite (a sequence on PostgreSQL), so that an id is never given twice.
+#: The constraint that keeps two versions of one model from taking the same number.
+MODEL_VERSION_KEY = "uq_models_registered_model_version"
+
+
+class RegisteredModelRow(Base):
+    """A model's name, the parent of its versions: ``last_version`` is the number its newest
+    version ever took, and only grows (a version deleted is never given again, so that
+    ``NAME@VERSION`` names one model for good).  The row stays when its versions are
+    deleted, keeping the count."""
+
+    __tablename__ = "registered_models"
+    __table_args__ = ({"sqlite_autoincrement": True},)
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    name: Mapped[str] = mapped_column(String(200), unique=True)
+    last_version: Mapped[int] = mapped_column(Integer, default=0)
+    created_at: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=utcnow)
 
 
 class ModelRow(Base):
-    """A trained model: the estimator's artifact (``format`` says how it is serialised;
-    only formats that cannot run code are loaded), its schema, and how its features were
-    extracted.
+    """A trained model, one version of a registered model: the estimator's artifact
+    (``format`` says how it is serialised; only formats that cannot run code are loaded),
+    its schema, and how its features were extracted.
 
-    Models trained under one name are its versions 1, 2, ...; ``id`` stays the row's own
-    number, unique across names.
+    ``id`` is the version's own number, unique across names and never given twice.
     """
 
     __tablename__ = "models"
-    __table_args__ = (UniqueConstraint("name", "version", name=MODEL_VERSION_KEY),)
+    __table_args__ = (
+        UniqueConstraint("registered_model_id", "version", name=MODEL_VERSION_KEY),
+        {"sqlite_autoincrement": True},
+    )
 
     id: Mapped[int] = mapped_column(Integer, primary_key=True)
-    name: Mapped[str] = mapped_column(String(200))
-    version: Mapped[int] = mapped_column(Integer, default=1)
+    registered_model_id: Mapped[int] = mapped_column(
+        ForeignKey("registered_models.id", ondelete="CASCADE")
+    )
+    version: Mapped[int] = mapped_column(Integer)
     dataset_id: Mapped[int | None] = mapped_column(ForeignKey("datasets.id", ondelete="SET NULL"))
     run_id: Mapped[int | None] = mapped_column(ForeignKey("runs.id", ondelete="SET NULL"))
     classifier: Mapped[str] = mapped_column(String(100))
@@ -201,14 +227,31 @@ class ModelRow(Base):
     format: Mapped[str] = mapped_column(String(20), default="skops")
     extraction: Mapped[dict[str, Any] | None] = mapped_column(JSON(none_as_null=True))
 
+    registered: Mapped[RegisteredModelRow] = relationship(lazy="joined", innerjoin=True)
+
+    @property
+    def name(self) -> str:
+        return self.registered.name
+
 
 class ModelAliasRow(Base):
     """A name for one version of a model (``champion``), moved by ``alias``, ``promote``
-    and ``rollback``: ``NAME@ALIAS`` is that version."""
+    and ``rollback``: ``NAME@ALIAS`` is that version.  It goes with the version it points
+    at (the foreign key on ``(registered_model_id, version)``)."""
 
     __tablename__ = "model_aliases"
+    __table_args__ = (
+        ForeignKeyConstraint(
+            ["registered_model_id", "version"],
+            ["models.registered_model_id", "models.version"],
+            ondelete="CASCADE",
+            name="fk_model_aliases_version",
+        ),
+    )
 
-    name: Mapped[str] = mapped_column(String(200), primary_key=True)
+    registered_model_id: Mapped[int] = mapped_column(
+        ForeignKey("registered_models.id", ondelete="CASCADE"), primary_key=True
+    )
     alias: Mapped[str] = mapped_column(String(100), primary_key=True)
     version: Mapped[int] = mapped_column(Integer)
     set_at: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=utcnow)
@@ -216,12 +259,19 @@ class ModelAliasRow(Base):
 
 class ModelAliasEventRow(Base):
     """Each version an alias was set to, in order: ``rollback`` steps back through them
-    (a step undone is marked, so that a second rollback goes one further back)."""
+    (a step undone is marked, so that a second rollback goes one further back; a version
+    deleted since is skipped, and never comes back under its number)."""
 
     __tablename__ = "model_alias_history"
+    __table_args__ = (
+        Index("ix_model_alias_history_alias", "registered_model_id", "alias", "id"),
+        {"sqlite_autoincrement": True},
+    )
 
     id: Mapped[int] = mapped_column(Integer, primary_key=True)
-    name: Mapped[str] = mapped_column(String(200), index=True)
+    registered_model_id: Mapped[int] = mapped_column(
+        ForeignKey("registered_models.id", ondelete="CASCADE")
+    )
     alias: Mapped[str] = mapped_column(String(100))
     version: Mapped[int] = mapped_column(Integer)
     set_at: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=utcnow)

@@ -143,3 +143,40 @@ def test_training_is_refused_naming_the_option(
         assert result.err.startswith(f"touchbench: error: {expected}"), result.err
     listing = run_cli(capsys, store_url, "models", "--json").json()["models"]
     assert [model["name"] for model in listing] == ["touch-nb"]
+
+
+def test_a_deleted_version_never_comes_back_under_its_number(
+    capsys: pytest.CaptureFixture[str], store_url: str, trained: Path
+) -> None:
+    """Issue 36: delete ``pin@2`` (the newest), train ``pin`` again with another classifier:
+    it becomes ``pin@3`` with an id never given before, and ``rollback pin`` refuses rather
+    than move ``@champion`` onto a model nobody promoted."""
+
+    def train(classifier: str) -> dict[str, object]:
+        done = run_cli(
+            capsys, store_url, "train", "touch", "-c", classifier, "--target", "gesture",
+            "--name", "pin", "--json",
+        )  # fmt: skip
+        assert done.code == 0, done.err
+        model: dict[str, object] = done.json()
+        return model
+
+    assert [train("nb")["version"], train("j48")["version"]] == [1, 2]
+    for version in ("pin@2", "pin@1"):
+        assert run_cli(capsys, store_url, "promote", version).code == 0
+    listing = run_cli(capsys, store_url, "models", "--json").json()["models"]
+    deleted_id = next(m["id"] for m in listing if m["name"] == "pin" and m["version"] == 2)
+    gone = run_cli(capsys, store_url, "delete-model", "pin")
+    assert gone.code == 0 and f"deleted model {deleted_id} 'pin@2'" in gone.err
+    again = train("ibk")
+    assert again["version"] == 3 and isinstance(again["id"], int) and again["id"] > deleted_id
+    refused = run_cli(capsys, store_url, "rollback", "pin")
+    assert refused.code == 2 and "nothing to roll back to" in refused.err, refused.err
+    missing = run_cli(capsys, store_url, "predict", "pin@2", str(trained))
+    assert missing.code == 2 and "model 'pin' has no version 2 (versions: 1, 3)" in missing.err
+    listing = run_cli(capsys, store_url, "models", "--json").json()["models"]
+    pins = [(m["id"], m["version"], m["classifier"], m["aliases"]) for m in listing[1:]]
+    assert pins == [
+        (pins[0][0], 1, "nb", ["champion"]),
+        (again["id"], 3, "ibk", []),
+    ]

@@ -15,7 +15,8 @@ from touchbench.app.schemas.extraction import ExtractRequest
 from touchbench.app.schemas.models import TrainRequest
 from touchbench.app.services.extraction import extract_and_store, extract_dataset
 from touchbench.app.services.live import LiveSession, open_live
-from touchbench.app.services.models import load_model, predict, train
+from touchbench.app.services.loading import load_model
+from touchbench.app.services.models import predict, train
 from touchbench.app.services.simulation import write_labels, write_session
 from touchbench.app.store.database import Store
 from touchbench.drivers.replay import FileReplaySource

@@ -10,31 +10,40 @@ from pathlib import Path
 
 import pytest
 from sqlalchemy import select
+from sqlalchemy.orm import Session
 
 from tests.app.cli_runner import run_cli
 from touchbench.app.errors import ConflictError, FieldError, NotFoundError
 from touchbench.app.schemas.models import TrainRequest
+from touchbench.app.store import aliases as store_aliases
 from touchbench.app.store import models as store_models
+from touchbench.app.store.aliases import delete_alias, rollback_alias, set_alias
 from touchbench.app.store.database import Store
+from touchbench.app.store.model_refs import model_version
 from touchbench.app.store.models import (
-    delete_alias,
+    ModelInfo,
     delete_model,
     get_model,
     list_models,
-    model_version,
-    rollback_alias,
     save_model,
-    set_alias,
 )
-from touchbench.app.store.tables import DatasetRow, ModelRow
+from touchbench.app.store.tables import DatasetRow, ModelRow, RegisteredModelRow
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 
 
-def _save(store: Store, name: str | None = "mic", dataset_id: int | None = None) -> int:
-    info = save_model(
+def _save(
+    store: Store, name: str | None = "mic", dataset_id: int | None = None, classifier: str = "nb"
+) -> int:
+    return _saved(store, name, dataset_id, classifier).version
+
+
+def _saved(
+    store: Store, name: str | None = "mic", dataset_id: int | None = None, classifier: str = "nb"
+) -> ModelInfo:
+    return save_model(
         store,
-        classifier="nb",
+        classifier=classifier,
         params={},
         schema={"relation": "r", "attributes": []},
         targets=["gesture"],
@@ -42,7 +51,6 @@ def _save(store: Store, name: str | None = "mic", dataset_id: int | None = None)
         name=name,
         dataset_id=dataset_id,
     )
-    return info.version
 
 
 def test_references_name_versions_and_aliases(store: Store) -> None:
@@ -50,7 +58,7 @@ def test_references_name_versions_and_aliases(store: Store) -> None:
     ids = [model.id for model in list_models(store)]
     assert model_version(store, "mic")[2] == "mic@3"  # a name alone: the newest version
     assert model_version(store, "mic@latest")[2] == "mic@3"
-    assert model_version(store, "mic@2") == (ids[1], model_version(store, ids[1])[1], "mic@2")
+    assert model_version(store, "mic@2") == (ids[1], model_version(store, ids[1])[1], "mic@2", None)
     assert get_model(store, "mic@1").id == ids[0] and get_model(store, ids[2]).version == 3
     with pytest.raises(NotFoundError, match=r"model 'mic' has no version 7 \(versions: 1, 2, 3\)"):
         get_model(store, "mic@7")
@@ -148,13 +156,45 @@ def test_a_rollback_reads_the_history_a_page_at_a_time(
         assert rollback_alias(store, "mic").model.label == "mic@3"
     finally:
         event.remove(Session, "loaded_as_persistent", count)
-    assert 0 < len(loaded) <= store_models.ALIAS_STEPS_PAGE  # not the 86 moves
-    monkeypatch.setattr(store_models, "ALIAS_STEPS_PAGE", 2)
+    assert 0 < len(loaded) <= store_aliases.ALIAS_STEPS_PAGE  # not the 86 moves
+    monkeypatch.setattr(store_aliases, "ALIAS_STEPS_PAGE", 2)
     for version in (2, 1):  # back over the moves to 2 (undone, then equal), pages of 2
         set_alias(store, f"mic@{version}", "champion")
     set_alias(store, "mic@2", "champion")
     set_alias(store, "mic@2", "champion")
     assert rollback_alias(store, "mic").model.label == "mic@1"
+
+
+def test_a_deleted_version_and_its_id_never_come_back(store: Store) -> None:
+    """Issue 36: delete ``pin@2`` (the newest), train ``pin`` again with another
+    classifier: it is ``pin@3`` with an id of its own, and ``rollback`` does not move the
+    champion onto it (nobody promoted it)."""
+    assert [_save(store, "pin"), _save(store, "pin")] == [1, 2]
+    set_alias(store, "pin@2", "champion")
+    set_alias(store, "pin@1", "champion")
+    gone = delete_model(store, "pin")
+    assert gone.label == "pin@2"
+    again = _saved(store, "pin", classifier="j48")
+    assert again.label == "pin@3" and again.id > gone.id
+    with pytest.raises(NotFoundError, match=r"model 'pin' has no version 2 \(versions: 1, 3\)"):
+        get_model(store, "pin@2")
+    with pytest.raises(NotFoundError):
+        get_model(store, gone.id)
+    with pytest.raises(ConflictError, match="nothing to roll back to"):
+        rollback_alias(store, "pin")
+    assert model_version(store, "pin@champion")[2] == "pin@1"
+
+    # every version deleted: the name keeps its count, and so do the ids
+    newest = again.id
+    for ref in ("pin@3", "pin@1"):
+        delete_model(store, ref)
+    with pytest.raises(NotFoundError, match=r"'pin' has no versions left \(versions up to 3"):
+        get_model(store, "pin")
+    with pytest.raises(NotFoundError, match=r"'pin' has no version 1 \(versions: none left\)"):
+        get_model(store, "pin@1")
+    fresh = _saved(store, "pin")
+    assert fresh.label == "pin@4" and fresh.id > newest
+    assert [m.label for m in list_models(store)] == ["pin@4"]
 
 
 def test_aliases_that_would_read_otherwise_are_refused(store: Store) -> None:
@@ -186,9 +226,12 @@ def test_names_with_at_are_refused_where_they_would_be_ambiguous(store: Store) -
     assert model_version(store, "lab_home-nb@2")[2] == "lab_home-nb@2"
     # a model stored with '@' before the rule is still found by its whole name
     with store.session() as session:
+        old = RegisteredModelRow(name="old@name", last_version=1)
+        session.add(old)
+        session.flush()
         session.add(
             ModelRow(
-                name="old@name",
+                registered_model_id=old.id,
                 version=1,
                 classifier="nb",
                 params={},
@@ -201,22 +244,28 @@ def test_names_with_at_are_refused_where_they_would_be_ambiguous(store: Store) -
     assert get_model(store, "old@name").name == "old@name"
 
 
-def test_a_version_taken_meanwhile_is_retried(
+def test_a_name_registered_meanwhile_is_retried(
     store: Store, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """Another process stores version 2 between this one's choice and its insert."""
-    _save(store)
-    chosen = store_models._next_version
-    stale = iter([1])
-    monkeypatch.setattr(
-        store_models,
-        "_next_version",
-        lambda session, name: next(stale, None) or chosen(session, name),
-    )
-    assert _save(store) == 2
+    """Another process registers the name between this one's look and its insert."""
+    real = store_models._register
+    first = iter([True])
+
+    def late(session: Session, name: str) -> int:
+        if next(first, False):
+            with store.session() as other:  # the other process registers it...
+                other.add(RegisteredModelRow(name=name, last_version=0))
+            # ... after this one looked and found nothing
+            session.add(RegisteredModelRow(name=name, last_version=0))
+            session.flush()
+        return real(session, name)
+
+    monkeypatch.setattr(store_models, "_register", late)
+    assert [_save(store), _save(store)] == [1, 2]
     with store.session() as session:
         versions = session.scalars(select(ModelRow.version).order_by(ModelRow.id)).all()
-    assert versions == [1, 2]
+        parents = session.scalars(select(RegisteredModelRow.last_version)).all()
+    assert versions == [1, 2] and parents == [2]
 
 
 SAVER = """

@@ -3,7 +3,10 @@ service: a model's ONNX twin answers what the model answers."""
 
 from __future__ import annotations
 
+import contextlib
+import hashlib
 import json
+import sqlite3
 import subprocess
 import sys
 from collections.abc import Callable, Iterator
@@ -12,11 +15,13 @@ from typing import Any
 
 import onnxruntime
 import pytest
+from sqlalchemy import create_engine, text
 
-from tests.app.api.conftest import Server, _servers
+from tests.app.api.conftest import Server, _servers, finished
 from tests.app.api.test_api_bench_request import CLI_WORDS
 from tests.app.api.test_api_live import _pcm_blocks, _stream, _ws_url
 from tests.app.cli_runner import run_cli
+from tests.app.rows import count_rows
 from touchbench.app.schemas.extraction import ExtractRequest
 from touchbench.app.schemas.models import TrainRequest
 from touchbench.app.services.datasets import read_data_file
@@ -153,10 +158,19 @@ def test_live_answers_the_same_with_either_engine(
 
 
 def test_the_service_serves_the_graph_and_predicts_with_the_engine_asked(
-    trained: tuple[str, Path, Path], make_server_on: Callable[[str], Server]
+    trained: tuple[str, Path, Path], make_server_on: Callable[[str], Server], tmp_path: Path
 ) -> None:
-    url, _, unseen = trained
+    url, folder, unseen = trained
+    url = _without_twins(url, folder, tmp_path)
     server = make_server_on(url)
+    missing = server.client.get("/api/models/touch-rf/onnx")  # a GET makes nothing
+    assert missing.status_code == 404, missing.text
+    assert "POST /api/models/touch-rf/onnx makes it (a job)" in missing.text
+    assert count_rows(url, "model_exports") == 0
+    started = server.client.post("/api/models/touch-rf/onnx")
+    assert started.status_code == 202, started.text
+    done = server.wait_for(f"/api/jobs/{started.json()['job']}", finished)
+    assert done["status"] == "done" and done["result"]["checked_instances"] == 16, done
     graph = server.client.get("/api/models/touch-rf/onnx")
     assert graph.status_code == 200, graph.text
     assert graph.headers["content-type"] == "application/octet-stream"
@@ -171,8 +185,10 @@ def test_the_service_serves_the_graph_and_predicts_with_the_engine_asked(
         assert response.status_code == 200, response.text
         answers[engine] = response.json()["predictions"][0]["gesture"]
     assert answers["onnx"] == answers["native"] == answers["auto"]
-    refused = server.client.get("/api/models/touch-j48/onnx")
-    assert refused.status_code in (400, 422) and "has no ONNX converter" in refused.text
+    refused = server.client.post("/api/models/touch-j48/onnx")
+    assert refused.status_code == 422 and "has no ONNX converter" in refused.text
+    assert refused.json()["error"]["where"] == "body.model", refused.text
+    assert server.client.get("/api/models/touch-j48/onnx").status_code == 404
     no_twin = server.client.post(
         "/api/models/touch-j48/predict", json={"instances": [instance], "engine": "onnx"}
     )
@@ -213,6 +229,20 @@ def test_the_service_serves_the_graph_and_predicts_with_the_engine_asked(
     header = {"samplerate": rate, "channels": channels, "engine": "fast"}
     _, code, reason = _stream(_ws_url(server, "touch-rf"), header, [])
     assert (code, reason) == (1007, "header: 'engine' must be auto, onnx or native")
+
+
+def _without_twins(url: str, folder: Path, tmp_path: Path) -> str:
+    """A copy of the store at ``url`` (in ``folder``) in ``tmp_path``, its models' twins
+    (made by another test of the module, or not) deleted."""
+    copy = tmp_path / "copy.db"
+    with (
+        contextlib.closing(sqlite3.connect(folder / "touchbench.db")) as source,
+        contextlib.closing(sqlite3.connect(copy)) as target,
+    ):
+        source.backup(target)  # with what the write-ahead log holds
+        target.execute("DELETE FROM model_exports")
+        target.commit()
+    return f"sqlite:///{copy}"
 
 
 @pytest.fixture
@@ -269,3 +299,54 @@ def test_a_chain_of_two_targets_exports_and_every_engine_gives_both_labels(
     listing = run_cli(capsys, url, "classifiers", "--multi-target", "--json").json()
     marks = {entry["id"]: entry["onnx"] for entry in listing["classifiers"]}
     assert marks["cc:rf"] and marks["lc:xgb"] and not marks["cc:j48"] and not marks["ecc:rf"]
+
+
+def test_the_command_line_makes_twins_only_when_asked_and_serves_none_broken(
+    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+) -> None:
+    """``train --onnx`` makes the twin (refused up front for a classifier without a
+    converter); ``export-model`` into a missing folder stores nothing; a stored twin that
+    cannot be loaded is not served: ``auto`` predicts with the model and says so once,
+    ``--engine onnx`` exits 2 naming the problem."""
+    from tests.app.rows import count_rows
+    from tests.app.synthetic import touch_arff
+
+    arff = touch_arff(tmp_path / "touch.arff", n=45, with_place=False)
+    assert run_cli(capsys, store_url, "import", str(arff)).code == 0
+    made = run_cli(capsys, store_url, "train", "touch", "-c", "rf", "--name", "forest", "--onnx")
+    assert made.code == 0 and "its ONNX twin" in made.err, made.err
+    refused = run_cli(capsys, store_url, "train", "touch", "-c", "j48", "--onnx")
+    assert refused.code == 2 and refused.err.count("\n") == 1, refused.err
+    assert "--onnx: classifier 'j48' has no ONNX converter" in refused.err
+    plain = run_cli(capsys, store_url, "train", "touch", "-c", "rf", "--name", "plain", "--json")
+    assert plain.code == 0 and plain.json()["onnx"] is None
+    assert count_rows(store_url, "models") == 2 and count_rows(store_url, "model_exports") == 1
+    nowhere = tmp_path / "missing" / "dir" / "x.onnx"
+    lost = run_cli(capsys, store_url, "export-model", "plain", "-o", str(nowhere))
+    assert lost.code == 2 and lost.err.count("\n") == 1, lost.err
+    assert f"--output: folder {nowhere.parent} does not exist" in lost.err
+    assert count_rows(store_url, "model_exports") == 1 and not nowhere.parent.exists()
+
+    garbage = b"\x08\x07 not a graph"
+    engine = create_engine(store_url.replace("postgresql://", "postgresql+psycopg://", 1))
+    with engine.begin() as connection:
+        connection.execute(
+            text("UPDATE model_exports SET data = :d, sha256 = :s, size_bytes = :n"),
+            {"d": garbage, "s": hashlib.sha256(garbage).hexdigest(), "n": len(garbage)},
+        )
+    engine.dispose()
+    native = run_cli(capsys, store_url, "predict", "forest", str(arff), "--engine", "native")
+    auto = run_cli(capsys, store_url, "predict", "forest", str(arff), "--json")
+    assert auto.code == 0, auto.err
+    (warning,) = auto.json()["warnings"]
+    assert "model 'forest@1': its ONNX twin cannot be loaded (" in warning
+    assert (
+        native.code == 0
+        and auto.json()["predictions"]
+        == run_cli(
+            capsys, store_url, "predict", "forest", str(arff), "--engine", "native", "--json"
+        ).json()["predictions"]
+    )
+    onnx = run_cli(capsys, store_url, "predict", "forest", str(arff), "--engine", "onnx")
+    assert onnx.code == 2 and onnx.err.count("\n") == 1, onnx.err
+    assert "--engine: model 'forest@1': its ONNX twin cannot be loaded (" in onnx.err

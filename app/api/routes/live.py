@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import asyncio
 import json
-from functools import partial
 from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
@@ -117,7 +116,8 @@ def _open(
         model_ref,
         samplerate=samplerate,
         n_channels=channels,
-        load=partial(service.models.get, engine=engine),
+        engine=engine,
+        cache=service.models,
         follow_seconds=service.settings.live_follow_seconds,
     )
 

@@ -1,5 +1,6 @@
-"""Models: train (a job, 202), list, describe, delete, predict (JSON instances or a file), and
-the aliases of their versions (alias, promote, rollback, delete an alias).
+"""Models: train (a job, 202), list, describe, delete, predict (JSON instances or a file), their
+ONNX twins (made by a job, 202; read as stored), and the aliases of their versions (alias,
+promote, rollback, delete an alias).
 
 ``{model_ref}`` is an id, ``NAME`` (its newest version), ``NAME@VERSION`` or ``NAME@ALIAS``.
 """
@@ -19,12 +20,14 @@ from fastapi import APIRouter, File, Form, Request, Response, UploadFile, status
 from touchbench.app.api.deps import PageDep, Service, ServiceDep, StoreDep, paginate, request_size
 from touchbench.app.api.direct import DirectRoute
 from touchbench.app.api.uploads import form_request, in_client_words, save_upload
+from touchbench.app.errors import ConflictError, NotFoundError
 from touchbench.app.schemas.jobs import JobCreated
 from touchbench.app.schemas.models import (
     AliasBody,
     AliasDeleted,
     AliasMoved,
     AliasRequest,
+    ExportRequest,
     ModelList,
     ModelSchema,
     PredictFileRequest,
@@ -32,7 +35,8 @@ from touchbench.app.schemas.models import (
     PredictRequest,
     TrainRequest,
 )
-from touchbench.app.services.jobs import submit_training
+from touchbench.app.services.jobs import submit_export, submit_training
+from touchbench.app.services.loading import with_known_problem
 from touchbench.app.store.models import count_models, delete_model, get_model, list_models
 
 router = APIRouter(prefix="/api/models", tags=["models"])
@@ -56,12 +60,15 @@ def train(body: TrainRequest, service: ServiceDep) -> JobCreated:
 def models(store: StoreDep, page: PageDep, request: Request, response: Response) -> ModelList:
     """The models, oldest first, a page of at most 1,000 (``X-Total-Count``, ``Link``)."""
     paginate(request, response, page, count_models(store))
-    return ModelList(models=[m.to_schema() for m in list_models(store, page=page)])
+    listed = list_models(store, page=page)
+    return ModelList(models=[with_known_problem(m).to_schema() for m in listed])
 
 
 @router.get("/{model_ref}", response_model=ModelSchema)
 def model(model_ref: str, store: StoreDep) -> ModelSchema:
-    return get_model(store, model_ref).to_schema()
+    """A model; ``onnx.problem`` says why its twin could not be loaded, once this service
+    tried (its predictions with engine auto then run the model itself)."""
+    return with_known_problem(get_model(store, model_ref)).to_schema()
 
 
 @router.get(
@@ -69,15 +76,23 @@ def model(model_ref: str, store: StoreDep) -> ModelSchema:
     response_class=Response,
     responses={200: {"content": {"application/octet-stream": {}}}},
 )
-def onnx_graph(model_ref: str, service: ServiceDep) -> Response:
-    """The model as one ONNX graph (input ``features``, outputs ``label`` and
-    ``probabilities``; attribute and label names in its metadata), exported and checked on
-    the training instances the first time it is asked for, then kept in the store."""
-    from touchbench.app.services.export import stored_export
+def onnx_graph(model_ref: str, store: StoreDep) -> Response:
+    """The model's ONNX twin as one graph (input ``features``, outputs ``label`` and
+    ``probabilities``; attribute and label names in its metadata), as stored: 404 when it
+    has none (``POST`` to this path makes one, a job), 409 while a job makes it."""
+    from touchbench.app.services.export import TwinMissing, TwinUnderWay, stored_twin
 
-    info, graph, exported = stored_export(service.store, model_ref)
-    if exported:
-        service.models.forget(info.id)  # predictions with engine auto take the twin now
+    try:
+        info, graph = stored_twin(store, model_ref)
+    except TwinMissing as missing:
+        raise NotFoundError(
+            f"{missing}; POST /api/models/{model_ref}/onnx makes it (a job), or train the "
+            'model with "onnx": true'
+        ) from None
+    except TwinUnderWay as under_way:
+        raise ConflictError(
+            f"{under_way}; GET /api/jobs/{under_way.job} says when it is done"
+        ) from None
     return Response(
         graph,
         media_type="application/octet-stream",
@@ -85,10 +100,21 @@ def onnx_graph(model_ref: str, service: ServiceDep) -> Response:
     )
 
 
+@router.post("/{model_ref}/onnx", status_code=status.HTTP_202_ACCEPTED, response_model=JobCreated)
+def make_onnx(model_ref: str, service: ServiceDep) -> JobCreated:
+    """Make the model's ONNX twin (again), checked on its training instances, as a job; while
+    one is under way for the model, it is the answer.  What the export would refuse without
+    converting (a classifier without a converter, a deleted data set) is refused at once."""
+    job, created = submit_export(service.store, ExportRequest(model=model_ref))
+    if created:
+        service.dispatcher.wake()
+    return JobCreated(job=job.id, status=job.status, kind=job.kind)
+
+
 @router.delete("/{model_ref}", response_model=ModelSchema)
 def remove(model_ref: str, service: ServiceDep) -> ModelSchema:
     gone = delete_model(service.store, model_ref)
-    service.models.forget(gone.id)
+    service.forget(gone.id)
     return gone.to_schema()
 
 
@@ -134,7 +160,7 @@ async def predict_instances(model_ref: str, body: PredictRequest, service: Servi
     """Predict instances given as ``{attribute: value}`` (matched to the model by name):
     per instance and target the predicted label and the class probabilities."""
     size = request_size(body.instances)
-    content = await service.models.run(
+    content = await service.placement.run(
         model_ref,
         size,
         functools.partial(_predict_records, service, model_ref, body, size),
@@ -150,7 +176,7 @@ def _predict_records(service: Service, model_ref: str, body: PredictRequest, siz
     info, trained = service.models.get(service.store, model_ref, body.engine)
     start = time.thread_time()
     report = records_report(info, trained, body.instances, missing=body.missing)
-    service.models.record(info.id, time.thread_time() - start, size)
+    service.placement.record(info.id, time.thread_time() - start, size)
     return report.model_dump_json().encode()
 
 

@@ -281,3 +281,57 @@ def test_a_flood_of_alias_moves_drops_no_stream_and_no_request(
     assert len(answers) == 5 and set(answers) <= {"mic@1", "mic@2"}
     assert len(switches) + len(warnings) <= len(blocks)
     assert lab.get("/healthz").status_code == 200
+
+
+def test_concurrent_alias_changes_answer_409_never_500(
+    make_server: Callable[..., Server], store_url: str
+) -> None:
+    """Issue 36 item 6: set, move, roll back and delete one alias from four clients at once,
+    on SQLite and PostgreSQL: each change answers 200, or 404/409 when another one changed
+    the alias first; never a 500; and the alias points at one existing version after."""
+    import threading
+    from concurrent.futures import ThreadPoolExecutor
+
+    from touchbench.app.store.models import save_model
+
+    store = Store(store_url)
+    try:
+        for _ in range(3):
+            save_model(
+                store, classifier="nb", params={}, schema={}, targets=["g"], artifact=b"m",
+                name="mic",
+            )  # fmt: skip
+    finally:
+        store.dispose()
+    server = make_server()
+    changes = [
+        ("POST", "/api/models/mic@1/aliases", {"alias": "champion"}),
+        ("DELETE", "/api/models/mic/aliases/champion", None),
+        ("POST", "/api/models/mic@2/promote", None),
+        ("DELETE", "/api/models/mic@2/aliases/champion", None),
+        ("POST", "/api/models/mic/rollback", None),
+        ("POST", "/api/models/mic@3/aliases", {"alias": "champion"}),
+    ]
+    statuses: list[int] = []
+    errors: list[str] = []
+    start = threading.Barrier(4)
+
+    def client(offset: int) -> None:
+        with httpx.Client(base_url=server.url, timeout=120) as http:
+            start.wait()
+            for i in range(40):
+                method, path, body = changes[(offset + i) % len(changes)]
+                answer = http.request(method, path, json=body)
+                statuses.append(answer.status_code)
+                if answer.status_code >= 500:
+                    errors.append(f"{method} {path}: {answer.text[:300]}")
+
+    with ThreadPoolExecutor(4) as clients:  # a client's own failure is raised here
+        list(clients.map(client, range(4)))
+    assert not errors, errors[:3]
+    assert len(statuses) == 160 and set(statuses) <= {200, 404, 409}, sorted(set(statuses))
+    assert statuses.count(200) >= 20
+    listed = server.client.get("/api/models").json()["models"]
+    assert sum(m["aliases"].count("champion") for m in listed) <= 1
+    champion = server.client.get("/api/models/mic@champion")
+    assert champion.status_code in (200, 404), champion.text

@@ -13,7 +13,7 @@ import pytest
 from fastapi.testclient import TestClient
 
 from tests.app.synthetic import touch_arff
-from touchbench.app.api.deps import INLINE_SECONDS, ModelCache, request_size
+from touchbench.app.api.deps import INLINE_SECONDS, PredictionPlacement, request_size
 from touchbench.app.main import create_app
 from touchbench.app.schemas.datasets import ImportRequest
 from touchbench.app.schemas.models import TrainRequest
@@ -24,30 +24,30 @@ from touchbench.app.store.database import Store
 
 
 def test_a_model_runs_inline_only_once_it_is_known_to_be_quick() -> None:
-    cache = ModelCache(4)
-    assert not cache.runs_inline("m", 1)  # not loaded
-    cache._models[(7, "sha", "m")] = (None, None)  # type: ignore[assignment]
-    assert not cache.runs_inline("m", 1)  # loaded, never timed
-    cache.record(7, INLINE_SECONDS / 10, 1)
-    assert cache.runs_inline("m", 1) and cache.runs_inline("7", 1)
-    assert not cache.runs_inline("m", 20)  # twenty times the size: twice the budget
-    assert not cache.runs_inline("other", 1)
+    loaded: dict[str, int] = {}
+    placement = PredictionPlacement(loaded.get)
+    assert not placement.runs_inline("m", 1)  # not loaded
+    loaded.update({"m": 7, "7": 7})
+    assert not placement.runs_inline("m", 1)  # loaded, never timed
+    placement.record(7, INLINE_SECONDS / 10, 1)
+    assert placement.runs_inline("m", 1) and placement.runs_inline("7", 1)
+    assert not placement.runs_inline("m", 20)  # twenty times the size: twice the budget
+    assert not placement.runs_inline("other", 1)
     for _ in range(5):  # a model that turns slow leaves the loop within a few calls
-        cache.record(7, INLINE_SECONDS * 10, 1)
-    assert not cache.runs_inline("m", 1)
+        placement.record(7, INLINE_SECONDS * 10, 1)
+    assert not placement.runs_inline("m", 1)
     for _ in range(20):  # and comes back once quick again
-        cache.record(7, INLINE_SECONDS / 10, 1)
-    assert cache.runs_inline("m", 1)
-    cache.forget(7)
-    assert not cache.runs_inline("m", 1)
+        placement.record(7, INLINE_SECONDS / 10, 1)
+    assert placement.runs_inline("m", 1)
+    placement.forget(7)
+    assert not placement.runs_inline("m", 1)
+    placement.close()
 
 
 def test_a_quick_model_waits_its_turn_in_the_thread_when_another_prediction_is_under_way() -> None:
-    cache = ModelCache(4)
-    cache._models[(7, "sha", "quick")] = (None, None)  # type: ignore[assignment]
-    cache._models[(8, "sha", "slow")] = (None, None)  # type: ignore[assignment]
-    cache.record(7, INLINE_SECONDS / 10, 1)
-    cache.record(8, INLINE_SECONDS * 10, 1)
+    placement = PredictionPlacement({"quick": 7, "slow": 8}.get)
+    placement.record(7, INLINE_SECONDS / 10, 1)
+    placement.record(8, INLINE_SECONDS * 10, 1)
 
     def where() -> int:
         time.sleep(0.05)
@@ -55,14 +55,14 @@ def test_a_quick_model_waits_its_turn_in_the_thread_when_another_prediction_is_u
 
     async def both() -> tuple[int, int, int]:
         slow, quick = await asyncio.gather(
-            cache.run("slow", 1, where), cache.run("quick", 1, where)
+            placement.run("slow", 1, where), placement.run("quick", 1, where)
         )
-        alone = await cache.run("quick", 1, where)
+        alone = await placement.run("quick", 1, where)
         return slow, quick, alone
 
     loop_thread = threading.get_ident()
     slow, quick, alone = asyncio.run(both())
-    cache.close()
+    placement.close()
     assert slow != loop_thread and quick == slow  # both in the one prediction thread
     assert alone == loop_thread  # alone, the quick model runs on the loop
 
@@ -86,7 +86,7 @@ def test_the_first_prediction_runs_in_a_thread_and_later_ones_on_the_loop(
 ) -> None:
     service = client.app.state.service  # type: ignore[attr-defined]
     threads: list[int] = []
-    record = service.models.record
+    record = service.placement.record
 
     def spy(model_id: int, seconds: float, size: int) -> None:
         """Where the call ran; the time recorded as a tenth of the budget per unit of size
@@ -95,7 +95,7 @@ def test_the_first_prediction_runs_in_a_thread_and_later_ones_on_the_loop(
         threads.append(threading.get_ident())
         record(model_id, size * INLINE_SECONDS / 10, size)
 
-    monkeypatch.setattr(service.models, "record", spy)
+    monkeypatch.setattr(service.placement, "record", spy)
     instance = {"f0": 0.1, "f1": -0.2, "f2": 0.3, "f3": None, "mic": "left"}
     answers = [
         client.post("/api/models/quick/predict", json={"instances": [instance]}) for _ in range(3)
