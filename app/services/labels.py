@@ -93,6 +93,7 @@ def read_labels(path: Path, *, max_rows: int | None = None) -> LabelTable:
         the line number.
     """
     if max_rows is None:
+        # start-up time: a command that lists or shows reads no settings (pydantic-settings)
         from touchbench.app.settings import get_settings
 
         max_rows = get_settings().max_label_rows

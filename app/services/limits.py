@@ -63,6 +63,7 @@ class DatasetLimits:
 def read_limits() -> ReadLimits:
     """The bounds of reading one recording (:class:`drivers.limits.ReadLimits`), from the
     settings."""
+    # start-up time: a command that lists or shows reads no settings (pydantic-settings)
     from touchbench.app.settings import get_settings
 
     settings = get_settings()
@@ -79,7 +80,7 @@ def raised_by(limit: str) -> str:
 def sequence_of(names: Sequence[str]) -> tuple[int, int] | None:
     """``(channels, steps)`` of the sequence among attribute ``names``
     (:func:`benchmark.sequence.find_sequence`), None for a flat data set."""
-    from touchbench.benchmark.sequence import find_sequence
+    from touchbench.benchmark.sequence import find_sequence  # start-up time: NumPy
 
     layout, _ = find_sequence(names)
     return None if layout is None else (layout.n_channels, layout.length)

@@ -161,7 +161,7 @@ def _old_registry(connection: Any) -> dict[int, bytes]:
 
 def test_the_registry_moves_under_registered_models_and_back(store_url: str) -> None:
     """A store of revision 0010 keeps every model, artifact, twin, alias and step of
-    history through the upgrade to registered models (0011) and the downgrade; the counter
+    history through the upgrade to registered models (0013) and the downgrade; the counter
     starts past every version the store knew of, deleted ones named in the history
     included."""
     url = store_url.replace("postgresql://", "postgresql+psycopg://", 1)

@@ -16,10 +16,7 @@ rebuilt, and dropping the old one deletes, by cascade, the rows that refer to it
 The aliases and their history are small and referred to by nothing: on both stores they are
 kept aside, created anew and filled again.
 
-Numbered 0011 but applied after 0012 (fold predictions), which was written alongside it and
-merged first: a store already at 0012 is brought here too.
-
-Revision ID: 0011
+Revision ID: 0013
 Revises: 0012
 """
 
@@ -31,7 +28,7 @@ from typing import Any
 import sqlalchemy as sa
 from alembic import op
 
-revision = "0011"
+revision = "0013"
 down_revision = "0012"
 branch_labels = None
 depends_on = None
