@@ -23,6 +23,7 @@ from touchbench.app.cli.output import (
 )
 from touchbench.app.cli.state import get_state
 from touchbench.app.schemas.runs import BenchRequest
+from touchbench.app.schemas.status import Status
 
 if TYPE_CHECKING:
     from touchbench.app.schemas.ablation import AblationResult
@@ -589,10 +590,12 @@ def bench_command(
         raise ConflictError(f"{busy} (`touchbench cancel {busy.run_id}` stops it)") from None
     except KeyboardInterrupt as interrupt:  # Ctrl-C or SIGTERM (app.cli.signals)
         code = getattr(interrupt, "exit_code", EXIT_INTERRUPTED)
-        raise ExitWith(_kept_message(store, run_id, "interrupted"), code) from None
+        raise ExitWith(_kept_message(store, run_id, Status.INTERRUPTED), code) from None
     except RunCancelled as cancelled:
-        raise ExitWith(_kept_message(store, cancelled.run.id, "cancelled"), EXIT_FAILED) from None
-    if run.status == "failed":
+        raise ExitWith(
+            _kept_message(store, cancelled.run.id, Status.CANCELLED), EXIT_FAILED
+        ) from None
+    if run.status == Status.FAILED:
         _print_run_report(store, run.id, metric, baseline, as_json)
         raise ExitWith(
             f"run {run.id} failed: {run.error} (`touchbench leaderboard {run.id}` lists why)",
@@ -662,7 +665,7 @@ def cancel_command(
     if as_json:
         print_json(run.to_json())
         return
-    if run.status == "cancelled":
+    if run.status == Status.CANCELLED:
         info(f"run {run.id} cancelled ({run.n_results}/{run.n_tasks} tasks kept)")
     else:
         info(f"run {run.id} is cancelling: {run.owner} stops it within about half a second")

@@ -10,24 +10,7 @@ from pydantic import Field, field_validator, model_validator
 
 from touchbench.app.errors import FieldError
 from touchbench.app.schemas.base import Request, Schema
-
-#: Where a run is in its life (the rules: :mod:`app.store.states`): ``queued`` (created,
-#: waiting for a worker), ``running``, ``cancelling`` (its process was asked to stop),
-#: ``done`` (every task has a result), ``failed`` (every task failed, or the run could not
-#: be carried out), ``cancelled`` (on request), ``interrupted`` (its process stopped: Ctrl-C,
-#: kill -9, a crash; resuming it finishes it).
-RunStatus = Literal["queued", "running", "cancelling", "done", "failed", "cancelled", "interrupted"]
-RUN_STATUSES: tuple[RunStatus, ...] = (
-    "queued",
-    "running",
-    "cancelling",
-    "done",
-    "failed",
-    "cancelled",
-    "interrupted",
-)
-#: Statuses after which nothing more happens unless the run is resumed.
-FINAL_STATUSES: frozenset[str] = frozenset({"done", "failed", "cancelled", "interrupted"})
+from touchbench.app.schemas.status import Status
 
 
 class RunSchema(Schema):
@@ -40,7 +23,7 @@ class RunSchema(Schema):
     targets: list[str]
     classifiers: list[str]
     config: dict[str, Any] = Field(description="Folds, repeats, seed, timeout, ...")
-    status: RunStatus
+    status: Status
     created_at: datetime
     started_at: datetime | None = None
     finished_at: datetime | None = None
@@ -66,7 +49,7 @@ class RunCreated(Schema):
     """What ``POST /api/runs`` answers at once: the run waits for a worker."""
 
     id: int
-    status: RunStatus
+    status: Status
 
 
 class MetricValue(Schema):
@@ -205,7 +188,7 @@ class LeaderboardSchema(Schema):
     dataset: str
     kind: str
     targets: list[str]
-    status: RunStatus
+    status: Status
     folds: str = Field(
         default="",
         description="How the folds were made: stratified k-fold, k-fold (shuffled), or their "

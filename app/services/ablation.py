@@ -18,6 +18,7 @@ from touchbench.app.schemas.ablation import (
     Grouping,
 )
 from touchbench.app.schemas.runs import BenchRequest
+from touchbench.app.schemas.status import Status
 from touchbench.app.services.importance import feature_names, refittable_run
 from touchbench.app.services.progress import throttled
 from touchbench.app.services.report import run_view
@@ -149,7 +150,7 @@ class _Plan:
     def __init__(self, store: Store, request: AblationRequest) -> None:
         view = run_view(store, request.run)
         run = refittable_run(view.run)
-        if run.status != "done":
+        if run.status != Status.DONE:
             raise ConflictError(
                 f"run {run.id} is {run.status}: an ablation compares against a finished run"
             )

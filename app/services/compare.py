@@ -29,6 +29,7 @@ from touchbench.app.schemas.compare import (
     NemenyiOut,
     PairOut,
 )
+from touchbench.app.schemas.status import Status
 from touchbench.app.services.beside import besides, merged_results
 from touchbench.app.services.imported import is_imported
 from touchbench.app.store.database import Store
@@ -236,7 +237,7 @@ def compare_runs(
     notes = beside_notes + [
         f"run {run.id} is {run.status}: {run.n_results} of {run.n_tasks} tasks have results"
         for run in runs
-        if run.status != "done"
+        if run.status != Status.DONE
     ]
     if len(runs) == 1:
         blocks_are: BlockKind = "folds"

@@ -31,9 +31,9 @@ from touchbench.app.schemas.runs import (
     LeaderboardSchema,
     MarkSummary,
     RaceSchema,
-    RunStatus,
     TunedComparisonSchema,
 )
+from touchbench.app.schemas.status import STOPPED_EARLY, UNFINISHED, Status
 from touchbench.app.services.beside import Beside, besides, merged_results, row_runs
 from touchbench.app.services.tuning import run_specs
 from touchbench.app.store.database import Store
@@ -492,7 +492,7 @@ def execute_run(
     """
     callbacks = callbacks or Callbacks()
     run = get_run(store, run_id)
-    if run.status == "done" and run.n_results >= run.n_tasks:
+    if run.status == Status.DONE and run.n_results >= run.n_tasks:
         return run
     owner = process_owner()
     run = claim_run(store, run.id, owner=owner)
@@ -568,20 +568,20 @@ def execute_run(
                 by_recording=run.config.get("aggregate") == "recording",
             )
         except RunStopped:
-            finish_run(store, run.id, "cancelled")
+            finish_run(store, run.id, Status.CANCELLED)
             raise RunCancelled(get_run(store, run.id)) from None
         finally:
             add_spent(store, run.id, time.monotonic() - began)
     except (KeyboardInterrupt, SystemExit):
-        finish_run(store, run.id, "interrupted")
+        finish_run(store, run.id, Status.INTERRUPTED)
         raise
     except RunCancelled:
         raise
     except (ConfigurationError, AppError) as error:
-        finish_run(store, run.id, "failed", error=str(error))
+        finish_run(store, run.id, Status.FAILED, error=str(error))
         raise
     except BaseException as error:
-        finish_run(store, run.id, "interrupted", error=f"{type(error).__name__}: {error}")
+        finish_run(store, run.id, Status.INTERRUPTED, error=f"{type(error).__name__}: {error}")
         raise
     finally:
         beat.stop()
@@ -619,11 +619,11 @@ def race_rule(run: RunInfo) -> RaceRule | None:
     )
 
 
-#: Why a run has no results yet, when it is under way.
+#: Why a run has no results yet, when it is under way (:data:`app.schemas.status.UNFINISHED`).
 _UNDER_WAY = {
-    "queued": "it waits for a worker",
-    "running": "it is still running",
-    "cancelling": "it is being cancelled",
+    Status.QUEUED: "it waits for a worker",
+    Status.RUNNING: "it is still running",
+    Status.CANCELLING: "it is being cancelled",
 }
 
 
@@ -640,7 +640,7 @@ class NoResultsError(ConfigurationError):
         hint = _UNDER_WAY.get(run.status, f"it is {run.status}; resuming it carries it out")
         super().__init__(f"run {run.id} has no results yet ({hint})")
         self.run = run
-        self.under_way = run.status in _UNDER_WAY
+        self.under_way = run.status in UNFINISHED
 
 
 @dataclass(frozen=True)
@@ -814,14 +814,9 @@ def run_leaderboard(
     return RunLeaderboard(run, board, results, tuple(others), drops)
 
 
-#: Statuses of a run that stopped before its end: its entries without a result never
-#: started, and its leaderboard lists them so.
-STOPPED_EARLY = frozenset({"cancelling", "cancelled", "interrupted", "failed"})
-
-
 def never_started(run: RunInfo, results: Sequence[TaskResult]) -> dict[str, Drop]:
-    """The entries of a stopped run (cancelled, interrupted) that have no result, by id:
-    a leaderboard lists them (marked ``never started``) rather than leave them out."""
+    """The entries of a run stopped early (cancelled, interrupted) that have no result, by
+    id: a leaderboard lists them (marked ``never started``) rather than leave them out."""
     if run.status not in STOPPED_EARLY:
         return {}
     started = {result.key.classifier for result in results}
@@ -981,18 +976,20 @@ def independent_runs(
     return IndependentResult(runs, product)
 
 
-def _outcome(results: Sequence[TaskResult]) -> tuple[RunStatus, str | None]:
+def _outcome(results: Sequence[TaskResult]) -> tuple[Status, str | None]:
     """``done``, or ``failed`` with a one-line reason when no task succeeded."""
     if any(result.ok for result in results):
-        return "done", None
+        return Status.DONE, None
     if not results:
-        return "failed", "no task was carried out"
+        return Status.FAILED, "no task was carried out"
     reasons: dict[str, int] = {}
     for result in results:
         reason = (result.error or result.status).split(" (at ", 1)[0]
         reasons[reason] = reasons.get(reason, 0) + 1
     common = max(reasons, key=lambda reason: reasons[reason])
-    return "failed", (f"all {len(results)} tasks failed; most often ({reasons[common]}x): {common}")
+    return Status.FAILED, (
+        f"all {len(results)} tasks failed; most often ({reasons[common]}x): {common}"
+    )
 
 
 def _tuning_config(

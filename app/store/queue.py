@@ -22,8 +22,9 @@ from typing import Any
 from sqlalchemy import select, update
 from sqlalchemy.orm import Session
 
+from touchbench.app.schemas.status import ACTIVE, Status
 from touchbench.app.store.database import Store
-from touchbench.app.store.states import ACTIVE, cancel_outcome
+from touchbench.app.store.states import cancel_outcome
 from touchbench.app.store.tables import utcnow
 
 #: Seconds between heartbeats of the process executing an item.
@@ -81,7 +82,7 @@ def request_cancel(store: Store, table: Any, item: Any, kind: str) -> str:
     if outcome == "unchanged":
         return outcome
     values: dict[str, Any] = {"status": outcome}
-    if outcome == "cancelling":
+    if outcome == Status.CANCELLING:
         values["cancel_requested"] = True
     else:
         values.update(finished_at=utcnow(), owner=None, heartbeat_at=None)

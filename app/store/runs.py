@@ -24,13 +24,14 @@ from sqlalchemy.orm import Session
 from touchbench.app.errors import ConflictError, NotFoundError
 from touchbench.app.schemas.base import finite
 from touchbench.app.schemas.listing import Page
-from touchbench.app.schemas.runs import FINAL_STATUSES, RunSchema, RunStatus
+from touchbench.app.schemas.runs import RunSchema
+from touchbench.app.schemas.status import ACTIVE, FINAL, Status
 from touchbench.app.store import queue
 from touchbench.app.store.database import Store
 from touchbench.app.store.naming import is_row_id
 from touchbench.app.store.ownership import aware, mark_lost, owner_alive, process_owner
 from touchbench.app.store.paging import count_rows, paged
-from touchbench.app.store.states import ACTIVE, LOST_AS, check_claim, check_resume
+from touchbench.app.store.states import LOST_AS, check_claim, check_resume
 from touchbench.app.store.tables import DatasetRow, EntryDropRow, FoldResultRow, RunRow, utcnow
 from touchbench.benchmark.results import TaskKey, TaskResult
 
@@ -53,7 +54,7 @@ class RunInfo:
     targets: list[str]
     classifiers: list[str]
     config: dict[str, Any]
-    status: RunStatus
+    status: Status
     created_at: datetime
     finished_at: datetime | None
     n_results: int
@@ -140,7 +141,7 @@ def create_run(
 ) -> RunInfo:
     """A new run, ``queued``."""
     with store.session() as session:
-        row = _new_run(session, dataset_id, kind, targets, classifiers, config, "queued")
+        row = _new_run(session, dataset_id, kind, targets, classifiers, config, Status.QUEUED)
         return _infos(session, [row])[0]
 
 
@@ -151,7 +152,7 @@ def _new_run(
     targets: Sequence[str],
     classifiers: Sequence[str],
     config: dict[str, Any],
-    status: RunStatus,
+    status: Status,
     **times: datetime,
 ) -> RunRow:
     """A run's row, added and flushed (so that it has its id)."""
@@ -190,7 +191,7 @@ def add_finished_run(
             targets,
             classifiers,
             config,
-            "done",
+            Status.DONE,
             started_at=now,
             finished_at=now,
         )
@@ -267,7 +268,7 @@ def claim_run(store: Store, run_id: int, *, owner: str | None = None) -> RunInfo
             update(RunRow)
             .where(RunRow.id == row.id, RunRow.status == row.status, same_owner)
             .values(
-                status="running",
+                status=Status.RUNNING,
                 owner=owner,
                 heartbeat_at=now,
                 started_at=func.coalesce(RunRow.started_at, now),
@@ -309,7 +310,7 @@ def update_config(store: Store, run_id: int, values: dict[str, Any]) -> None:
         row.config = {**row.config, **values}
 
 
-def finish_run(store: Store, run_id: int, status: RunStatus, *, error: str | None = None) -> None:
+def finish_run(store: Store, run_id: int, status: Status, *, error: str | None = None) -> None:
     """Leave a run in ``status`` (``finished_at`` set for final ones), its owner released."""
     with store.session() as session:
         session.execute(
@@ -318,7 +319,7 @@ def finish_run(store: Store, run_id: int, status: RunStatus, *, error: str | Non
             .values(
                 status=status,
                 error=error,
-                finished_at=utcnow() if status in FINAL_STATUSES else None,
+                finished_at=utcnow() if status in FINAL else None,
                 heartbeat_at=None,
                 owner=None,
             )
@@ -348,8 +349,8 @@ def request_cancel(store: Store, run_id: int | str) -> RunInfo:
     outcome = queue.request_cancel(store, RunRow, run, "run")
     if outcome == "changed":  # the run changed meanwhile: judge it again
         return request_cancel(store, run.id)
-    if outcome == "cancelling":  # what this request did, whatever the run's process does next
-        return replace(run, status="cancelling", cancel_requested=True)
+    if outcome == Status.CANCELLING:  # what this request did, whatever the run's process does
+        return replace(run, status=Status.CANCELLING, cancel_requested=True)
     return get_run(store, run.id)
 
 
@@ -363,7 +364,7 @@ def requeue_run(store: Store, run_id: int | str) -> RunInfo:
         The run is queued, executing, being cancelled or done.
     """
     check_resume(get_run(store, run_id))
-    finish_run(store, int(str(run_id)), "queued")
+    finish_run(store, int(str(run_id)), Status.QUEUED)
     return get_run(store, run_id)
 
 
@@ -373,7 +374,7 @@ def mark_lost_runs(store: Store) -> list[int]:
     lost: list[int] = []
     with store.session() as session:
         for status, becomes in LOST_AS.items():
-            values = {"finished_at": utcnow()} if becomes in FINAL_STATUSES else {}
+            values = {"finished_at": utcnow()} if becomes in FINAL else {}
             lost += mark_lost(
                 session, RunRow, of=status, status=becomes, owner=None, heartbeat_at=None, **values
             )
@@ -535,7 +536,7 @@ def _infos(session: Session, rows: Sequence[RunRow]) -> list[RunInfo]:
             targets=list(row.targets),
             classifiers=list(row.classifiers),
             config=dict(row.config),
-            status=row.status,  # type: ignore[arg-type]  # a RunStatus literal in the column
+            status=Status(row.status),
             created_at=row.created_at,
             finished_at=row.finished_at,
             n_results=counts.get(row.id, (0, 0))[0],

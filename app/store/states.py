@@ -16,9 +16,10 @@ process was lost is ``interrupted`` for good, and is submitted again instead.
 
 An item is *active* while a process executes it (``running``, ``cancelling``); a cancel of
 an active item asks its process to stop (status ``cancelling`` until it has), a cancel of
-any other unfinished item takes effect at once.  Every rule about these changes lives here;
-the store's functions (:mod:`app.store.runs`, :mod:`app.store.jobs`, the protocol both
-follow in :mod:`app.store.queue`) apply them.
+any other unfinished item takes effect at once.  Every rule about these changes lives here
+(the statuses and their named sets are :mod:`app.schemas.status`); the store's functions
+(:mod:`app.store.runs`, :mod:`app.store.jobs`, the protocol both follow in
+:mod:`app.store.queue`) apply them.
 """
 
 from __future__ import annotations
@@ -26,15 +27,17 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Protocol
 
 from touchbench.app.errors import ConflictError
+from touchbench.app.schemas.status import ACTIVE, FINAL, Status
 
 if TYPE_CHECKING:
     from touchbench.app.store.runs import RunInfo
 
-#: A process executes the run.
-ACTIVE: frozenset[str] = frozenset({"running", "cancelling"})
 #: What a process whose owner died leaves, of a run or a job: a running one is interrupted,
 #: one being cancelled is cancelled (its process stopped, as asked).
-LOST_AS: dict[str, str] = {"running": "interrupted", "cancelling": "cancelled"}
+LOST_AS: dict[Status, Status] = {
+    Status.RUNNING: Status.INTERRUPTED,
+    Status.CANCELLING: Status.CANCELLED,
+}
 
 
 class RunBusy(ConflictError):  # noqa: N818 (a state, like ConflictError's other cases)
@@ -73,9 +76,9 @@ def check_claim(run: RunInfo, owner: str) -> None:
     ConflictError
         It is being cancelled.
     """
-    if run.status == "cancelling" and run.owner_alive():
+    if run.status == Status.CANCELLING and run.owner_alive():
         raise ConflictError(f"run {run.id} is being cancelled; resume it once it is cancelled")
-    if run.status == "running" and run.owner != owner and run.owner_alive():
+    if run.status == Status.RUNNING and run.owner != owner and run.owner_alive():
         raise RunBusy(run)
 
 
@@ -88,12 +91,13 @@ def cancel_outcome(item: Item, kind: str = "run") -> str:
     ConflictError
         The item is done, failed or already cancelled; a job that was interrupted.
     """
-    over = ("done", "failed", "cancelled") + (("interrupted",) if kind == "job" else ())
+    # an interrupted run waits to be resumed, and a cancel settles it; a job is never resumed
+    over = FINAL if kind == "job" else FINAL - {Status.INTERRUPTED}
     if item.status in over:
         raise ConflictError(f"{kind} {item.id} is already {item.status}; nothing to cancel")
-    if item.status == "cancelling" and item.owner_alive():
+    if item.status == Status.CANCELLING and item.owner_alive():
         return "unchanged"
-    return "cancelling" if is_active(item) else "cancelled"
+    return Status.CANCELLING if is_active(item) else Status.CANCELLED
 
 
 def check_resume(run: RunInfo) -> None:
@@ -103,14 +107,14 @@ def check_resume(run: RunInfo) -> None:
     ------
     ConflictError
     """
-    if run.status == "cancelling" and run.owner_alive():
+    if run.status == Status.CANCELLING and run.owner_alive():
         raise ConflictError(
             f"run {run.id} is being cancelled; resume it once it is cancelled (its process "
             "stops within a second)"
         )
-    if run.status == "running" and run.owner_alive():
+    if run.status == Status.RUNNING and run.owner_alive():
         raise ConflictError(f"run {run.id} is running; nothing to resume")
-    if run.status == "done":
+    if run.status == Status.DONE:
         raise ConflictError(f"run {run.id} is done; nothing to resume")
-    if run.status == "queued":
+    if run.status == Status.QUEUED:
         raise ConflictError(f"run {run.id} is queued already; it starts when a worker is free")

@@ -22,7 +22,7 @@ from touchbench.app.errors import NotFoundError
 from touchbench.app.reports import bounds
 from touchbench.app.reports.answer_tables import run_answer_tables
 from touchbench.app.reports.run_tables import RunTable, run_tables
-from touchbench.app.schemas.runs import FINAL_STATUSES
+from touchbench.app.schemas.status import FINAL, RESUMABLE, Status
 from touchbench.app.services.answers import run_answers
 from touchbench.app.services.listing import list_datasets
 from touchbench.app.services.runs import NoResultsError, run_leaderboard
@@ -52,7 +52,7 @@ def runs(store: StoreDep) -> HTMLResponse:
     return render(
         "fragments/runs.html.j2",
         runs=listed,
-        active=any(run.status not in FINAL_STATUSES for run in listed.items),
+        active=any(run.status not in FINAL for run in listed.items),
     )
 
 
@@ -78,7 +78,13 @@ def run_form(
 def progress(run_id: int, store: StoreDep) -> HTMLResponse:
     """Status and tasks done; polled every second until the run is over."""
     run = get_run(store, run_id).schema()
-    return render("fragments/progress.html.j2", run=run, final=run.status in FINAL_STATUSES)
+    return render(
+        "fragments/progress.html.j2",
+        run=run,
+        final=run.status in FINAL,
+        resumable=run.status in RESUMABLE,
+        done=run.status == Status.DONE,
+    )
 
 
 @router.get("/{run_id}/leaderboard", response_class=HTMLResponse)
