@@ -25,13 +25,13 @@ from touchbench.app.errors import ConflictError, NotFoundError
 from touchbench.app.schemas.base import finite
 from touchbench.app.schemas.listing import Page
 from touchbench.app.schemas.runs import RunSchema
-from touchbench.app.schemas.status import ACTIVE, FINAL, Status
+from touchbench.app.schemas.status import FINAL, Status
 from touchbench.app.store import queue
 from touchbench.app.store.database import Store
 from touchbench.app.store.naming import is_row_id
 from touchbench.app.store.ownership import aware, mark_lost, owner_alive, process_owner
 from touchbench.app.store.paging import count_rows, paged
-from touchbench.app.store.states import LOST_AS, check_claim, check_resume
+from touchbench.app.store.states import LOST_AS, check_claim, check_resume, is_active
 from touchbench.app.store.tables import DatasetRow, EntryDropRow, FoldResultRow, RunRow, utcnow
 from touchbench.benchmark.results import TaskKey, TaskResult
 
@@ -94,7 +94,7 @@ class RunInfo:
 
     def is_alive(self) -> bool:
         """Whether a live process is executing the run (``running`` or ``cancelling``)."""
-        return self.status in ACTIVE and self.owner_alive()
+        return is_active(self)
 
     def owner_alive(self) -> bool:
         """Whether the process named as the run's owner still runs."""

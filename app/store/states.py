@@ -24,13 +24,10 @@ any other unfinished item takes effect at once.  Every rule about these changes 
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Protocol
+from typing import Protocol
 
 from touchbench.app.errors import ConflictError
 from touchbench.app.schemas.status import ACTIVE, FINAL, Status
-
-if TYPE_CHECKING:
-    from touchbench.app.store.runs import RunInfo
 
 #: What a process whose owner died leaves, of a run or a job: a running one is interrupted,
 #: one being cancelled is cancelled (its process stopped, as asked).
@@ -40,10 +37,33 @@ LOST_AS: dict[Status, Status] = {
 }
 
 
+class Item(Protocol):
+    """What the rules read of a run or a job."""
+
+    @property
+    def id(self) -> int: ...
+
+    @property
+    def status(self) -> str: ...
+
+    def owner_alive(self) -> bool: ...
+
+
+class Claimed(Item, Protocol):
+    """What the rules of claims read of a run (:class:`app.store.runs.RunInfo`): who
+    executes it, and when it was last heard from.  A protocol, so that these rules sit
+    below the store's runs, which apply them."""
+
+    @property
+    def owner(self) -> str | None: ...
+
+    def seconds_since_heartbeat(self) -> float: ...
+
+
 class RunBusy(ConflictError):  # noqa: N818 (a state, like ConflictError's other cases)
     """Another live process executes the run."""
 
-    def __init__(self, run: RunInfo) -> None:
+    def __init__(self, run: Claimed) -> None:
         super().__init__(
             f"run {run.id} is being executed by {run.owner} (heard from "
             f"{run.seconds_since_heartbeat():.0f} s ago); wait for it to end or cancel it"
@@ -51,21 +71,12 @@ class RunBusy(ConflictError):  # noqa: N818 (a state, like ConflictError's other
         self.run_id = run.id
 
 
-class Item(Protocol):
-    """What the rules read of a run or a job."""
-
-    id: int
-    status: str
-
-    def owner_alive(self) -> bool: ...
-
-
 def is_active(item: Item) -> bool:
     """Whether a live process executes the item."""
     return item.status in ACTIVE and item.owner_alive()
 
 
-def check_claim(run: RunInfo, owner: str) -> None:
+def check_claim(run: Claimed, owner: str) -> None:
     """Refuse to let ``owner`` execute a run that another live process executes or that is
     being cancelled.
 
@@ -100,7 +111,7 @@ def cancel_outcome(item: Item, kind: str = "run") -> str:
     return Status.CANCELLING if is_active(item) else Status.CANCELLED
 
 
-def check_resume(run: RunInfo) -> None:
+def check_resume(run: Item) -> None:
     """Refuse to queue again a run that is queued, executing, being cancelled or done.
 
     Raises

@@ -9,6 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import grimp
 import pytest
 
 import touchbench.app
@@ -137,3 +138,16 @@ def test_a_status_is_spelt_in_app_schemas_status_only() -> None:
         }
     assert {place for place in spelt if place[0] != "schemas/status.py"} == NOT_A_STATUS
     assert {word for where, word in spelt if where == "schemas/status.py"} == words
+
+
+def test_the_rules_of_states_sit_below_the_runs_and_the_queue_that_apply_them() -> None:
+    """No import circle among app.store.states, runs and queue (imports under
+    TYPE_CHECKING and inside functions count)."""
+    graph = grimp.build_graph("touchbench", include_external_packages=False)
+    below = {
+        "touchbench.app.store.states": {"runs", "queue", "jobs"},
+        "touchbench.app.store.queue": {"runs", "jobs"},
+    }
+    for module, above in below.items():
+        for name in above:
+            assert not graph.chain_exists(module, f"touchbench.app.store.{name}"), (module, name)
