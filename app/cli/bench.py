@@ -920,7 +920,7 @@ def _print_leaderboard(ranked: RunLeaderboard) -> None:
     scored = ", scored per recording" if ranked.per_recording else ""
     table(
         f"run {run.id}: {run.dataset_name} ({', '.join(run.targets)}), "
-        f"{run.config.get('folds')}-fold x {run.config.get('repeats')} ({run.fold_scheme}), "
+        f"{run.config.folds}-fold x {run.config.repeats} ({run.fold_scheme}), "
         f"ranked by {board.metric}{direction}{scored}",
         leaderboard_header(board, columns, ranked.besides),
         leaderboard_rows(board, columns, ranked.besides),

@@ -222,7 +222,7 @@ def compare_runs(
             run_scores(replace(run, classifiers=[*run.classifiers, *names]), metric, results)
         )
         beside_notes += [
-            f"run {b.run.id} ({b.run.config.get('name') or b.run.fold_scheme}) joins "
+            f"run {b.run.id} ({b.run.config.name or b.run.fold_scheme}) joins "
             f"run {run.id} (same data set and target); as for their folds: {b.note}"
             for b in others
         ]

@@ -24,6 +24,7 @@ from sqlalchemy.orm import Session
 from touchbench.app.errors import ConflictError, NotFoundError
 from touchbench.app.schemas.base import finite
 from touchbench.app.schemas.listing import Page
+from touchbench.app.schemas.run_config import RunConfig
 from touchbench.app.schemas.runs import RunSchema
 from touchbench.app.schemas.status import FINAL, Status
 from touchbench.app.store import queue
@@ -53,7 +54,7 @@ class RunInfo:
     kind: str
     targets: list[str]
     classifiers: list[str]
-    config: dict[str, Any]
+    config: RunConfig
     status: Status
     created_at: datetime
     finished_at: datetime | None
@@ -72,7 +73,7 @@ class RunInfo:
 
     @property
     def n_tasks(self) -> int:
-        return int(self.config.get("n_tasks", 0))
+        return self.config.n_tasks
 
     def tasks_text(self) -> str:
         """Progress as listings say it: ``done/total``, and with drops ``done done,
@@ -86,11 +87,10 @@ class RunInfo:
     def fold_scheme(self) -> str:
         """How the folds were made (``stratified k-fold``, ``group k-fold``...); runs stored
         before it was recorded are described from their kind and whether they had groups."""
-        recorded = self.config.get("fold_scheme")
-        if recorded:
-            return str(recorded)
+        if self.config.fold_scheme:
+            return self.config.fold_scheme
         stratified = "stratified " if self.kind == "multiclass" else ""
-        return stratified + ("group " if self.config.get("grouped") else "") + "k-fold"
+        return stratified + ("group " if self.config.grouped else "") + "k-fold"
 
     def is_alive(self) -> bool:
         """Whether a live process is executing the run (``running`` or ``cancelling``)."""
@@ -114,7 +114,7 @@ class RunInfo:
             kind=self.kind,
             targets=self.targets,
             classifiers=self.classifiers,
-            config=self.config,
+            config=self.config.to_json(),
             status=self.status,
             created_at=self.created_at,
             started_at=self.started_at,
@@ -137,7 +137,7 @@ def create_run(
     kind: str,
     targets: Sequence[str],
     classifiers: Sequence[str],
-    config: dict[str, Any],
+    config: RunConfig,
 ) -> RunInfo:
     """A new run, ``queued``."""
     with store.session() as session:
@@ -151,7 +151,7 @@ def _new_run(
     kind: str,
     targets: Sequence[str],
     classifiers: Sequence[str],
-    config: dict[str, Any],
+    config: RunConfig,
     status: Status,
     **times: datetime,
 ) -> RunRow:
@@ -161,7 +161,7 @@ def _new_run(
         kind=kind,
         targets=list(targets),
         classifiers=list(classifiers),
-        config=config,
+        config=config.to_json(),
         status=status,
         **times,
     )
@@ -177,7 +177,7 @@ def add_finished_run(
     kind: str,
     targets: Sequence[str],
     classifiers: Sequence[str],
-    config: dict[str, Any],
+    config: RunConfig,
     results: Sequence[TaskResult],
 ) -> RunInfo:
     """A run that is ``done`` on arrival, stored with its results in one transaction (an
@@ -302,12 +302,12 @@ def should_stop(store: Store, run_id: int, owner: str) -> bool:
     return queue.should_stop(store, RunRow, run_id, owner)
 
 
-def update_config(store: Store, run_id: int, values: dict[str, Any]) -> None:
-    """Merge ``values`` into a run's stored config (what its executing process decided
-    when it started, such as the memory cap it derived)."""
+def update_config(store: Store, run_id: int, **values: Any) -> None:
+    """Set ``values`` in a run's stored config (what its executing process decided when it
+    started, such as the memory cap it derived)."""
     with store.session() as session:
         row = _row(session, run_id)
-        row.config = {**row.config, **values}
+        row.config = RunConfig.load(row.config).updated(**values).to_json()
 
 
 def finish_run(store: Store, run_id: int, status: Status, *, error: str | None = None) -> None:
@@ -527,6 +527,7 @@ def _infos(session: Session, rows: Sequence[RunRow]) -> list[RunInfo]:
         select(EntryDropRow.run_id, EntryDropRow.after_fold).where(EntryDropRow.run_id.in_(ids))
     ).all():
         stopped.setdefault(run_id, []).append(int(after_fold))
+    configs = {row.id: RunConfig.load(row.config) for row in rows}
     return [
         RunInfo(
             id=row.id,
@@ -535,7 +536,7 @@ def _infos(session: Session, rows: Sequence[RunRow]) -> list[RunInfo]:
             kind=row.kind,
             targets=list(row.targets),
             classifiers=list(row.classifiers),
-            config=dict(row.config),
+            config=configs[row.id],
             status=Status(row.status),
             created_at=row.created_at,
             finished_at=row.finished_at,
@@ -546,14 +547,14 @@ def _infos(session: Session, rows: Sequence[RunRow]) -> list[RunInfo]:
             heartbeat_at=row.heartbeat_at,
             error=row.error,
             cancel_requested=bool(row.cancel_requested),
-            n_dropped=_skipped(row, stopped.get(row.id, [])),
+            n_dropped=_skipped(row, configs[row.id], stopped.get(row.id, [])),
             seconds_spent=float(row.seconds_spent or 0.0),
         )
         for row in rows
     ]
 
 
-def _skipped(row: RunRow, folds_run: Sequence[int]) -> int:
+def _skipped(row: RunRow, config: RunConfig, folds_run: Sequence[int]) -> int:
     """Tasks a run's dropped entries will not run: each entry's folds after its last."""
-    per_entry = int(row.config.get("n_tasks", 0)) // max(len(row.classifiers), 1)
+    per_entry = config.n_tasks // max(len(row.classifiers), 1)
     return sum(max(per_entry - folds, 0) for folds in folds_run)

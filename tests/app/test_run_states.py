@@ -15,6 +15,7 @@ import pytest
 import touchbench.app
 from tests.app.test_store import small_dataset
 from touchbench.app.errors import ConflictError
+from touchbench.app.schemas.run_config import RunConfig
 from touchbench.app.schemas.status import Status
 from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import add_dataset
@@ -41,7 +42,7 @@ def _run(store: Store) -> int:
         kind="multiclass",
         targets=["c"],
         classifiers=["nb"],
-        config={"folds": 2, "repeats": 1, "seed": 0, "n_tasks": 2},
+        config=RunConfig(folds=2, repeats=1, seed=0, n_tasks=2),
     )
     return run.id
 

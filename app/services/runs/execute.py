@@ -97,8 +97,8 @@ def execute_run(
         options = RunOptions.from_config(run.config)
         prepared = prepare_problem(
             load_dataset(store, run.dataset_id),
-            run.config.get("targets_given"),
-            run.config.get("position") or (),
+            run.config.targets_given,
+            run.config.position or (),
         )
         folds = fold_plan(prepared, options).folds
         race = race_rule(run)
@@ -120,10 +120,8 @@ def execute_run(
         update_config(
             store,
             run.id,
-            {
-                "task_memory_mb": None if max_memory is None else round(max_memory / 2**20),
-                "task_memory_from": memory_from,
-            },
+            task_memory_mb=None if max_memory is None else round(max_memory / 2**20),
+            task_memory_from=memory_from,
         )
 
         def persist(result: TaskResult) -> None:
@@ -160,7 +158,7 @@ def execute_run(
                 budget=budget,
                 previous=previous,
                 on_drop=dropped,
-                by_recording=run.config.get("aggregate") == "recording",
+                by_recording=run.config.by_recording,
             )
         except RunStopped:
             finish_run(store, run.id, Status.CANCELLED)

@@ -24,7 +24,7 @@ from touchbench.app.schemas.runs import (
 )
 from touchbench.app.schemas.status import UNFINISHED, Status
 from touchbench.app.services.beside import Beside, besides, merged_results, row_runs
-from touchbench.app.services.runs.ranking import DEFAULT_METRIC, check_metric
+from touchbench.app.services.runs.ranking import check_metric, run_metric
 from touchbench.app.services.runs.stopping import RACE_TEST, never_started
 from touchbench.app.store.database import Store
 from touchbench.app.store.drops import load_drops
@@ -87,7 +87,7 @@ class RunLeaderboard:
     @property
     def per_recording(self) -> bool:
         """Whether the run scored each recording's windows as one prediction."""
-        return self.run.config.get("aggregate") == "recording"
+        return self.run.config.by_recording
 
     def notes(self) -> list[str]:
         """What the leaderboard of a run scored per recording, raced, budgeted or stopped
@@ -105,10 +105,10 @@ class RunLeaderboard:
 
     def race(self) -> RaceSchema | None:
         """How the run raced; ``None`` for a run that did not."""
-        race = self.run.config.get("race")
-        if not race:
+        race = self.run.config.race
+        if race is None:
             return None
-        alpha = float(race["alpha"])
+        alpha = race.alpha
         dropped = sum(1 for d in self.drops.values() if d.reason == "race")
         return RaceSchema(
             alpha=alpha,
@@ -119,7 +119,7 @@ class RunLeaderboard:
 
     def budget(self) -> BudgetSchema | None:
         """What the run's total budget cut; ``None`` for a run without one."""
-        minutes = self.run.config.get("budget_total")
+        minutes = self.run.config.budget_total
         if minutes is None:
             return None
         cut = [c for c, d in self.drops.items() if d.reason == "budget"]
@@ -131,11 +131,11 @@ class RunLeaderboard:
         missing = max(self.run.n_tasks - len(self.results) - raced_out, 0)
         cut_text = f"; cut: {', '.join(cut)}" if cut else ""
         return BudgetSchema(
-            minutes=float(minutes),
+            minutes=minutes,
             cut=cut,
             tasks_not_run=missing,
             minutes_spent=self.run.seconds_spent / 60.0,
-            note=f"total budget {float(minutes):g} min: {missing} task(s) not run{cut_text}",
+            note=f"total budget {minutes:g} min: {missing} task(s) not run{cut_text}",
         )
 
     def report(self) -> LeaderboardSchema:
@@ -216,15 +216,15 @@ def run_leaderboard(
     if not results:
         raise NoResultsError(run)
     if metric is not None:
-        check_metric(run.kind, metric, position=bool(run.config.get("position")), run_id=run.id)
-    metric = metric or run.config.get("metric") or DEFAULT_METRIC.get(run.kind, "f1_weighted")
+        check_metric(run.kind, metric, position=bool(run.config.position), run_id=run.id)
+    metric = metric or run_metric(run)
     others = besides(run, [get_run(store, ref) for ref in dict.fromkeys(beside)])
     ranked, groups = merged_results(results, [(b, load_results(store, b.run.id)) for b in others])
     drops = {**never_started(run, results), **load_drops(store, run.id)}
     board = build_leaderboard(
         ranked,
         metric=metric,
-        baseline=baseline or run.config.get("baseline"),
+        baseline=baseline or run.config.baseline,
         groups=groups if others else None,
         drops=drops,
     )

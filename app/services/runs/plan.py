@@ -12,9 +12,15 @@ from __future__ import annotations
 # scikit-learn and scipy, which only the functions that need them import.
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from touchbench.app.errors import FieldError
+from touchbench.app.schemas.run_config import (
+    ExtraSpecsConfig,
+    RaceConfig,
+    RunConfig,
+    TuneConfig,
+)
 from touchbench.app.schemas.runs import RACE_MIN_FOLDS, BenchRequest
 from touchbench.app.services.runs.problem import (
     OneValueError,
@@ -145,7 +151,7 @@ class Plan:
     kind: str
     targets: list[str]
     classifiers: list[str]
-    config: dict[str, Any]
+    config: RunConfig
     notes: list[str]
 
 
@@ -228,7 +234,7 @@ def plan_run(store: Store, request: BenchRequest) -> Plan:
             regression_size=problem.n_instances if numeric else None,
         )
     ids = list(dict.fromkeys([*ids, *commands]))
-    tuning = _tuning_config(commands, request.tune, request.budget, request.stack)
+    extras = _extra_specs(commands, request.tune, request.budget, request.stack)
     if request.tune:
         from touchbench.app.services.tuning import with_tuned_twins
 
@@ -237,7 +243,7 @@ def plan_run(store: Store, request: BenchRequest) -> Plan:
         from touchbench.app.services.tuning import add_stack
 
         ids = add_stack(ids, request.stack, multitarget=problem.kind == "multitarget")
-    check_classifiers(problem, ids, run_specs(tuning, ids), asked=request.classifiers or ())
+    check_classifiers(problem, ids, run_specs(extras, ids), asked=request.classifiers or ())
     if request.baseline is not None and request.baseline not in ids:
         raise FieldError(
             "baseline",
@@ -257,24 +263,29 @@ def plan_run(store: Store, request: BenchRequest) -> Plan:
             f"needs at least {RACE_MIN_FOLDS} folds in all, and the data allow "
             f"{len(plan.folds)} ({'; '.join(plan.notes)})",
         )
-    config = {
-        **options.to_json(),
-        "folds": max(f.fold for f in plan.folds) + 1,
-        "folds_requested": options.folds,
-        "targets_given": targets,
-        "suite": None if request.classifiers or request.weka else (request.suite or "default"),
-        **tuning,
-        "n_tasks": len(ids) * len(plan.folds),
-        "n_instances": int(problem.X.shape[0]),
-        "grouped": problem.groups is not None,
-        "fold_scheme": plan.scheme,
-        "position": position or None,
-        "metric": request.metric,
-        "baseline": request.baseline,
-        "race": {"alpha": request.race_alpha} if request.race else None,
-        "budget_total": request.budget_total,
-        "aggregate": request.aggregate,
-    }
+    config = RunConfig(
+        folds=max(f.fold for f in plan.folds) + 1,
+        repeats=options.repeats,
+        seed=options.seed,
+        timeout=options.timeout,
+        max_memory_mb=options.max_memory_mb,
+        folds_requested=options.folds,
+        targets_given=targets,
+        suite=None if request.classifiers or request.weka else (request.suite or "default"),
+        weka=extras.weka,
+        tune=extras.tune,
+        stack=extras.stack,
+        n_tasks=len(ids) * len(plan.folds),
+        n_instances=int(problem.X.shape[0]),
+        grouped=problem.groups is not None,
+        fold_scheme=plan.scheme,
+        position=position or None,
+        metric=request.metric,
+        baseline=request.baseline,
+        race=RaceConfig(alpha=request.race_alpha) if request.race else None,
+        budget_total=request.budget_total,
+        aggregate=request.aggregate,
+    )
     return Plan(
         info.id, problem.kind, prepared.target_names, ids, config, prepared.warnings + plan.notes
     )
@@ -297,12 +308,12 @@ def store_plan(
     return run
 
 
-def _tuning_config(
+def _extra_specs(
     commands: Mapping[str, ClassifierSpec], tune: bool, budget: float | None, stack: int | None
-) -> dict[str, Any]:
+) -> ExtraSpecsConfig:
     """The parts of a run's config that say how to build its extra specs again."""
-    return {
-        "weka": {spec_id: spec.weka_command for spec_id, spec in commands.items()},
-        "tune": {"budget_minutes": budget} if tune else None,
-        "stack": stack,
-    }
+    return ExtraSpecsConfig(
+        weka={spec_id: spec.weka_command for spec_id, spec in commands.items()},
+        tune=TuneConfig(budget_minutes=budget) if tune else None,
+        stack=stack,
+    )

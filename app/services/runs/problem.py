@@ -9,11 +9,12 @@ from __future__ import annotations
 # when a run first makes its folds.
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from touchbench.app.errors import FieldError
+from touchbench.app.schemas.run_config import RunConfig
 from touchbench.app.schemas.runs import BenchRequest
 from touchbench.benchmark.dataset import Dataset
 from touchbench.benchmark.errors import ConfigurationError
@@ -27,7 +28,8 @@ if TYPE_CHECKING:
 class RunOptions:
     """How a run cross-validates, as its stored config says: what a resumed run gets back.
 
-    The defaults and bounds are the request's (:class:`app.schemas.runs.BenchRequest`).
+    The defaults and bounds are the request's (:class:`app.schemas.runs.BenchRequest`); a
+    run's stored configuration (:class:`app.schemas.run_config.RunConfig`) keeps them.
 
     Attributes
     ----------
@@ -47,15 +49,6 @@ class RunOptions:
     timeout: float | None
     max_memory_mb: float | None
 
-    def to_json(self) -> dict[str, Any]:
-        return {
-            "folds": self.folds,
-            "repeats": self.repeats,
-            "seed": self.seed,
-            "timeout": self.timeout,
-            "max_memory_mb": self.max_memory_mb,
-        }
-
     @classmethod
     def from_request(cls, request: BenchRequest) -> RunOptions:
         return cls(
@@ -67,13 +60,22 @@ class RunOptions:
         )
 
     @classmethod
-    def from_config(cls, config: dict[str, Any]) -> RunOptions:
+    def from_config(cls, config: RunConfig) -> RunOptions:
+        """The options a run was planned with.
+
+        Raises
+        ------
+        ConfigurationError
+            The configuration has no folds or repeats (an imported run's may lack them).
+        """
+        if config.asked_folds is None or config.repeats is None:
+            raise ConfigurationError("the run's configuration does not say its folds")
         return cls(
-            folds=int(config.get("folds_requested", config["folds"])),
-            repeats=int(config["repeats"]),
-            seed=int(config["seed"]),
-            timeout=config.get("timeout"),
-            max_memory_mb=config.get("max_memory_mb"),
+            folds=config.asked_folds,
+            repeats=config.repeats,
+            seed=config.seed,
+            timeout=config.timeout,
+            max_memory_mb=config.max_memory_mb,
         )
 
 

@@ -4,10 +4,16 @@ from __future__ import annotations
 
 # Imports inside functions: start-up time: the metrics (scikit-learn) load when a metric
 # is first checked.
+from touchbench.app.store.runs import RunInfo
 from touchbench.benchmark.errors import ConfigurationError
 
 #: Metric a leaderboard is ranked by unless asked otherwise, per kind of run.
 DEFAULT_METRIC = {"multiclass": "f1_weighted", "multitarget": "hamming_score", "regression": "mae"}
+
+
+def run_metric(run: RunInfo) -> str:
+    """The metric a run ranks by: the one it was asked, else its kind's."""
+    return run.config.metric or DEFAULT_METRIC.get(run.kind, "f1_weighted")
 
 
 def check_metric(kind: str, metric: str, *, position: bool, run_id: int | None = None) -> None:

@@ -11,7 +11,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from touchbench.app.schemas.status import STOPPED_EARLY
-from touchbench.app.services.runs.ranking import DEFAULT_METRIC
+from touchbench.app.services.runs.ranking import run_metric
 from touchbench.app.store.runs import RunInfo
 from touchbench.benchmark.results import Drop, TaskResult
 
@@ -30,24 +30,24 @@ NO_BUDGET_LEFT = 1e-6
 
 def budget_left(run: RunInfo) -> float | None:
     """Seconds of the run's total budget its earlier executions left; ``None`` without one."""
-    minutes = run.config.get("budget_total")
+    minutes = run.config.budget_total
     if minutes is None:
         return None
-    return max(float(minutes) * 60.0 - run.seconds_spent, NO_BUDGET_LEFT)
+    return max(minutes * 60.0 - run.seconds_spent, NO_BUDGET_LEFT)
 
 
 def race_rule(run: RunInfo) -> RaceRule | None:
     """How a run races, from its config: its ranking metric, level and baseline; ``None``
     for a run that is not raced."""
-    race = run.config.get("race")
-    if not race:
+    race = run.config.race
+    if race is None:
         return None
     from touchbench.benchmark.run.racing import RaceRule
 
-    baseline = run.config.get("baseline")
+    baseline = run.config.baseline
     return RaceRule(
-        metric=run.config.get("metric") or DEFAULT_METRIC.get(run.kind, "f1_weighted"),
-        alpha=float(race["alpha"]),
+        metric=run_metric(run),
+        alpha=race.alpha,
         protected=frozenset({baseline} if baseline else ()),
     )
 
