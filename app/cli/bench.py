@@ -659,9 +659,9 @@ def cancel_command(
     as_json: JsonOption = False,
 ) -> None:
     """Cancel a run: a queued run at once, a running one as soon as its process hears of it."""
-    from touchbench.app.store.runs import request_cancel
+    from touchbench.app.services.lifecycle import cancel_run
 
-    run = request_cancel(get_state(ctx).store, run_id)
+    run = cancel_run(get_state(ctx).store, run_id)
     if as_json:
         print_json(run.to_json())
         return
@@ -685,7 +685,7 @@ def _check_jobs(jobs: int, oversubscribe: bool) -> int:
 
 
 def _kept_message(store: Store, run_id: int, what: str) -> str:
-    from touchbench.app.store.runs import get_run
+    from touchbench.app.services.lifecycle import get_run
 
     run = get_run(store, run_id)
     return (
@@ -781,7 +781,7 @@ def _ranked(
 def runs_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
     """List benchmark runs with their status and progress."""
     from touchbench.app.schemas.runs import RunList
-    from touchbench.app.store.runs import list_runs
+    from touchbench.app.services.lifecycle import list_runs
 
     runs = list_runs(get_state(ctx).store)
     if as_json:

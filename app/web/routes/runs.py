@@ -24,10 +24,9 @@ from touchbench.app.reports.answer_tables import run_answer_tables
 from touchbench.app.reports.run_tables import RunTable, run_tables
 from touchbench.app.schemas.status import FINAL, RESUMABLE, Status
 from touchbench.app.services.answers import run_answers
-from touchbench.app.services.listing import list_datasets
+from touchbench.app.services.lifecycle import count_runs, get_run, list_runs
+from touchbench.app.services.listing import count_datasets, list_datasets
 from touchbench.app.services.runs import NoResultsError, run_leaderboard
-from touchbench.app.store.listing import count_datasets
-from touchbench.app.store.runs import count_runs, get_run, list_runs
 from touchbench.app.web.deps import StoreDep
 from touchbench.app.web.listing import newest
 from touchbench.app.web.rendering import draw, render
