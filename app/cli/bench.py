@@ -6,10 +6,12 @@ from __future__ import annotations
 # one chosen loads only what it uses (the CLI imports the module when a command of it
 # is chosen).
 import sys
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
+from typer.models import ArgumentInfo, OptionInfo
+from typer.utils import get_params_from_function
 
 from touchbench.app.cli.output import (
     EXIT_FAILED,
@@ -289,7 +291,7 @@ def bench_command(
         str | None,
         typer.Option("--classifiers", "-c", metavar="ID,ID,...", help="Classifier ids to run."),
     ] = None,
-    suite_name: Annotated[
+    suite: Annotated[
         str | None,
         typer.Option("--suite", metavar="NAME", help="fast, default or all (default: default)."),
     ] = None,
@@ -352,7 +354,7 @@ def bench_command(
             show_default=False,
         ),
     ] = None,
-    max_memory: Annotated[
+    max_memory_mb: Annotated[
         str | None,
         typer.Option(
             "--max-memory",
@@ -525,6 +527,7 @@ def bench_command(
     ranked by mean absolute error. Ctrl-C keeps
     every finished fold: `touchbench bench --resume RUN` carries out the rest.
     """
+    values = _bench_values(locals())  # first: the parameters, before any other name
     from touchbench.app.cli.progress import TaskProgress
     from touchbench.app.cli.requests import build_request
     from touchbench.app.errors import ConflictError
@@ -532,29 +535,6 @@ def bench_command(
     from touchbench.app.store.states import RunBusy
 
     store = get_state(ctx).store
-    values = {
-        "dataset": dataset,
-        "target": target,
-        "classifiers": _split(classifiers),
-        "suite": suite_name,
-        "folds": folds,
-        "repeats": repeats,
-        "seed": seed,
-        "timeout": timeout,
-        "max_memory_mb": max_memory,
-        "metric": metric,
-        "baseline": baseline,
-        "weka": weka or None,
-        "position": _split(position),
-        "tune": tune,
-        "budget": budget,
-        "stack": stack,
-        "independent": independent,
-        "race": race,
-        "race_alpha": race_alpha,
-        "budget_total": budget_total,
-        "aggregate": aggregate,
-    }
     if resume is not None:
         _check_resume(values)
     elif dataset is None:
@@ -607,30 +587,26 @@ def bench_command(
     _print_run_report(store, run.id, metric, baseline, as_json, ablation)
 
 
-#: The option of each field of :class:`app.schemas.runs.BenchRequest`.
-BENCH_OPTIONS = {
-    "dataset": "DATASET",
-    "target": "--target",
-    "classifiers": "--classifiers",
-    "suite": "--suite",
-    "folds": "--folds",
-    "repeats": "--repeats",
-    "seed": "--seed",
-    "timeout": "--timeout",
-    "max_memory_mb": "--max-memory",
-    "metric": "--metric",
-    "baseline": "--baseline",
-    "weka": "--weka",
-    "position": "--position",
-    "tune": "--tune",
-    "budget": "--budget",
-    "stack": "--stack",
-    "independent": "--independent",
-    "race": "--race",
-    "race_alpha": "--race-alpha",
-    "budget_total": "--budget-total",
-    "aggregate": "--aggregate",
-}
+def _options_of(command: Callable[..., Any]) -> dict[str, str]:
+    """How the command line spells each parameter of ``command``, as typer reads its
+    signature: its first option name, or an argument's metavar (what a refused field is
+    shown as, :mod:`app.cli.requests`)."""
+    spelt = {}
+    for name, parameter in get_params_from_function(command).items():
+        declared = parameter.default
+        if isinstance(declared, OptionInfo) and declared.param_decls:
+            spelt[name] = declared.param_decls[0]
+        elif isinstance(declared, ArgumentInfo):
+            spelt[name] = declared.metavar or name.upper()
+    return spelt
+
+
+#: The option of each parameter of ``bench``: each field of
+#: :class:`app.schemas.runs.BenchRequest` is a parameter of the same name, declared once, in
+#: the command's signature.
+BENCH_OPTIONS = _options_of(bench_command)
+#: Fields given as comma-separated lists (``-c nb,j48``).
+_COMMA_LISTS = ("classifiers", "position")
 #: Fields that only say how ``bench`` prints the leaderboard of a resumed run.
 _REPORT_FIELDS = ("metric", "baseline")
 
@@ -638,6 +614,20 @@ _REPORT_FIELDS = ("metric", "baseline")
 def _split(text: str | None) -> list[str] | None:
     """``a, b,c`` as ``["a", "b", "c"]``; ``None`` when not given."""
     return None if text is None else [part.strip() for part in text.split(",") if part.strip()]
+
+
+def _bench_values(parameters: Mapping[str, Any]) -> dict[str, Any]:
+    """The fields of a :class:`BenchRequest` from ``bench``'s parameters: lists split, an
+    option not given (``None``, a repeatable one empty) left out of the request's way."""
+    values = {}
+    for field in BenchRequest.model_fields:
+        value = parameters[field]
+        if field in _COMMA_LISTS:
+            value = _split(value)
+        elif isinstance(value, list):
+            value = value or None
+        values[field] = value
+    return values
 
 
 def _check_resume(values: Mapping[str, object]) -> None:
