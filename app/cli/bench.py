@@ -24,7 +24,7 @@ from touchbench.app.cli.output import (
     table,
 )
 from touchbench.app.cli.state import get_state
-from touchbench.app.schemas.runs import BenchRequest
+from touchbench.app.schemas.runs import BenchHereRequest, BenchRequest
 from touchbench.app.schemas.status import Status
 
 if TYPE_CHECKING:
@@ -528,10 +528,11 @@ def bench_command(
     every finished fold: `touchbench bench --resume RUN` carries out the rest.
     """
     values = _bench_values(locals())  # first: the parameters, before any other name
-    from touchbench.app.cli.progress import TaskProgress
+    from touchbench.app.cli.progress import TaskProgress, TenthsProgress
     from touchbench.app.cli.requests import build_request
     from touchbench.app.errors import ConflictError
-    from touchbench.app.services.runs import RunCancelled, create_run, execute_run, independent_runs
+    from touchbench.app.services.bench import RunInterrupted, bench_here
+    from touchbench.app.services.runs import RunCancelled
     from touchbench.app.store.states import RunBusy
 
     store = get_state(ctx).store
@@ -539,9 +540,10 @@ def bench_command(
         _check_resume(values)
     elif dataset is None:
         raise typer.BadParameter("missing DATASET (or --resume RUN)")
-    request = None if resume is not None else build_request(BenchRequest, BENCH_OPTIONS, **values)
-    if ablate_groups is not None:
-        _check_ablation(store, request, resume, ablate_groups)
+    bench = None if resume is not None else build_request(BenchRequest, BENCH_OPTIONS, **values)
+    request = build_request(
+        BenchHereRequest, BENCH_OPTIONS, bench=bench, resume=resume, ablate_groups=ablate_groups
+    )
     jobs = _check_jobs(jobs, oversubscribe)
     if scheduler is not None:
         from touchbench.benchmark.run.dask_backend import connect
@@ -549,42 +551,40 @@ def bench_command(
         connect(scheduler).close()  # fail before a run exists, not after
     # On stderr whatever the output: --json keeps stdout to the JSON, not the progress.
     progress = TaskProgress()
-    if request is not None and request.independent:
-        with progress:
-            result = independent_runs(
-                store, request, jobs=jobs, scheduler=scheduler, callbacks=progress.callbacks()
-            )
-        _print_independent(result, as_json)
-        return
-    if request is None:
-        assert resume is not None
-        run_id = resume
-    else:
-        run_id = create_run(store, request, on_warning=progress.note).id
     try:
         with progress:
-            run = execute_run(
-                store, run_id, jobs=jobs, scheduler=scheduler, callbacks=progress.callbacks()
+            benched = bench_here(
+                store,
+                request,
+                jobs=jobs,
+                scheduler=scheduler,
+                callbacks=progress.callbacks(),
+                # a line per tenth of the work: an ablation reruns every classifier per group
+                on_ablation=TenthsProgress("ablation", quiet=as_json),
             )
     except RunBusy as busy:
         raise ConflictError(f"{busy} (`touchbench cancel {busy.run_id}` stops it)") from None
-    except KeyboardInterrupt as interrupt:  # Ctrl-C or SIGTERM (app.cli.signals)
-        code = getattr(interrupt, "exit_code", EXIT_INTERRUPTED)
-        raise ExitWith(_kept_message(store, run_id, Status.INTERRUPTED), code) from None
+    except RunInterrupted as interrupted:  # Ctrl-C or SIGTERM (app.cli.signals)
+        code = getattr(interrupted.__cause__, "exit_code", EXIT_INTERRUPTED)
+        message = _kept_message(store, interrupted.run_id, Status.INTERRUPTED)
+        raise ExitWith(message, code) from None
     except RunCancelled as cancelled:
-        raise ExitWith(
-            _kept_message(store, cancelled.run.id, Status.CANCELLED), EXIT_FAILED
-        ) from None
+        message = _kept_message(store, cancelled.run.id, Status.CANCELLED)
+        raise ExitWith(message, EXIT_FAILED) from None
+    if benched.independent is not None:
+        _print_independent(benched.independent, as_json)
+        return
+    run = benched.run
+    assert run is not None  # a run of its own when the targets are not benchmarked apart
     if run.status == Status.FAILED:
         _print_run_report(store, run.id, metric, baseline, as_json)
         raise ExitWith(
             f"run {run.id} failed: {run.error} (`touchbench leaderboard {run.id}` lists why)",
             EXIT_FAILED,
         )
-    ablation = None
-    if ablate_groups is not None:
-        ablation = _ablate(store, run.id, ablate_groups, jobs, as_json)
-    _print_run_report(store, run.id, metric, baseline, as_json, ablation)
+    if benched.ablation_job is not None and not as_json:
+        info(f"ablation kept as job {benched.ablation_job}")
+    _print_run_report(store, run.id, metric, baseline, as_json, benched.ablation)
 
 
 def _options_of(command: Callable[..., Any]) -> dict[str, str]:
@@ -602,8 +602,9 @@ def _options_of(command: Callable[..., Any]) -> dict[str, str]:
 
 
 #: The option of each parameter of ``bench``: each field of
-#: :class:`app.schemas.runs.BenchRequest` is a parameter of the same name, declared once, in
-#: the command's signature.
+#: :class:`app.schemas.runs.BenchRequest` (and ``resume`` and ``ablate_groups`` of
+#: :class:`app.schemas.runs.BenchHereRequest`) is a parameter of the same name, declared once,
+#: in the command's signature.
 BENCH_OPTIONS = _options_of(bench_command)
 #: Fields given as comma-separated lists (``-c nb,j48``).
 _COMMA_LISTS = ("classifiers", "position")
@@ -708,41 +709,6 @@ def _print_run_report(
             "change: mean of (without - full) over the folds; can go: no significant change; "
             "needed: significantly worse without"
         )
-
-
-#: The option of each field of :class:`app.schemas.ablation.AblationRequest`.
-_ABLATION_OPTIONS = {"grouping": "--ablate-groups", "classifiers": "--classifiers"}
-
-
-def _check_ablation(
-    store: Store, request: BenchRequest | None, resume: int | None, grouping: str
-) -> None:
-    """Refuse ``--ablate-groups`` before the run: a grouping that does not exist, or that
-    the data set's feature names do not give."""
-    from touchbench.app.cli.requests import build_request
-    from touchbench.app.schemas.ablation import AblationRequest
-    from touchbench.app.services.ablation import check_grouping
-
-    if request is not None and request.independent:
-        raise typer.BadParameter("is not used with --independent", param_hint="--ablate-groups")
-    checked = build_request(AblationRequest, _ABLATION_OPTIONS, run=resume or 1, grouping=grouping)
-    check_grouping(store, checked.grouping, bench=request, run=resume)
-
-
-def _ablate(store: Store, run_id: int, grouping: str, jobs: int, as_json: bool) -> AblationResult:
-    """Carry out the ablation of a finished run, as a job the store keeps."""
-    from touchbench.app.cli.progress import TenthsProgress
-    from touchbench.app.cli.requests import build_request
-    from touchbench.app.schemas.ablation import AblationRequest, AblationResult
-    from touchbench.app.services.jobs import carry_out_here
-
-    request = build_request(AblationRequest, _ABLATION_OPTIONS, run=run_id, grouping=grouping)
-    # a line per tenth of the work: an ablation reruns every classifier per group
-    progress = TenthsProgress("ablation", quiet=as_json)
-    job_id, result = carry_out_here(store, request, jobs=jobs, on_progress=progress)
-    if not as_json:
-        info(f"ablation kept as job {job_id}")
-    return AblationResult.model_validate(result)
 
 
 def _ranked(

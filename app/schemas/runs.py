@@ -9,6 +9,7 @@ from typing import Any, Literal
 from pydantic import Field, field_validator, model_validator
 
 from touchbench.app.errors import FieldError
+from touchbench.app.schemas.ablation import Grouping
 from touchbench.app.schemas.base import Request, Schema
 from touchbench.app.schemas.status import Status
 
@@ -453,4 +454,28 @@ class BenchRequest(Request):
             )
         if "race_alpha" in self.model_fields_set and not self.race:
             raise FieldError("race_alpha", "is only meaningful with `race`")
+        return self
+
+
+class BenchHereRequest(Request):
+    """A run carried out at once by the process that asks (``touchbench bench``): a new one
+    (``bench``) or a stored one to finish (``resume``), then, if asked, its ablation as a
+    job the store keeps (``ablate_groups``)."""
+
+    bench: BenchRequest | None = Field(default=None, description="A new run.")
+    resume: int | None = Field(
+        default=None, ge=1, description="A stored run whose tasks without a result to carry out."
+    )
+    ablate_groups: Grouping | None = Field(
+        default=None,
+        description="Then rerun the run's classifiers on its folds without each group of "
+        "features (an ablation's `grouping`).",
+    )
+
+    @model_validator(mode="after")
+    def _one_run(self) -> BenchHereRequest:
+        if (self.bench is None) == (self.resume is None):
+            raise FieldError("resume", "give a new run or a run to resume, one of the two")
+        if self.ablate_groups is not None and self.bench is not None and self.bench.independent:
+            raise FieldError("ablate_groups", "is not used with `independent`")
         return self

@@ -47,6 +47,8 @@ class Callbacks:
     on_result: Callable[[TaskResult], None] = lambda result: None
     on_warning: Callable[[str], None] = lambda message: None
     on_note: Callable[[str], None] = lambda message: None
+    #: The run's end is recorded (a progress bar stops before what comes after the run).
+    on_end: Callable[[RunInfo], None] = lambda run: None
 
 
 class RunCancelled(Exception):  # noqa: N818 (an outcome, not an error)
@@ -88,6 +90,7 @@ def execute_run(
     callbacks = callbacks or Callbacks()
     run = get_run(store, run_id)
     if run.status == Status.DONE and run.n_results >= run.n_tasks:
+        callbacks.on_end(run)
         return run
     owner = process_owner()
     run = claim_run(store, run.id, owner=owner)
@@ -180,7 +183,9 @@ def execute_run(
         beat.stop()
     status, error_text = _outcome(load_results(store, run.id))
     finish_run(store, run.id, status, error=error_text)
-    return get_run(store, run.id)
+    ended = get_run(store, run.id)
+    callbacks.on_end(ended)
+    return ended
 
 
 def _outcome(results: Sequence[TaskResult]) -> tuple[Status, str | None]:
