@@ -16,13 +16,16 @@ from touchbench.app.store.database import Store
 from touchbench.app.store.runs import RunInfo
 
 
-def list_runs(store: Store, *, page: Page | None = None) -> list[RunInfo]:
-    """The runs, oldest first (those of ``page``, when given)."""
-    return stored_runs.list_runs(store, page=page)
+def list_runs(
+    store: Store, *, dataset_id: int | None = None, page: Page | None = None
+) -> list[RunInfo]:
+    """The runs (on ``dataset_id``), oldest first (those of ``page``, when given)."""
+    return stored_runs.list_runs(store, dataset_id=dataset_id, page=page)
 
 
-def count_runs(store: Store) -> int:
-    return stored_runs.count_runs(store)
+def count_runs(store: Store, *, dataset_id: int | None = None) -> int:
+    """How many runs there are (on ``dataset_id``)."""
+    return stored_runs.count_runs(store, dataset_id=dataset_id)
 
 
 def get_run(store: Store, run_id: int | str) -> RunInfo:

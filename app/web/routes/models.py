@@ -8,7 +8,7 @@ from fastapi import APIRouter
 from fastapi.responses import HTMLResponse
 
 from touchbench.app.schemas.status import FINAL
-from touchbench.app.store.jobs import count_jobs, list_jobs
+from touchbench.app.services.lifecycle import count_jobs, list_jobs
 from touchbench.app.store.models import count_models, get_model, list_models
 from touchbench.app.web.deps import StoreDep
 from touchbench.app.web.listing import newest
