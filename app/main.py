@@ -19,6 +19,7 @@ from touchbench.app.api.stopping import CutByStop
 from touchbench.app.api.trust import Cors, Trust
 from touchbench.app.jobs.dispatcher import Dispatcher
 from touchbench.app.redaction import install as hide_keys_in_logs
+from touchbench.app.schemas.status import Status
 from touchbench.app.services.model_cache import ModelCache
 from touchbench.app.settings import Settings, get_settings
 from touchbench.app.store.database import Store
@@ -53,8 +54,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         mark_lost_jobs(store)
         if settings.resume_on_start:  # runs their process left; not those being cancelled
             for run_id in lost:
-                if get_run(store, run_id).status == "interrupted":
-                    finish_run(store, run_id, "queued")
+                if get_run(store, run_id).status == Status.INTERRUPTED:
+                    finish_run(store, run_id, Status.QUEUED)
         settings.work_dir.mkdir(parents=True, exist_ok=True)
         dispatcher = Dispatcher(store, settings)
         models = ModelCache(settings.model_cache)

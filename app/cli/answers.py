@@ -166,13 +166,13 @@ def import_results_command(
     if as_json:
         print_json(run.to_json())
         return
-    schemes = run.config.get("schemes", [])
+    config = run.config
     table(
-        f"run {run.id}: {run.config.get('name')} on {run.dataset_name} "
-        f"({', '.join(run.targets)}), {run.config.get('folds')} folds x "
-        f"{run.config.get('repeats')} runs, {run.n_results} results",
+        f"run {run.id}: {config.name} on {run.dataset_name} "
+        f"({', '.join(run.targets)}), {config.folds} folds x "
+        f"{config.repeats} runs, {run.n_results} results",
         ["classifier", "WEKA scheme", "options"],
-        [(s["classifier"], s["scheme"], s["options"]) for s in schemes],
+        [(s.classifier, s.scheme, s.options) for s in config.schemes],
     )
     info(
         f"`touchbench leaderboard RUN --beside {run.id}` ranks these beside a run of yours "

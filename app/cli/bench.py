@@ -6,10 +6,12 @@ from __future__ import annotations
 # one chosen loads only what it uses (the CLI imports the module when a command of it
 # is chosen).
 import sys
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
+from typer.models import ArgumentInfo, OptionInfo
+from typer.utils import get_params_from_function
 
 from touchbench.app.cli.output import (
     EXIT_FAILED,
@@ -22,7 +24,8 @@ from touchbench.app.cli.output import (
     table,
 )
 from touchbench.app.cli.state import get_state
-from touchbench.app.schemas.runs import BenchRequest
+from touchbench.app.schemas.runs import BenchHereRequest, BenchRequest
+from touchbench.app.schemas.status import Status
 
 if TYPE_CHECKING:
     from touchbench.app.schemas.ablation import AblationResult
@@ -288,7 +291,7 @@ def bench_command(
         str | None,
         typer.Option("--classifiers", "-c", metavar="ID,ID,...", help="Classifier ids to run."),
     ] = None,
-    suite_name: Annotated[
+    suite: Annotated[
         str | None,
         typer.Option("--suite", metavar="NAME", help="fast, default or all (default: default)."),
     ] = None,
@@ -351,7 +354,7 @@ def bench_command(
             show_default=False,
         ),
     ] = None,
-    max_memory: Annotated[
+    max_memory_mb: Annotated[
         str | None,
         typer.Option(
             "--max-memory",
@@ -524,43 +527,23 @@ def bench_command(
     ranked by mean absolute error. Ctrl-C keeps
     every finished fold: `touchbench bench --resume RUN` carries out the rest.
     """
-    from touchbench.app.cli.progress import TaskProgress
+    values = _bench_values(locals())  # first: the parameters, before any other name
+    from touchbench.app.cli.progress import TaskProgress, TenthsProgress
     from touchbench.app.cli.requests import build_request
     from touchbench.app.errors import ConflictError
-    from touchbench.app.services.runs import RunCancelled, create_run, execute_run, independent_runs
+    from touchbench.app.services.bench import RunInterrupted, bench_here
+    from touchbench.app.services.runs import RunCancelled
     from touchbench.app.store.states import RunBusy
 
     store = get_state(ctx).store
-    values = {
-        "dataset": dataset,
-        "target": target,
-        "classifiers": _split(classifiers),
-        "suite": suite_name,
-        "folds": folds,
-        "repeats": repeats,
-        "seed": seed,
-        "timeout": timeout,
-        "max_memory_mb": max_memory,
-        "metric": metric,
-        "baseline": baseline,
-        "weka": weka or None,
-        "position": _split(position),
-        "tune": tune,
-        "budget": budget,
-        "stack": stack,
-        "independent": independent,
-        "race": race,
-        "race_alpha": race_alpha,
-        "budget_total": budget_total,
-        "aggregate": aggregate,
-    }
     if resume is not None:
         _check_resume(values)
     elif dataset is None:
         raise typer.BadParameter("missing DATASET (or --resume RUN)")
-    request = None if resume is not None else build_request(BenchRequest, BENCH_OPTIONS, **values)
-    if ablate_groups is not None:
-        _check_ablation(store, request, resume, ablate_groups)
+    bench = None if resume is not None else build_request(BenchRequest, BENCH_OPTIONS, **values)
+    request = build_request(
+        BenchHereRequest, BENCH_OPTIONS, bench=bench, resume=resume, ablate_groups=ablate_groups
+    )
     jobs = _check_jobs(jobs, oversubscribe)
     if scheduler is not None:
         from touchbench.benchmark.run.dask_backend import connect
@@ -568,66 +551,63 @@ def bench_command(
         connect(scheduler).close()  # fail before a run exists, not after
     # On stderr whatever the output: --json keeps stdout to the JSON, not the progress.
     progress = TaskProgress()
-    if request is not None and request.independent:
-        with progress:
-            result = independent_runs(
-                store, request, jobs=jobs, scheduler=scheduler, callbacks=progress.callbacks()
-            )
-        _print_independent(result, as_json)
-        return
-    if request is None:
-        assert resume is not None
-        run_id = resume
-    else:
-        run_id = create_run(store, request, on_warning=progress.note).id
     try:
         with progress:
-            run = execute_run(
-                store, run_id, jobs=jobs, scheduler=scheduler, callbacks=progress.callbacks()
+            benched = bench_here(
+                store,
+                request,
+                jobs=jobs,
+                scheduler=scheduler,
+                callbacks=progress.callbacks(),
+                # a line per tenth of the work: an ablation reruns every classifier per group
+                on_ablation=TenthsProgress("ablation", quiet=as_json),
             )
     except RunBusy as busy:
         raise ConflictError(f"{busy} (`touchbench cancel {busy.run_id}` stops it)") from None
-    except KeyboardInterrupt as interrupt:  # Ctrl-C or SIGTERM (app.cli.signals)
-        code = getattr(interrupt, "exit_code", EXIT_INTERRUPTED)
-        raise ExitWith(_kept_message(store, run_id, "interrupted"), code) from None
+    except RunInterrupted as interrupted:  # Ctrl-C or SIGTERM (app.cli.signals)
+        code = getattr(interrupted.__cause__, "exit_code", EXIT_INTERRUPTED)
+        message = _kept_message(store, interrupted.run_id, Status.INTERRUPTED)
+        raise ExitWith(message, code) from None
     except RunCancelled as cancelled:
-        raise ExitWith(_kept_message(store, cancelled.run.id, "cancelled"), EXIT_FAILED) from None
-    if run.status == "failed":
+        message = _kept_message(store, cancelled.run.id, Status.CANCELLED)
+        raise ExitWith(message, EXIT_FAILED) from None
+    if benched.independent is not None:
+        _print_independent(benched.independent, as_json)
+        return
+    run = benched.run
+    assert run is not None  # a run of its own when the targets are not benchmarked apart
+    if run.status == Status.FAILED:
         _print_run_report(store, run.id, metric, baseline, as_json)
         raise ExitWith(
             f"run {run.id} failed: {run.error} (`touchbench leaderboard {run.id}` lists why)",
             EXIT_FAILED,
         )
-    ablation = None
-    if ablate_groups is not None:
-        ablation = _ablate(store, run.id, ablate_groups, jobs, as_json)
-    _print_run_report(store, run.id, metric, baseline, as_json, ablation)
+    if benched.ablation_job is not None and not as_json:
+        info(f"ablation kept as job {benched.ablation_job}")
+    _print_run_report(store, run.id, metric, baseline, as_json, benched.ablation)
 
 
-#: The option of each field of :class:`app.schemas.runs.BenchRequest`.
-BENCH_OPTIONS = {
-    "dataset": "DATASET",
-    "target": "--target",
-    "classifiers": "--classifiers",
-    "suite": "--suite",
-    "folds": "--folds",
-    "repeats": "--repeats",
-    "seed": "--seed",
-    "timeout": "--timeout",
-    "max_memory_mb": "--max-memory",
-    "metric": "--metric",
-    "baseline": "--baseline",
-    "weka": "--weka",
-    "position": "--position",
-    "tune": "--tune",
-    "budget": "--budget",
-    "stack": "--stack",
-    "independent": "--independent",
-    "race": "--race",
-    "race_alpha": "--race-alpha",
-    "budget_total": "--budget-total",
-    "aggregate": "--aggregate",
-}
+def _options_of(command: Callable[..., Any]) -> dict[str, str]:
+    """How the command line spells each parameter of ``command``, as typer reads its
+    signature: its first option name, or an argument's metavar (what a refused field is
+    shown as, :mod:`app.cli.requests`)."""
+    spelt = {}
+    for name, parameter in get_params_from_function(command).items():
+        declared = parameter.default
+        if isinstance(declared, OptionInfo) and declared.param_decls:
+            spelt[name] = declared.param_decls[0]
+        elif isinstance(declared, ArgumentInfo):
+            spelt[name] = declared.metavar or name.upper()
+    return spelt
+
+
+#: The option of each parameter of ``bench``: each field of
+#: :class:`app.schemas.runs.BenchRequest` (and ``resume`` and ``ablate_groups`` of
+#: :class:`app.schemas.runs.BenchHereRequest`) is a parameter of the same name, declared once,
+#: in the command's signature.
+BENCH_OPTIONS = _options_of(bench_command)
+#: Fields given as comma-separated lists (``-c nb,j48``).
+_COMMA_LISTS = ("classifiers", "position")
 #: Fields that only say how ``bench`` prints the leaderboard of a resumed run.
 _REPORT_FIELDS = ("metric", "baseline")
 
@@ -635,6 +615,20 @@ _REPORT_FIELDS = ("metric", "baseline")
 def _split(text: str | None) -> list[str] | None:
     """``a, b,c`` as ``["a", "b", "c"]``; ``None`` when not given."""
     return None if text is None else [part.strip() for part in text.split(",") if part.strip()]
+
+
+def _bench_values(parameters: Mapping[str, Any]) -> dict[str, Any]:
+    """The fields of a :class:`BenchRequest` from ``bench``'s parameters: lists split, an
+    option not given (``None``, a repeatable one empty) left out of the request's way."""
+    values = {}
+    for field in BenchRequest.model_fields:
+        value = parameters[field]
+        if field in _COMMA_LISTS:
+            value = _split(value)
+        elif isinstance(value, list):
+            value = value or None
+        values[field] = value
+    return values
 
 
 def _check_resume(values: Mapping[str, object]) -> None:
@@ -656,13 +650,13 @@ def cancel_command(
     as_json: JsonOption = False,
 ) -> None:
     """Cancel a run: a queued run at once, a running one as soon as its process hears of it."""
-    from touchbench.app.store.runs import request_cancel
+    from touchbench.app.services.lifecycle import cancel_run
 
-    run = request_cancel(get_state(ctx).store, run_id)
+    run = cancel_run(get_state(ctx).store, run_id)
     if as_json:
         print_json(run.to_json())
         return
-    if run.status == "cancelled":
+    if run.status == Status.CANCELLED:
         info(f"run {run.id} cancelled ({run.n_results}/{run.n_tasks} tasks kept)")
     else:
         info(f"run {run.id} is cancelling: {run.owner} stops it within about half a second")
@@ -682,7 +676,7 @@ def _check_jobs(jobs: int, oversubscribe: bool) -> int:
 
 
 def _kept_message(store: Store, run_id: int, what: str) -> str:
-    from touchbench.app.store.runs import get_run
+    from touchbench.app.services.lifecycle import get_run
 
     run = get_run(store, run_id)
     return (
@@ -717,41 +711,6 @@ def _print_run_report(
         )
 
 
-#: The option of each field of :class:`app.schemas.ablation.AblationRequest`.
-_ABLATION_OPTIONS = {"grouping": "--ablate-groups", "classifiers": "--classifiers"}
-
-
-def _check_ablation(
-    store: Store, request: BenchRequest | None, resume: int | None, grouping: str
-) -> None:
-    """Refuse ``--ablate-groups`` before the run: a grouping that does not exist, or that
-    the data set's feature names do not give."""
-    from touchbench.app.cli.requests import build_request
-    from touchbench.app.schemas.ablation import AblationRequest
-    from touchbench.app.services.ablation import check_grouping
-
-    if request is not None and request.independent:
-        raise typer.BadParameter("is not used with --independent", param_hint="--ablate-groups")
-    checked = build_request(AblationRequest, _ABLATION_OPTIONS, run=resume or 1, grouping=grouping)
-    check_grouping(store, checked.grouping, bench=request, run=resume)
-
-
-def _ablate(store: Store, run_id: int, grouping: str, jobs: int, as_json: bool) -> AblationResult:
-    """Carry out the ablation of a finished run, as a job the store keeps."""
-    from touchbench.app.cli.progress import TenthsProgress
-    from touchbench.app.cli.requests import build_request
-    from touchbench.app.schemas.ablation import AblationRequest, AblationResult
-    from touchbench.app.services.jobs import carry_out_here
-
-    request = build_request(AblationRequest, _ABLATION_OPTIONS, run=run_id, grouping=grouping)
-    # a line per tenth of the work: an ablation reruns every classifier per group
-    progress = TenthsProgress("ablation", quiet=as_json)
-    job_id, result = carry_out_here(store, request, jobs=jobs, on_progress=progress)
-    if not as_json:
-        info(f"ablation kept as job {job_id}")
-    return AblationResult.model_validate(result)
-
-
 def _ranked(
     store: Store,
     run_id: int,
@@ -778,7 +737,7 @@ def _ranked(
 def runs_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
     """List benchmark runs with their status and progress."""
     from touchbench.app.schemas.runs import RunList
-    from touchbench.app.store.runs import list_runs
+    from touchbench.app.services.lifecycle import list_runs
 
     runs = list_runs(get_state(ctx).store)
     if as_json:
@@ -917,7 +876,7 @@ def _print_leaderboard(ranked: RunLeaderboard) -> None:
     scored = ", scored per recording" if ranked.per_recording else ""
     table(
         f"run {run.id}: {run.dataset_name} ({', '.join(run.targets)}), "
-        f"{run.config.get('folds')}-fold x {run.config.get('repeats')} ({run.fold_scheme}), "
+        f"{run.config.folds}-fold x {run.config.repeats} ({run.fold_scheme}), "
         f"ranked by {board.metric}{direction}{scored}",
         leaderboard_header(board, columns, ranked.besides),
         leaderboard_rows(board, columns, ranked.besides),

@@ -47,7 +47,7 @@ def demo_command(
     columns = metric_columns(result.run, result.leaderboard)
     table(
         f"leaderboard of run {result.run.id} ({result.leaderboard.metric}, "
-        f"{result.run.config['folds']}-fold)",
+        f"{result.run.config.folds}-fold)",
         leaderboard_header(result.leaderboard, columns),
         leaderboard_rows(result.leaderboard, columns),
     )

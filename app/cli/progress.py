@@ -70,6 +70,7 @@ class TaskProgress:
             on_result=self.finish,
             on_warning=self.warn,
             on_note=self.note,
+            on_end=lambda run: self._progress.stop(),  # what follows the run is not its bar
         )
 
     def plan(self, total: int, done: int) -> None:

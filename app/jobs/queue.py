@@ -12,6 +12,7 @@ from collections.abc import Collection
 from dataclasses import dataclass
 from typing import Literal
 
+from touchbench.app.schemas.status import Status
 from touchbench.app.store.database import Store
 from touchbench.app.store.jobs import queued_jobs
 from touchbench.app.store.runs import list_runs
@@ -33,7 +34,7 @@ def waiting(store: Store, *, host: str | None = None) -> list[Item]:
     Items queued at the same moment come in id order, runs before jobs.
     """
     host = host or socket.gethostname()
-    runs = [(run.created_at, Item("run", run.id)) for run in list_runs(store, status="queued")]
+    runs = [(run.created_at, Item("run", run.id)) for run in list_runs(store, status=Status.QUEUED)]
     jobs = [
         (job.created_at, Item("job", job.id))
         for job in queued_jobs(store)

@@ -203,7 +203,7 @@ def _run(report: Report, view: RunView, plots: list[_Plot]) -> dict[str, Any]:
                 )
             )
     sure = _how_sure(view, [row.classifier for row in board.rows[: report.confusions]], plots)
-    config = dict(run.config)
+    config = run.config.to_json()
     return {
         "id": run.id,
         "title": view.title,

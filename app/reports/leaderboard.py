@@ -104,7 +104,7 @@ def beside_notes(besides: Sequence[Beside]) -> list[str]:
     out = []
     for beside in besides:
         run = beside.run
-        name = f" ({run.config['name']})" if run.config.get("name") else ""
+        name = f" ({run.config.name})" if run.config.name else ""
         out.append(f"run {run.id}{name}, {run.fold_scheme}: {beside.note}")
     if any(b.test == "means" for b in besides):
         out.append("= : means only, no t-test (folds that do not pair with the baseline's)")

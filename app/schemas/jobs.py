@@ -15,6 +15,7 @@ from touchbench.app.schemas.extraction import ExtractRequest
 from touchbench.app.schemas.importance import ImportanceRequest
 from touchbench.app.schemas.learning import LearningCurveRequest
 from touchbench.app.schemas.models import ExportRequest, TrainRequest
+from touchbench.app.schemas.status import Status
 
 JobKind = Literal["extract", "train", "export", "ablation", "importance", "learning-curve"]
 #: The request each kind of job carries out (its JSON is the job's ``params``).
@@ -26,10 +27,6 @@ JOB_REQUESTS: dict[JobKind, type[Request]] = {
     "importance": ImportanceRequest,
     "learning-curve": LearningCurveRequest,
 }
-#: Same life as a run's (app/store/states.py), without resume: queued -> running -> done |
-#: failed | cancelling -> cancelled (| interrupted after a crash).
-JobStatus = Literal["queued", "running", "cancelling", "done", "failed", "cancelled", "interrupted"]
-
 
 #: Params that are the service's own business: where an upload was saved, which host's
 #: workers may take the job.
@@ -39,7 +36,7 @@ _SERVICE_ONLY = frozenset({"folder", "host"})
 class JobSchema(Schema):
     id: int
     kind: JobKind
-    status: JobStatus
+    status: Status  # a run's life without resume (app.store.states)
     params: dict[str, Any] = Field(
         description="What the job was asked to do: its request (TrainRequest, ExtractRequest)."
     )
@@ -71,5 +68,5 @@ class JobCreated(Schema):
     """What a request that starts a job answers at once (status 202)."""
 
     job: int
-    status: JobStatus
+    status: Status
     kind: JobKind

@@ -9,25 +9,9 @@ from typing import Any, Literal
 from pydantic import Field, field_validator, model_validator
 
 from touchbench.app.errors import FieldError
+from touchbench.app.schemas.ablation import Grouping
 from touchbench.app.schemas.base import Request, Schema
-
-#: Where a run is in its life (the rules: :mod:`app.store.states`): ``queued`` (created,
-#: waiting for a worker), ``running``, ``cancelling`` (its process was asked to stop),
-#: ``done`` (every task has a result), ``failed`` (every task failed, or the run could not
-#: be carried out), ``cancelled`` (on request), ``interrupted`` (its process stopped: Ctrl-C,
-#: kill -9, a crash; resuming it finishes it).
-RunStatus = Literal["queued", "running", "cancelling", "done", "failed", "cancelled", "interrupted"]
-RUN_STATUSES: tuple[RunStatus, ...] = (
-    "queued",
-    "running",
-    "cancelling",
-    "done",
-    "failed",
-    "cancelled",
-    "interrupted",
-)
-#: Statuses after which nothing more happens unless the run is resumed.
-FINAL_STATUSES: frozenset[str] = frozenset({"done", "failed", "cancelled", "interrupted"})
+from touchbench.app.schemas.status import Status
 
 
 class RunSchema(Schema):
@@ -40,7 +24,7 @@ class RunSchema(Schema):
     targets: list[str]
     classifiers: list[str]
     config: dict[str, Any] = Field(description="Folds, repeats, seed, timeout, ...")
-    status: RunStatus
+    status: Status
     created_at: datetime
     started_at: datetime | None = None
     finished_at: datetime | None = None
@@ -66,7 +50,7 @@ class RunCreated(Schema):
     """What ``POST /api/runs`` answers at once: the run waits for a worker."""
 
     id: int
-    status: RunStatus
+    status: Status
 
 
 class MetricValue(Schema):
@@ -205,7 +189,7 @@ class LeaderboardSchema(Schema):
     dataset: str
     kind: str
     targets: list[str]
-    status: RunStatus
+    status: Status
     folds: str = Field(
         default="",
         description="How the folds were made: stratified k-fold, k-fold (shuffled), or their "
@@ -470,4 +454,28 @@ class BenchRequest(Request):
             )
         if "race_alpha" in self.model_fields_set and not self.race:
             raise FieldError("race_alpha", "is only meaningful with `race`")
+        return self
+
+
+class BenchHereRequest(Request):
+    """A run carried out at once by the process that asks (``touchbench bench``): a new one
+    (``bench``) or a stored one to finish (``resume``), then, if asked, its ablation as a
+    job the store keeps (``ablate_groups``)."""
+
+    bench: BenchRequest | None = Field(default=None, description="A new run.")
+    resume: int | None = Field(
+        default=None, ge=1, description="A stored run whose tasks without a result to carry out."
+    )
+    ablate_groups: Grouping | None = Field(
+        default=None,
+        description="Then rerun the run's classifiers on its folds without each group of "
+        "features (an ablation's `grouping`).",
+    )
+
+    @model_validator(mode="after")
+    def _one_run(self) -> BenchHereRequest:
+        if (self.bench is None) == (self.resume is None):
+            raise FieldError("resume", "give a new run or a run to resume, one of the two")
+        if self.ablate_groups is not None and self.bench is not None and self.bench.independent:
+            raise FieldError("ablate_groups", "is not used with `independent`")
         return self

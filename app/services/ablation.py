@@ -18,6 +18,7 @@ from touchbench.app.schemas.ablation import (
     Grouping,
 )
 from touchbench.app.schemas.runs import BenchRequest
+from touchbench.app.schemas.status import Status
 from touchbench.app.services.importance import feature_names, refittable_run
 from touchbench.app.services.progress import throttled
 from touchbench.app.services.report import run_view
@@ -52,7 +53,7 @@ def check_grouping(
     else:
         assert run is not None
         found = get_run(store, run)
-        dataset_id, targets = found.dataset_id, found.config.get("targets_given")
+        dataset_id, targets = found.dataset_id, found.config.targets_given
     dataset = load_dataset(store, dataset_id)
     _groups(dataset, targets, grouping, dataset.name or str(dataset_id))
 
@@ -149,7 +150,7 @@ class _Plan:
     def __init__(self, store: Store, request: AblationRequest) -> None:
         view = run_view(store, request.run)
         run = refittable_run(view.run)
-        if run.status != "done":
+        if run.status != Status.DONE:
             raise ConflictError(
                 f"run {run.id} is {run.status}: an ablation compares against a finished run"
             )
@@ -171,13 +172,13 @@ class _Plan:
                 "classifiers", f"run {run.id} has no classifier with a successful fold"
             )
         dataset = load_dataset(store, run.dataset_id)
-        targets = run.config.get("targets_given")
+        targets = run.config.targets_given
         names, groups = _groups(dataset, targets, request.grouping, run.dataset_name)
         self.request = request
         self.run = run
         self.classifiers = chosen
         self.options = RunOptions.from_config(run.config)
-        prepared = prepare_problem(dataset, targets, run.config.get("position") or ())
+        prepared = prepare_problem(dataset, targets, run.config.position or ())
         self.problem = prepared.problem
         self.folds = fold_plan(prepared, self.options).folds
         self.specs = run_specs(run.config, run.classifiers)

@@ -59,11 +59,11 @@ class Beside:
     def schema(self) -> BesideSchema:
         return BesideSchema(
             run_id=self.run.id,
-            name=self.run.config.get("name"),
+            name=self.run.config.name,
             origin="imported" if is_imported(self.run) else "touchbench",
             folds=self.run.fold_scheme,
-            n_folds=_count(self.run, "folds"),
-            n_repeats=_count(self.run, "repeats"),
+            n_folds=_folds(self.run),
+            n_repeats=_repeats(self.run),
             test=self.test,
             note=self.note,
             classifiers=self.names,
@@ -87,16 +87,16 @@ def pairing(run: RunInfo, other: RunInfo) -> tuple[BesideTest, str]:
         )
     if other.kind != run.kind:
         raise FieldError("beside", f"run {other.id} is {other.kind} and run {run.id} {run.kind}")
-    shape = (_count(run, "folds"), _count(run, "repeats"))
-    other_shape = (_count(other, "folds"), _count(other, "repeats"))
+    shape = (_folds(run), _repeats(run))
+    other_shape = (_folds(other), _repeats(other))
     if shape != other_shape:
         return "means", (
             f"means only: run {other.id} has {other_shape[0]} folds x {other_shape[1]} and "
             f"run {run.id} {shape[0]} x {shape[1]}, so no folds pair"
         )
     ours = not is_imported(run) and not is_imported(other)
-    same = ("fold_scheme", "seed", "n_instances")
-    if ours and all(run.config.get(key) == other.config.get(key) for key in same):
+    same = [(c.fold_scheme, c.seed, c.n_instances) for c in (run.config, other.config)]
+    if ours and same[0] == same[1]:
         return "paired", "the same folds (same data set, fold scheme, k, repeats and seed)"
     return "by fold number", (
         f"corrected t-test with folds paired by number: same data set, target, "
@@ -154,5 +154,9 @@ def _renamed(result: TaskResult, name: str) -> TaskResult:
     return TaskResult(**fields)
 
 
-def _count(run: RunInfo, key: str) -> int:
-    return int(run.config.get(key) or 1)
+def _folds(run: RunInfo) -> int:
+    return run.config.folds or 1
+
+
+def _repeats(run: RunInfo) -> int:
+    return run.config.repeats or 1

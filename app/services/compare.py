@@ -29,6 +29,7 @@ from touchbench.app.schemas.compare import (
     NemenyiOut,
     PairOut,
 )
+from touchbench.app.schemas.status import Status
 from touchbench.app.services.beside import besides, merged_results
 from touchbench.app.services.imported import is_imported
 from touchbench.app.store.database import Store
@@ -221,7 +222,7 @@ def compare_runs(
             run_scores(replace(run, classifiers=[*run.classifiers, *names]), metric, results)
         )
         beside_notes += [
-            f"run {b.run.id} ({b.run.config.get('name') or b.run.fold_scheme}) joins "
+            f"run {b.run.id} ({b.run.config.name or b.run.fold_scheme}) joins "
             f"run {run.id} (same data set and target); as for their folds: {b.note}"
             for b in others
         ]
@@ -236,7 +237,7 @@ def compare_runs(
     notes = beside_notes + [
         f"run {run.id} is {run.status}: {run.n_results} of {run.n_tasks} tasks have results"
         for run in runs
-        if run.status != "done"
+        if run.status != Status.DONE
     ]
     if len(runs) == 1:
         blocks_are: BlockKind = "folds"

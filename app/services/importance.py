@@ -65,7 +65,7 @@ def run_importance(
     """
     run = check_importance(store, request)
     dataset = load_dataset(store, run.dataset_id)
-    targets = run.config.get("targets_given")  # as the run prepared its problem
+    targets = run.config.targets_given  # as the run prepared its problem
     prepared = prepare_problem(dataset, targets)
     names = feature_names(dataset, targets)
     options = RunOptions.from_config(run.config)

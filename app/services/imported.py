@@ -9,10 +9,10 @@ classifiers beside ours (:mod:`app.services.beside`).
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 from touchbench.app.errors import FieldError
 from touchbench.app.schemas.imported import ImportResultsRequest
+from touchbench.app.schemas.run_config import IMPORTED, ImportedScheme, RunConfig
 from touchbench.app.services.listing import list_datasets
 from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import load_schema
@@ -22,13 +22,10 @@ from touchbench.benchmark.errors import DataFormatError
 from touchbench.benchmark.evaluation.results_import import ImportedResults, import_weka_results
 from touchbench.benchmark.io.arff import open_arff
 
-#: ``config["origin"]`` of an imported run (runs touchbench carried out have none).
-IMPORTED = "imported"
-
 
 def is_imported(run: RunInfo) -> bool:
     """Whether the run's results were imported rather than computed here."""
-    return run.config.get("origin") == IMPORTED
+    return run.config.imported
 
 
 def import_results(store: Store, request: ImportResultsRequest) -> RunInfo:
@@ -47,7 +44,7 @@ def import_results(store: Store, request: ImportResultsRequest) -> RunInfo:
     -------
     RunInfo
         Status ``done``; classifiers named by WEKA class (``RandomForest``), their
-        options in ``config["schemes"]``.
+        options in ``config.schemes``.
 
     Raises
     ------
@@ -78,17 +75,17 @@ def import_results(store: Store, request: ImportResultsRequest) -> RunInfo:
             f"'{info.name}' has {info.n_instances}: they are not results on it",
             source=label,
         )
-    config: dict[str, Any] = {
-        "origin": IMPORTED,
-        "name": request.name or f"WEKA {Path(request.source_name or request.file).name}",
-        "source": Path(request.source_name or request.file).name,
-        "key_dataset": imported.key_dataset,
-        "folds": imported.n_folds,
-        "repeats": imported.n_repeats,
-        "fold_scheme": f"WEKA Experimenter's {imported.n_folds}-fold (imported)",
-        "n_tasks": len(imported.results),
-        "schemes": [scheme.to_json() for scheme in imported.schemes],
-    }
+    config = RunConfig(
+        origin=IMPORTED,
+        name=request.name or f"WEKA {Path(request.source_name or request.file).name}",
+        source=Path(request.source_name or request.file).name,
+        key_dataset=imported.key_dataset,
+        folds=imported.n_folds,
+        repeats=imported.n_repeats,
+        fold_scheme=f"WEKA Experimenter's {imported.n_folds}-fold (imported)",
+        n_tasks=len(imported.results),
+        schemes=[ImportedScheme(**scheme.to_json()) for scheme in imported.schemes],
+    )
     return add_finished_run(
         store,
         dataset_id=info.id,

@@ -30,6 +30,7 @@ from touchbench.app.schemas.importance import ImportanceRequest
 from touchbench.app.schemas.jobs import JOB_REQUESTS, JobKind, JobSchema
 from touchbench.app.schemas.learning import LearningCurveRequest
 from touchbench.app.schemas.models import ExportRequest, TrainRequest
+from touchbench.app.schemas.status import Status
 from touchbench.app.store.database import Store
 from touchbench.app.store.exports import queue_export
 from touchbench.app.store.jobs import (
@@ -152,16 +153,18 @@ def carry_out_here(
         finally:  # before the end is recorded, which the heartbeat would take for a cancel
             beat.stop()
     except KeyboardInterrupt:
-        stopper.finish("cancelled" if stopper.asked else "interrupted", error="interrupted")
+        stopper.finish(
+            Status.CANCELLED if stopper.asked else Status.INTERRUPTED, error=Status.INTERRUPTED
+        )
         raise
     except USER_ERRORS as error:
-        stopper.finish("failed", error=str(error))
+        stopper.finish(Status.FAILED, error=str(error))
         raise
     except Exception as error:
-        stopper.finish("failed", error=f"unexpected {type(error).__name__}: {error}")
+        stopper.finish(Status.FAILED, error=f"unexpected {type(error).__name__}: {error}")
         raise
     else:
-        stopper.finish("done", result=result)
+        stopper.finish(Status.DONE, result=result)
     return job.id, result
 
 
@@ -240,16 +243,16 @@ def execute_job(store: Store, job_id: int) -> JobSchema | None:
                 shutil.rmtree(folder, ignore_errors=True)
     except KeyboardInterrupt:
         if not stopper.asked:
-            stopper.finish("interrupted", error="interrupted")
+            stopper.finish(Status.INTERRUPTED, error=Status.INTERRUPTED)
             raise
-        stopper.finish("cancelled")
+        stopper.finish(Status.CANCELLED)
     except USER_ERRORS as error:
-        stopper.finish("failed", error=client_words(str(error), folder))
+        stopper.finish(Status.FAILED, error=client_words(str(error), folder))
     except Exception as error:
         message = f"unexpected {type(error).__name__}: {error}"
-        stopper.finish("failed", error=client_words(message, folder))
+        stopper.finish(Status.FAILED, error=client_words(message, folder))
     else:
-        stopper.finish("done", result=result)
+        stopper.finish(Status.DONE, result=result)
     return get_job(store, job.id)
 
 
@@ -281,7 +284,7 @@ class _Stopper:
         timer.daemon = True
         timer.start()
 
-    def finish(self, status: str, **values: Any) -> None:
+    def finish(self, status: Status, **values: Any) -> None:
         """Record how the job ended, unless that is done already."""
         with self._lock:
             if self._finished:
@@ -294,7 +297,7 @@ class _Stopper:
             if self._finished:
                 return
             self._finished = True
-            finish_job(self._store, self._job_id, "cancelled")
+            finish_job(self._store, self._job_id, Status.CANCELLED)
             if self._folder:
                 shutil.rmtree(self._folder, ignore_errors=True)
         os._exit(1)

@@ -31,3 +31,8 @@ def summary(info: DatasetInfo) -> DatasetSummary:
 def list_datasets(store: Readable, *, page: Page | None = None) -> list[DatasetSummary]:
     """Every stored data set (those of ``page``), oldest first."""
     return [summary(info) for info in stored.list_datasets(store, page=page)]
+
+
+def count_datasets(store: Readable) -> int:
+    """How many data sets the store holds."""
+    return stored.count_datasets(store)

@@ -7,9 +7,10 @@ from __future__ import annotations
 # Imports inside functions: start-up time: the catalogue loads scikit-learn, which only
 # a run with tuned twins or a stack needs.
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from touchbench.app.errors import FieldError
+from touchbench.app.schemas.run_config import ExtraSpecsConfig
 
 if TYPE_CHECKING:
     from touchbench.benchmark.catalogue import ClassifierSpec
@@ -60,14 +61,14 @@ def with_tuned_twins(
     return list(dict.fromkeys(out))
 
 
-def run_specs(config: Mapping[str, Any], classifiers: Sequence[str]) -> dict[str, ClassifierSpec]:
+def run_specs(config: ExtraSpecsConfig, classifiers: Sequence[str]) -> dict[str, ClassifierSpec]:
     """Every spec outside the catalogue that a run's classifiers need, by id.
 
     Parameters
     ----------
-    config : mapping
-        The run's stored config: ``weka`` (id -> WEKA command), ``tune`` (``{"budget_minutes":
-        float or None}`` or absent) and ``stack`` (TOP_N or absent).
+    config : ExtraSpecsConfig
+        What the run adds (its stored config, a :class:`app.schemas.run_config.RunConfig`):
+        ``weka`` (id -> WEKA command), ``tune`` and ``stack``.
     classifiers : sequence of str
         The run's classifier ids.
     """
@@ -77,22 +78,22 @@ def run_specs(config: Mapping[str, Any], classifiers: Sequence[str]) -> dict[str
     from touchbench.benchmark.estimators import classifier_spec
 
     specs: dict[str, ClassifierSpec] = {}
-    for text in (config.get("weka") or {}).values():
+    for text in config.weka.values():
         if text:
             spec = parse_weka_command(text)
             specs[spec.id] = spec
-    tune = config.get("tune")
+    tune = config.tune
     if tune is not None:
         for classifier in classifiers:
             base = classifier.rpartition(":")[2]
             if is_tuned_id(base):
                 untuned = classifier_spec(base.removesuffix(TUNED_SUFFIX), specs)
-                specs[base] = tuned_spec(untuned, tune.get("budget_minutes"))
-    top_n = config.get("stack")
+                specs[base] = tuned_spec(untuned, tune.budget_minutes)
+    top_n = config.stack
     if top_n:
-        name = stack_id(int(top_n))
+        name = stack_id(top_n)
         members = [classifier_spec(c, specs) for c in classifiers if c != name]
-        specs[name] = stacked_spec(members, int(top_n))
+        specs[name] = stacked_spec(members, top_n)
     return specs
 
 

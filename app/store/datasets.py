@@ -24,6 +24,7 @@ from sqlalchemy.orm import Session
 
 from touchbench.app.errors import AppError, ConflictError, FieldError
 from touchbench.app.schemas.names import check_name
+from touchbench.app.schemas.status import UNFINISHED, Status
 from touchbench.app.store.database import Store
 from touchbench.app.store.listing import DatasetInfo
 from touchbench.app.store.naming import default_name, find_row, free_name, shorten
@@ -602,11 +603,11 @@ def _live_run(session: Session, dataset_id: int) -> tuple[int, str] | None:
     runs = session.execute(
         select(RunRow.id, RunRow.status, RunRow.owner, RunRow.heartbeat_at)
         .where(RunRow.dataset_id == dataset_id)
-        .where(RunRow.status.in_(("queued", "running", "cancelling")))
+        .where(RunRow.status.in_(UNFINISHED))
         .order_by(RunRow.id)
     ).all()
     for run_id, status, owner, heartbeat in runs:
-        if status == "queued" or owner_alive(owner, heartbeat):
+        if status == Status.QUEUED or owner_alive(owner, heartbeat):
             return run_id, status
     return None
 

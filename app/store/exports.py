@@ -11,7 +11,7 @@ from sqlalchemy import delete, select
 from sqlalchemy.orm import Session
 
 from touchbench.app.errors import AppError
-from touchbench.app.schemas.runs import FINAL_STATUSES
+from touchbench.app.schemas.status import FINAL, Status
 from touchbench.app.store.database import Store
 from touchbench.app.store.models import held_version
 from touchbench.app.store.tables import JobRow, ModelExportRow
@@ -98,7 +98,9 @@ def queue_export(store: Store, model_id: int, format: str) -> tuple[int, bool]:
         under_way = _under_way(session, model_id, format)
         if under_way is not None:
             return under_way, False
-        row = JobRow(kind=EXPORT_JOB, status="queued", params={"model": model_id, "format": format})
+        row = JobRow(
+            kind=EXPORT_JOB, status=Status.QUEUED, params={"model": model_id, "format": format}
+        )
         session.add(row)
         session.flush()
         return row.id, True
@@ -114,7 +116,7 @@ def export_under_way(store: Store, model_id: int, format: str) -> int | None:
 def _under_way(session: Session, model_id: int, format: str) -> int | None:
     unfinished = session.execute(
         select(JobRow.id, JobRow.params)
-        .where(JobRow.kind == EXPORT_JOB, JobRow.status.not_in(FINAL_STATUSES))
+        .where(JobRow.kind == EXPORT_JOB, JobRow.status.not_in(FINAL))
         .order_by(JobRow.id)
     )
     for job_id, params in unfinished:

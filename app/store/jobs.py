@@ -14,6 +14,7 @@ from sqlalchemy import select, update
 from touchbench.app.errors import NotFoundError
 from touchbench.app.schemas.jobs import JobSchema
 from touchbench.app.schemas.listing import Page
+from touchbench.app.schemas.status import ACTIVE, Status
 from touchbench.app.store import queue
 from touchbench.app.store.database import Store
 from touchbench.app.store.naming import is_row_id
@@ -31,7 +32,7 @@ class _JobState:
     """What the state rules (:mod:`app.store.states`) read of a job."""
 
     id: int
-    status: str
+    status: Status
     owner: str | None
     heartbeat_at: datetime | None
 
@@ -41,7 +42,7 @@ class _JobState:
 
 def create_job(store: Store, kind: str, params: dict[str, Any]) -> JobSchema:
     with store.session() as session:
-        row = JobRow(kind=kind, status="queued", params=params)
+        row = JobRow(kind=kind, status=Status.QUEUED, params=params)
         session.add(row)
         session.flush()
         return _schema(row)
@@ -54,7 +55,7 @@ def start_job(store: Store, kind: str, params: dict[str, Any], *, owner: str) ->
     with store.session() as session:
         row = JobRow(
             kind=kind,
-            status="running",
+            status=Status.RUNNING,
             params=params,
             owner=owner,
             started_at=now,
@@ -71,7 +72,7 @@ def record_job_progress(store: Store, job_id: int, result: dict[str, Any]) -> No
     with store.session() as session:
         session.execute(
             update(JobRow)
-            .where(JobRow.id == job_id, JobRow.status.in_(("running", "cancelling")))
+            .where(JobRow.id == job_id, JobRow.status.in_(ACTIVE))
             .values(result=result)
             .execution_options(synchronize_session=False)
         )
@@ -91,7 +92,7 @@ def done_jobs_naming(
     with store.session() as session:
         rows = session.scalars(
             select(JobRow)
-            .where(JobRow.kind == kind, JobRow.status == "done")
+            .where(JobRow.kind == kind, JobRow.status == Status.DONE)
             .order_by(JobRow.id.desc())
         )
         return [_schema(row) for row in rows if row.params.get(field) in values]
@@ -115,7 +116,9 @@ def count_jobs(store: Store) -> int:
 
 def queued_jobs(store: Store) -> list[JobSchema]:
     with store.session() as session:
-        rows = session.scalars(select(JobRow).where(JobRow.status == "queued").order_by(JobRow.id))
+        rows = session.scalars(
+            select(JobRow).where(JobRow.status == Status.QUEUED).order_by(JobRow.id)
+        )
         return [_schema(row) for row in rows]
 
 
@@ -125,9 +128,9 @@ def claim_job(store: Store, job_id: int, *, owner: str | None = None) -> bool:
     with store.session() as session:
         claimed = session.execute(
             update(JobRow)
-            .where(JobRow.id == job_id, JobRow.status == "queued")
+            .where(JobRow.id == job_id, JobRow.status == Status.QUEUED)
             .values(
-                status="running",
+                status=Status.RUNNING,
                 owner=owner or process_owner(),
                 started_at=now,
                 heartbeat_at=now,
@@ -141,7 +144,7 @@ def claim_job(store: Store, job_id: int, *, owner: str | None = None) -> bool:
 def finish_job(
     store: Store,
     job_id: int,
-    status: str,
+    status: Status,
     *,
     result: dict[str, Any] | None = None,
     error: str | None = None,
@@ -173,13 +176,13 @@ def request_job_cancel(store: Store, job_id: int | str) -> JobSchema:
     """
     with store.session() as session:
         row = _row(session, job_id)
-        state = _JobState(row.id, row.status, row.owner, row.heartbeat_at)
+        state = _JobState(row.id, Status(row.status), row.owner, row.heartbeat_at)
     outcome = queue.request_cancel(store, JobRow, state, "job")
     if outcome == "changed":  # the job changed meanwhile: judge it again
         return request_job_cancel(store, state.id)
     job = get_job(store, state.id)
-    if outcome == "cancelling":  # what this request did, whatever the job's process does next
-        return job.model_copy(update={"status": "cancelling"})
+    if outcome == Status.CANCELLING:  # what this request did, whatever the job's process does
+        return job.model_copy(update={"status": Status.CANCELLING})
     return job
 
 
@@ -197,9 +200,7 @@ def mark_lost_jobs(store: Store) -> list[int]:
     lost: list[int] = []
     with store.session() as session:
         for status, becomes in LOST_AS.items():
-            error = (
-                "the worker process stopped before the job ended" if status == "running" else None
-            )
+            error = _LOST_ERROR if status == Status.RUNNING else None
             lost += mark_lost(
                 session,
                 JobRow,
@@ -225,7 +226,7 @@ def _schema(row: JobRow) -> JobSchema:
     return JobSchema(
         id=row.id,
         kind=row.kind,  # type: ignore[arg-type]  # a JobKind literal in the column
-        status=row.status,  # type: ignore[arg-type]  # a JobStatus literal in the column
+        status=Status(row.status),
         params=dict(row.params),
         result=row.result,
         error=row.error,

@@ -15,6 +15,7 @@ from typing import Any
 from sqlalchemy import select, update
 from sqlalchemy.orm import Session
 
+from touchbench.app.schemas.status import Status
 from touchbench.app.store.naming import is_decimal
 
 #: A running item whose heartbeat is older than this has lost its process.
@@ -41,7 +42,9 @@ def owner_alive(owner: str | None, heartbeat_at: datetime | None) -> bool:
     return datetime.now(UTC) - aware(heartbeat_at) < timedelta(seconds=STALE_AFTER)
 
 
-def mark_lost(session: Session, table: Any, *, of: str = "running", **values: Any) -> list[int]:
+def mark_lost(
+    session: Session, table: Any, *, of: Status = Status.RUNNING, **values: Any
+) -> list[int]:
     """Set ``values`` on the rows of ``table`` left in status ``of`` by a dead owner; their
     ids.
 

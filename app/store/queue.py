@@ -22,8 +22,9 @@ from typing import Any
 from sqlalchemy import select, update
 from sqlalchemy.orm import Session
 
+from touchbench.app.schemas.status import ACTIVE, Status
 from touchbench.app.store.database import Store
-from touchbench.app.store.states import ACTIVE, cancel_outcome
+from touchbench.app.store.states import Item, cancel_outcome
 from touchbench.app.store.tables import utcnow
 
 #: Seconds between heartbeats of the process executing an item.
@@ -61,7 +62,7 @@ def _should_stop(session: Session, table: Any, item_id: int, owner: str) -> bool
     return bool(cancel) or current_owner != owner or status not in ACTIVE
 
 
-def request_cancel(store: Store, table: Any, item: Any, kind: str) -> str:
+def request_cancel(store: Store, table: Any, item: Item, kind: str) -> str:
     """Apply a cancel to ``item`` (a run's or job's description, as read just before):
     ask its process to stop, or cancel it at once (see
     :func:`app.store.states.cancel_outcome`).
@@ -81,7 +82,7 @@ def request_cancel(store: Store, table: Any, item: Any, kind: str) -> str:
     if outcome == "unchanged":
         return outcome
     values: dict[str, Any] = {"status": outcome}
-    if outcome == "cancelling":
+    if outcome == Status.CANCELLING:
         values["cancel_requested"] = True
     else:
         values.update(finished_at=utcnow(), owner=None, heartbeat_at=None)

@@ -24,13 +24,15 @@ from sqlalchemy.orm import Session
 from touchbench.app.errors import ConflictError, NotFoundError
 from touchbench.app.schemas.base import finite
 from touchbench.app.schemas.listing import Page
-from touchbench.app.schemas.runs import FINAL_STATUSES, RunSchema, RunStatus
+from touchbench.app.schemas.run_config import RunConfig
+from touchbench.app.schemas.runs import RunSchema
+from touchbench.app.schemas.status import FINAL, Status
 from touchbench.app.store import queue
 from touchbench.app.store.database import Store
 from touchbench.app.store.naming import is_row_id
 from touchbench.app.store.ownership import aware, mark_lost, owner_alive, process_owner
 from touchbench.app.store.paging import count_rows, paged
-from touchbench.app.store.states import ACTIVE, LOST_AS, check_claim, check_resume
+from touchbench.app.store.states import LOST_AS, check_claim, check_resume, is_active
 from touchbench.app.store.tables import DatasetRow, EntryDropRow, FoldResultRow, RunRow, utcnow
 from touchbench.benchmark.results import TaskKey, TaskResult
 
@@ -52,8 +54,8 @@ class RunInfo:
     kind: str
     targets: list[str]
     classifiers: list[str]
-    config: dict[str, Any]
-    status: RunStatus
+    config: RunConfig
+    status: Status
     created_at: datetime
     finished_at: datetime | None
     n_results: int
@@ -71,7 +73,7 @@ class RunInfo:
 
     @property
     def n_tasks(self) -> int:
-        return int(self.config.get("n_tasks", 0))
+        return self.config.n_tasks
 
     def tasks_text(self) -> str:
         """Progress as listings say it: ``done/total``, and with drops ``done done,
@@ -85,15 +87,14 @@ class RunInfo:
     def fold_scheme(self) -> str:
         """How the folds were made (``stratified k-fold``, ``group k-fold``...); runs stored
         before it was recorded are described from their kind and whether they had groups."""
-        recorded = self.config.get("fold_scheme")
-        if recorded:
-            return str(recorded)
+        if self.config.fold_scheme:
+            return self.config.fold_scheme
         stratified = "stratified " if self.kind == "multiclass" else ""
-        return stratified + ("group " if self.config.get("grouped") else "") + "k-fold"
+        return stratified + ("group " if self.config.grouped else "") + "k-fold"
 
     def is_alive(self) -> bool:
         """Whether a live process is executing the run (``running`` or ``cancelling``)."""
-        return self.status in ACTIVE and self.owner_alive()
+        return is_active(self)
 
     def owner_alive(self) -> bool:
         """Whether the process named as the run's owner still runs."""
@@ -113,7 +114,7 @@ class RunInfo:
             kind=self.kind,
             targets=self.targets,
             classifiers=self.classifiers,
-            config=self.config,
+            config=self.config.to_json(),
             status=self.status,
             created_at=self.created_at,
             started_at=self.started_at,
@@ -136,11 +137,11 @@ def create_run(
     kind: str,
     targets: Sequence[str],
     classifiers: Sequence[str],
-    config: dict[str, Any],
+    config: RunConfig,
 ) -> RunInfo:
     """A new run, ``queued``."""
     with store.session() as session:
-        row = _new_run(session, dataset_id, kind, targets, classifiers, config, "queued")
+        row = _new_run(session, dataset_id, kind, targets, classifiers, config, Status.QUEUED)
         return _infos(session, [row])[0]
 
 
@@ -150,8 +151,8 @@ def _new_run(
     kind: str,
     targets: Sequence[str],
     classifiers: Sequence[str],
-    config: dict[str, Any],
-    status: RunStatus,
+    config: RunConfig,
+    status: Status,
     **times: datetime,
 ) -> RunRow:
     """A run's row, added and flushed (so that it has its id)."""
@@ -160,7 +161,7 @@ def _new_run(
         kind=kind,
         targets=list(targets),
         classifiers=list(classifiers),
-        config=config,
+        config=config.to_json(),
         status=status,
         **times,
     )
@@ -176,7 +177,7 @@ def add_finished_run(
     kind: str,
     targets: Sequence[str],
     classifiers: Sequence[str],
-    config: dict[str, Any],
+    config: RunConfig,
     results: Sequence[TaskResult],
 ) -> RunInfo:
     """A run that is ``done`` on arrival, stored with its results in one transaction (an
@@ -190,7 +191,7 @@ def add_finished_run(
             targets,
             classifiers,
             config,
-            "done",
+            Status.DONE,
             started_at=now,
             finished_at=now,
         )
@@ -267,7 +268,7 @@ def claim_run(store: Store, run_id: int, *, owner: str | None = None) -> RunInfo
             update(RunRow)
             .where(RunRow.id == row.id, RunRow.status == row.status, same_owner)
             .values(
-                status="running",
+                status=Status.RUNNING,
                 owner=owner,
                 heartbeat_at=now,
                 started_at=func.coalesce(RunRow.started_at, now),
@@ -301,15 +302,15 @@ def should_stop(store: Store, run_id: int, owner: str) -> bool:
     return queue.should_stop(store, RunRow, run_id, owner)
 
 
-def update_config(store: Store, run_id: int, values: dict[str, Any]) -> None:
-    """Merge ``values`` into a run's stored config (what its executing process decided
-    when it started, such as the memory cap it derived)."""
+def update_config(store: Store, run_id: int, **values: Any) -> None:
+    """Set ``values`` in a run's stored config (what its executing process decided when it
+    started, such as the memory cap it derived)."""
     with store.session() as session:
         row = _row(session, run_id)
-        row.config = {**row.config, **values}
+        row.config = RunConfig.load(row.config).updated(**values).to_json()
 
 
-def finish_run(store: Store, run_id: int, status: RunStatus, *, error: str | None = None) -> None:
+def finish_run(store: Store, run_id: int, status: Status, *, error: str | None = None) -> None:
     """Leave a run in ``status`` (``finished_at`` set for final ones), its owner released."""
     with store.session() as session:
         session.execute(
@@ -318,7 +319,7 @@ def finish_run(store: Store, run_id: int, status: RunStatus, *, error: str | Non
             .values(
                 status=status,
                 error=error,
-                finished_at=utcnow() if status in FINAL_STATUSES else None,
+                finished_at=utcnow() if status in FINAL else None,
                 heartbeat_at=None,
                 owner=None,
             )
@@ -348,8 +349,8 @@ def request_cancel(store: Store, run_id: int | str) -> RunInfo:
     outcome = queue.request_cancel(store, RunRow, run, "run")
     if outcome == "changed":  # the run changed meanwhile: judge it again
         return request_cancel(store, run.id)
-    if outcome == "cancelling":  # what this request did, whatever the run's process does next
-        return replace(run, status="cancelling", cancel_requested=True)
+    if outcome == Status.CANCELLING:  # what this request did, whatever the run's process does
+        return replace(run, status=Status.CANCELLING, cancel_requested=True)
     return get_run(store, run.id)
 
 
@@ -363,7 +364,7 @@ def requeue_run(store: Store, run_id: int | str) -> RunInfo:
         The run is queued, executing, being cancelled or done.
     """
     check_resume(get_run(store, run_id))
-    finish_run(store, int(str(run_id)), "queued")
+    finish_run(store, int(str(run_id)), Status.QUEUED)
     return get_run(store, run_id)
 
 
@@ -373,7 +374,7 @@ def mark_lost_runs(store: Store) -> list[int]:
     lost: list[int] = []
     with store.session() as session:
         for status, becomes in LOST_AS.items():
-            values = {"finished_at": utcnow()} if becomes in FINAL_STATUSES else {}
+            values = {"finished_at": utcnow()} if becomes in FINAL else {}
             lost += mark_lost(
                 session, RunRow, of=status, status=becomes, owner=None, heartbeat_at=None, **values
             )
@@ -526,6 +527,7 @@ def _infos(session: Session, rows: Sequence[RunRow]) -> list[RunInfo]:
         select(EntryDropRow.run_id, EntryDropRow.after_fold).where(EntryDropRow.run_id.in_(ids))
     ).all():
         stopped.setdefault(run_id, []).append(int(after_fold))
+    configs = {row.id: RunConfig.load(row.config) for row in rows}
     return [
         RunInfo(
             id=row.id,
@@ -534,8 +536,8 @@ def _infos(session: Session, rows: Sequence[RunRow]) -> list[RunInfo]:
             kind=row.kind,
             targets=list(row.targets),
             classifiers=list(row.classifiers),
-            config=dict(row.config),
-            status=row.status,  # type: ignore[arg-type]  # a RunStatus literal in the column
+            config=configs[row.id],
+            status=Status(row.status),
             created_at=row.created_at,
             finished_at=row.finished_at,
             n_results=counts.get(row.id, (0, 0))[0],
@@ -545,14 +547,14 @@ def _infos(session: Session, rows: Sequence[RunRow]) -> list[RunInfo]:
             heartbeat_at=row.heartbeat_at,
             error=row.error,
             cancel_requested=bool(row.cancel_requested),
-            n_dropped=_skipped(row, stopped.get(row.id, [])),
+            n_dropped=_skipped(row, configs[row.id], stopped.get(row.id, [])),
             seconds_spent=float(row.seconds_spent or 0.0),
         )
         for row in rows
     ]
 
 
-def _skipped(row: RunRow, folds_run: Sequence[int]) -> int:
+def _skipped(row: RunRow, config: RunConfig, folds_run: Sequence[int]) -> int:
     """Tasks a run's dropped entries will not run: each entry's folds after its last."""
-    per_entry = int(row.config.get("n_tasks", 0)) // max(len(row.classifiers), 1)
+    per_entry = config.n_tasks // max(len(row.classifiers), 1)
     return sum(max(per_entry - folds, 0) for folds in folds_run)

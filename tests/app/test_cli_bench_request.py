@@ -11,7 +11,8 @@ import pytest
 from tests.app.cli_runner import CliResult, run_cli
 from tests.app.rows import count_rows
 from tests.app.synthetic import position_arff, touch_arff
-from touchbench.app.schemas.runs import BenchRequest
+from touchbench.app.cli.bench import BENCH_OPTIONS
+from touchbench.app.schemas.runs import BenchHereRequest, BenchRequest
 from touchbench.app.services.runs import NoResultsError, create_run, run_leaderboard
 from touchbench.app.store.database import Store
 
@@ -188,3 +189,26 @@ def test_a_run_without_results_says_how_to_carry_it_out_in_the_adapters_words(
         )
     finally:
         store.dispose()
+
+
+def test_each_field_of_the_requests_is_one_option_of_bench(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """The command's signature declares the options; the table the CLI names refused
+    fields by is read from it, and covers every field of both requests."""
+    fields = set(BenchRequest.model_fields) | set(BenchHereRequest.model_fields) - {"bench"}
+    assert fields <= set(BENCH_OPTIONS)
+    shown = run_cli(capsys, f"sqlite:///{tmp_path / 'h.db'}", "bench", "--help")
+    assert shown.code == 0
+    for field in fields - {"dataset"}:
+        assert BENCH_OPTIONS[field] in shown.out, field
+    both = run_cli(
+        capsys,
+        f"sqlite:///{tmp_path / 'h.db'}",
+        "bench",
+        "touch",
+        "--independent",
+        "--ablate-groups",
+        "channel",
+    )
+    _refused(both, "--ablate-groups: is not used with --independent")

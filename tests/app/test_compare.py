@@ -12,6 +12,7 @@ from tests.app.cli_runner import run_cli
 from tests.app.synthetic import touch_arff
 from tests.benchmark.test_statistics import DEMSAR_AUC, DEMSAR_NAMES
 from touchbench.app.errors import NotFoundError
+from touchbench.app.schemas.run_config import RunConfig
 from touchbench.app.services.compare import compare_runs, comparison_schema
 from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import add_dataset, dataset_digest
@@ -45,7 +46,7 @@ def stored_runs(
             kind="multiclass",
             targets=["gesture"],
             classifiers=list(classifiers),
-            config={"folds": FOLDS, "repeats": 1, "seed": 0, "n_tasks": FOLDS * len(classifiers)},
+            config=RunConfig(folds=FOLDS, repeats=1, seed=0, n_tasks=FOLDS * len(classifiers)),
         )
         for classifier, value in zip(classifiers, row, strict=True):
             for fold in range(FOLDS):

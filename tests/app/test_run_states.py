@@ -3,13 +3,20 @@ after a cancel, claims by a second process, and what a lost process leaves."""
 
 from __future__ import annotations
 
+import ast
+import re
 import subprocess
 import sys
+from pathlib import Path
 
+import grimp
 import pytest
 
+import touchbench.app
 from tests.app.test_store import small_dataset
 from touchbench.app.errors import ConflictError
+from touchbench.app.schemas.run_config import RunConfig
+from touchbench.app.schemas.status import Status
 from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import add_dataset
 from touchbench.app.store.ownership import process_owner
@@ -35,7 +42,7 @@ def _run(store: Store) -> int:
         kind="multiclass",
         targets=["c"],
         classifiers=["nb"],
-        config={"folds": 2, "repeats": 1, "seed": 0, "n_tasks": 2},
+        config=RunConfig(folds=2, repeats=1, seed=0, n_tasks=2),
     )
     return run.id
 
@@ -108,3 +115,40 @@ def test_a_lost_process_leaves_its_run_interrupted_or_cancelled(
     assert requeue_run(store, run_id).status == "queued"
     claimed = claim_run(store, run_id, owner=process_owner())  # and a new process takes it
     assert claimed.status == "running"
+
+
+#: Strings in app/ that are the words of a status without being one: an ablation entry's
+#: verdict and the count of tasks a partial answer has done.
+NOT_A_STATUS = {("services/ablation.py", "failed"), ("cli/progress.py", "done")}
+
+
+def test_a_status_is_spelt_in_app_schemas_status_only() -> None:
+    """Every other module names the statuses and their sets through app.schemas.status."""
+    app = Path(touchbench.app.__file__).resolve().parent
+    words = {status.value for status in Status}
+    spelt = set()
+    for path in app.rglob("*.py"):
+        where = str(path.relative_to(app))
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Constant) and node.value in words:
+                spelt.add((where, node.value))
+    for path in app.rglob("*.j2"):
+        where = str(path.relative_to(app))
+        spelt |= {
+            (where, word) for word in words if re.search(f"['\"]{word}['\"]", path.read_text())
+        }
+    assert {place for place in spelt if place[0] != "schemas/status.py"} == NOT_A_STATUS
+    assert {word for where, word in spelt if where == "schemas/status.py"} == words
+
+
+def test_the_rules_of_states_sit_below_the_runs_and_the_queue_that_apply_them() -> None:
+    """No import circle among app.store.states, runs and queue (imports under
+    TYPE_CHECKING and inside functions count)."""
+    graph = grimp.build_graph("touchbench", include_external_packages=False)
+    below = {
+        "touchbench.app.store.states": {"runs", "queue", "jobs"},
+        "touchbench.app.store.queue": {"runs", "jobs"},
+    }
+    for module, above in below.items():
+        for name in above:
+            assert not graph.chain_exists(module, f"touchbench.app.store.{name}"), (module, name)

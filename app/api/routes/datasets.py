@@ -32,10 +32,9 @@ from touchbench.app.services.datasets import (
     import_file,
     rename_dataset,
 )
-from touchbench.app.services.listing import list_datasets
+from touchbench.app.services.listing import count_datasets, list_datasets
 from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import find_dataset
-from touchbench.app.store.listing import count_datasets
 
 router = APIRouter(prefix="/api/datasets", tags=["datasets"])
 

@@ -12,7 +12,7 @@ from touchbench.app.schemas.importance import ImportanceRequest
 from touchbench.app.schemas.jobs import JobCreated, JobList, JobSchema
 from touchbench.app.schemas.learning import LearningCurveRequest
 from touchbench.app.services.jobs import submit_answer
-from touchbench.app.store.jobs import count_jobs, get_job, list_jobs, request_job_cancel
+from touchbench.app.services.lifecycle import cancel_job, count_jobs, get_job, list_jobs
 
 router = APIRouter(prefix="/api/jobs", tags=["jobs"])
 
@@ -64,7 +64,7 @@ def job(job_id: int, store: StoreDep) -> JobSchema:
 def cancel(job_id: int, store: StoreDep) -> JobSchema:
     """Cancel a queued job at once; a running one becomes ``cancelling`` and stops within
     about half a second (work in native code within a few seconds)."""
-    return request_job_cancel(store, job_id).for_client()
+    return cancel_job(store, job_id).for_client()
 
 
 @router.get(

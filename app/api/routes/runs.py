@@ -28,8 +28,14 @@ from touchbench.app.schemas.runs import (
 from touchbench.app.services.answers import latest_ablation
 from touchbench.app.services.certainty import run_certainty
 from touchbench.app.services.imported import import_results
+from touchbench.app.services.lifecycle import (
+    cancel_run,
+    count_runs,
+    get_run,
+    list_runs,
+    requeue_run,
+)
 from touchbench.app.services.runs import create_run, run_leaderboard
-from touchbench.app.store.runs import count_runs, get_run, list_runs, request_cancel, requeue_run
 
 router = APIRouter(prefix="/api/runs", tags=["runs"])
 
@@ -78,7 +84,7 @@ def run(run_id: int, store: StoreDep) -> RunSchema:
 def cancel(run_id: int, store: StoreDep) -> RunSchema:
     """Cancel a queued run at once; a running one becomes ``cancelling`` and stops within
     about half a second. Finished folds stay."""
-    return request_cancel(store, run_id).schema()
+    return cancel_run(store, run_id).schema()
 
 
 @router.post("/{run_id}/resume", status_code=status.HTTP_202_ACCEPTED, response_model=RunSchema)

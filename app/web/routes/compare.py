@@ -6,18 +6,21 @@ from __future__ import annotations
 # Imports inside functions: start-up time: matplotlib and the statistics load when a
 # comparison is first drawn, not when the service starts.
 from functools import partial
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 from fastapi import APIRouter, Query
 from fastapi.responses import HTMLResponse
 
 from touchbench.app.errors import AppError
 from touchbench.app.reports.bounds import Shown
-from touchbench.app.store.runs import RunInfo, count_runs, list_runs
+from touchbench.app.services.lifecycle import count_runs, list_runs
 from touchbench.app.web.deps import StoreDep
 from touchbench.app.web.listing import newest
 from touchbench.app.web.rendering import draw, render
 from touchbench.benchmark.errors import BenchmarkError
+
+if TYPE_CHECKING:
+    from touchbench.app.store.runs import RunInfo
 
 router = APIRouter(prefix="/fragments/compare", include_in_schema=False)
 

@@ -11,9 +11,8 @@ from fastapi.responses import HTMLResponse
 
 from touchbench.app.services.answers import latest_learning_curve
 from touchbench.app.services.datasets import describe_dataset
-from touchbench.app.services.listing import list_datasets
-from touchbench.app.store.listing import count_datasets
-from touchbench.app.store.runs import count_runs, list_runs
+from touchbench.app.services.lifecycle import count_runs, list_runs
+from touchbench.app.services.listing import count_datasets, list_datasets
 from touchbench.app.web.deps import StoreDep
 from touchbench.app.web.listing import newest
 from touchbench.app.web.rendering import draw, render

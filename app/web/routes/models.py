@@ -7,8 +7,8 @@ from functools import partial
 from fastapi import APIRouter
 from fastapi.responses import HTMLResponse
 
-from touchbench.app.schemas.runs import FINAL_STATUSES
-from touchbench.app.store.jobs import count_jobs, list_jobs
+from touchbench.app.schemas.status import FINAL
+from touchbench.app.services.lifecycle import count_jobs, list_jobs
 from touchbench.app.store.models import count_models, get_model, list_models
 from touchbench.app.web.deps import StoreDep
 from touchbench.app.web.listing import newest
@@ -23,7 +23,7 @@ router = APIRouter(prefix="/fragments/models", include_in_schema=False)
 def models(store: StoreDep) -> HTMLResponse:
     """Every model; polled while a training job is queued or running."""
     recent = newest(count_jobs(store), partial(list_jobs, store)).items
-    training = [job for job in recent if job.kind == "train" and job.status not in FINAL_STATUSES]
+    training = [job for job in recent if job.kind == "train" and job.status not in FINAL]
     listed = newest(count_models(store), partial(list_models, store))
     return render("fragments/models.html.j2", models=listed, training=training)
 

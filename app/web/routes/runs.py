@@ -22,12 +22,11 @@ from touchbench.app.errors import NotFoundError
 from touchbench.app.reports import bounds
 from touchbench.app.reports.answer_tables import run_answer_tables
 from touchbench.app.reports.run_tables import RunTable, run_tables
-from touchbench.app.schemas.runs import FINAL_STATUSES
+from touchbench.app.schemas.status import FINAL, RESUMABLE, Status
 from touchbench.app.services.answers import run_answers
-from touchbench.app.services.listing import list_datasets
+from touchbench.app.services.lifecycle import count_runs, get_run, list_runs
+from touchbench.app.services.listing import count_datasets, list_datasets
 from touchbench.app.services.runs import NoResultsError, run_leaderboard
-from touchbench.app.store.listing import count_datasets
-from touchbench.app.store.runs import count_runs, get_run, list_runs
 from touchbench.app.web.deps import StoreDep
 from touchbench.app.web.listing import newest
 from touchbench.app.web.rendering import draw, render
@@ -52,7 +51,7 @@ def runs(store: StoreDep) -> HTMLResponse:
     return render(
         "fragments/runs.html.j2",
         runs=listed,
-        active=any(run.status not in FINAL_STATUSES for run in listed.items),
+        active=any(run.status not in FINAL for run in listed.items),
     )
 
 
@@ -78,7 +77,13 @@ def run_form(
 def progress(run_id: int, store: StoreDep) -> HTMLResponse:
     """Status and tasks done; polled every second until the run is over."""
     run = get_run(store, run_id).schema()
-    return render("fragments/progress.html.j2", run=run, final=run.status in FINAL_STATUSES)
+    return render(
+        "fragments/progress.html.j2",
+        run=run,
+        final=run.status in FINAL,
+        resumable=run.status in RESUMABLE,
+        done=run.status == Status.DONE,
+    )
 
 
 @router.get("/{run_id}/leaderboard", response_class=HTMLResponse)

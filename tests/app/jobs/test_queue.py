@@ -11,6 +11,7 @@ from sqlalchemy import update
 
 from tests.app.synthetic import touch_arff
 from touchbench.app.jobs.queue import Item, next_item, waiting
+from touchbench.app.schemas.run_config import RunConfig
 from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import add_dataset, dataset_digest
 from touchbench.app.store.jobs import create_job
@@ -28,7 +29,7 @@ def _queued_run(store: Store, dataset_id: int, minute: int) -> Item:
         kind="multiclass",
         targets=["gesture"],
         classifiers=["nb"],
-        config={"folds": 2, "repeats": 1, "seed": 0, "n_tasks": 2},
+        config=RunConfig(folds=2, repeats=1, seed=0, n_tasks=2),
     )
     _queued_at(store, RunRow, run.id, minute)
     return Item("run", run.id)

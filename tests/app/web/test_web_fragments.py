@@ -12,7 +12,7 @@ from urllib.parse import quote
 
 import pytest
 
-from tests.app.api.conftest import Server
+from tests.app.api.conftest import Server, finished
 from tests.app.cli_runner import run_cli
 from tests.app.synthetic import touch_arff
 from tests.app.test_plots import FETCHES
@@ -105,6 +105,21 @@ def test_plots_of_every_kind_of_run_and_figures_drawn_at_once(
     assert run_cli(capsys, db, "import", str(data), "--name", "touch").code == 0
     single = _bench(capsys, db, "touch", "--target", "gesture", "-c", "nb,zeror,j48", "-k", "3")
     multi = _bench(capsys, db, "touch", "-c", "cr:nb,cc:j48", "-k", "3")
+
+    # the progress box's buttons follow the run's status: a done run trains its best
+    # classifier, a stopped one is resumed
+    done = api.get(f"/fragments/runs/{single}/progress").text
+    assert "Train its best classifier" in done and "Resume" not in done and "Cancel" not in done
+    queued = api.post(
+        "/api/runs",
+        json={"dataset": "touch", "target": "gesture", "classifiers": ["nb"], "folds": 3},
+    )
+    assert queued.status_code == 202, queued.text
+    stopped = queued.json()["id"]
+    assert api.post(f"/api/runs/{stopped}/cancel").status_code == 200
+    assert server.wait_for(f"/api/runs/{stopped}", finished)["status"] == "cancelled"
+    resumable = api.get(f"/fragments/runs/{stopped}/progress").text
+    assert "Resume" in resumable and "Train its best classifier" not in resumable
 
     single_plots = _figures(api.get(f"/fragments/runs/{single}/plots").text)
     assert "f1_weighted per fold (higher is better; bar: mean)" in single_plots[0]
