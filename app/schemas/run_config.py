@@ -127,16 +127,6 @@ class RunConfig(ExtraSpecsConfig):
         """This configuration with ``values`` set (validated)."""
         return RunConfig.load({**self.to_json(), **values})
 
-    def get(self, key: str, default: Any = None) -> Any:
-        """The field ``key``, for code that still reads the configuration as the dict it was.
-
-        Transitional: :mod:`app.services.models` reads ``seed`` and ``targets_given`` so
-        while another change works on that module; read the attributes instead, and this
-        goes once no caller is left.
-        """
-        value = getattr(self, key, None)
-        return default if value is None else value
-
     @property
     def imported(self) -> bool:
         """Whether the run's results were imported rather than computed here."""

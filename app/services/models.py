@@ -118,8 +118,8 @@ def check_training(store: Store, request: TrainRequest) -> Training:
     targets: list[str] | None
     if request.run is not None:
         run, classifier = _best_of_run(store, request.run)
-        run_id, dataset_id, seed = run.id, run.dataset_id, int(run.config.get("seed", 0))
-        targets = run.config.get("targets_given")
+        run_id, dataset_id, seed = run.id, run.dataset_id, run.config.seed
+        targets = run.config.targets_given
     else:
         assert request.dataset is not None and request.classifier is not None  # the request's rule
         run_id, classifier, seed = None, request.classifier, request.seed
