@@ -12,6 +12,7 @@ from sqlalchemy import text
 
 from tests.app.rows import count_rows
 from tests.app.synthetic import touch_arff
+from touchbench.app.schemas.run_config import RunConfig
 from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import add_dataset, dataset_digest
 from touchbench.app.store.predictions import (
@@ -35,7 +36,7 @@ def _run(store: Store, tmp_path: Path) -> int:
         kind="multiclass",
         targets=["gesture"],
         classifiers=["nb"],
-        config={"folds": 2, "repeats": 1, "seed": 0, "n_tasks": 2},
+        config=RunConfig.load({"folds": 2, "repeats": 1, "seed": 0, "n_tasks": 2}),
     )
     return run.id
 
