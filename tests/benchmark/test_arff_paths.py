@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.app.test_cli_datasets import TOUCH_ARFF
+from tests.app.cli.test_datasets import TOUCH_ARFF
 from tests.benchmark.test_arff import CANONICAL, HEADER, MESSY, _random_dataset
 from touchbench.benchmark.dataset import Dataset
 from touchbench.benchmark.errors import DataFormatError

@@ -18,9 +18,9 @@ import httpx
 import numpy as np
 import soundfile
 
-from tests.app.api.conftest import ROOT, Server
-from tests.app.synthetic import touch_arff
-from tests.app.web.conftest import figure_texts
+from tests.support.browser import figure_texts
+from tests.support.service import ROOT, Server
+from tests.support.synthetic import touch_arff
 from touchbench.app.reports import bounds
 
 #: Far above what a bounded service needs, far below what the issue measured (9.2 GB).

@@ -13,9 +13,9 @@ import pytest
 from websockets.exceptions import InvalidStatus
 from websockets.sync.client import connect
 
-from tests.app.api.conftest import Server, finished
-from tests.app.cli_runner import run_cli
-from tests.app.synthetic import touch_arff
+from tests.support.cli_runner import run_cli
+from tests.support.service import Server, finished
+from tests.support.synthetic import touch_arff
 
 FOREIGN = "http://127.0.0.1:9"  # another port of the same machine is another origin
 KEY = "trust-key-of-the-lab"

@@ -1,0 +1,23 @@
+"""Test stores' URLs: the PostgreSQL test server's, and a database emptied for reuse."""
+
+from __future__ import annotations
+
+from sqlalchemy import create_engine, text
+
+DEFAULT_POSTGRES = "postgresql://postgres:postgres@127.0.0.1:5432/test"
+
+
+def psycopg_url(url: str) -> str:
+    return (
+        "postgresql+psycopg://" + url.split("://", 1)[1] if url.startswith("postgresql://") else url
+    )
+
+
+def emptied(url: str) -> str:
+    """``url``, a PostgreSQL database, once its tables are all dropped."""
+    engine = create_engine(url, isolation_level="AUTOCOMMIT")
+    with engine.connect() as connection:
+        connection.execute(text("DROP SCHEMA public CASCADE"))
+        connection.execute(text("CREATE SCHEMA public"))
+    engine.dispose()
+    return url
