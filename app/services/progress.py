@@ -2,8 +2,9 @@
 
 Such an answer hears of every finished task, but its summary so far is built from every
 result yet (quadratic over the job) and is written to the job's row each time, so a large
-learning curve spent most of its CPU on summaries.  Told at most every :data:`PROGRESS_SECONDS`, that work follows the job's
-duration, not its number of tasks squared.
+learning curve spent most of its CPU on summaries.  Told at most every
+:data:`PROGRESS_SECONDS`, that work follows the job's duration, not its number of tasks
+squared.
 """
 
 from __future__ import annotations

@@ -74,7 +74,9 @@ def results_arff(path: Path, *, n_classifiers: int, n_instances: int = 90, folds
                     key, "ok", None, metrics, confusion.tolist(), n_instances - per_fold, per_fold
                 )
             )
-    text = dumps_arff(results_to_dataset(results, dataset_name="touch", scheme_names="id"))
+    text = dumps_arff(
+        results_to_dataset(results, dataset_name="touch", specs={}, scheme_names="id")
+    )
     header, data = text.split("@data\n", 1)
     names = [f"c{index:04d}" for index in range(n_classifiers)]
     lines = []

@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 from sklearn.metrics import f1_score, jaccard_score, log_loss
 
-from touchbench.benchmark.multitarget._targets import TargetError, all_binary, validate_targets
+from touchbench.benchmark.targets import TargetError, all_binary, validate_targets
 
 #: Scalar keys :func:`multitarget_scores` can return, higher-is-better ones first.
 MULTITARGET_METRICS: tuple[str, ...] = (
