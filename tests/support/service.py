@@ -15,8 +15,11 @@ from pathlib import Path
 from typing import Any
 
 import httpx
+import pytest
 
+from tests.support.cli_runner import run_cli
 from tests.support.gate import Gate
+from tests.support.synthetic import touch_arff
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -145,3 +148,26 @@ def servers(database_url: str, tmp_path: Path) -> Iterator[Callable[..., Server]
     yield build
     for server in servers:
         server.stop()
+
+
+def cancelled_run(capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path) -> int:
+    """A run of the gate classifier cancelled before any fold: resuming it changes it."""
+    path = touch_arff(tmp_path / "touch.arff", n=60)
+    assert run_cli(capsys, server.database_url, "import", str(path), "--name", "touch").code == 0
+    api, gate = server.client, server.gate
+    assert gate is not None
+    created = api.post(
+        "/api/runs",
+        json={"dataset": "touch", "target": "gesture", "classifiers": ["gate"], "folds": 3},
+    )
+    assert created.status_code == 202, created.text
+    run_id: int = created.json()["id"]
+    gate.wait_started(1)
+    assert api.post(f"/api/runs/{run_id}/cancel").status_code == 200
+    assert server.wait_for(f"/api/runs/{run_id}", finished)["status"] == "cancelled"
+    return run_id
+
+
+def upload(server: Server, path: Path, **fields: str) -> httpx.Response:
+    with path.open("rb") as handle:
+        return server.client.post("/api/datasets", files={"file": (path.name, handle)}, data=fields)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 from sqlalchemy import create_engine, text
 
 DEFAULT_POSTGRES = "postgresql://postgres:postgres@127.0.0.1:5432/test"
@@ -21,3 +23,15 @@ def emptied(url: str) -> str:
         connection.execute(text("CREATE SCHEMA public"))
     engine.dispose()
     return url
+
+
+def alembic(connection: Any, action: str, revision: str) -> None:
+    from alembic import command
+    from alembic.config import Config
+
+    from touchbench.app.store.database import MIGRATIONS
+
+    config = Config()
+    config.set_main_option("script_location", str(MIGRATIONS))
+    config.attributes["connection"] = connection
+    getattr(command, action)(config, revision)

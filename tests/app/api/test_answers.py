@@ -10,9 +10,9 @@ from pathlib import Path
 
 import pytest
 
-from tests.app.services.test_answers import mics_arff
 from tests.support.cli_runner import run_cli
 from tests.support.service import Server
+from tests.support.synthetic import mics_arff
 
 
 def test_a_kept_ablation_over_http_and_refused_jobs(

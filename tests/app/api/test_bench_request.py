@@ -10,13 +10,10 @@ from typing import Any
 
 import pytest
 
-from tests.support.cli_runner import run_cli
+from tests.support.cli_runner import CLI_WORDS, run_cli
 from tests.support.rows import count_rows
 from tests.support.service import Server, finished
 from tests.support.synthetic import position_arff, touch_arff
-
-#: A command-line word: an option (``--budget``) or a command (``touchbench bench``).
-CLI_WORDS = re.compile(r"(^|[\s\"'`(])--[a-z]|touchbench [a-z]")
 
 BASE = {"dataset": "touch", "classifiers": ["zeror", "nb"], "folds": 3}
 

@@ -6,31 +6,25 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
-import httpx
 import pytest
 
 from tests.support.cli_runner import run_cli
-from tests.support.service import Server, finished
+from tests.support.service import Server, finished, upload
 from tests.support.synthetic import touch_arff
 from touchbench.app.services.simulation import write_labels, write_session
-
-
-def _upload(server: Server, path: Path, **fields: str) -> httpx.Response:
-    with path.open("rb") as handle:
-        return server.client.post("/api/datasets", files={"file": (path.name, handle)}, data=fields)
 
 
 def test_upload_describe_download_rename_delete(
     capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path
 ) -> None:
     path = touch_arff(tmp_path / "touch.arff", n=60)
-    response = _upload(server, path)
+    response = upload(server, path)
     assert response.status_code == 201, response.text
     created = response.json()
     assert (created["name"], created["n_instances"], created["n_features"]) == ("touch", 60, 5)
     assert created["targets"] == ["gesture", "place"] and created["created"] is True
 
-    again = _upload(server, path)
+    again = upload(server, path)
     assert again.status_code == 200
     assert again.json()["id"] == created["id"] and again.json()["created"] is False
 
@@ -60,7 +54,7 @@ def test_upload_describe_download_rename_delete(
 def test_bad_uploads_are_4xx_json_and_store_nothing(server: Server, tmp_path: Path) -> None:
     broken = tmp_path / "broken.arff"
     broken.write_text("@relation r\n@attribute a numeric\n@attribute c {x,y}\n@data\n1,x\n2,z\n")
-    response = _upload(server, broken)
+    response = upload(server, broken)
     assert response.status_code == 400
     error = response.json()["error"]
     assert error["type"] == "DataFormatError" and "broken.arff:6" in error["where"]
@@ -68,7 +62,7 @@ def test_bad_uploads_are_4xx_json_and_store_nothing(server: Server, tmp_path: Pa
 
     binary = tmp_path / "noise.wav"
     binary.write_bytes(bytes(range(256)) * 64)
-    assert _upload(server, binary).status_code == 400
+    assert upload(server, binary).status_code == 400
 
     api = server.client
     assert api.post("/api/datasets").status_code == 422
@@ -132,7 +126,7 @@ def test_uploads_over_the_limit_are_refused_while_streaming(
     server = make_server(max_upload_mb="1")
     big = touch_arff(tmp_path / "big.arff", n=40000)
     assert big.stat().st_size > 2**20
-    response = _upload(server, big)
+    response = upload(server, big)
     assert response.status_code == 413
     assert response.json()["error"]["type"] == "UploadTooLarge"
 

@@ -8,10 +8,9 @@ from pathlib import Path
 
 import pytest
 
-from tests.app.api.test_datasets import _upload as upload
 from tests.support.cli_runner import run_cli
 from tests.support.grasp_table import FEATURES, grasp_arff, grasp_csv
-from tests.support.service import Server
+from tests.support.service import Server, upload
 
 
 def test_an_upload_sets_the_group_column_and_ignored_columns_aside(

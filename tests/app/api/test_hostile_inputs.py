@@ -20,7 +20,6 @@ from typing import Any
 import httpx
 import pytest
 
-from tests.app.api.test_bounded_work import DATA_URI, peak_rss_mb
 from tests.support.browser import figure_texts
 from tests.support.hostile_inputs import (
     RLO_NAME,
@@ -32,6 +31,7 @@ from tests.support.hostile_inputs import (
     results_arff,
     timed_takes,
 )
+from tests.support.memory import DATA_URI, peak_rss_mb
 from tests.support.service import ROOT, Server, finished, servers
 from tests.support.stores import emptied
 from tests.support.synthetic import touch_arff

@@ -8,13 +8,11 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pytest
 import soundfile
-from websockets.exceptions import ConnectionClosed
-from websockets.sync.client import connect
 
 from tests.support.cli_runner import run_cli
+from tests.support.live import as_int16, pcm_blocks, stream, ws_url
 from tests.support.service import Server
 from touchbench.app.schemas.extraction import ExtractRequest
 from touchbench.app.schemas.models import TrainRequest
@@ -43,44 +41,6 @@ def live_model(tmp_path: Path, store_url: str) -> tuple[str, Path]:
     return model.name, unseen
 
 
-def _ws_url(server: Server, model: str) -> str:
-    return server.url.replace("http://", "ws://") + f"/api/models/{model}/live"
-
-
-def _stream(
-    url: str, header: dict[str, Any], blocks: list[bytes], headers: dict[str, str] | None = None
-) -> tuple[list[dict[str, Any]], int, str]:
-    """Send a header and blocks, then the end; the messages and the close code and reason."""
-    messages: list[dict[str, Any]] = []
-    with connect(url, additional_headers=headers or {}, open_timeout=60) as socket:
-        try:
-            socket.send(json.dumps(header))
-            for block in blocks:
-                socket.send(block)
-            socket.send(json.dumps({"end": True}))
-            while True:
-                messages.append(json.loads(socket.recv(timeout=120)))
-        except ConnectionClosed:
-            pass
-        assert socket.close_code is not None
-        return messages, socket.close_code, socket.close_reason or ""
-
-
-def _as_int16(path: Path) -> tuple[np.ndarray, int]:
-    """A recording's samples as 16-bit PCM, shape (n_frames, channels)."""
-    samples, rate = soundfile.read(path, always_2d=True)
-    return np.round(np.clip(samples, -1, 1) * 32767).astype("<i2"), int(rate)
-
-
-def _pcm_blocks(path: Path, frames: int = 2048) -> tuple[int, int, list[bytes]]:
-    samples, rate = _as_int16(path)
-    blocks = [
-        np.ascontiguousarray(samples[i : i + frames]).tobytes()
-        for i in range(0, len(samples), frames)
-    ]
-    return rate, samples.shape[1], blocks
-
-
 def test_live_over_a_websocket_says_what_live_says(
     capsys: pytest.CaptureFixture[str],
     make_server: Callable[..., Server],
@@ -89,9 +49,9 @@ def test_live_over_a_websocket_says_what_live_says(
 ) -> None:
     name, unseen = live_model
     server = make_server(api_key="live-key-of-the-lab")
-    rate, channels, blocks = _pcm_blocks(unseen)
-    messages, code, reason = _stream(
-        _ws_url(server, name),
+    rate, channels, blocks = pcm_blocks(unseen)
+    messages, code, reason = stream(
+        ws_url(server, name),
         {"samplerate": rate, "channels": channels, "format": "S16LE"},
         blocks,
         headers={"X-API-Key": "live-key-of-the-lab"},
@@ -99,7 +59,7 @@ def test_live_over_a_websocket_says_what_live_says(
     assert (code, reason) == (1000, "stream ended")
     # the CLI on the same samples (as 16-bit PCM, as the socket received them)
     as_sent = tmp_path / "as-sent.wav"
-    soundfile.write(as_sent, _as_int16(unseen)[0], rate, subtype="PCM_16")
+    soundfile.write(as_sent, as_int16(unseen)[0], rate, subtype="PCM_16")
     cli = run_cli(
         capsys, server.database_url, "live", "--model", name, "--replay", str(as_sent), "--json"
     )
@@ -123,7 +83,7 @@ def test_bad_streams_are_closed_with_a_reason(
 ) -> None:
     name, _ = live_model
     server = make_server(api_key="live-key-of-the-lab")
-    url = _ws_url(server, name)
+    url = ws_url(server, name)
     key = {"X-API-Key": "live-key-of-the-lab"}
     good = {"samplerate": 44100, "channels": 3, "format": "S16LE"}
     cases: list[tuple[dict[str, Any], list[bytes], dict[str, str], int, str]] = [
@@ -135,9 +95,9 @@ def test_bad_streams_are_closed_with_a_reason(
         (good, [b"\x00" * 7], key, 1007, "frames"),
     ]
     for header, blocks, headers, code, words in cases:
-        _, got_code, reason = _stream(url, header, blocks, headers)
+        _, got_code, reason = stream(url, header, blocks, headers)
         assert got_code == code and words in reason, (header, got_code, reason)
-    _, code, reason = _stream(
+    _, code, reason = stream(
         server.url.replace("http://", "ws://") + "/api/models/nope/live", good, [], key
     )
     assert code == 1008 and "no model 'nope'" in reason

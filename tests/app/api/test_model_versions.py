@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from websockets.sync.client import ClientConnection, connect
 
-from tests.app.api.test_live import _as_int16
+from tests.support.live import as_int16
 from tests.support.service import Server
 from tests.support.synthetic import touch_arff
 from touchbench.app.schemas.datasets import ImportRequest
@@ -137,7 +137,7 @@ def test_a_live_session_follows_the_champion_mid_stream(
     assert refused.status_code == 403 and "needs a write key" in refused.text
     assert lab.post("/api/models/mic@1/promote").json()["model"] == "mic@1"
 
-    samples, rate = _as_int16(tmp_path / "unseen.wav")
+    samples, rate = as_int16(tmp_path / "unseen.wav")
     assert rate == SAMPLERATE
     frames = 2048
     # each part ends as a touch begins: the one before it is over and answered
@@ -201,7 +201,7 @@ def test_deleting_the_alias_a_live_session_follows_keeps_its_version(
     robot = httpx.Client(base_url=server.url, headers={"X-API-Key": PREDICT}, timeout=60)
     lab.post("/api/models/mic@1/promote").raise_for_status()
 
-    samples, rate = _as_int16(tmp_path / "unseen.wav")
+    samples, rate = as_int16(tmp_path / "unseen.wav")
     frames, cut = 2048, int(touches[2][0] * rate)
     parts = [samples[:cut], samples[cut:]]
     blocks = [[p[i : i + frames].tobytes() for i in range(0, len(p), frames)] for p in parts]
@@ -258,7 +258,7 @@ def test_a_flood_of_alias_moves_drops_no_stream_and_no_request(
             for path, body in moves:
                 statuses.append(lab.post(path, json=body).status_code)
 
-    samples, rate = _as_int16(tmp_path / "unseen.wav")
+    samples, rate = as_int16(tmp_path / "unseen.wav")
     blocks = [samples[i : i + 2048].tobytes() for i in range(0, len(samples), 2048)]
     seen: list[dict[str, Any]] = []
     flooding = threading.Thread(target=flood)

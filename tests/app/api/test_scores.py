@@ -12,9 +12,8 @@ from pathlib import Path
 import pytest
 from sqlalchemy import create_engine, text
 
-from tests.app.cli.test_predict_recordings import _take
-from tests.app.cli.test_scores import PER_RECORDING, _add, recorded_windows
 from tests.support.cli_runner import run_cli
+from tests.support.recordings import PER_RECORDING, recorded_windows, store_dataset, write_take
 from tests.support.service import Server, finished
 from tests.support.synthetic import touch_arff
 
@@ -24,7 +23,7 @@ def test_scores_per_recording_never_started_and_raw_recordings_predicted(
 ) -> None:
     server = make_sqlite_server()
     db, api = server.database_url, server.client
-    _add(db, recorded_windows(), "takes")
+    store_dataset(db, recorded_windows(), "takes")
     run_cli(capsys, db, "import", str(touch_arff(tmp_path / "t.arff")), "--name", "touch")
     body = {"classifiers": ["nb", "zeror"], "folds": 4, "aggregate": "recording"}
     refused = api.post("/api/runs", json={**body, "dataset": "touch", "target": "gesture"})
@@ -64,7 +63,7 @@ def test_scores_per_recording_never_started_and_raw_recordings_predicted(
     rows = ["file,state"]
     for take in range(4):
         kind = "slip" if take % 2 else "still"
-        _take(tmp_path / f"take-{take}.csv", kind, seed=take)
+        write_take(tmp_path / f"take-{take}.csv", kind, seed=take)
         rows.append(f"take-{take}.csv,{kind}")
     (tmp_path / "labels.csv").write_text("\n".join(rows) + "\n")
     takes = [str(tmp_path / f"take-{take}.csv") for take in range(4)]
@@ -78,7 +77,7 @@ def test_scores_per_recording_never_started_and_raw_recordings_predicted(
     model = trained.json()["name"]
 
     unseen = tmp_path / "unseen.csv"
-    _take(unseen, "slip", seed=42)
+    write_take(unseen, "slip", seed=42)
     with unseen.open("rb") as handle:
         answer = api.post(
             f"/api/models/{model}/predict/file", files={"file": (unseen.name, handle)}

@@ -7,30 +7,8 @@ from pathlib import Path
 import pytest
 
 from tests.support.cli_runner import run_cli
+from tests.support.synthetic import TOUCH_ARFF, write
 from touchbench.benchmark.io.arff import read_arff
-
-TOUCH_ARFF = """% two targets, MEKA style
-@relation 'touch: -C 2'
-@attribute gesture {tap, slap, 'soft stroke'}
-@attribute place {head, arm}
-@attribute energy numeric
-@attribute zcr integer
-@attribute mic {left, right}
-@data
-tap, head, 0.5, 3, left
-slap, arm, 1.25, 7, right
-'soft stroke', head, ?, 2, left
-tap, arm, 0.75, ?, ?
-"""
-
-
-def write(tmp_path: Path, name: str, text: str | bytes) -> Path:
-    path = tmp_path / name
-    if isinstance(text, bytes):
-        path.write_bytes(text)
-    else:
-        path.write_text(text, encoding="utf-8")
-    return path
 
 
 def test_import_prints_the_summary_as_json(

@@ -11,8 +11,9 @@ from pathlib import Path
 
 import pytest
 
-from tests.app.cli.test_datasets import TOUCH_ARFF, write
-from tests.support.cli_runner import CliResult, run_cli
+from tests.support.cli_runner import one_error_line, run_cli
+from tests.support.rows import stored_names
+from tests.support.synthetic import TOUCH_ARFF, write
 from touchbench.app.schemas.datasets import ImportRequest
 from touchbench.app.services import datasets as dataset_service
 from touchbench.app.services.listing import list_datasets
@@ -21,23 +22,6 @@ from touchbench.app.store.database import Store
 from touchbench.app.store.tables import RunRow
 from touchbench.benchmark.errors import DataFormatError
 from touchbench.benchmark.io.arff import read_arff
-
-
-def one_error_line(result: CliResult, *expected: str) -> str:
-    """The single error line of a refused command (exit 2, no traceback)."""
-    assert result.code == 2, (result.code, result.out, result.err)
-    lines = result.err.strip().splitlines()
-    assert len(lines) == 1, result.err
-    assert lines[0].startswith("touchbench: error: ")
-    for text in expected:
-        assert text in lines[0], lines[0]
-    return lines[0]
-
-
-def stored_names(capsys: pytest.CaptureFixture[str], store_url: str) -> list[str]:
-    listing = run_cli(capsys, store_url, "datasets", "--json").json()
-    return [d["name"] for d in listing["datasets"]]
-
 
 # ------------------------------------------------------------------------------- names
 

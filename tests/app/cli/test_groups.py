@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 from sqlalchemy import func, select
 
-from tests.app.cli.test_datasets_bad_input import one_error_line, stored_names
-from tests.support.cli_runner import run_cli
+from tests.support.cli_runner import one_error_line, run_cli
 from tests.support.grasp_table import FEATURES, OBJECTS, grasp_arff, grasp_csv
+from tests.support.rows import stored_names
 from touchbench.app.services.datasets import describe_dataset
 from touchbench.app.store import datasets as stored
 from touchbench.app.store.database import Store

@@ -15,8 +15,8 @@ from pathlib import Path
 
 import pytest
 
-from tests.app.cli.test_import_streaming import _CLI_WITH_PEAK, REPOSITORY
 from tests.support.hostile_inputs import gap_csv, nan_stamp_csv, one_line_csv, tactile_sequences
+from tests.support.memory import CLI_WITH_PEAK, REPOSITORY
 
 #: Far above what a bounded command needs (about 200 MB), far below what the issue saw
 #: (13.5 GB for a one-line CSV).
@@ -33,7 +33,7 @@ def cli(db: str, *args: str, **settings: str) -> tuple[int, float, str, str]:
     environment = {**os.environ, "PYTHONPATH": str(REPOSITORY)}
     environment.update({f"TOUCHBENCH_{key.upper()}": value for key, value in settings.items()})
     done = subprocess.run(
-        [sys.executable, "-c", _CLI_WITH_PEAK, "--db", db, *args],
+        [sys.executable, "-c", CLI_WITH_PEAK, "--db", db, *args],
         env=environment,
         capture_output=True,
         text=True,

@@ -22,21 +22,12 @@ import numpy as np
 import pytest
 from sqlalchemy import func, select
 
+from tests.support.memory import CLI_WITH_PEAK, REPOSITORY
 from touchbench.app.store.database import Store
 from touchbench.app.store.listing import list_datasets
 from touchbench.app.store.tables import InstanceBlockRow, InstanceRow
 
-REPOSITORY = Path(__file__).resolve().parents[3]
 PEAK_BOUND_MB = 400
-_CLI_WITH_PEAK = """
-import sys
-from touchbench.app.cli.main import main
-code = main(sys.argv[1:])
-with open("/proc/self/status") as status:
-    peak = next(line.split()[1] for line in status if line.startswith("VmHWM:"))
-print(f"peak-rss-kb {peak}", file=sys.stderr)
-sys.exit(code)
-"""
 
 # A shell that runs a command in the background starts it with Ctrl-C ignored, which
 # Python then keeps ignoring: the CLI is started as a terminal would start it.
@@ -56,7 +47,7 @@ pytestmark = [
 def cli_peak_mb(*args: str) -> tuple[int, float, str]:
     """``touchbench ARGS`` in its own process: exit status, peak RSS in MB, stderr."""
     done = subprocess.run(
-        [sys.executable, "-c", _CLI_WITH_PEAK, *args],
+        [sys.executable, "-c", CLI_WITH_PEAK, *args],
         env={**os.environ, "PYTHONPATH": str(REPOSITORY)},
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,

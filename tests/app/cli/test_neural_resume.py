@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.benchmark.test_sequences import sequence_dataset, shapes
 from tests.support.gate import CNN1D_PARAMS, SMALL, Gate
+from tests.support.sequences import sequence_dataset, shapes
 from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import add_dataset, dataset_digest
 from touchbench.benchmark.catalogue import get_spec

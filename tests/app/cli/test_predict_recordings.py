@@ -9,20 +9,7 @@ import numpy as np
 import pytest
 
 from tests.support.cli_runner import run_cli
-from tests.support.csvfiles import write_biotac_csv
-
-RATE = 100.0
-
-
-def _take(path: Path, kind: str, seed: int) -> np.ndarray:
-    """Three channels, 6 s: a 12 Hz vibration when slipping, noise when still."""
-    rng = np.random.default_rng(seed)
-    t = np.arange(600) / RATE
-    samples = 0.1 * rng.standard_normal((3, 600))
-    if kind == "slip":
-        samples += np.sin(2 * np.pi * 12 * t)
-    write_biotac_csv(path, samples, rate=RATE, seed=seed, jitter=0.003)
-    return samples
+from tests.support.recordings import RATE, write_take
 
 
 @pytest.fixture
@@ -33,7 +20,7 @@ def model(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> tuple[str, Path
     rows = ["file,state"]
     for take in range(8):
         kind = "slip" if take % 2 else "still"
-        _take(folder / f"take-{take}.csv", kind, seed=take)
+        write_take(folder / f"take-{take}.csv", kind, seed=take)
         rows.append(f"take-{take}.csv,{kind}")
     labels = folder / "labels.csv"
     labels.write_text("\n".join(rows) + "\n")
@@ -64,7 +51,7 @@ def test_predict_extracts_a_raw_recording_with_the_models_recipe(
     name, folder = model
     url = f"sqlite:///{folder / 'touchbench.db'}"
     unseen = folder / "unseen.csv"
-    _take(unseen, "slip", seed=42)
+    write_take(unseen, "slip", seed=42)
     result = run_cli(capsys, url, "predict", name, str(unseen), "--json")
     assert result.code == 0, result.err
     report = result.json()

@@ -15,15 +15,10 @@ from typing import Any
 import pytest
 from sqlalchemy import text
 
-from tests.app.cli.test_runs_interrupted import (
-    ROOT,
-    _bench_process,
-    _engine,
-    _scalar,
-    _wait_for_results,
-)
 from tests.support.cli_runner import run_cli
 from tests.support.gate import Gate
+from tests.support.processes import bench_process, scalar, store_engine, wait_for_results
+from tests.support.service import ROOT
 from tests.support.synthetic import touch_arff
 
 RACE = ["--target", "gesture", "--folds", "5", "--race", "--seed", "3"]
@@ -57,7 +52,7 @@ def test_bad_race_and_budget_values_are_refused_in_one_line(
     assert result.code == 2
     lines = result.err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith(f"touchbench: error: {words}"), result.err
-    assert _scalar(store_url, "SELECT count(*) FROM runs") == 0
+    assert scalar(store_url, "SELECT count(*) FROM runs") == 0
 
 
 def _rows(board: dict[str, Any]) -> list[tuple[Any, ...]]:
@@ -94,8 +89,8 @@ def test_a_raced_run_says_what_it_dropped_in_every_view(
     assert zeror["dropped"]["leader"] == board["baseline"]
     assert all(row["dropped"] is None for row in board["leaderboard"] if row is not zeror)
     # the stored run: 3 + 5 + 5 results, one drop record
-    assert _scalar(store_url, "SELECT count(*) FROM fold_results") == 13
-    assert _scalar(store_url, "SELECT after_fold FROM entry_drops") == 3
+    assert scalar(store_url, "SELECT count(*) FROM fold_results") == 13
+    assert scalar(store_url, "SELECT after_fold FROM entry_drops") == 3
     markdown = run_cli(capsys, store_url, "leaderboard", "1", "-f", "markdown").out
     assert "zeror (dropped after fold 3 (p " in markdown and "raced at alpha 0.01" in markdown
     csv = run_cli(capsys, store_url, "leaderboard", "1", "-f", "csv").out
@@ -109,7 +104,7 @@ def test_a_raced_run_says_what_it_dropped_in_every_view(
 
 
 def _execute(url: str, statement: str) -> None:
-    engine = _engine(url)
+    engine = store_engine(url)
     try:
         with engine.begin() as connection:
             connection.execute(text(statement))
@@ -144,7 +139,7 @@ def test_a_budget_that_fits_cuts_nothing_and_a_resume_gets_what_is_left(
     budget = resumed.json()["budget"]
     assert budget["cut"] == ["nb"] and budget["tasks_not_run"] == 3
     assert budget["minutes_spent"] >= 60
-    assert _scalar(store_url, "SELECT count(*) FROM fold_results") == 3
+    assert scalar(store_url, "SELECT count(*) FROM fold_results") == 3
     listed = run_cli(capsys, store_url, "runs", "--json").json()["runs"][0]
     assert (listed["tasks_done"], listed["tasks_dropped"], listed["tasks"]) == (3, 3, 6)
     assert "3 done, 3 dropped / 6" in run_cli(capsys, store_url, "runs").out
@@ -160,15 +155,15 @@ def test_a_race_interrupted_by_ctrl_c_resumes_to_the_uninterrupted_leaderboard(
     run_cli(capsys, store_url, "import", str(path), "--name", "touch")
     args = ["touch", "-c", "gate,nb,j48", *RACE, "-j", "1"]
     gate = Gate(tmp_path / "gate")
-    child = _bench_process(store_url, gate, *args)
+    child = bench_process(store_url, gate, *args)
     gate.let_through(2)
-    _wait_for_results(store_url, child, 6)  # two rounds of three
+    wait_for_results(store_url, child, 6)  # two rounds of three
     gate.wait_started(3)
     child.send_signal(signal.SIGINT)
     _, err = child.communicate(timeout=60)
     assert child.returncode == 130, err.decode()
-    assert _scalar(store_url, "SELECT status FROM runs WHERE id = 1") == "interrupted"
-    stored = _scalar(store_url, "SELECT count(*) FROM fold_results")
+    assert scalar(store_url, "SELECT status FROM runs WHERE id = 1") == "interrupted"
+    stored = scalar(store_url, "SELECT count(*) FROM fold_results")
     assert 6 <= stored < 9
     gate.open()
     environment = {**os.environ, **gate.environment()}
@@ -205,4 +200,4 @@ def test_a_race_on_data_that_allow_fewer_folds_is_refused_before_it_exists(
         "touchbench: error: --race: needs at least 3 folds in all, and the data allow 2 (the "
         "smallest class has only 2 instance(s): using 2 folds instead of 3)"
     )
-    assert _scalar(store_url, "SELECT count(*) FROM runs") == 0
+    assert scalar(store_url, "SELECT count(*) FROM runs") == 0

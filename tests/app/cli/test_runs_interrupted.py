@@ -10,15 +10,14 @@ import pickle
 import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
-from typing import Any
 
 import pytest
 from sqlalchemy import create_engine, event, text
 
 from tests.support.cli_runner import run_cli
 from tests.support.gate import Gate
+from tests.support.processes import bench_process, scalar, store_engine, wait_for_results
 from tests.support.synthetic import touch_arff
 from touchbench.app.store.database import Store
 from touchbench.app.store.models import list_models
@@ -26,50 +25,9 @@ from touchbench.app.store.models import list_models
 ROOT = Path(__file__).resolve().parents[3]
 
 
-def _engine(url: str) -> Any:
-    return create_engine(url.replace("postgresql://", "postgresql+psycopg://", 1))
-
-
-def _scalar(url: str, query: str) -> Any:
-    engine = _engine(url)
-    try:
-        with engine.connect() as connection:
-            return connection.execute(text(query)).scalar()
-    finally:
-        engine.dispose()
-
-
 def _import(capsys: pytest.CaptureFixture[str], url: str, path: Path, name: str) -> None:
     result = run_cli(capsys, url, "import", str(path), "--name", name)
     assert result.code == 0, result.err
-
-
-def _bench_process(
-    url: str, gate: Gate, *args: str, ignore_sigint: bool = False
-) -> subprocess.Popen[bytes]:
-    """``touchbench bench`` in a subprocess that knows the ``gate`` entry; with
-    ``ignore_sigint`` it starts as a background job of a script does, SIGINT ignored."""
-    command = [sys.executable, "-m", "touchbench.app.cli.main", "--db", url, "bench", *args]
-
-    def ignore() -> None:
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-
-    return subprocess.Popen(
-        command,
-        cwd=ROOT,
-        env={**os.environ, **gate.environment()},
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.PIPE,
-        preexec_fn=ignore if ignore_sigint else None,
-    )
-
-
-def _wait_for_results(url: str, child: subprocess.Popen[bytes], at_least: int) -> None:
-    deadline = time.monotonic() + 120
-    while (_scalar(url, "SELECT count(*) FROM fold_results") or 0) < at_least:
-        assert child.poll() is None, child.stderr.read().decode() if child.stderr else ""
-        assert time.monotonic() < deadline, "the run recorded nothing in two minutes"
-        time.sleep(0.05)
 
 
 #: 10 tasks of the gate entry: each fit waits until the test lets it through.
@@ -100,9 +58,9 @@ def test_an_interrupt_keeps_the_folds_and_resume_finishes(
 ) -> None:
     _import(capsys, store_url, touch_arff(tmp_path / "t.arff", n=300), "touch")
     gate = Gate(tmp_path / "gate")
-    child = _bench_process(store_url, gate, "touch", *GATED, ignore_sigint=ignore_sigint)
+    child = bench_process(store_url, gate, "touch", *GATED, ignore_sigint=ignore_sigint)
     gate.let_through(3)
-    _wait_for_results(store_url, child, 3)
+    wait_for_results(store_url, child, 3)
     gate.wait_started(4)  # the fourth task waits at the gate: the signal comes mid-task
     child.send_signal(sig)
     _, err = child.communicate(timeout=60)
@@ -110,8 +68,8 @@ def test_an_interrupt_keeps_the_folds_and_resume_finishes(
     assert child.returncode == code, message
     assert "run 1 interrupted" in message and "touchbench bench --resume 1" in message
     assert "Traceback" not in message
-    assert _scalar(store_url, "SELECT status FROM runs WHERE id = 1") == "interrupted"
-    assert _scalar(store_url, "SELECT count(*) FROM fold_results") == 3
+    assert scalar(store_url, "SELECT status FROM runs WHERE id = 1") == "interrupted"
+    assert scalar(store_url, "SELECT count(*) FROM fold_results") == 3
     assert "3 of 10 tasks are stored" in message
     gate.open()
     resumed = subprocess.run(
@@ -131,8 +89,8 @@ def test_an_interrupt_keeps_the_folds_and_resume_finishes(
         timeout=300,
     )
     assert resumed.returncode == 0, resumed.stderr.decode()
-    assert _scalar(store_url, "SELECT status FROM runs WHERE id = 1") == "done"
-    assert _scalar(store_url, "SELECT count(*) FROM fold_results") == 10
+    assert scalar(store_url, "SELECT status FROM runs WHERE id = 1") == "done"
+    assert scalar(store_url, "SELECT count(*) FROM fold_results") == 10
 
 
 def test_a_run_whose_every_task_fails_is_failed_and_says_why(
@@ -175,10 +133,10 @@ def test_a_running_run_is_not_resumed_twice_and_can_be_cancelled(
 ) -> None:
     _import(capsys, store_url, touch_arff(tmp_path / "t.arff", n=300), "touch")
     gate = Gate(tmp_path / "gate")
-    child = _bench_process(store_url, gate, "touch", *GATED)
+    child = bench_process(store_url, gate, "touch", *GATED)
     try:
         gate.let_through(2)
-        _wait_for_results(store_url, child, 2)
+        wait_for_results(store_url, child, 2)
         gate.wait_started(3)
         second = run_cli(capsys, store_url, "bench", "--resume", "1")
         assert second.code == 2
@@ -191,7 +149,7 @@ def test_a_running_run_is_not_resumed_twice_and_can_be_cancelled(
             child.kill()
     assert child.returncode == 1, err.decode()
     assert "run 1 cancelled: 2 of 10 tasks are stored" in err.decode()
-    assert _scalar(store_url, "SELECT status FROM runs WHERE id = 1") == "cancelled"
+    assert scalar(store_url, "SELECT status FROM runs WHERE id = 1") == "cancelled"
     again = run_cli(capsys, store_url, "cancel", "1")
     assert again.code == 2 and "already cancelled" in again.err
 
@@ -260,7 +218,7 @@ def test_a_crafted_artifact_with_a_matching_digest_runs_nothing(
     assert trained.code == 0, trained.err
     marker = tmp_path / "pwned"
     crafted = pickle.dumps(_Touch(marker))
-    engine = _engine(store_url)
+    engine = store_engine(store_url)
     with engine.begin() as connection:
         connection.execute(text("UPDATE model_artifacts SET artifact = :a"), {"a": crafted})
         connection.execute(
@@ -369,8 +327,8 @@ def test_an_old_store_migrates_and_finished_runs_become_done(tmp_path: Path) -> 
     engine.dispose()
     store = Store(url)
     try:
-        assert _scalar(url, "SELECT status FROM runs") == "done"
-        assert _scalar(url, "SELECT version_num FROM alembic_version") == HEAD_REVISION
+        assert scalar(url, "SELECT status FROM runs") == "done"
+        assert scalar(url, "SELECT version_num FROM alembic_version") == HEAD_REVISION
     finally:
         store.dispose()
 
@@ -440,7 +398,7 @@ def test_processes_opening_a_new_store_at_once_migrate_it_once(store_url: str) -
     results = [(p.wait(120), *p.communicate()) for p in processes]
     assert [code for code, _, _ in results] == [0, 0, 0, 0], results
     assert all(json.loads(out) == {"datasets": []} for _, out, _ in results)
-    assert _scalar(store_url, "SELECT count(*) FROM alembic_version") == 1
+    assert scalar(store_url, "SELECT count(*) FROM alembic_version") == 1
 
 
 def test_weka_command_lines_run_and_export_as_weka_wrote_them(

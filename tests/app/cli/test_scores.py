@@ -13,48 +13,14 @@ import pytest
 from sqlalchemy import create_engine, text
 
 from tests.support.cli_runner import run_cli
+from tests.support.recordings import PER_RECORDING, recorded_windows, store_dataset
 from tests.support.synthetic import touch_arff
-from touchbench.app.store.database import Store
-from touchbench.app.store.datasets import add_dataset
-from touchbench.benchmark.dataset import Attribute, Dataset, Schema
-
-PER_RECORDING = "scored per recording: each test recording's windows pooled"
-
-
-def recorded_windows(*, recordings: int = 16, windows: int = 16, mixed: bool = False) -> Dataset:
-    """Windows whose one feature is their recording's class plus noise as large as the
-    gap between classes: a window is often wrong, the mean of a recording's windows rarely.
-
-    ``mixed``: one recording holds windows of both classes.
-    """
-    rng = np.random.default_rng(5)
-    label = np.repeat(np.arange(recordings) % 2, windows)
-    noise = rng.normal(scale=0.8, size=(label.size, 2))
-    values = np.column_stack([label, label + noise[:, 0], noise[:, 1]]).astype(float)
-    if mixed:
-        values[1, 0] = 1 - values[1, 0]
-    target = Attribute("gesture", "nominal", ("tap", "press"))
-    schema = Schema(
-        relation="takes",
-        attributes=(target, Attribute("level", "numeric"), Attribute("hum", "numeric")),
-        target_indices=(0,),
-    )
-    groups = np.array([f"take{i:02d}.wav" for i in np.repeat(np.arange(recordings), windows)])
-    return Dataset(schema=schema, values=values, groups=groups.astype(object))
-
-
-def _add(url: str, dataset: Dataset, name: str) -> None:
-    store = Store(url)
-    try:
-        add_dataset(store, dataset, sha256=name[0] * 64, name=name)
-    finally:
-        store.dispose()
 
 
 def test_per_recording_scores_and_never_started_classifiers_in_every_view(
     capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
 ) -> None:
-    _add(store_url, recorded_windows(), "takes")
+    store_dataset(store_url, recorded_windows(), "takes")
     bench = run_cli(
         capsys, store_url, "bench", "takes", "-c", "nb,ridge,zeror", "-k", "4",
         "--aggregate", "recording", "--json",
@@ -110,7 +76,7 @@ def test_per_recording_scores_are_refused_where_they_mean_nothing(
     capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
 ) -> None:
     run_cli(capsys, store_url, "import", str(touch_arff(tmp_path / "t.arff")), "--name", "touch")
-    _add(store_url, recorded_windows(mixed=True), "mixed")
+    store_dataset(store_url, recorded_windows(mixed=True), "mixed")
     for name, words in (
         ("touch", "--aggregate: needs windows grouped by recording, and data set 'touch' has"),
         ("mixed", "--aggregate: 1 recording(s) hold windows of several values of 'gesture'"),

@@ -16,8 +16,8 @@ from pathlib import Path
 
 import pytest
 
-from tests.app.cli.test_datasets_bad_input import one_error_line, stored_names
-from tests.support.cli_runner import run_cli
+from tests.support.cli_runner import one_error_line, run_cli
+from tests.support.rows import stored_names
 from tests.support.service import ROOT, free_port
 from tests.support.synthetic import touch_arff
 

@@ -8,7 +8,7 @@ from typing import Any
 import pytest
 from sqlalchemy import update
 
-from tests.app.store.test_round_trips import small_dataset
+from tests.support.synthetic import small_dataset
 from touchbench.app.schemas.run_config import RunConfig
 from touchbench.app.schemas.status import Status
 from touchbench.app.services.runs import RunOptions, execute_run, run_leaderboard

@@ -6,31 +6,15 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 from tests.support.cli_runner import run_cli
-from tests.support.synthetic import touch_arff
+from tests.support.synthetic import mics_arff, touch_arff
 from touchbench.app.schemas.importance import ImportanceRequest
 from touchbench.app.services.answers import latest_ablation
 from touchbench.app.services.jobs import execute_job, submit_answer
 from touchbench.app.store.database import Store
 from touchbench.app.store.jobs import list_jobs
-
-
-def mics_arff(path: Path, *, n: int = 90, seed: int = 0) -> Path:
-    """Microphone 1 hears the gesture (level_1), microphone 2 only noise."""
-    rng = np.random.default_rng(seed)
-    y = np.arange(n) % 3
-    lines = ["@relation mics"]
-    lines += [f"@attribute {name} numeric" for name in ("level_1", "snr_1", "level_2", "snr_2")]
-    lines += ["@attribute gesture {tap,slap,stroke}", "@data"]
-    for label in y:
-        level, *noise = label + rng.normal(scale=0.2), *rng.normal(size=3)
-        values = ",".join(f"{v:.4f}" for v in (level, noise[0], noise[1], noise[2]))
-        lines.append(f"{values},{('tap', 'slap', 'stroke')[label]}")
-    path.write_text("\n".join(lines) + "\n")
-    return path
 
 
 @pytest.fixture

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from tests.benchmark.test_statistics import DEMSAR_AUC, DEMSAR_NAMES
 from tests.support.cli_runner import run_cli
+from tests.support.demsar import DEMSAR_AUC, DEMSAR_NAMES
 from tests.support.synthetic import touch_arff
 from touchbench.app.errors import NotFoundError
 from touchbench.app.schemas.run_config import RunConfig

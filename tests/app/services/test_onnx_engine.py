@@ -17,9 +17,8 @@ import onnxruntime
 import pytest
 from sqlalchemy import create_engine, text
 
-from tests.app.api.test_bench_request import CLI_WORDS
-from tests.app.api.test_live import _pcm_blocks, _stream, _ws_url
-from tests.support.cli_runner import run_cli
+from tests.support.cli_runner import CLI_WORDS, run_cli
+from tests.support.live import pcm_blocks, stream, ws_url
 from tests.support.rows import count_rows
 from tests.support.service import Server, finished, servers
 from touchbench.app.schemas.extraction import ExtractRequest
@@ -218,16 +217,16 @@ def test_the_service_serves_the_graph_and_predicts_with_the_engine_asked(
         assert not CLI_WORDS.search(refused.json()["error"]["message"]), refused.text
 
     # the live WebSocket, with each engine, on the same samples
-    rate, channels, blocks = _pcm_blocks(unseen)
+    rate, channels, blocks = pcm_blocks(unseen)
     labels = {}
     for engine in ("native", "onnx"):
         header = {"samplerate": rate, "channels": channels, "format": "S16LE", "engine": engine}
-        messages, code, reason = _stream(_ws_url(server, "touch-rf"), header, blocks)
+        messages, code, reason = stream(ws_url(server, "touch-rf"), header, blocks)
         assert (code, reason) == (1000, "stream ended")
         labels[engine] = [m["predictions"]["gesture"]["value"] for m in messages]
     assert len(labels["onnx"]) == 4 and labels["onnx"] == labels["native"]
     header = {"samplerate": rate, "channels": channels, "engine": "fast"}
-    _, code, reason = _stream(_ws_url(server, "touch-rf"), header, [])
+    _, code, reason = stream(ws_url(server, "touch-rf"), header, [])
     assert (code, reason) == (1007, "header: 'engine' must be auto, onnx or native")
 
 

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tests.app.cli.test_datasets import TOUCH_ARFF
+from tests.support.synthetic import TOUCH_ARFF
 from touchbench.app.errors import AppError
 from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import DatasetInMemory, add_dataset_stream

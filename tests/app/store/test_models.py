@@ -10,7 +10,7 @@ from typing import Any
 import pytest
 from sqlalchemy import create_engine, func, select, text
 
-from tests.app.store.test_round_trips import _alembic
+from tests.support.stores import alembic
 from touchbench.app.errors import NotFoundError
 from touchbench.app.store.aliases import rollback_alias
 from touchbench.app.store.database import Store
@@ -77,7 +77,7 @@ def test_artifacts_move_to_their_own_table_and_back(store_url: str) -> None:
     blobs = {1: os.urandom(200_000), 2: b"small"}
     engine = create_engine(url)
     with engine.begin() as connection:
-        _alembic(connection, "upgrade", "0004")
+        alembic(connection, "upgrade", "0004")
         for model_id, blob in blobs.items():
             connection.execute(
                 text(
@@ -102,7 +102,7 @@ def test_artifacts_move_to_their_own_table_and_back(store_url: str) -> None:
     finally:
         store.dispose()
     with engine.begin() as connection:
-        _alembic(connection, "downgrade", "0004")
+        alembic(connection, "downgrade", "0004")
         back = dict(connection.execute(text("SELECT id, artifact FROM models")).all())
     engine.dispose()
     assert {key: bytes(value) for key, value in back.items()} == blobs
@@ -167,7 +167,7 @@ def test_the_registry_moves_under_registered_models_and_back(store_url: str) -> 
     url = store_url.replace("postgresql://", "postgresql+psycopg://", 1)
     engine = create_engine(url)
     with engine.begin() as connection:
-        _alembic(connection, "upgrade", "0010")
+        alembic(connection, "upgrade", "0010")
         blobs = _old_registry(connection)
     store = Store(store_url)
     try:
@@ -198,7 +198,7 @@ def test_the_registry_moves_under_registered_models_and_back(store_url: str) -> 
     finally:
         store.dispose()
     with engine.begin() as connection:
-        _alembic(connection, "downgrade", "0010")
+        alembic(connection, "downgrade", "0010")
         rows = connection.execute(text("SELECT id, name, version FROM models ORDER BY id")).all()
         aliases = connection.execute(text("SELECT name, alias, version FROM model_aliases")).all()
         history = connection.execute(

@@ -12,6 +12,8 @@ import numpy as np
 import pytest
 from sqlalchemy import func, select
 
+from tests.support.stores import alembic
+from tests.support.synthetic import small_dataset
 from touchbench.app.errors import AppError, NotFoundError
 from touchbench.app.store import datasets as store_datasets
 from touchbench.app.store.database import Store
@@ -25,34 +27,6 @@ from touchbench.app.store.datasets import (
 from touchbench.app.store.listing import COLUMNS, count_datasets, list_datasets
 from touchbench.app.store.reading import SQLiteFile, sqlite_file
 from touchbench.app.store.tables import DatasetRow, InstanceBlockRow, InstanceRow
-from touchbench.benchmark.dataset import Attribute, Dataset, Schema
-
-
-def small_dataset(n: int = 7, relation: str = "touch: -C 1") -> Dataset:
-    schema = Schema(
-        relation=relation,
-        attributes=(
-            Attribute("gesture", "nominal", ("tap", "slap", "stroke")),
-            Attribute("energy", "numeric", declared_type="real"),
-            Attribute("count", "numeric", declared_type="integer"),
-            Attribute("note", "string", ("first", "second")),
-            Attribute("when", "date"),
-        ),
-        target_indices=(0,),
-    )
-    rng = np.random.default_rng(0)
-    values = np.column_stack(
-        [
-            np.arange(n) % 3,
-            rng.normal(size=n),
-            np.arange(n) * 10,
-            np.arange(n) % 2,
-            1.7e9 + np.arange(n) * 60,
-        ]
-    ).astype(float)
-    values[2, 1] = np.nan
-    values[4, 0] = np.nan
-    return Dataset(schema=schema, values=values)
 
 
 def count_rows(store: Store) -> tuple[int, int, int]:
@@ -187,18 +161,6 @@ def test_a_fresh_store_is_migrated_to_head(store: Store) -> None:
     assert store.revision() == HEAD_REVISION
 
 
-def _alembic(connection: Any, action: str, revision: str) -> None:
-    from alembic import command
-    from alembic.config import Config
-
-    from touchbench.app.store.database import MIGRATIONS
-
-    config = Config()
-    config.set_main_option("script_location", str(MIGRATIONS))
-    config.attributes["connection"] = connection
-    getattr(command, action)(config, revision)
-
-
 def test_instances_stored_one_a_row_move_into_blocks_and_back(store_url: str) -> None:
     """A store of revision 0003 (one row per instance) migrates to blocks; downgraded, it has
     its rows back as they were."""
@@ -219,7 +181,7 @@ def test_instances_stored_one_a_row_move_into_blocks_and_back(store_url: str) ->
     ]
     engine = create_engine(store_url)
     with engine.begin() as connection:
-        _alembic(connection, "upgrade", "0003")
+        alembic(connection, "upgrade", "0003")
         connection.execute(
             text(
                 "INSERT INTO datasets (id, name, relation, schema, target_names, n_instances, "
@@ -246,7 +208,7 @@ def test_instances_stored_one_a_row_move_into_blocks_and_back(store_url: str) ->
     finally:
         store.dispose()
     with engine.begin() as connection:
-        _alembic(connection, "downgrade", "0003")
+        alembic(connection, "downgrade", "0003")
         back = connection.execute(
             text("SELECT position, data, weight, group_id FROM instances ORDER BY position")
         ).all()

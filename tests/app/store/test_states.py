@@ -13,7 +13,7 @@ import grimp
 import pytest
 
 import touchbench.app
-from tests.app.store.test_round_trips import small_dataset
+from tests.support.synthetic import small_dataset
 from touchbench.app.errors import ConflictError
 from touchbench.app.schemas.run_config import RunConfig
 from touchbench.app.schemas.status import Status

@@ -16,9 +16,8 @@ from typing import Any
 import pytest
 from playwright.sync_api import Response, expect
 
-from tests.app.api.test_trust import cancelled_run
 from tests.support.browser import Tab
-from tests.support.service import Server
+from tests.support.service import Server, cancelled_run
 from tests.support.synthetic import touch_arff
 
 #: The attacker's page: it sends what a browser sends without asking (no-cors requests and
