@@ -49,8 +49,7 @@ import soundfile
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from tests.support.ros_peer import Peer
-from tests.support.ros_peer import rosmaster
+from tests.support.ros_peer import Peer, rosmaster
 from touchbench.app.schemas.extraction import ExtractRequest
 from touchbench.app.schemas.models import Engine, ExportRequest, TrainRequest
 from touchbench.app.services.export import export_model
