@@ -12,6 +12,7 @@ sent again, and an error answer (4xx, 5xx) is never retried.
 from __future__ import annotations
 
 import contextlib
+import json as jsonlib
 import math
 import os
 import time
@@ -383,12 +384,9 @@ class Client:
                 files=lambda stack: [("file", _opened(stack, file))],
             )
         else:
-            body: dict[str, Any] = {"instances": _records(instances)}
-            if missing is not None:
-                body["missing"] = missing
-            if engine is not None:
-                body["engine"] = engine
-            response = self._send("POST", f"/api/models/{ref}/predict", json=body)
+            options = {k: v for k, v in (("missing", missing), ("engine", engine)) if v is not None}
+            body = _instances_json(instances, options)
+            response = self._send("POST", f"/api/models/{ref}/predict", content=body)
         return PredictionReport.model_validate(response.json())
 
     # --- jobs -----------------------------------------------------------------------
@@ -416,12 +414,15 @@ class Client:
         *,
         params: Mapping[str, Any] | None = None,
         json: Any = None,
+        content: bytes | None = None,
         data: Mapping[str, Any] | None = None,
         files: Callable[[contextlib.ExitStack], Files] | None = None,
     ) -> httpx.Response:
         """One request, retried as the module says; an error answer raised as its
-        :class:`~app.python.errors.ServiceError`.  ``files`` opens the uploads afresh for
-        each attempt (an attempt may have read them)."""
+        :class:`~app.python.errors.ServiceError`.  ``content`` is a JSON body already
+        encoded; ``files`` opens the uploads afresh for each attempt (an attempt may have
+        read them)."""
+        headers = {"content-type": "application/json"} if content is not None else None
         attempt = 0
         while True:
             try:
@@ -431,6 +432,8 @@ class Client:
                         path,
                         params=params,
                         json=json,
+                        content=content,
+                        headers=headers,
                         data=data,
                         files=files(stack) if files is not None else None,
                     )
@@ -500,6 +503,25 @@ def _opened(stack: contextlib.ExitStack, path: Path) -> tuple[str, Any, str]:
     """The upload of ``path`` under its own name (a missing file: FileNotFoundError, before
     anything is sent)."""
     return (path.name, stack.enter_context(path.open("rb")), "application/octet-stream")
+
+
+def _instances_json(
+    instances: pd.DataFrame | Sequence[Mapping[str, Any]] | Mapping[str, Any],
+    options: Mapping[str, Any],
+) -> bytes:
+    """A prediction's JSON body.  Rows of plain values are encoded as they are, by the
+    json module's C encoder in one call; anything else (a DataFrame, NaN, numpy scalars)
+    goes through :func:`_records` first."""
+    if isinstance(instances, list | tuple):
+        try:
+            return _dumps({"instances": instances, **options})
+        except (TypeError, ValueError):  # NaN or values JSON lacks: converted below
+            pass
+    return _dumps({"instances": _records(instances), **options})
+
+
+def _dumps(body: Any) -> bytes:
+    return jsonlib.dumps(body, allow_nan=False, separators=(",", ":")).encode()
 
 
 def _records(
