@@ -5,7 +5,7 @@ wait for it to finish with a progress bar (tqdm: in Jupyter and in a terminal)."
 from __future__ import annotations
 
 import time
-from typing import TYPE_CHECKING, Any, Generic, Self, TypeVar
+from typing import TYPE_CHECKING, Any, Generic, Protocol, Self, TypeVar
 
 from touchbench.app.python.errors import ServiceError, WaitTimeoutError
 from touchbench.app.schemas.jobs import JobSchema
@@ -14,7 +14,6 @@ from touchbench.app.schemas.runs import RunSchema
 from touchbench.app.schemas.status import FINAL, Status
 
 if TYPE_CHECKING:
-    from touchbench.app.python.client import Client
     from touchbench.app.python.leaderboard import Leaderboard
 
 #: Longest pause between two polls, in seconds (the first ones are shorter: quick work
@@ -25,13 +24,32 @@ _FIRST_POLL = 0.05
 S = TypeVar("S", RunSchema, JobSchema)
 
 
+class Service(Protocol):
+    """What a run or a job asks of the client that made it (:class:`app.python.client.Client`,
+    which imports this module)."""
+
+    def run(self, run: int, /) -> Run: ...
+
+    def job(self, job: int, /) -> Job: ...
+
+    def cancel(self, run: int, /) -> Run: ...
+
+    def cancel_job(self, job: int, /) -> Job: ...
+
+    def model(self, model: str | int, /) -> ModelSchema: ...
+
+    def leaderboard(
+        self, run: int, /, *, metric: str | None = None, baseline: str | None = None
+    ) -> Leaderboard: ...
+
+
 class Work(Generic[S]):
     """A run or a job: its response model, refreshed from the service on request."""
 
     #: What the progress bar counts.
     unit = "task"
 
-    def __init__(self, client: Client, schema: S) -> None:
+    def __init__(self, client: Service, schema: S) -> None:
         self._client = client
         self.schema: S = schema
 

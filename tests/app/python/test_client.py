@@ -16,9 +16,9 @@ import pytest
 from matplotlib.figure import Figure
 
 import touchbench
-from tests.app.api.conftest import Server, _servers
-from tests.app.cli_runner import run_cli
-from tests.app.synthetic import touch_arff
+from tests.support.cli_runner import run_cli
+from tests.support.service import Server, servers
+from tests.support.synthetic import touch_arff
 from touchbench.app.python import errors
 from touchbench.app.python.client import Client, _HttpSource
 from touchbench.app.python.sources import stored_leaderboard
@@ -34,7 +34,7 @@ READ = "client-test-read-key-0123456789"
 def server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
     """One service for the module (SQLite), a write and a read-only key."""
     folder = tmp_path_factory.mktemp("client")
-    builds = _servers(f"sqlite:///{folder / 'touchbench.db'}", folder)
+    builds = servers(f"sqlite:///{folder / 'touchbench.db'}", folder)
     build = next(builds)
     yield build(api_keys=f"lab:write:{WRITE},robot:read:{READ}")
     next(builds, None)  # stops it

@@ -11,8 +11,8 @@ from typing import Any
 import pytest
 from matplotlib.figure import Figure
 
-from tests.app.cli_runner import run_cli
-from tests.app.synthetic import touch_arff
+from tests.support.cli_runner import run_cli
+from tests.support.synthetic import touch_arff
 from touchbench.app.errors import AppError
 from touchbench.app.python.leaderboard import Leaderboard
 from touchbench.app.python.sources import StoreSource, stored_leaderboard
