@@ -17,6 +17,7 @@ from touchbench.app.api.deps import PageDep, ServiceDep, StoreDep, paginate
 from touchbench.app.api.uploads import form_request, save_upload
 from touchbench.app.schemas.ablation import AblationResult
 from touchbench.app.schemas.certainty import RunCertainty
+from touchbench.app.schemas.folds import FoldScoresSchema
 from touchbench.app.schemas.imported import ImportResultsRequest
 from touchbench.app.schemas.runs import (
     BenchRequest,
@@ -27,6 +28,7 @@ from touchbench.app.schemas.runs import (
 )
 from touchbench.app.services.answers import latest_ablation
 from touchbench.app.services.certainty import run_certainty
+from touchbench.app.services.folds import run_fold_scores
 from touchbench.app.services.imported import import_results
 from touchbench.app.services.lifecycle import (
     cancel_run,
@@ -161,6 +163,18 @@ def classes(run_id: int, store: StoreDep, classifier: ClassifiersQuery = None) -
     """Per-class precision, recall and F1, confusion matrices (summed over folds) per
     target, and out-of-fold calibration of each classifier (``touchbench classes --json``)."""
     return run_certainty(store, run_id, classifiers=_classifiers(classifier))
+
+
+@router.get("/{run_id}/folds", response_model=FoldScoresSchema)
+def folds(
+    run_id: int,
+    store: StoreDep,
+    metric: Annotated[str | None, Query(max_length=100)] = None,
+    alpha: Annotated[float, Query(gt=0, lt=1)] = 0.05,
+) -> FoldScoresSchema:
+    """Every fold's score of every classifier, and their ranks over the folds (Friedman,
+    Nemenyi's critical difference): what ``plot --kind folds`` and ``--kind cd`` draw."""
+    return run_fold_scores(store, run_id, metric=metric, alpha=alpha)
 
 
 @router.get("/{run_id}/ablation", response_model=AblationResult)
