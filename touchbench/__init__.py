@@ -8,5 +8,40 @@ folders and install as its subpackages:
 ``touchbench.benchmark``  data sets, ARFF/CSV, the catalogue, cross-validation, statistics
 ``touchbench.app``        the store, the services, the CLI, the REST service, the web page
 
-Importing ``touchbench`` itself imports none of them.
+Importing ``touchbench`` itself imports none of them.  Its Python API (``touchbench.bench``,
+``.extract``, ``.train``, ``.Leaderboard``, ``.Client``: :mod:`touchbench.app.python`) is
+imported when first used.
 """
+
+from __future__ import annotations
+
+from typing import Any
+
+#: The Python API, loaded when first used (``import touchbench`` stays cheap): name -> module.
+#: No import of them here, not even for type checkers: every part of touchbench imports
+#: this package, and the adapters must not import each other through it.
+_LAZY = {
+    "bench": "touchbench.app.python.api",
+    "extract": "touchbench.app.python.api",
+    "train": "touchbench.app.python.api",
+    "Leaderboard": "touchbench.app.python.leaderboard",
+    "Client": "touchbench.app.python.client",
+}
+
+__all__ = ["Client", "Leaderboard", "bench", "extract", "train"]
+
+
+def __getattr__(name: str) -> Any:
+    """``touchbench.bench`` and the rest of the Python API, imported on first use."""
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'touchbench' has no attribute '{name}'")
+    import importlib
+
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted([*globals(), *_LAZY])
