@@ -15,8 +15,6 @@ from touchbench.app.store.database import Store
 StoreLike = Store | str | Path | None
 
 _temporary: Store | None = None
-#: The stores opened by URL, kept open for the leaderboards and models made in them.
-_opened: dict[str, Store] = {}
 
 
 def store_url(store: str | Path) -> str:
@@ -34,10 +32,9 @@ def open_store(store: StoreLike) -> Store:
     if isinstance(store, Store):
         return store
     if store is not None:
-        url = store_url(store)
-        if url not in _opened:
-            _opened[url] = Store(url)
-        return _opened[url]
+        # opened afresh on each call (the leaderboards and models made keep theirs): a
+        # store its owner replaced meanwhile is seen as it now is
+        return Store(store_url(store))
     if _temporary is None:
         folder = tempfile.mkdtemp(prefix="touchbench-")
         _temporary = Store(f"sqlite:///{folder}/touchbench.db")
