@@ -8,9 +8,9 @@ folders and install as its subpackages:
 ``touchbench.benchmark``  data sets, ARFF/CSV, the catalogue, cross-validation, statistics
 ``touchbench.app``        the store, the services, the CLI, the REST service, the web page
 
-Importing ``touchbench`` itself imports none of them.  Its Python API (``touchbench.bench``,
-``.extract``, ``.train``, ``.Leaderboard``, ``.Client``: :mod:`touchbench.app.python`) is
-imported when first used.
+Importing ``touchbench`` itself imports none of them.  Its Python API
+(:mod:`touchbench.app.python`: ``touchbench.bench``, ``.extract``, ``.train``,
+``.simulate``, ``.Leaderboard``, ``.Client``) is imported when first used.
 """
 
 from __future__ import annotations
@@ -24,11 +24,12 @@ _LAZY = {
     "bench": "touchbench.app.python.api",
     "extract": "touchbench.app.python.api",
     "train": "touchbench.app.python.api",
+    "simulate": "touchbench.app.python.api",
     "Leaderboard": "touchbench.app.python.leaderboard",
     "Client": "touchbench.app.python.client",
 }
 
-__all__ = ["Client", "Leaderboard", "bench", "extract", "train"]
+__all__ = ["Client", "Leaderboard", "bench", "extract", "simulate", "train"]
 
 
 def __getattr__(name: str) -> Any:

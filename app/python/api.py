@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal
 
 from pydantic import ValidationError
 
@@ -177,6 +177,49 @@ def extract(
     return frame
 
 
+def simulate(
+    out: str | Path,
+    sensor: Literal["contact-mic", "oscillating-link"] = "contact-mic",
+    *,
+    trials: int = 3,
+    seed: int = 0,
+    touches: int = 16,
+) -> tuple[list[Path], Path]:
+    """Write simulated recordings and their labels CSV, as ``touchbench simulate`` does.
+
+    Parameters
+    ----------
+    out : path
+        The folder (made if missing).
+    sensor : {"contact-mic", "oscillating-link"}
+        Sessions of taps and strokes on three contact microphones (extract them with
+        ``extractor="uc3m-audio"``), or trials of a shaken link with an accelerometer
+        (``extractor="band-peaks"``).
+    trials : int
+        Sessions or trials.
+    seed : int
+        Seed of every random draw.
+    touches : int
+        Touches per contact-microphone session.
+
+    Returns
+    -------
+    recordings : list of Path
+    labels : Path
+    """
+    from touchbench.app.services.simulation import write_contact_mic_sessions, write_link_trials
+
+    if trials < 1:
+        raise FieldError("trials", f"must be at least 1, got {trials}")
+    if sensor == "contact-mic":
+        if touches < 1:
+            raise FieldError("touches", f"must be at least 1, got {touches}")
+        return write_contact_mic_sessions(Path(out), trials=trials, seed=seed, n_touches=touches)
+    if sensor == "oscillating-link":
+        return write_link_trials(Path(out), trials=trials, seed=seed)
+    raise FieldError("sensor", f"must be contact-mic or oscillating-link, got '{sensor}'")
+
+
 def train(
     data: Any = None,
     *,
@@ -189,21 +232,43 @@ def train(
     store: StoreLike = None,
 ) -> Model:
     """Fit a classifier on every row of ``data`` and keep it as a model, as ``touchbench
-    train`` does; or, with a :class:`Leaderboard` as ``data``, its run's best classifier.
+    train`` does; or, with a :class:`Leaderboard` as ``data``, its run's best classifier
+    (or ``classifier``, one of its rows) on the run's data set.
 
     Parameters
     ----------
     data : DataFrame, (X, y), path, stored name or Leaderboard
+        As :func:`bench` takes it.
+    target, groups, ignore, store
+        As :func:`bench` takes them.
     classifier : str, optional
-        A catalogue id (required unless ``data`` is a leaderboard).
+        A catalogue id (required unless ``data`` is a leaderboard).  Estimators of the
+        caller's own are benchmarked, not trained: models are kept in a format that runs
+        no code, which knows the catalogue's classifiers only.
+    name : str, optional
+        The model's name (default ``DATASET-CLASSIFIER``); each call adds a version.
+    seed : int
+        Seed of the classifier.
 
     Returns
     -------
     Model
     """
-    if isinstance(data, Leaderboard):
+    if isinstance(data, Leaderboard) and classifier is None:
         opened = open_store(store if store is not None else _leaderboard_store(data))
         request = _request(TrainRequest, run=data.run_id, name=name)
+    elif isinstance(data, Leaderboard) and classifier is not None:  # one of its rows
+        opened = open_store(store if store is not None else _leaderboard_store(data))
+        data.row(classifier)  # one of the run's
+        targets = data.schema.targets
+        request = _request(
+            TrainRequest,
+            dataset=data.schema.dataset,
+            classifier=classifier,
+            target=targets[0] if len(targets) == 1 else None,
+            name=name,
+            seed=seed,
+        )
     else:
         if classifier is None:
             raise FieldError("classifier", "is required (or a leaderboard, for its best)")
