@@ -11,7 +11,8 @@ refused field is one :class:`app.errors.FieldError` naming it.  What was made is
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -30,9 +31,13 @@ from touchbench.app.schemas.extraction import ExtractRequest
 from touchbench.app.schemas.models import TrainRequest
 from touchbench.app.schemas.runs import BenchHereRequest, BenchRequest
 from touchbench.app.services.bench import bench_here
+from touchbench.app.services.datasets import delete_dataset
 from touchbench.app.services.extraction import extract_and_store
+from touchbench.app.services.models import check_training
 from touchbench.app.services.models import train as train_model
 from touchbench.app.services.own_specs import own_specs_added
+from touchbench.app.services.runs import create_run
+from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import load_dataset
 
 if TYPE_CHECKING:
@@ -103,22 +108,24 @@ def bench(
         # the request first: a refused field stores nothing, not even the data set
         _request(BenchRequest, dataset="-", classifiers=ids or None, suite=suite, folds=folds,
                  repeats=repeats, seed=seed, metric=metric, race=race)  # fmt: skip
-        name = stored_data(opened, data, target=target, groups=groups, ignore=ignore)
-        request = _request(
-            BenchRequest,
-            dataset=name,
-            target=target if _names_target(data) else None,
-            classifiers=ids or None,
-            suite=suite,
-            folds=folds,
-            repeats=repeats,
-            seed=seed,
-            metric=metric,
-            race=race,
-        )
+        name, created = stored_data(opened, data, target=target, groups=groups, ignore=ignore)
+        with _kept_if_used(opened, name, created):
+            request = _request(
+                BenchRequest,
+                dataset=name,
+                target=target if _names_target(data) else None,
+                classifiers=ids or None,
+                suite=suite,
+                folds=folds,
+                repeats=repeats,
+                seed=seed,
+                metric=metric,
+                race=race,
+            )
+            run = create_run(opened, request, on_warning=RunBar.warn)
         with RunBar(show=progress) as bar:  # closed on an interrupt too (RunInterrupted)
             benched = bench_here(
-                opened, BenchHereRequest(bench=request), jobs=jobs, callbacks=bar.callbacks()
+                opened, BenchHereRequest(resume=run.id), jobs=jobs, callbacks=bar.callbacks()
             )
     assert benched.run is not None
     return stored_leaderboard(opened, benched.run.id)
@@ -274,15 +281,17 @@ def train(
             raise FieldError("classifier", "is required (or a leaderboard, for its best)")
         opened = open_store(store)
         _request(TrainRequest, dataset="-", classifier=classifier, name=name, seed=seed)
-        dataset = stored_data(opened, data, target=target, groups=groups, ignore=ignore)
-        request = _request(
-            TrainRequest,
-            dataset=dataset,
-            classifier=classifier,
-            target=target if _names_target(data) else None,
-            name=name,
-            seed=seed,
-        )
+        dataset, created = stored_data(opened, data, target=target, groups=groups, ignore=ignore)
+        with _kept_if_used(opened, dataset, created):
+            request = _request(
+                TrainRequest,
+                dataset=dataset,
+                classifier=classifier,
+                target=target if _names_target(data) else None,
+                name=name,
+                seed=seed,
+            )
+            check_training(opened, request)
     return Model(train_model(opened, request), opened)
 
 
@@ -296,6 +305,18 @@ def _request(kind: type[Request], **values: Any) -> Any:
         return kind(**{k: v for k, v in values.items() if v is not None})
     except ValidationError as error:
         raise field_error(error) from None
+
+
+@contextmanager
+def _kept_if_used(store: Store, dataset: str, created: bool) -> Iterator[None]:
+    """Remove the data set this call stored if what it was stored for is refused: a
+    refused call leaves nothing behind."""
+    try:
+        yield
+    except BaseException:
+        if created:
+            delete_dataset(store, dataset)
+        raise
 
 
 def _names_target(data: Any) -> bool:

@@ -47,8 +47,9 @@ def stored_data(
     groups: str | None = None,
     ignore: Sequence[str] = (),
     name: str | None = None,
-) -> str:
-    """Store ``data`` (unless it is a stored name) and return its data set's name.
+) -> tuple[str, bool]:
+    """Store ``data`` (unless it is a stored name): its data set's name, and whether this
+    call created it (rather than found it stored).
 
     Parameters
     ----------
@@ -77,7 +78,8 @@ def stored_data(
     if isinstance(data, tuple) and len(data) == 2:
         if groups is not None or ignore:
             raise FieldError("groups" if groups else "ignore", "names a column of a DataFrame")
-        return _store_frame(store, pair_frame(*data), target or PAIR_TARGET, None, (), name)
+        pair = pair_frame(*data)
+        return _store_frame(store, pair, target or PAIR_TARGET, None, (), name)
     if isinstance(data, str | Path):
         path = Path(data).expanduser()
         if path.is_file():
@@ -88,7 +90,8 @@ def stored_data(
                 groups=groups,
                 ignore=list(ignore),
             )
-            return import_file(store, request).name
+            result = import_file(store, request)
+            return result.name, result.created
         if isinstance(data, Path) or any(sep in str(data) for sep in ("/", "\\", ".arff", ".csv")):
             raise NotFoundError(f"data: no file '{data}'")
         info, schema, _ = load_schema(store, str(data))  # a stored data set: NotFoundError
@@ -99,7 +102,7 @@ def stored_data(
             )
         if target is not None:
             _known_column(target, [a.name for a in schema.attributes], "target", info.name)
-        return info.name
+        return info.name, False
     raise FieldError(
         "data",
         "must be a pandas DataFrame, an (X, y) pair of arrays, a path to an ARFF or CSV "
@@ -226,12 +229,12 @@ def _store_frame(
     groups: str | None,
     ignore: Sequence[str],
     name: str | None,
-) -> str:
+) -> tuple[str, bool]:
     if target is None:
         raise FieldError("target", "is required with a DataFrame: name the column to predict")
     dataset = frame_dataset(frame, target, groups, ignore, relation=name or "dataframe")
-    info, _ = add_dataset(store, dataset, sha256=dataset_digest(dataset), name=name)
-    return info.name
+    info, created = add_dataset(store, dataset, sha256=dataset_digest(dataset), name=name)
+    return info.name, created
 
 
 def _known_column(column: str, names: Sequence[str], field: str, source: str) -> None:

@@ -38,8 +38,8 @@ class RunBar:
         return Callbacks(
             on_plan=self._plan,
             on_result=self._result,
-            on_warning=self._warn,
-            on_note=self._warn,
+            on_warning=self.warn,
+            on_note=self.warn,
             on_end=lambda run: self.close(),
         )
 
@@ -59,5 +59,7 @@ class RunBar:
             )
             self._bar.update(1)
 
-    def _warn(self, message: str) -> None:
+    @staticmethod
+    def warn(message: str) -> None:
+        """An adjustment the run made (fewer folds than asked...), as a Python warning."""
         warnings.warn(message, stacklevel=1)
