@@ -4,6 +4,7 @@ leaderboard equal to the CLI's, retries only where the service never got the req
 
 from __future__ import annotations
 
+import contextlib
 import math
 from collections.abc import Iterator
 from pathlib import Path
@@ -19,7 +20,7 @@ from tests.app.api.conftest import Server, _servers
 from tests.app.cli_runner import run_cli
 from tests.app.synthetic import touch_arff
 from touchbench.app.python import errors
-from touchbench.app.python.client import Client
+from touchbench.app.python.client import Client, _HttpSource
 from touchbench.app.python.sources import stored_leaderboard
 from touchbench.app.python.work import Run
 from touchbench.app.services.simulation import write_labels, write_session
@@ -98,7 +99,7 @@ def test_bench_waits_and_the_leaderboard_is_the_clis(
     pd.testing.assert_frame_equal(board.fold_scores(), stored.fold_scores())
     assert board.fold_scores().shape == (3, 3)
     for kind in ("cd", "folds", "confusion"):
-        figure = board.plot(kind)  # type: ignore[arg-type]
+        figure = board.plot(kind)
         assert isinstance(figure, Figure) and figure.axes
     confusion = board.plot("confusion", classifier="j48")
     assert "j48, summed over 3 folds" in " ".join(confusion.get_suptitle().split())
@@ -112,7 +113,9 @@ def test_bench_waits_and_the_leaderboard_is_the_clis(
     assert "<table>" in html and "(base)" in html
 
 
-def test_a_refused_request_raises_with_the_services_field(service: Client, touch: str) -> None:
+def test_a_refused_request_raises_with_the_services_field(
+    service: Client, touch: str, done_run: Run
+) -> None:
     with pytest.raises(errors.InvalidRequestError) as few:
         service.bench(touch, target="gesture", classifiers=["nb"], folds=1)
     assert (few.value.status, few.value.field, few.value.where) == (422, "folds", "body.folds")
@@ -134,7 +137,11 @@ def test_a_refused_request_raises_with_the_services_field(service: Client, touch
     assert missing.value.kind == "NotFoundError" and missing.value.field is None
 
     with pytest.raises(errors.ConflictError):  # a finished run cannot be cancelled
-        service.cancel(service.runs()[0])
+        service.cancel(done_run)
+
+    with pytest.raises(errors.BadRequestError) as metric:  # the plots' numbers, refused
+        _HttpSource(service).fold_scores(done_run.id, metric="no-such-metric")
+    assert metric.value.status == 400 and "no-such-metric" in metric.value.message
 
 
 def test_keys_read_only_refused_on_write_and_never_shown(
@@ -246,6 +253,12 @@ class _Flaky(httpx.BaseTransport):
         self.real.close()
 
 
+def _stop(service: Client, run: Run) -> None:
+    """Cancel a run the test no longer needs (the module's service stays free)."""
+    with contextlib.suppress(errors.ConflictError):  # finished already
+        service.cancel(run)
+
+
 def _client(server: Server, transport: _Flaky, **options: Any) -> Client:
     return Client(server.url, api_key=WRITE, transport=transport, **options)
 
@@ -257,7 +270,7 @@ def test_retries_only_where_the_service_never_got_the_request(
     with _client(server, flaky, retries=2) as client:  # a POST never sent: sent again
         run = client.bench(touch, target="gesture", classifiers=["zeror"], folds=2)
     assert flaky.sent[0] == "POST" and flaky.sent.count("POST") == 1
-    service.run(run.id).wait(progress=False, timeout=120)
+    _stop(service, run)
 
     with (
         _client(server, _Flaky(refuse=3), retries=2) as client,
@@ -277,7 +290,7 @@ def test_retries_only_where_the_service_never_got_the_request(
         assert broken.sent == ["POST", "GET", "GET", "GET", "GET"]
     after = service.runs()
     assert len(after) == before + 1  # one run, not four
-    after[-1].wait(progress=False, timeout=120)
+    _stop(service, after[-1])
 
     slow = _Flaky(timeout=True)
     with (
@@ -300,4 +313,4 @@ def test_touchbench_exports_the_client() -> None:
     assert touchbench.Client is Client
     assert touchbench.ServiceError is errors.ServiceError
     with pytest.raises(AttributeError):
-        _ = touchbench.no_such_name  # type: ignore[attr-defined]
+        _ = touchbench.no_such_name
