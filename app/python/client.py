@@ -512,17 +512,28 @@ def _records(
         rows = instances.to_dict(orient="records")
     else:
         rows = instances
-    out = []
-    for row in rows:
-        record = {}
-        for key, value in row.items():
-            if hasattr(value, "item"):  # numpy scalars
-                value = value.item()
-            if isinstance(value, float) and math.isnan(value):
-                value = None
-            record[str(key)] = value
-        out.append(record)
-    return out
+    return [
+        {key if type(key) is str else str(key): _plain(value) for key, value in row.items()}
+        for row in rows
+    ]
+
+
+#: Values sent as they are (the usual case, checked by exact type: the quickest test).
+_PLAIN = frozenset({str, int, bool, type(None)})
+
+
+def _plain(value: Any) -> Any:
+    """A value as JSON takes it: NaN as null (a missing value), numpy scalars as Python's."""
+    kind = type(value)
+    if kind in _PLAIN:
+        return value
+    if kind is float:
+        return None if math.isnan(value) else value
+    if hasattr(value, "item"):  # numpy scalars
+        value = value.item()
+    if isinstance(value, float) and math.isnan(value):
+        return None
+    return value
 
 
 def _json_or_none(response: httpx.Response) -> Any:

@@ -81,8 +81,9 @@ class Work(Generic[S]):
                 self.refresh()
                 done, total = self._progress()
                 bar.total = total
+                bar.set_postfix_str(str(self.status), refresh=False)
                 bar.update(done - bar.n)
-                bar.set_postfix_str(str(self.status))
+                bar.refresh()
         return self
 
     def _read(self) -> S:
