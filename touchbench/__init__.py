@@ -10,7 +10,8 @@ folders and install as its subpackages:
 
 Importing ``touchbench`` itself imports none of them.  Its Python API
 (:mod:`touchbench.app.python`: ``touchbench.bench``, ``.extract``, ``.train``,
-``.simulate``, ``.Leaderboard``, ``.Client``) is imported when first used.
+``.simulate``, ``.Leaderboard``, ``.Client``, ``.ServiceError``) is imported when first
+used.
 """
 
 from __future__ import annotations
@@ -27,9 +28,10 @@ _LAZY = {
     "simulate": "touchbench.app.python.api",
     "Leaderboard": "touchbench.app.python.leaderboard",
     "Client": "touchbench.app.python.client",
+    "ServiceError": "touchbench.app.python.errors",
 }
 
-__all__ = ["Client", "Leaderboard", "bench", "extract", "simulate", "train"]
+__all__ = ["Client", "Leaderboard", "ServiceError", "bench", "extract", "simulate", "train"]
 
 
 def __getattr__(name: str) -> Any:

@@ -11,6 +11,8 @@ response models, so a plot reads the same whichever way the leaderboard came.
 
 from __future__ import annotations
 
+# Imports inside functions: start-up time: pandas, numpy, matplotlib and the report tables
+# load when a table or a plot is first asked for, not when the leaderboard arrives.
 import html
 import math
 from collections.abc import Sequence
