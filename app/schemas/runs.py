@@ -313,11 +313,14 @@ def folds_value(value: Any) -> Any:
             )
         value = int(text)
     if isinstance(value, int) and not isinstance(value, bool):
-        if not MIN_FOLDS <= value <= MAX_FOLDS:
-            raise FieldError(
-                "folds", f"must be between {MIN_FOLDS} and {MAX_FOLDS}, or {LOGO}, got {value}"
-            )
-        return value
+        # pydantic's words for a bound, as every other field's refusal says it
+        if value < MIN_FOLDS:
+            bound = f"greater than or equal to {MIN_FOLDS}"
+        elif value > MAX_FOLDS:
+            bound = f"less than or equal to {MAX_FOLDS}"
+        else:
+            return value
+        raise FieldError("folds", f"Input should be {bound} (or {LOGO}: leave-one-group-out)")
     raise FieldError("folds", f"must be a number of folds or {LOGO} (leave-one-group-out)")
 
 

@@ -82,7 +82,7 @@ def test_the_issues_independent_command_is_refused_at_its_first_dropped_option(
         (["--max-memory", "0.5"], "--max-memory: Input should be greater than or equal to 1"),
         (["--timeout", "-1"], "--timeout: Input should be greater than or equal to 0"),
         (["--timeout", "1e9"], "--timeout: Input should be less than or equal to 604800"),
-        (["--folds", "1"], "--folds: must be between 2 and 100, or logo, got 1"),
+        (["--folds", "1"], "--folds: Input should be greater than or equal to 2"),
         (["--repeats", "0"], "--repeats: Input should be greater than or equal to 1"),
         (["--seed", "-1"], "--seed: Input should be greater than or equal to 0"),
         (["--budget", "5"], "--budget: is only meaningful with --tune"),

@@ -84,7 +84,8 @@ def test_k_fold_views_name_k(
         (False, ["--folds", "logo"], ["--folds: logo (leave-one-group-out) needs groups"]),
         (True, ["--folds", "logo", "--repeats", "3"], ["--repeats: must be 1 with --folds logo"]),
         (True, ["--folds", "lobo"], ["--folds: must be a number of folds or logo"]),
-        (True, ["--folds", "1"], ["--folds: must be between 2 and 100, or logo"]),
+        (True, ["--folds", "1"], ["--folds: Input should be greater than or equal to 2 (or logo"]),
+        (True, ["--folds", "101"], ["--folds: Input should be less than or equal to 100"]),
     ],
 )
 def test_leave_one_group_out_where_it_means_nothing_is_one_line_and_stores_no_run(

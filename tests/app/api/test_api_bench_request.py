@@ -36,7 +36,7 @@ REFUSALS: list[tuple[dict[str, Any], str, str]] = [
     ({"max_memory_mb": 1e308}, "max_memory_mb", "less than or equal to 1048576"),
     ({"max_memory_mb": 1e15}, "max_memory_mb", "less than or equal to 1048576"),
     ({"timeout": -1}, "timeout", "greater than or equal to 0"),
-    ({"folds": 1}, "folds", "must be between 2 and 100, or logo"),
+    ({"folds": 1}, "folds", "greater than or equal to 2"),
     ({"folds": "lobo"}, "folds", "must be a number of folds or logo"),
     ({"folds": "logo", "target": "gesture"}, "folds", "needs groups, and the data set has none"),
     ({"folds": "logo", "repeats": 2}, "repeats", "must be 1 with `folds` logo"),
