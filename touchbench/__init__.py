@@ -8,29 +8,43 @@ folders and install as its subpackages:
 ``touchbench.benchmark``  data sets, ARFF/CSV, the catalogue, cross-validation, statistics
 ``touchbench.app``        the store, the services, the CLI, the REST service, the web page
 
-Importing ``touchbench`` itself imports none of them: the Python API's names below load
-their module when first used.
+Importing ``touchbench`` itself imports none of them.  Its Python API
+(:mod:`touchbench.app.python`: ``touchbench.bench``, ``.extract``, ``.train``,
+``.simulate``, ``.Leaderboard``, ``.Client``, ``.ServiceError``) is imported when first
+used.
 """
 
 from __future__ import annotations
 
-import importlib
 from typing import Any
 
-#: The Python API's names, by the module that defines each.  Not imported here, not even for
-#: type checkers: every module of the package imports this one (its parent), so an import
-#: here would tie the CLI, the service and the web page to the Python adapter.
+#: The Python API, loaded when first used (``import touchbench`` stays cheap): name -> module.
+#: No import of them here, not even for type checkers: every part of touchbench imports
+#: this package, and the adapters must not import each other through it.
 _LAZY = {
+    "bench": "touchbench.app.python.api",
+    "extract": "touchbench.app.python.api",
+    "train": "touchbench.app.python.api",
+    "simulate": "touchbench.app.python.api",
+    "Leaderboard": "touchbench.app.python.leaderboard",
     "Client": "touchbench.app.python.client",
     "ServiceError": "touchbench.app.python.errors",
-    "Leaderboard": "touchbench.app.python.leaderboard",
 }
 
-__all__ = ["Client", "Leaderboard", "ServiceError"]
+__all__ = ["Client", "Leaderboard", "ServiceError", "bench", "extract", "simulate", "train"]
 
 
 def __getattr__(name: str) -> Any:
+    """``touchbench.bench`` and the rest of the Python API, imported on first use."""
     module = _LAZY.get(name)
     if module is None:
         raise AttributeError(f"module 'touchbench' has no attribute '{name}'")
-    return getattr(importlib.import_module(module), name)
+    import importlib
+
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted([*globals(), *_LAZY])

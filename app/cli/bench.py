@@ -296,12 +296,14 @@ def bench_command(
         typer.Option("--suite", metavar="NAME", help="fast, default or all (default: default)."),
     ] = None,
     folds: Annotated[
-        int | None,
+        str | None,
         typer.Option(
             "--folds",
             "-k",
-            metavar="K",
-            help=f"Folds per repeat (2-100; default {_default('folds')}).",
+            metavar="K|logo",
+            help=f"Folds per repeat (2-100; default {_default('folds')}), or logo "
+            "(alias leave-one-group-out): one fold per group of the data set (its import's "
+            "--groups column, or its recordings), with --repeats 1.",
             show_default=False,
         ),
     ] = None,
@@ -876,7 +878,7 @@ def _print_leaderboard(ranked: RunLeaderboard) -> None:
     scored = ", scored per recording" if ranked.per_recording else ""
     table(
         f"run {run.id}: {run.dataset_name} ({', '.join(run.targets)}), "
-        f"{run.config.folds}-fold x {run.config.repeats} ({run.fold_scheme}), "
+        f"{run.folds_text}, "
         f"ranked by {board.metric}{direction}{scored}",
         leaderboard_header(board, columns, ranked.besides),
         leaderboard_rows(board, columns, ranked.besides),

@@ -21,7 +21,7 @@ from typing import Any, TypeVar
 from pydantic import ValidationError
 
 from touchbench.app.errors import FieldError
-from touchbench.app.schemas.base import Request
+from touchbench.app.schemas.base import Request, field_error
 
 RequestType = TypeVar("RequestType", bound=Request)
 
@@ -53,14 +53,6 @@ def build_request(
         return kind(**{field: value for field, value in values.items() if value is not None})
     except ValidationError as error:
         raise field_error(error) from None
-
-
-def field_error(error: ValidationError) -> FieldError:
-    """The first problem of a pydantic validation error, as a :class:`FieldError`."""
-    problem = error.errors()[0]
-    field = ".".join(str(part) for part in problem.get("loc", ())) or "request"
-    message = str(problem.get("msg", "invalid value"))
-    return FieldError(field, message.removeprefix("Value error, "))
 
 
 def option_of(field: str) -> str:

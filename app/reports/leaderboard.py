@@ -127,7 +127,7 @@ def leaderboard_markdown(
     run_column = " run |" if besides else ""
     lines = [
         f"Run {run.id} on {run.dataset_name} ({', '.join(run.targets)}), "
-        f"{run.fold_scheme}, ranked by {board.metric}; {marks}",
+        f"{run.folds_text}, ranked by {board.metric}; {marks}",
         "",
         "| rank | classifier |" + run_column + " | " + " | ".join(columns) + " |",
         "|---:|---|" + ("---:|" if besides else "") + ":-:|" + "---:|" * len(columns),

@@ -6,7 +6,9 @@ import math
 from datetime import UTC, datetime
 from typing import Any
 
-from pydantic import BaseModel, ConfigDict, field_validator
+from pydantic import BaseModel, ConfigDict, ValidationError, field_validator
+
+from touchbench.app.errors import FieldError
 
 
 class Schema(BaseModel):
@@ -36,6 +38,15 @@ class Request(BaseModel):
     """
 
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+
+
+def field_error(error: ValidationError) -> FieldError:
+    """The first problem of a request's validation error, as a :class:`FieldError` (what
+    the CLI and the Python API raise for a refused field)."""
+    problem = error.errors()[0]
+    field = ".".join(str(part) for part in problem.get("loc", ())) or "request"
+    message = str(problem.get("msg", "invalid value"))
+    return FieldError(field, message.removeprefix("Value error, "))
 
 
 def finite(data: Any) -> Any:

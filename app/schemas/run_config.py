@@ -11,11 +11,17 @@ version does not know are kept as they are.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
 from touchbench.app.schemas.runs import Aggregate
+
+#: How a run's instances are split into folds: k folds (stratified and group-aware where
+#: they can be), or one fold per group (:data:`benchmark.run.folds.Split`, said again here
+#: because the schemas stand below the engine and load nothing of it).
+Split = Literal["k-fold", "leave-one-group-out"]
+LEAVE_ONE_GROUP_OUT: Split = "leave-one-group-out"
 
 #: ``origin`` of an imported run (runs touchbench carried out have none).
 IMPORTED = "imported"
@@ -72,7 +78,15 @@ class RunConfig(ExtraSpecsConfig):
     """
 
     # How it cross-validates (what a resume gets back).
-    folds: int | None = Field(default=None, description="Folds per repeat the data allowed.")
+    folds: int | None = Field(
+        default=None,
+        description="Folds per repeat the data allowed (leave-one-group-out: its groups).",
+    )
+    split: Split = Field(
+        default="k-fold",
+        description="How the folds were made: k-fold, or one fold per group "
+        "(leave-one-group-out); an old store's runs are k-fold.",
+    )
     folds_requested: int | None = Field(
         default=None, description="Folds per repeat asked (absent: as many as `folds`)."
     )

@@ -24,6 +24,11 @@ class RunSchema(Schema):
     targets: list[str]
     classifiers: list[str]
     config: dict[str, Any] = Field(description="Folds, repeats, seed, timeout, ...")
+    folds: str = Field(
+        default="",
+        description="How the folds were made, as the leaderboard's `folds` says it "
+        "(`stratified 10-fold`, `leave-one-group-out, 7 groups`).",
+    )
     status: Status
     created_at: datetime
     started_at: datetime | None = None
@@ -192,8 +197,9 @@ class LeaderboardSchema(Schema):
     status: Status
     folds: str = Field(
         default="",
-        description="How the folds were made: stratified k-fold, k-fold (shuffled), or their "
-        "group k-fold variants (recordings/sessions never straddle training and test).",
+        description="How the folds were made: `stratified 10-fold`, `10-fold` (shuffled), "
+        "their group variants (recordings/sessions never straddle training and test), `x 3 "
+        "repeats`, or `leave-one-group-out, 7 groups` (one fold per group).",
     )
     metric: str
     lower_is_better: bool = Field(
@@ -280,6 +286,44 @@ def id_as_text(value: Any) -> Any:
     return value
 
 
+#: ``folds`` of a leave-one-group-out run, and the other spelling it accepts.
+LeaveOneGroupOut = Literal["logo"]
+LOGO: LeaveOneGroupOut = "logo"
+LOGO_ALIASES = frozenset({LOGO, "leave-one-group-out"})
+#: Bounds of k in k-fold.
+MIN_FOLDS, MAX_FOLDS = 2, 100
+
+
+def folds_value(value: Any) -> Any:
+    """A request's ``folds``: k (an int, or its digits as text), or leave-one-group-out
+    under either of its names.
+
+    Raises
+    ------
+    FieldError
+        For ``folds``: neither a k between the bounds nor a name of leave-one-group-out.
+    """
+    if isinstance(value, str):
+        text = value.strip().lower()
+        if text in LOGO_ALIASES:
+            return LOGO
+        if not text.isdigit():
+            raise FieldError(
+                "folds", f"must be a number of folds or {LOGO} (leave-one-group-out), got '{value}'"
+            )
+        value = int(text)
+    if isinstance(value, int) and not isinstance(value, bool):
+        # pydantic's words for a bound, as every other field's refusal says it
+        if value < MIN_FOLDS:
+            bound = f"greater than or equal to {MIN_FOLDS}"
+        elif value > MAX_FOLDS:
+            bound = f"less than or equal to {MAX_FOLDS}"
+        else:
+            return value
+        raise FieldError("folds", f"Input should be {bound} (or {LOGO}: leave-one-group-out)")
+    raise FieldError("folds", f"must be a number of folds or {LOGO} (leave-one-group-out)")
+
+
 def zero_is_no_limit(value: float | None) -> float | None:
     """A ``timeout`` of 0 means none (a request's ``timeout`` validator)."""
     return value or None
@@ -322,7 +366,12 @@ class BenchRequest(Request):
         description="2 or 3 numeric targets that are a position's coordinates: the run also "
         "scores the mean Euclidean error.",
     )
-    folds: int = Field(default=10, ge=2, le=100, description="k of k-fold cross-validation.")
+    folds: int | LeaveOneGroupOut = Field(
+        default=10,
+        description="k of k-fold cross-validation (2-100), or `logo` (alias "
+        "`leave-one-group-out`): one fold per group of the data set (an import's group column, "
+        "an extracted data set's recordings), that group on the test side; `repeats` must be 1.",
+    )
     repeats: int = Field(default=1, ge=1, le=100, description="Repeats of the whole k-fold.")
     seed: int = Field(default=0, ge=0, le=2**31 - 1, description="Seed of folds and classifiers.")
     timeout: float | None = Field(
@@ -408,6 +457,7 @@ class BenchRequest(Request):
     )
 
     _id_as_text = field_validator("dataset", mode="before")(id_as_text)
+    _folds = field_validator("folds", mode="before")(folds_value)
     _zero_is_no_limit = field_validator("timeout", mode="after")(zero_is_no_limit)
 
     @model_validator(mode="before")
@@ -442,7 +492,13 @@ class BenchRequest(Request):
             raise FieldError("suite", "is not used with `classifiers`: give one or the other")
         if self.budget is not None and not self.tune:
             raise FieldError("budget", "is only meaningful with `tune`")
-        if self.race and self.folds * self.repeats < RACE_MIN_FOLDS:
+        if self.folds == LOGO and self.repeats != 1:
+            raise FieldError(
+                "repeats",
+                f"must be 1 with `folds` {LOGO} (leave-one-group-out makes one partition, "
+                f"the same every time), got {self.repeats}",
+            )
+        if self.race and isinstance(self.folds, int) and self.folds * self.repeats < RACE_MIN_FOLDS:
             raise FieldError(
                 "race",
                 f"needs at least {RACE_MIN_FOLDS} folds in all (it first tests after the "

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 from touchbench.app.errors import FieldError
 from touchbench.app.schemas.run_config import ExtraSpecsConfig
+from touchbench.app.services.own_specs import own_specs
 
 if TYPE_CHECKING:
     from touchbench.benchmark.catalogue import ClassifierSpec
@@ -71,13 +72,15 @@ def run_specs(config: ExtraSpecsConfig, classifiers: Sequence[str]) -> dict[str,
         ``weka`` (id -> WEKA command), ``tune`` and ``stack``.
     classifiers : sequence of str
         The run's classifier ids.
+
+    The specs the caller brought (:mod:`app.services.own_specs`) are among them.
     """
     from touchbench.benchmark.catalogue import parse_weka_command
     from touchbench.benchmark.catalogue.stacking import stack_id, stacked_spec
     from touchbench.benchmark.catalogue.tuning import TUNED_SUFFIX, is_tuned_id, tuned_spec
     from touchbench.benchmark.estimators import classifier_spec
 
-    specs: dict[str, ClassifierSpec] = {}
+    specs: dict[str, ClassifierSpec] = dict(own_specs())
     for text in config.weka.values():
         if text:
             spec = parse_weka_command(text)

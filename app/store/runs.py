@@ -24,7 +24,7 @@ from sqlalchemy.orm import Session
 from touchbench.app.errors import ConflictError, NotFoundError
 from touchbench.app.schemas.base import finite
 from touchbench.app.schemas.listing import Page
-from touchbench.app.schemas.run_config import RunConfig
+from touchbench.app.schemas.run_config import LEAVE_ONE_GROUP_OUT, RunConfig
 from touchbench.app.schemas.runs import RunSchema
 from touchbench.app.schemas.status import FINAL, Status
 from touchbench.app.store import queue
@@ -92,6 +92,18 @@ class RunInfo:
         stratified = "stratified " if self.kind == "multiclass" else ""
         return stratified + ("group " if self.config.grouped else "") + "k-fold"
 
+    @property
+    def folds_text(self) -> str:
+        """How the folds were made, as every view says it: ``stratified 10-fold``,
+        ``group 5-fold x 3 repeats``, ``leave-one-group-out, 7 groups``."""
+        config = self.config
+        if config.split == LEAVE_ONE_GROUP_OUT:
+            return f"leave-one-group-out, {config.folds} groups"
+        if config.folds is None or "k-fold" not in self.fold_scheme:  # an imported run's
+            return self.fold_scheme
+        repeats = f" x {config.repeats} repeats" if config.repeats and config.repeats > 1 else ""
+        return self.fold_scheme.replace("k-fold", f"{config.folds}-fold") + repeats
+
     def is_alive(self) -> bool:
         """Whether a live process is executing the run (``running`` or ``cancelling``)."""
         return is_active(self)
@@ -115,6 +127,7 @@ class RunInfo:
             targets=self.targets,
             classifiers=self.classifiers,
             config=self.config.to_json(),
+            folds=self.folds_text,
             status=self.status,
             created_at=self.created_at,
             started_at=self.started_at,

@@ -163,7 +163,7 @@ class RunLeaderboard:
             kind=run.kind,
             targets=run.targets,
             status=run.status,
-            folds=run.fold_scheme,
+            folds=run.folds_text,
             metric=data["metric"],
             lower_is_better=data["lower_is_better"],
             baseline=data["baseline"],

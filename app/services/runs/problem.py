@@ -14,8 +14,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from touchbench.app.errors import FieldError
-from touchbench.app.schemas.run_config import RunConfig
-from touchbench.app.schemas.runs import BenchRequest
+from touchbench.app.schemas.run_config import LEAVE_ONE_GROUP_OUT, RunConfig, Split
+from touchbench.app.schemas.runs import LOGO, BenchRequest
 from touchbench.benchmark.dataset import Dataset
 from touchbench.benchmark.errors import ConfigurationError
 from touchbench.benchmark.problem import Problem, problem_from_dataset, restrict_targets
@@ -34,13 +34,16 @@ class RunOptions:
     Attributes
     ----------
     folds, repeats, seed : int
-        k of k-fold, repetitions of the whole partition, seed of folds and classifiers.
+        k of k-fold (unused by leave-one-group-out), repetitions of the whole partition,
+        seed of folds and classifiers.
     timeout : float or None
         Seconds one task may take before its worker process is killed; ``None``: no limit.
     max_memory_mb : float or None
         Megabytes one task may allocate beyond its worker's copy of the data; 0: no limit;
         None: derived from the machine when the run starts
         (:func:`app.services.runs.memory.task_memory`).
+    split : {"k-fold", "leave-one-group-out"}
+        How the instances are split: k folds, or one fold per group.
     """
 
     folds: int
@@ -48,11 +51,15 @@ class RunOptions:
     seed: int
     timeout: float | None
     max_memory_mb: float | None
+    split: Split = "k-fold"
 
     @classmethod
     def from_request(cls, request: BenchRequest) -> RunOptions:
+        logo = request.folds == LOGO
         return cls(
-            folds=request.folds,
+            # leave-one-group-out makes as many folds as groups, whatever k says
+            folds=0 if logo else int(request.folds),
+            split=LEAVE_ONE_GROUP_OUT if logo else "k-fold",
             repeats=request.repeats,
             seed=request.seed,
             timeout=request.timeout,
@@ -76,6 +83,7 @@ class RunOptions:
             seed=config.seed,
             timeout=config.timeout,
             max_memory_mb=config.max_memory_mb,
+            split=config.split,
         )
 
 
@@ -132,9 +140,26 @@ def prepare_problem(
 
 
 def fold_plan(prepared: PreparedProblem, options: RunOptions) -> FoldPlan:
-    """The folds a run with these options makes on this problem (the same on resume)."""
+    """The folds a run with these options makes on this problem (the same on resume).
+
+    Raises
+    ------
+    FieldError
+        For ``folds``: leave-one-group-out on data without groups (or with one group), or
+        folds the data cannot be split into.
+    ConfigurationError
+        The problem itself cannot be cross-validated (a target with one class).
+    """
     from touchbench.benchmark.run.folds import make_fold_plan
 
+    logo = options.split == LEAVE_ONE_GROUP_OUT
+    if logo and prepared.problem.groups is None:
+        raise FieldError(
+            "folds",
+            f"{LOGO} (leave-one-group-out) needs groups, and the data set has none: name a "
+            "group column on import, or extract the data set from recordings (each "
+            "recording is a group)",
+        )
     try:
         return make_fold_plan(
             prepared.problem.Y,
@@ -144,6 +169,11 @@ def fold_plan(prepared: PreparedProblem, options: RunOptions) -> FoldPlan:
             groups=prepared.problem.groups,
             target_names=prepared.target_names,
             regression=prepared.problem.kind == "regression",
+            split=options.split,
         )
+    except ConfigurationError as error:
+        if logo and "group" in str(error):
+            raise FieldError("folds", str(error)) from None
+        raise
     except ValueError as error:  # scikit-learn's splitters on data too small to split
         raise FieldError("folds", f"cannot make {options.folds} folds: {error}") from None

@@ -34,6 +34,9 @@ REFUSALS: list[tuple[dict[str, Any], str, str]] = [
     ({"max_memory_mb": 1e15}, "max_memory_mb", "less than or equal to 1048576"),
     ({"timeout": -1}, "timeout", "greater than or equal to 0"),
     ({"folds": 1}, "folds", "greater than or equal to 2"),
+    ({"folds": "lobo"}, "folds", "must be a number of folds or logo"),
+    ({"folds": "logo", "target": "gesture"}, "folds", "needs groups, and the data set has none"),
+    ({"folds": "logo", "repeats": 2}, "repeats", "must be 1 with `folds` logo"),
     ({"budget": 2000, "tune": True}, "budget", "less than or equal to 1440"),
     ({"stack": 21}, "stack", "less than or equal to 20"),
     # rules across fields, and those that need the data set

@@ -38,7 +38,7 @@ def test_bench_leaderboard_train_predict_on_numeric_targets(
     report = bench.json()
     assert report["kind"] == "regression" and report["targets"] == ["x", "y"]
     assert report["metric"] == "mae" and report["lower_is_better"] is True
-    assert report["folds"] == "k-fold"
+    assert report["folds"] == "3-fold"
     rows = {row["classifier"]: row for row in report["leaderboard"]}
     assert report["leaderboard"][-1]["classifier"] == "zeror"
     assert rows["zeror"]["mark"] == "*"  # a larger error than the best: significantly worse
@@ -49,7 +49,7 @@ def test_bench_leaderboard_train_predict_on_numeric_targets(
 
     table = run_cli(capsys, db, "leaderboard", "1", "--metric", "rmse")
     assert table.code == 0, table.err
-    assert "(k-fold), ranked by rmse (lower is better)" in " ".join(table.out.split())
+    assert "3-fold, ranked by rmse (lower is better)" in " ".join(table.out.split())
 
     train = run_cli(capsys, db, "train", "contact", "-c", "ridge", "--json")
     assert train.code == 0, train.err
@@ -77,7 +77,7 @@ def test_classification_leaderboards_name_their_folds_and_refuse_regression_metr
         capsys, db, "bench", "touch", "--target", "gesture", "-c", "zeror", "-k", "3", "--json"
     )
     assert bench.code == 0, bench.err
-    assert bench.json()["folds"] == "stratified k-fold"
+    assert bench.json()["folds"] == "stratified 3-fold"
     assert bench.json()["lower_is_better"] is False
     refused(
         run_cli(capsys, db, "leaderboard", "1", "--metric", "mae"),

@@ -28,7 +28,7 @@ def test_per_recording_scores_and_never_started_classifiers_in_every_view(
     assert bench.code == 0, bench.err
     board = bench.json()
     assert board["aggregate"] == "recording" and board["notes"][0].startswith(PER_RECORDING)
-    assert board["folds"] == "stratified group k-fold"
+    assert board["folds"] == "stratified group 4-fold"
     assert [row["classifier"] for row in board["leaderboard"]] == ["nb", "ridge", "zeror"]
     # 4 recordings a test fold, 2 classes: the confusion matrices count recordings
     classes = run_cli(capsys, store_url, "classes", "1", "-c", "nb", "--json").json()

@@ -143,7 +143,7 @@ def test_a_run_stored_by_the_first_version_is_resumed_and_ranked(store: Store) -
     ranked = run_leaderboard(store, run.id)
     assert {row.classifier for row in ranked.board.rows} == {"nb", "zeror"}
     assert (
-        ranked.report().folds == "stratified k-fold"
+        ranked.report().folds == "stratified 2-fold"
         and ranked.race() is None
         and ranked.budget() is None
     )
