@@ -68,14 +68,39 @@ def browser() -> Iterator[Browser]:
         launched.close()
 
 
+#: A projector's screen: every new page is shown readable at this size (docs/web.md).
+PROJECTOR = {"width": 1280, "height": 720}
+
+
 @pytest.fixture
 def tab(browser: Browser, request: pytest.FixtureRequest) -> Iterator[Tab]:
     """A fresh tab (its own session storage) on a laptop-sized screen; the test fails if
     the page threw an error or broke its Content-Security-Policy."""
+    yield from _tab(browser, request, {"width": 1366, "height": 850})
+
+
+@pytest.fixture
+def projector_tab(browser: Browser, request: pytest.FixtureRequest) -> Iterator[Tab]:
+    """A fresh tab on a projector's 1280x720 screen (:data:`PROJECTOR`)."""
+    yield from _tab(browser, request, PROJECTOR)
+
+
+def screen(tab: Tab, name: str) -> Path:
+    """What the screen shows (not the whole page), as ``test-artifacts/web/NAME.png``: the
+    pictures docs/web.md shows of each page."""
+    tab.page.wait_for_function("[...document.images].every(image => image.complete)")
+    path = ARTIFACTS / f"{name}.png"
+    tab.page.screenshot(path=str(path))
+    return path
+
+
+def _tab(
+    browser: Browser, request: pytest.FixtureRequest, viewport: dict[str, int]
+) -> Iterator[Tab]:
     folder = ARTIFACTS / request.node.name
     shutil.rmtree(folder, ignore_errors=True)
     folder.mkdir(parents=True)
-    context = browser.new_context(viewport={"width": 1366, "height": 850})
+    context = browser.new_context(viewport=viewport)  # type: ignore[arg-type]
     context.set_default_timeout(30_000)
     page = context.new_page()
     opened = Tab(page, folder)
