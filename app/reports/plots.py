@@ -483,7 +483,7 @@ def change_bars(
     if not labels:
         raise AppError("no change to plot")
     values = np.array([np.nan if changes[k] is None else changes[k] for k in labels], dtype=float)
-    figure = Figure(figsize=(6.4, 1.2 + 0.28 * len(labels)), layout="constrained")
+    figure = Figure(figsize=(7.4, 1.2 + 0.28 * len(labels)), layout="constrained")
     ax = figure.add_subplot()
     rows = np.arange(len(labels))
     strong = set(marked)
