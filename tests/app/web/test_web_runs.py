@@ -2,17 +2,22 @@
 every field of the run request in its group with the request's defaults, bad values refused
 by the page and then by the service under the request's field names, a raced run on a
 total budget started from the form with the dropped classifier marked, calibration on the
-run's page, and an ablation started from the run's page with its plot."""
+run's page, and an ablation started from the run's page with its plot; a page on another
+origin can start none of these on the same (keyless) service."""
 
 from __future__ import annotations
 
+import functools
 import re
+import threading
 from collections.abc import Iterator
+from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
-from playwright.sync_api import expect
+from playwright.sync_api import Response, expect
 
 from tests.app.api.conftest import Server, _servers, finished
 from tests.app.synthetic import touch_arff
@@ -166,3 +171,70 @@ def test_an_ablation_started_from_the_run_page_shows_its_plot(
     expect(table.locator("tbody tr", has_text="channel 1")).to_contain_text("needed")
     job.scroll_into_view_if_needed()
     screen(tab, "run-ablation")
+
+
+#: A page on another site: what a browser sends without asking (no-cors requests) to start
+#: a run, an ablation, an extraction and a promotion on the service.
+ATTACK = """<!doctype html>
+<html><head><meta charset="utf-8"><title>another site</title></head><body><script>
+async function attack(service, run) {
+  const json = (body) => ({method: "POST", mode: "no-cors", body: JSON.stringify(body),
+                           headers: {"Content-Type": "text/plain"}});
+  const session = new FormData();
+  session.append("recordings", new Blob(["RIFF"]), "take.wav");
+  const tries = [
+    ["/api/runs", json({dataset: "touch", classifiers: ["nb"], folds: 3})],
+    ["/api/jobs/ablation", json({run: run})],
+    ["/api/datasets/recordings", {method: "POST", mode: "no-cors", body: session}],
+    ["/api/models/1/promote", {method: "POST", mode: "no-cors"}],
+  ];
+  const outcome = {};
+  for (const [path, options] of tries) {
+    try { await fetch(service + path, options); outcome[path] = "sent"; }
+    catch (error) { outcome[path] = String(error); }
+  }
+  return outcome;
+}
+</script></body></html>
+"""
+
+
+@pytest.fixture
+def foreign_site(tmp_path: Path) -> Iterator[str]:
+    """A second web server on loopback (another port: another origin) serving the page."""
+    (tmp_path / "attack.html").write_text(ATTACK)
+
+    class Quiet(SimpleHTTPRequestHandler):
+        def log_message(self, format: str, *args: Any) -> None:
+            pass
+
+    httpd = ThreadingHTTPServer(("127.0.0.1", 0), functools.partial(Quiet, directory=str(tmp_path)))
+    thread = threading.Thread(target=httpd.serve_forever, daemon=True)
+    thread.start()
+    try:
+        yield f"http://127.0.0.1:{httpd.server_address[1]}"
+    finally:
+        httpd.shutdown()
+        httpd.server_close()
+        thread.join()
+
+
+def test_a_page_on_another_origin_can_start_nothing(
+    tab: Tab, service: Server, foreign_site: str
+) -> None:
+    api = service.client
+    before = (api.get("/api/runs").json(), api.get("/api/jobs").json())
+    run_id = before[0]["runs"][0]["id"]
+    statuses: dict[str, int] = {}
+
+    def seen(response: Response) -> None:
+        if response.url.startswith(service.url) and response.request.method == "POST":
+            statuses[response.url.removeprefix(service.url)] = response.status
+
+    tab.page.on("response", seen)
+    tab.page.goto(f"{foreign_site}/attack.html")
+    outcome = tab.page.evaluate("([s, r]) => attack(s, r)", [service.url, run_id])
+    paths = ["/api/runs", "/api/jobs/ablation", "/api/datasets/recordings", "/api/models/1/promote"]
+    assert outcome == dict.fromkeys(paths, "sent")
+    assert statuses == dict.fromkeys(paths, 403)
+    assert (api.get("/api/runs").json(), api.get("/api/jobs").json()) == before
