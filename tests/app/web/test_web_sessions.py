@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 from playwright.sync_api import expect
 
-from tests.app.api.conftest import Server, _servers
+from tests.app.api.conftest import Server, _servers, finished
 from tests.app.web.conftest import Tab, screen
 from touchbench.app.services.simulation import write_labels, write_session
 
@@ -123,3 +123,33 @@ def test_a_session_uploaded_from_the_page_becomes_a_data_set(
     described = service.client.get("/api/datasets/robot-take").json()
     assert described["targets"] == ["gesture", "place"]
     screen(tab, "session-dataset")
+
+
+def test_a_model_of_the_session_predicts_an_uploaded_raw_recording(
+    tab: Tab, service: Server, session: tuple[list[Path], Path]
+) -> None:
+    api = service.client
+    if not any(d["name"] == "robot-take" for d in api.get("/api/datasets").json()["datasets"]):
+        pytest.skip("needs the data set the upload test makes")
+    job = api.post(
+        "/api/models",
+        json={"dataset": "robot-take", "classifier": "nb", "target": "gesture", "name": "feeler"},
+    ).json()["job"]
+    model = service.wait_for(f"/api/jobs/{job}", finished)
+    assert model["status"] == "done", model
+    page = tab.page
+    page.goto(f"{service.url}/models/{model['result']['id']}")
+    form = page.locator("form[data-action=predict-file]")
+    expect(form).to_contain_text("or a raw recording")
+    take = session[0][0]
+    form.locator("input[name=file]").set_input_files(str(take))
+    form.get_by_role("button", name="Predict the file").click()
+    with take.open("rb") as handle:
+        answer = api.post(
+            f"/api/models/{model['result']['id']}/predict/file", files={"file": (take.name, handle)}
+        ).json()
+    rows = page.locator("#predictions tbody tr")
+    expect(rows).to_have_count(len(answer["predictions"]), timeout=JOB_TIMEOUT)
+    assert len(answer["predictions"]) >= 3
+    labels = [p["gesture"] for p in answer["predictions"]]
+    expect(rows.locator("td:nth-child(2)")).to_have_text(labels)
