@@ -155,12 +155,24 @@ def plots(run_id: int, store: StoreDep, metric: Metric = None) -> HTMLResponse:
     if view.per_target is not None:
         drawn.append(draw("Accuracy per target", partial(figures.targets_figure, view)))
     drawn.append(draw("Instances per class", partial(figures.classes_figure, view)))
-    return render("fragments/plots.html.j2", plots=drawn, sure=_calibration(view))
+    return render("fragments/plots.html.j2", plots=drawn)
 
 
-def _calibration(view: RunView) -> dict[str, Any] | None:
-    """Every classifier's calibration (table) and the best ones' reliability diagram; none
-    for a regression or an imported run (no predictions kept)."""
+@router.get("/{run_id}/calibration", response_class=HTMLResponse)
+def calibration(run_id: int, store: StoreDep) -> HTMLResponse:
+    """Every classifier's calibration (table) and the best ones' reliability diagram; why
+    there is none for a regression or an imported run (no predictions kept)."""
+    from touchbench.app.services.report import run_view
+
+    run = get_run(store, run_id)
+    if run.n_results == 0:
+        return render("fragments/calibration.html.j2", sure=None)
+    view = run_view(store, run.id)
+    return render("fragments/calibration.html.j2", sure=_calibration(view))
+
+
+def _calibration(view: RunView) -> dict[str, Any]:
+    """The calibration table and diagram of a run read, or why it has none."""
     from touchbench.app.reports import figures
     from touchbench.app.reports.certainty_tables import calibration_table
     from touchbench.app.services.certainty import certainty_of

@@ -216,7 +216,7 @@ async function refused(form, response, outcome) {
   const error = await errorOf(response);
   const text = await problem(response);
   const field = (error.where || "").split(".")[1];
-  const input = field ? find(form, `[data-field="${field}"]`) : null;
+  const input = field ? find(form, `[data-field="${CSS.escape(field)}"]`) : null;
   // the request's field first, as the page's own checks say it (`race: needs ...`)
   const named = error.message && !error.message.startsWith("body.") ? `${field}: ${text}` : text;
   if (input) return markInvalid(form, [[input, named]], outcome);
