@@ -11,8 +11,10 @@ from matplotlib.figure import Figure
 
 from touchbench.app.reports import plots
 from touchbench.app.reports.certainty_tables import calibrations
+from touchbench.app.schemas.ablation import AblationResult
 from touchbench.app.schemas.certainty import RunCertainty
 from touchbench.app.schemas.datasets import DatasetDescription
+from touchbench.app.schemas.importance import ImportanceResult
 from touchbench.app.schemas.learning import LearningCurveResult
 from touchbench.app.services.compare import Comparison
 from touchbench.app.services.report import RunView
@@ -141,6 +143,32 @@ def learning_figure(result: LearningCurveResult) -> Figure:
         lower_is_better=result.lower_is_better,
         title=f"{result.dataset} ({', '.join(result.targets)}): learning curves over "
         f"{result.n_folds} folds",
+    )
+
+
+def ablation_figure(result: AblationResult) -> Figure:
+    """Each classifier's score without each group less its score with every feature (those
+    scored so far)."""
+    changes = {f"{e.classifier}: {e.group}": e.change for e in result.entries}
+    marked = [f"{e.classifier}: {e.group}" for e in result.entries if e.significant]
+    direction = "lower is better" if result.lower_is_better else "higher is better"
+    return plots.change_bars(
+        changes,
+        marked=marked,
+        xlabel=f"change of {result.metric} without the {result.grouping} ({direction})",
+        title=f"run {result.run_id} ({result.dataset}): each {result.grouping} removed",
+    )
+
+
+def importance_figure(result: ImportanceResult) -> Figure:
+    """The drop of a classifier's score when each group of features (or, without groups,
+    each feature) is shuffled on the test folds."""
+    found = next((items for items in result.groups.values() if items), result.features)
+    return plots.change_bars(
+        {item.name: item.mean for item in found},
+        marked=[item.name for item in found if item.significant],
+        xlabel=f"drop of {result.metric} when shuffled",
+        title=f"run {result.run_id}: permutation importance of {result.classifier}",
     )
 
 

@@ -463,6 +463,54 @@ def learning_curve_figure(
     return figure
 
 
+@_styled
+def change_bars(
+    changes: Mapping[str, float | None], *, marked: Sequence[str], xlabel: str, title: str
+) -> Figure:
+    """Horizontal bars of signed changes (an ablation's score without each group less the
+    full set's, a feature's drop when shuffled), one per label, in the given order.
+
+    Parameters
+    ----------
+    changes : mapping of str to float or None
+        label -> change (``None``: not scored, drawn as an empty row).
+    marked : sequence of str
+        Labels whose change is significant, drawn dark.
+    xlabel, title : str
+    """
+    shown = first(changes, DRAWN)
+    labels = shown.items
+    if not labels:
+        raise AppError("no change to plot")
+    values = np.array([np.nan if changes[k] is None else changes[k] for k in labels], dtype=float)
+    figure = Figure(figsize=(7.4, 1.2 + 0.28 * len(labels)), layout="constrained")
+    ax = figure.add_subplot()
+    rows = np.arange(len(labels))
+    strong = set(marked)
+    colours = [_ACCENT if label in strong else _MUTED for label in labels]
+    ax.barh(rows, np.nan_to_num(values), color=colours, edgecolor=_ACCENT)
+    ax.set_yticks(rows, labels)
+    ax.set_ylim(len(labels) - 0.5, -0.5)
+    ax.axvline(0, color=_LINE, linewidth=0.8)
+    for row, value in enumerate(values.tolist()):
+        text = "not scored" if np.isnan(value) else f" {value:+.3f} "
+        ax.text(
+            0 if np.isnan(value) else value,
+            row,
+            text,
+            va="center",
+            ha="left" if np.isnan(value) or value >= 0 else "right",
+        )
+    finite = values[~np.isnan(values)]
+    reach = float(np.max(np.abs(finite))) if finite.size else 1.0
+    ax.set_xlim(-reach * 1.6 - 1e-9, reach * 1.6 + 1e-9)
+    ax.set_xlabel(xlabel + " (dark: significant, p <= 0.05)")
+    ax.grid(axis="x", color="#dddddd", linewidth=0.6)
+    ax.set_axisbelow(True)
+    _suptitle(figure, title, of_all(shown, "bars") if shown.more else "")
+    return figure
+
+
 def _suptitle(figure: Figure, title: str, shown: str = "") -> None:
     """A figure title wrapped to the figure's width (about 13 characters an inch at 9 pt),
     saying what is ``shown`` of all there is ("first 6 of 800 targets") when not empty."""

@@ -44,3 +44,12 @@ def figure_texts(src: str | None) -> list[str]:
     match = DATA_SVG.match(src)
     assert match, f"not an SVG data URI: {src[:60]}"
     return svg_texts(base64.b64decode(match.group(1)).decode("utf-8"))
+
+
+def screen(tab: Tab, name: str) -> Path:
+    """What the screen shows (not the whole page), as ``test-artifacts/web/NAME.png``: the
+    pictures docs/web.md shows of each page."""
+    tab.page.wait_for_function("[...document.images].every(image => image.complete)")
+    path = ARTIFACTS / f"{name}.png"
+    tab.page.screenshot(path=str(path))
+    return path

@@ -121,7 +121,9 @@ def servers(database_url: str, tmp_path: Path) -> Iterator[Callable[..., Server]
     servers: list[Server] = []
 
     def build(*, arguments: tuple[str, ...] = (), **settings: str) -> Server:
-        gate = Gate(tmp_path / "gate")  # the `gate` entry waits for the test (tests/gate.py)
+        gate = Gate(
+            tmp_path / "gate"
+        )  # the `gate` entry waits for the test (tests/support/gate.py)
         environment = {
             **os.environ,
             **gate.environment(),

@@ -3,14 +3,16 @@ as a job whose result is the new data set."""
 
 from __future__ import annotations
 
+import json
 import shutil
 import uuid
-from typing import Annotated
+from typing import Annotated, Any
 
 from fastapi import APIRouter, File, Form, UploadFile, status
 
 from touchbench.app.api.deps import ServiceDep
 from touchbench.app.api.uploads import form_request, in_client_words, save_upload
+from touchbench.app.errors import FieldError
 from touchbench.app.schemas.extraction import DEFAULT_EXTRACTOR, ExtractRequest
 from touchbench.app.schemas.jobs import JobCreated
 from touchbench.app.services.jobs import submit_extraction
@@ -51,6 +53,13 @@ def upload_session(
     sample_format: Annotated[
         str | None, Form(description="S16LE, S32LE or F32LE: raw PCM in bags without AudioInfo.")
     ] = None,
+    options: Annotated[
+        str | None,
+        Form(
+            description="Options of the extractor and the event detector as a JSON object "
+            '(`{"threshold": 12}`), as `-O name=value` on the command line.'
+        ),
+    ] = None,
 ) -> JobCreated:
     """Save the session and queue its extraction (answer: the job's id, status 202).
 
@@ -71,6 +80,7 @@ def upload_session(
         "time_unit": time_unit,
         "channels": channels,
         "sample_format": sample_format,
+        "options": _options(options),
     }
     # Checked before a byte is saved (the files' names stand for them), so that a refused
     # request leaves nothing on the disk.
@@ -93,3 +103,16 @@ def upload_session(
         raise
     service.dispatcher.wake()
     return JobCreated(job=job.id, status=job.status, kind=job.kind)
+
+
+def _options(text: str | None) -> dict[str, Any] | None:
+    """The ``options`` form field's JSON object (``None``: none given)."""
+    if text is None or not text.strip():
+        return None
+    try:
+        value = json.loads(text)
+    except ValueError:
+        raise FieldError("options", "is not JSON: give an object of option -> value") from None
+    if not isinstance(value, dict):
+        raise FieldError("options", "is not a JSON object of option -> value")
+    return value

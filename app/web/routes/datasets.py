@@ -9,10 +9,12 @@ from functools import partial
 from fastapi import APIRouter
 from fastapi.responses import HTMLResponse
 
+from touchbench.app.schemas.extraction import ExtractionSummary
 from touchbench.app.services.answers import latest_learning_curve
 from touchbench.app.services.datasets import describe_dataset
-from touchbench.app.services.lifecycle import count_runs, list_runs
+from touchbench.app.services.lifecycle import count_runs, get_job, list_runs
 from touchbench.app.services.listing import count_datasets, list_datasets
+from touchbench.app.store.database import Store
 from touchbench.app.web.deps import StoreDep
 from touchbench.app.web.listing import newest
 from touchbench.app.web.rendering import draw, render
@@ -29,9 +31,10 @@ def datasets(store: StoreDep) -> HTMLResponse:
 
 
 @router.get("/{dataset}", response_class=HTMLResponse)
-def dataset(dataset: Ref, store: StoreDep) -> HTMLResponse:
+def dataset(dataset: Ref, store: StoreDep, job: int | None = None) -> HTMLResponse:
     """Attributes, class distribution per target (table and plot), the runs on it, and its
-    newest learning curve (table and plot) when one was computed."""
+    newest learning curve (table and plot) when one was computed; with ``job``, the
+    extraction job that made it: what it found, dropped and noted."""
     from touchbench.app.reports.answer_tables import learning_table
     from touchbench.app.reports.figures import dataset_classes_figure, learning_figure
 
@@ -40,6 +43,7 @@ def dataset(dataset: Ref, store: StoreDep) -> HTMLResponse:
     return render(
         "fragments/dataset.html.j2",
         dataset=description,
+        extraction=_extraction(store, job, description.id),
         plot=draw("Instances per class", partial(dataset_classes_figure, description)),
         runs=newest(
             count_runs(store, dataset_id=description.id),
@@ -49,4 +53,17 @@ def dataset(dataset: Ref, store: StoreDep) -> HTMLResponse:
         learning_plot=None
         if curve is None
         else draw("Score by share of each training fold", partial(learning_figure, curve)),
+    )
+
+
+def _extraction(store: Store, job_id: int | None, dataset_id: int) -> ExtractionSummary | None:
+    """The summary of extraction job ``job_id`` when it made data set ``dataset_id``."""
+    if job_id is None:
+        return None
+    found = get_job(store, job_id)
+    if found.kind != "extract" or not found.result or found.result.get("id") != dataset_id:
+        return None
+    fields = ExtractionSummary.model_fields  # the result also holds the job's own keys
+    return ExtractionSummary.model_validate(
+        {key: value for key, value in found.result.items() if key in fields}
     )

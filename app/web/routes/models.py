@@ -1,4 +1,5 @@
-"""Fragments of models: the list, and one model with the form that predicts with it."""
+"""Fragments of models: the list, and one model: its versions and aliases with the actions
+that move them, its ONNX twin, and the forms that predict with it."""
 
 from __future__ import annotations
 
@@ -7,14 +8,20 @@ from functools import partial
 from fastapi import APIRouter
 from fastapi.responses import HTMLResponse
 
+from touchbench.app.errors import AppError
+from touchbench.app.schemas.models import AliasBody
 from touchbench.app.schemas.status import FINAL
 from touchbench.app.services.lifecycle import count_jobs, list_jobs
 from touchbench.app.services.registry import count_models, find_model, list_models
+from touchbench.app.store.database import Store
+from touchbench.app.store.models import ModelInfo
 from touchbench.app.web.deps import StoreDep
 from touchbench.app.web.listing import newest
 from touchbench.app.web.rendering import render
+from touchbench.app.web.request_form import form_fields
 from touchbench.app.web.routes.pages import Ref
 from touchbench.benchmark.dataset import Schema
+from touchbench.benchmark.errors import BenchmarkError
 
 router = APIRouter(prefix="/fragments/models", include_in_schema=False)
 
@@ -30,11 +37,31 @@ def models(store: StoreDep) -> HTMLResponse:
 
 @router.get("/{model}", response_class=HTMLResponse)
 def model(model: Ref, store: StoreDep) -> HTMLResponse:
-    """What the model classifies, and one input per feature it needs (a number, or a
-    choice of the labels it was trained with)."""
+    """What the model classifies, its name's versions (score in the run each came from,
+    aliases, the actions that move them), its ONNX twin, and the forms that predict: one
+    input per feature it needs, or a file (instances, or a raw recording)."""
     info = find_model(store, model)
+    listed = newest(count_models(store), partial(list_models, store))
+    versions = [found for found in listed.items if found.name == info.name]
     return render(
         "fragments/model.html.j2",
         model=info.to_schema(),
         features=Schema.from_json(info.schema).features,
+        versions=[(found.to_schema(), _score(store, found)) for found in reversed(versions)],
+        older=bool(listed.more),
+        alias_field=form_fields(AliasBody)["alias"],
     )
+
+
+def _score(store: Store, found: ModelInfo) -> str:
+    """The version's classifier's mean score in the run it came from (``-``: none)."""
+    from touchbench.app.services.runs import NoResultsError, run_leaderboard
+
+    if found.run_id is None:
+        return "-"
+    try:
+        board = run_leaderboard(store, found.run_id).board
+        mean = board.row(found.classifier).metrics[board.metric][0]
+    except (AppError, BenchmarkError, NoResultsError, KeyError):
+        return "-"
+    return f"{board.metric} {mean:.4f}"

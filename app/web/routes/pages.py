@@ -30,6 +30,12 @@ def dataset(dataset: Ref) -> HTMLResponse:
     return render("dataset.html.j2", title=f"data set {dataset}", dataset=dataset)
 
 
+@router.get("/recordings/new", response_class=HTMLResponse)
+def new_session() -> HTMLResponse:
+    """The form that uploads a recording session and extracts a data set from it."""
+    return render("new_session.html.j2", title="upload a recording session")
+
+
 @router.get("/runs/new", response_class=HTMLResponse)
 def new_run(dataset: Annotated[str | None, Query(max_length=200)] = None) -> HTMLResponse:
     return render("new_run.html.j2", title="new run", dataset=dataset)

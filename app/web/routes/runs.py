@@ -22,6 +22,7 @@ from touchbench.app.errors import NotFoundError
 from touchbench.app.reports import bounds
 from touchbench.app.reports.answer_tables import run_answer_tables
 from touchbench.app.reports.run_tables import RunTable, run_tables
+from touchbench.app.schemas.runs import BenchRequest
 from touchbench.app.schemas.status import FINAL, RESUMABLE, Status
 from touchbench.app.services.answers import run_answers
 from touchbench.app.services.lifecycle import count_runs, get_run, list_runs
@@ -30,6 +31,7 @@ from touchbench.app.services.runs import NoResultsError, run_leaderboard
 from touchbench.app.web.deps import StoreDep
 from touchbench.app.web.listing import newest
 from touchbench.app.web.rendering import draw, render
+from touchbench.app.web.request_form import form_fields, grouped
 from touchbench.app.web.routes.pages import Ref
 
 # The plots and the statistics (matplotlib, scipy) load with the first fragment that needs
@@ -39,6 +41,24 @@ if TYPE_CHECKING:
     from touchbench.app.services.runs import RunLeaderboard
 
 router = APIRouter(prefix="/fragments/runs", include_in_schema=False)
+
+#: Classifiers drawn in a run's reliability diagram (the table lists every one).
+RELIABILITY_CURVES = 5
+
+#: The run form's groups of :class:`BenchRequest`'s fields (a field not named here shows
+#: in a last group of its own).
+RUN_GROUPS = (
+    (
+        "basic",
+        (
+            "dataset", "target", "classifiers", "suite", "folds", "repeats", "seed", "metric",
+            "baseline", "aggregate", "independent", "position", "weka",
+        ),
+    ),
+    ("racing and budget", ("race", "race_alpha", "budget_total")),
+    ("tuning and stacking", ("tune", "budget", "stack")),
+    ("limits", ("timeout", "max_memory_mb")),
+)  # fmt: skip
 
 Metric = Annotated[str | None, Query(max_length=100)]
 Baseline = Annotated[str | None, Query(max_length=200)]
@@ -59,17 +79,20 @@ def runs(store: StoreDep) -> HTMLResponse:
 def run_form(
     store: StoreDep, dataset: Annotated[str | None, Query(max_length=200)] = None
 ) -> HTMLResponse:
-    """The form that starts a run: data sets with their targets, suites, classifier ids."""
-    from touchbench.benchmark.catalogue import CATALOGUE, SUITES
+    """The form that starts a run: every field of :class:`BenchRequest` in its groups, with
+    the data sets and their targets, and the classifier ids and metrics to pick from."""
+    from touchbench.benchmark.catalogue import CATALOGUE
+    from touchbench.benchmark.evaluation.metrics import MULTICLASS_METRICS, REGRESSION_METRICS
     from touchbench.benchmark.multitarget import multitarget_configurations
 
     return render(
         "fragments/run_form.html.j2",
         datasets=newest(count_datasets(store), partial(list_datasets, store)),
         chosen=dataset,
-        suites=SUITES,
+        groups=grouped(form_fields(BenchRequest), RUN_GROUPS),
         catalogue=[(spec.id, spec.description) for spec in CATALOGUE.values()],
         multitarget=multitarget_configurations(),
+        metrics=[*MULTICLASS_METRICS, *REGRESSION_METRICS],
     )
 
 
@@ -133,6 +156,66 @@ def plots(run_id: int, store: StoreDep, metric: Metric = None) -> HTMLResponse:
         drawn.append(draw("Accuracy per target", partial(figures.targets_figure, view)))
     drawn.append(draw("Instances per class", partial(figures.classes_figure, view)))
     return render("fragments/plots.html.j2", plots=drawn)
+
+
+@router.get("/{run_id}/calibration", response_class=HTMLResponse)
+def calibration(run_id: int, store: StoreDep) -> HTMLResponse:
+    """Every classifier's calibration (table) and the best ones' reliability diagram; why
+    there is none for a regression or an imported run (no predictions kept)."""
+    from touchbench.app.services.report import run_view
+
+    run = get_run(store, run_id)
+    if run.n_results == 0:
+        return render("fragments/calibration.html.j2", sure=None)
+    view = run_view(store, run.id)
+    return render("fragments/calibration.html.j2", sure=_calibration(view))
+
+
+def _calibration(view: RunView) -> dict[str, Any]:
+    """The calibration table and diagram of a run read, or why it has none."""
+    from touchbench.app.reports import figures
+    from touchbench.app.reports.certainty_tables import calibration_table
+    from touchbench.app.services.certainty import certainty_of
+    from touchbench.benchmark.errors import BenchmarkError
+
+    try:
+        certainty = certainty_of(view)
+    except BenchmarkError as why:
+        return {"table": None, "diagram": None, "why": str(why)}
+    return {
+        "table": _first_rows(calibration_table(certainty)),
+        "diagram": draw(
+            "Reliability: accuracy of the top label against its confidence, out of fold",
+            partial(figures.reliability_figure, certainty, RELIABILITY_CURVES),
+        ),
+        "why": None,
+    }
+
+
+@router.get("/{run_id}/answers", response_class=HTMLResponse)
+def answers(run_id: int, store: StoreDep) -> HTMLResponse:
+    """The forms that start a run's answers as jobs (an ablation, a classifier's permutation
+    importance, learning curves on its data set), each field from its request type."""
+    from touchbench.app.schemas.ablation import AblationRequest
+    from touchbench.app.schemas.importance import ImportanceRequest
+    from touchbench.app.schemas.learning import LearningCurveRequest
+
+    run = get_run(store, run_id).schema()
+    fixed = {"run", "dataset"}
+    forms = {
+        kind: [f for name, f in form_fields(request).items() if name not in fixed]
+        for kind, request in (
+            ("ablation", AblationRequest),
+            ("importance", ImportanceRequest),
+            ("learning-curve", LearningCurveRequest),
+        )
+    }
+    return render(
+        "fragments/answers.html.j2",
+        run=run,
+        done=run.status == Status.DONE,
+        forms=forms,
+    )
 
 
 @router.get("/{run_id}/classifiers/{classifier}", response_class=HTMLResponse)

@@ -22,27 +22,36 @@ function apiHeaders(extra = {}) {
 // (a region still loading when a new key was entered) must not overwrite the newer state.
 const keyStill = (sent) => sessionStorage.getItem(KEY) === sent;
 
+// The service's words for a key it does not know (a key it knows but whose role is too low
+// is refused with a message of its own, shown as it is).
+const WRONG_KEY = "wrong API key";
+
+async function errorOf(response) {
+  try {
+    return (await response.clone().json()).error || {};
+  } catch (_) {
+    return {};
+  }
+}
+
 async function call(url, options = {}) {
   const sent = sessionStorage.getItem(KEY);
   const response = await fetch(url, { ...options, headers: apiHeaders(options.headers) });
-  if ((response.status === 401 || response.status === 403) && keyStill(sent)) {
-    showKeyState(response.status);
+  if (response.status === 401 && keyStill(sent)) showKeyState(401);
+  if (response.status === 403 && keyStill(sent)) {
+    if ((await errorOf(response)).message === WRONG_KEY) showKeyState(403);
   }
   return response;
 }
 
 async function problem(response) {
   // One line from the JSON error body the service always answers.
-  try {
-    const body = await response.json();
-    const error = body.error || {};
-    const where = error.where ? ` (${error.where})` : "";
-    if (response.status === 401) return "This service needs an API key: enter it at the top.";
-    if (response.status === 403) return "The API key is wrong: enter the service's key at the top.";
-    return `${error.message || response.statusText}${where}`;
-  } catch (_) {
-    return `${response.status} ${response.statusText}`;
-  }
+  const error = await errorOf(response);
+  if (!error.message) return `${response.status} ${response.statusText}`;
+  const where = error.where ? ` (${error.where})` : "";
+  if (response.status === 401) return "This service needs an API key: enter it at the top.";
+  if (error.message === WRONG_KEY) return "The API key is wrong: enter the service's key at the top.";
+  return `${error.message}${where}`;
 }
 
 function showKeyState(status) {
@@ -105,9 +114,12 @@ async function load(region) {
       document.querySelectorAll(`[data-follows-final="${region.id}"]`).forEach(load);
     }
   }
+  const go = region.querySelector("[data-go]");
+  if (go) return location.assign(go.dataset.go); // a job made a page to see: open it
   const poll = region.querySelector("[data-poll]");
   if (poll) timers.set(region, setTimeout(() => load(region), Number(poll.dataset.poll)));
   fillTargets(region);
+  region.querySelectorAll("form[data-action=upload-session]").forEach(showOptions);
 }
 
 function loadAll() {
@@ -129,29 +141,168 @@ async function upload(form, outcome) {
   document.querySelectorAll("#datasets-list").forEach(load);
 }
 
-async function startRun(form, outcome) {
-  const data = new FormData(form);
-  const body = {
-    dataset: data.get("dataset"),
-    folds: Number(data.get("folds")),
-    repeats: Number(data.get("repeats")),
-    seed: Number(data.get("seed")),
-  };
-  if (data.get("target")) body.target = data.get("target");
-  if (data.get("choice") === "classifiers") {
-    body.classifiers = String(data.get("classifiers")).split(/[\s,]+/).filter(Boolean);
-    if (!body.classifiers.length) return message(outcome, "Give at least one classifier id.");
-  } else {
-    body.suite = data.get("suite");
+// ------------------------------------------------------------------------------ requests
+
+// A request's fields as the form holds them (inputs with data-field, their kind, default and
+// the request's bounds in data- attributes): the values that differ from the defaults, and
+// what breaks a bound, in the request's own field names.
+function bounded(value, bounds, name, unit = "") {
+  const limits = [
+    ["minimum", (v, b) => v >= b, "greater than or equal to"],
+    ["maximum", (v, b) => v <= b, "less than or equal to"],
+    ["exclusiveminimum", (v, b) => v > b, "greater than"],
+    ["exclusivemaximum", (v, b) => v < b, "less than"],
+  ];
+  for (const [key, holds, words] of limits) {
+    if (bounds[key] !== undefined && !holds(value, Number(bounds[key]))) {
+      return `${name}: Input should be ${words} ${bounds[key]}${unit}`;
+    }
   }
-  const response = await call("/api/runs", {
+  return null;
+}
+
+function readRequest(form) {
+  const body = {};
+  const errors = [];
+  for (const input of findAll(form, "[data-field]")) {
+    if (input.closest("[hidden]")) continue;
+    input.removeAttribute("aria-invalid");
+    const name = input.dataset.field;
+    const kind = input.dataset.kind;
+    const fail = (text) => errors.push([input, text]);
+    if (kind === "boolean") {
+      if (input.checked !== (input.dataset.default === "true")) body[name] = input.checked;
+      continue;
+    }
+    const text = input.value.trim();
+    if (text === "") {
+      if (input.required) fail(`${name}: Field required`);
+      continue;
+    }
+    if (text === input.dataset.default) continue;
+    let value = text;
+    if (kind === "integer" || kind === "number") {
+      value = Number(text);
+      if (!Number.isFinite(value)) { fail(`${name}: Input should be a finite number`); continue; }
+      if (kind === "integer" && !Number.isInteger(value)) { fail(`${name}: Input should be a valid integer`); continue; }
+      const wrong = bounded(value, input.dataset, name);
+      if (wrong) { fail(wrong); continue; }
+    } else if (kind === "list" || kind === "lines") {
+      value = text.split(kind === "list" ? /[\s,]+/ : /\n/).map((v) => v.trim()).filter(Boolean);
+      if (input.dataset.items === "number") {
+        value = value.map(Number);
+        if (value.some((v) => !Number.isFinite(v))) { fail(`${name}: Input should be a list of numbers`); continue; }
+      }
+      const items = { minimum: input.dataset.minitems, maximum: input.dataset.maxitems };
+      const wrong = bounded(value.length, items, name, " items");
+      if (wrong) { fail(wrong); continue; }
+    } else {
+      const wrong = bounded(text.length, { minimum: input.dataset.minlength, maximum: input.dataset.maxlength }, name, " characters");
+      if (wrong) { fail(wrong); continue; }
+    }
+    body[name] = value;
+  }
+  return { body, errors };
+}
+
+// Mark the inputs a problem names (the page's own, or the service's `body.FIELD`).
+function markInvalid(form, errors, outcome) {
+  for (const [input] of errors) input.setAttribute("aria-invalid", "true");
+  message(outcome, errors.map(([, text]) => text).join("; "));
+  if (errors.length) errors[0][0].focus();
+}
+
+async function refused(form, response, outcome) {
+  const error = await errorOf(response);
+  const text = await problem(response);
+  const field = (error.where || "").split(".")[1];
+  const input = field ? find(form, `[data-field="${CSS.escape(field)}"]`) : null;
+  // the request's field first, as the page's own checks say it (`race: needs ...`)
+  const named = error.message && !error.message.startsWith("body.") ? `${field}: ${text}` : text;
+  if (input) return markInvalid(form, [[input, named]], outcome);
+  message(outcome, text);
+}
+
+async function sendRequest(form, outcome, url) {
+  const { body, errors } = readRequest(form);
+  if (errors.length) return markInvalid(form, errors, outcome);
+  const response = await call(url, {
     method: "POST",
     headers: { "Content-Type": "application/json" },
     body: JSON.stringify(body),
   });
-  if (!response.ok) return message(outcome, await problem(response));
-  const run = await response.json();
-  location.assign(`/runs/${run.id}`);
+  if (!response.ok) {
+    await refused(form, response, outcome);
+    return null;
+  }
+  return response.json();
+}
+
+async function startRun(form, outcome) {
+  const run = await sendRequest(form, outcome, "/api/runs");
+  if (run) location.assign(`/runs/${run.id}`);
+}
+
+// A job's fragment, polled into `region` until the job ends.
+function followJob(region, job) {
+  region.dataset.src = `/fragments/jobs/${job}`;
+  region.classList.add("region");
+  load(region);
+}
+
+async function startJob(form, outcome) {
+  const created = await sendRequest(form, outcome, attribute(form, "data-url"));
+  if (!created) return;
+  message(outcome, `Job ${created.job} ${created.status}.`, "ok");
+  followJob(document.getElementById(attribute(form, "data-into")), created.job);
+}
+
+async function uploadSession(form, outcome) {
+  const { body, errors } = readRequest(form);
+  const files = find(form, "input[name=recordings]");
+  if (!files.files.length) errors.push([files, "recordings: Field required"]);
+  if (errors.length) return markInvalid(form, errors, outcome);
+  const data = new FormData();
+  for (const file of files.files) data.append("recordings", file);
+  const labels = find(form, "input[name=labels]");
+  if (labels.files.length) data.append("labels", labels.files[0]);
+  for (const name of ["extractor", "events"]) {
+    const value = find(form, `select[name=${name}]`).value;
+    if (value) data.append(name, value);
+  }
+  for (const [name, value] of Object.entries(body)) {
+    for (const item of Array.isArray(value) ? value : [value]) data.append(name, String(item));
+  }
+  const options = {};
+  for (const input of findAll(form, "[data-option]")) {
+    if (!input.closest("[hidden]") && input.value.trim() !== "") {
+      options[input.dataset.option] = input.value.trim();
+    }
+  }
+  if (Object.keys(options).length) data.append("options", JSON.stringify(options));
+  const response = await call("/api/datasets/recordings", { method: "POST", body: data });
+  if (!response.ok) return refused(form, response, outcome);
+  const created = await response.json();
+  message(outcome, `Extraction job ${created.job} ${created.status}: its progress below.`, "ok");
+  followJob(document.getElementById("session-job"), created.job);
+}
+
+// Show the options of the extractor and the event detection chosen, and no others.
+function showOptions(form) {
+  const extractor = find(form, "select[name=extractor]");
+  const events = find(form, "select[name=events]");
+  if (!extractor || !events) return;
+  const detector = events.value || extractor.selectedOptions[0].dataset.defaultEvents;
+  for (const box of findAll(form, "[data-owner]")) {
+    const owner = box.dataset.owner;
+    box.hidden = owner !== `extractor:${extractor.value}` && owner !== `events:${detector}`;
+  }
+}
+
+async function alias(form, outcome) {
+  const model = attribute(form, "data-model");
+  const created = await sendRequest(form, outcome, `/api/models/${encodeURIComponent(model)}/aliases`);
+  if (created) loadAll();
 }
 
 function instanceOf(form) {
@@ -234,7 +385,7 @@ function showPredictions(target, report) {
 async function post(button) {
   const box = button.closest(".region") || document.body;
   const outcome = box.querySelector(".outcome") || box;
-  const options = { method: "POST" };
+  const options = { method: button.dataset.method || "POST" };
   if (button.dataset.body) {
     options.headers = { "Content-Type": "application/json" };
     options.body = button.dataset.body;
@@ -243,6 +394,10 @@ async function post(button) {
   const response = await call(button.dataset.post, options);
   button.disabled = false;
   if (!response.ok) return message(outcome, await problem(response));
+  if (button.dataset.into) {
+    const created = await response.json();
+    return followJob(document.getElementById(button.dataset.into), created.job);
+  }
   if (button.dataset.then) return location.assign(button.dataset.then);
   loadAll();
 }
@@ -285,6 +440,9 @@ function fillTargets(root) {
 const ACTIONS = {
   upload: upload,
   "start-run": startRun,
+  "start-job": startJob,
+  "upload-session": uploadSession,
+  alias: alias,
   predict: (form) => predict(form, false),
   "predict-file": (form) => predict(form, true),
 };
@@ -329,6 +487,7 @@ document.addEventListener("click", (event) => {
 
 document.addEventListener("change", (event) => {
   const form = event.target.form;
+  if (form && attribute(form, "data-action") === "upload-session") showOptions(form);
   if (form && attribute(form, "data-autosubmit") !== null) {
     HTMLFormElement.prototype.requestSubmit.call(form);
   }

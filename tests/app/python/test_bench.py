@@ -16,8 +16,8 @@ from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.neighbors import KNeighborsClassifier
 
 import touchbench
-from tests.app.cli_runner import run_cli
-from tests.grasp_table import FEATURES, OBJECTS, grasp_arff
+from tests.support.cli_runner import run_cli
+from tests.support.grasp_table import FEATURES, OBJECTS, grasp_arff
 from touchbench.app.errors import FieldError, NotFoundError
 from touchbench.app.python.progress import RunBar
 from touchbench.app.services.runs import RunOptions, fold_plan, prepare_problem

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 import touchbench
-from tests.app.cli_runner import run_cli
+from tests.support.cli_runner import run_cli
 from touchbench.app.errors import FieldError
 
 

@@ -25,14 +25,30 @@ def browser() -> Iterator[Browser]:
         launched.close()
 
 
+#: A projector's screen: every new page is shown readable at this size (docs/web.md).
+PROJECTOR = {"width": 1280, "height": 720}
+
+
 @pytest.fixture
 def tab(browser: Browser, request: pytest.FixtureRequest) -> Iterator[Tab]:
     """A fresh tab (its own session storage) on a laptop-sized screen; the test fails if
     the page threw an error or broke its Content-Security-Policy."""
+    yield from _tab(browser, request, {"width": 1366, "height": 850})
+
+
+@pytest.fixture
+def projector_tab(browser: Browser, request: pytest.FixtureRequest) -> Iterator[Tab]:
+    """A fresh tab on a projector's 1280x720 screen (:data:`PROJECTOR`)."""
+    yield from _tab(browser, request, PROJECTOR)
+
+
+def _tab(
+    browser: Browser, request: pytest.FixtureRequest, viewport: dict[str, int]
+) -> Iterator[Tab]:
     folder = ARTIFACTS / request.node.name
     shutil.rmtree(folder, ignore_errors=True)
     folder.mkdir(parents=True)
-    context = browser.new_context(viewport={"width": 1366, "height": 850})
+    context = browser.new_context(viewport=viewport)  # type: ignore[arg-type]
     context.set_default_timeout(30_000)
     page = context.new_page()
     opened = Tab(page, folder)

@@ -61,7 +61,6 @@ def test_a_researcher_benchmarks_compares_and_predicts_in_the_browser(
     form = page.locator("form[data-action=start-run]")
     expect(form.locator("select[name=dataset]")).to_have_value("touch")
     form.locator("select[name=target]").select_option("gesture")
-    form.locator("input[name=choice][value=classifiers]").check()
     form.locator("input[name=classifiers]").fill(", ".join(CLASSIFIERS))
     form.locator("input[name=folds]").fill("3")
     tab.shot("run-form")
