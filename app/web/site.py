@@ -17,12 +17,13 @@ from fastapi import FastAPI
 from fastapi.staticfiles import StaticFiles
 
 from touchbench.app.web.rendering import STATIC
-from touchbench.app.web.routes import compare, datasets, models, pages, runs
+from touchbench.app.web.routes import compare, datasets, live, models, pages, runs
 
 
 def install(app: FastAPI, dependencies: Sequence[Any]) -> None:
     """Add the pages, the fragments (behind ``dependencies``) and the static files."""
     app.include_router(pages.router)
+    app.include_router(live.router)  # a page: no data, the socket checks the key
     for router in (datasets.router, runs.router, models.router, compare.router):
         app.include_router(router, dependencies=list(dependencies))
     app.mount("/static", StaticFiles(directory=STATIC), name="static")

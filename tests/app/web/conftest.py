@@ -8,12 +8,17 @@ Screenshots of every step go to ``test-artifacts/web/<test name>/`` at the repos
 from __future__ import annotations
 
 import base64
+import functools
 import os
 import re
 import shutil
+import threading
 from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
+from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
+from typing import Any
 
 import pytest
 from playwright.sync_api import Browser, Page, sync_playwright
@@ -92,3 +97,23 @@ def tab(browser: Browser, request: pytest.FixtureRequest) -> Iterator[Tab]:
     context.close()
     assert not opened.page_errors, opened.page_errors
     assert not opened.policy_violations, opened.policy_violations
+
+
+@contextmanager
+def static_site(folder: Path) -> Iterator[str]:
+    """A second web server on loopback (another port: another origin) serving ``folder``;
+    its URL."""
+
+    class Quiet(SimpleHTTPRequestHandler):
+        def log_message(self, format: str, *args: Any) -> None:
+            pass
+
+    httpd = ThreadingHTTPServer(("127.0.0.1", 0), functools.partial(Quiet, directory=str(folder)))
+    thread = threading.Thread(target=httpd.serve_forever, daemon=True)
+    thread.start()
+    try:
+        yield f"http://127.0.0.1:{httpd.server_address[1]}"
+    finally:
+        httpd.shutdown()
+        httpd.server_close()
+        thread.join()
