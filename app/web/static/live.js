@@ -19,6 +19,7 @@
 
   let socket = null;
   let view = null; // what the canvas draws: signal columns, touches, switches
+  let drawing = false; // a frame is asked for: what arrived is drawn in it
 
   function say(text, kind = "note") {
     const status = $("live-status");
@@ -190,6 +191,7 @@
     $("live-last").replaceChildren();
     $("live-switch").hidden = true;
     $("live-source").textContent = "";
+    redraw();
   }
 
   function receive(message) {
@@ -208,7 +210,7 @@
       `channel(s) at ${source.samplerate} Hz, ${speed}`;
     setRunning(true, "running");
     say("Listening…");
-    requestAnimationFrame(draw);
+    redraw();
   }
 
   function addSignal(signal) {
@@ -219,6 +221,7 @@
     view.step = signal.step;
     view.end = signal.time + count * signal.step;
     while (view.columns.length && view.columns[0].t < view.end - WINDOW) view.columns.shift();
+    redraw();
   }
 
   function switched(message) {
@@ -234,6 +237,7 @@
     cell.textContent = `switched from ${message.from} to ${message.switched}`;
     row.append(cell);
     $("live-touches").tBodies[0].prepend(row);
+    redraw();
   }
 
   function colour(label) {
@@ -277,6 +281,7 @@
     const shown = cell(row, "…", "num delay");
     $("live-touches").tBodies[0].prepend(row);
     showLast(mark);
+    redraw();
     // The frame that draws the mark: how long after the touch's end (on the service's
     // clock, the same as this machine's on loopback) the page showed it.
     requestAnimationFrame(() => {
@@ -323,6 +328,17 @@
   }
 
   // ---------------------------------------------------------------------------- canvas
+
+  // Drawn in the next animation frame after something arrived, not every frame: the
+  // signal comes 20 times a second, and a projector's laptop has other work to do.
+  function redraw() {
+    if (drawing) return;
+    drawing = true;
+    requestAnimationFrame(() => {
+      drawing = false;
+      draw();
+    });
+  }
 
   function draw() {
     const canvas = $("live-signal");
@@ -382,7 +398,6 @@
     g.fillStyle = "#5b6570";
     g.textBaseline = "bottom";
     for (let t = Math.ceil(left); t <= view.end; t += 1) g.fillText(`${t} s`, x(t) + 2, height);
-    if (socket) requestAnimationFrame(draw);
   }
 
   // ---------------------------------------------------------------------------- wiring

@@ -14,6 +14,8 @@ from typing import Any
 
 import pytest
 from playwright.sync_api import Page, expect
+from websockets.exceptions import ConnectionClosed
+from websockets.sync.client import connect
 
 from tests.app.api.conftest import Server, _servers
 from tests.app.web.conftest import ARTIFACTS, Tab, static_site
@@ -253,3 +255,53 @@ def test_a_page_on_another_origin_cannot_open_the_stream(
     assert outcome == {"upload": "sent", "socket": "refused"}
     assert statuses == {f"{server.url}/api/live/recordings": 403}
     assert server.client.get("/api/live/recordings").json()["replays"] == before
+
+
+def _refusal(server: Server, model: str, header: dict[str, Any]) -> tuple[int, str]:
+    """The close code and reason of a live session opened with ``header``."""
+    address = server.url.replace("http://", "ws://") + f"/api/models/{model}/live"
+    with connect(address, additional_headers={"X-API-Key": KEY}, open_timeout=60) as socket:
+        socket.send(json.dumps(header))
+        try:
+            while True:
+                socket.recv(timeout=60)
+        except ConnectionClosed:
+            pass
+        assert socket.close_code is not None
+        return socket.close_code, socket.close_reason or ""
+
+
+def test_sources_the_service_cannot_read_are_refused_in_one_line(
+    live_service: tuple[Server, Path], tmp_path: Path
+) -> None:
+    server, _ = live_service
+    not_audio = tmp_path / "notes.wav"
+    not_audio.write_text("not a recording")
+    answer = server.client.post(
+        "/api/live/recordings", files={"recording": ("notes.wav", not_audio.read_bytes())}
+    )
+    assert answer.status_code == 400, answer.text
+    message = answer.json()["error"]["message"]
+    assert message.startswith("notes.wav: ") and str(server.work_dir) not in message
+    kept = server.client.get("/api/live/recordings").json()["replays"]
+    assert all(replay["name"] != "notes.wav" for replay in kept)
+    assert len(list((server.work_dir / "live-replays").iterdir())) == len(kept)  # nothing left
+
+    model = f"{MODEL}@1"
+    cases: list[tuple[dict[str, Any], int, str]] = [
+        ({"source": {"kind": "camera"}}, 1007, "source.kind"),
+        ({"source": {"kind": "simulated", "speed": 100}}, 1007, "source.speed"),
+        ({"source": {"kind": "replay"}}, 1007, "needs the id of an uploaded recording"),
+        ({"source": {"kind": "replay", "replay": "0" * 32}}, 1008, "no uploaded recording"),
+        ({"source": {"kind": "simulated", "touches": 1000}}, 1008, "LIVE_SOURCE_SECONDS"),
+    ]
+    for header, code, words in cases:
+        got, reason = _refusal(server, model, header)
+        assert got == code and words in reason, (header, got, reason)
+    # without the key in the header or the handshake: refused before the source is read
+    address = server.url.replace("http://", "ws://") + f"/api/models/{model}/live"
+    with connect(address, open_timeout=60) as socket:
+        socket.send(json.dumps({"source": {"kind": "simulated", "touches": 1}}))
+        with pytest.raises(ConnectionClosed):
+            socket.recv(timeout=60)
+        assert socket.close_code == 1008 and "API key" in (socket.close_reason or "")
