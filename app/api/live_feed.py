@@ -27,6 +27,7 @@ import time
 from collections.abc import Awaitable, Callable, Mapping
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
 from fastapi import WebSocket, WebSocketDisconnect
 from pydantic import ValidationError
 from starlette.concurrency import run_in_threadpool
@@ -37,11 +38,13 @@ from touchbench.app.schemas.live import LiveSource
 if TYPE_CHECKING:
     from touchbench.app.api.deps import Service
     from touchbench.app.services.live import LiveSession, TouchPrediction
-    from touchbench.drivers.source import Source
+    from touchbench.drivers.source import Block, Source
 
 POLICY, INVALID, TOO_BIG, NORMAL, INTERNAL, TRY_AGAIN = 1008, 1007, 1009, 1000, 1011, 1013
 #: Seconds between two signal messages (the touches go at once).
 SIGNAL_SECONDS = 0.05
+#: Most seconds of the source fed at once when the service has fallen behind.
+CATCH_UP_SECONDS = 1.0
 
 
 class Closed(Exception):  # noqa: N818 (ends the session with a close frame)
@@ -100,8 +103,6 @@ async def serve_source(
 
 
 async def _stream(websocket: WebSocket, source: Source, session: LiveSession, speed: float) -> None:
-    from touchbench.app.services.live_sources import peaks
-
     started, clock = time.time(), time.perf_counter()
     await websocket.send_json(
         {
@@ -125,39 +126,84 @@ async def _stream(websocket: WebSocket, source: Source, session: LiveSession, sp
             await websocket.send_json(message)
 
     heard = asyncio.ensure_future(websocket.receive())
-    blocks = source.blocks()
+    reader = _Reader(source, session, clock, speed)
     signal: list[list[float]] = []
-    first, step, last_sent = 0.0, 0.0, clock
+    first, last_sent = 0.0, clock
     stopped = False
     try:
-        while not stopped:
-            block = await run_in_threadpool(next, blocks, None)
-            if block is None:
-                break
-            length = block.samples.shape[1]
-            due = clock + (block.time + length / source.samplerate) / speed
+        due = await run_in_threadpool(reader.read)
+        while due is not None and not stopped:
             wait = due - time.perf_counter()
             if wait > 0:
                 await asyncio.wait({heard}, timeout=wait)
             if heard.done():
                 stopped = _stop(heard.result())
-            touches = await run_in_threadpool(
-                session.feed, block.samples, block.time, arrived=time.perf_counter()
-            )
-            if not signal:
-                first, step = block.time, length / source.samplerate
-            signal.append(peaks(block.samples))
+            at, columns, touches, due = await run_in_threadpool(reader.step)
+            first = first if signal else at
+            signal += columns
             now = time.perf_counter()
             if touches or session.events or now - last_sent >= SIGNAL_SECONDS:
-                await websocket.send_json({"signal": _signal(first, step, signal)})
+                await websocket.send_json({"signal": _signal(first, reader.step_seconds, signal)})
                 signal, last_sent = [], now
                 await send(touches)
         if signal:
-            await websocket.send_json({"signal": _signal(first, step, signal)})
+            await websocket.send_json({"signal": _signal(first, reader.step_seconds, signal)})
         await send(await run_in_threadpool(session.finish))
     finally:
         heard.cancel()
     raise Closed(NORMAL, "stream ended" if stopped else "source ended")
+
+
+class _Reader:
+    """The source's blocks into the session, each when it is due (``clock`` + its end /
+    ``speed``, on ``time.perf_counter()``); blocks already due when one is fed (the
+    service fell behind) are fed with it, so that it catches up instead of lagging more."""
+
+    def __init__(self, source: Source, session: LiveSession, clock: float, speed: float) -> None:
+        self.blocks = source.blocks()
+        self.samplerate = source.samplerate
+        self.session = session
+        self.clock = clock
+        self.speed = speed
+        self.next: Block | None = None
+        self.step_seconds = 0.0
+
+    def _due(self, block: Block) -> float:
+        return self.clock + (block.time + block.samples.shape[1] / self.samplerate) / self.speed
+
+    def read(self) -> float | None:
+        """Read the next block ahead; when it is due (None: the source ended)."""
+        self.next = next(self.blocks, None)
+        if self.next is None:
+            return None
+        if not self.step_seconds:
+            self.step_seconds = self.next.samples.shape[1] / self.samplerate
+        return self._due(self.next)
+
+    def step(self) -> tuple[float, list[list[float]], list[TouchPrediction], float | None]:
+        """Feed the block read ahead and those due since: the source time of the first,
+        their peaks (one column per block), the touches that ended in them, and when the
+        next block is due (None: the source ended)."""
+        from touchbench.app.services.live_sources import peaks  # start-up time: see live
+
+        assert self.next is not None, "read() first"
+        taken = [self.next]
+        due = self.read()
+        most = max(1, int(CATCH_UP_SECONDS / self.step_seconds))
+        while due is not None and due <= time.perf_counter() and len(taken) < most:
+            assert self.next is not None
+            taken.append(self.next)
+            due = self.read()
+        samples = (
+            taken[0].samples
+            if len(taken) == 1
+            else np.concatenate([block.samples for block in taken], axis=1)
+        )
+        # Arrived when the last of them was due: a block is late by what the service fell
+        # behind, as a sound card's would wait in its queue.
+        arrived = self._due(taken[-1])
+        touches = self.session.feed(samples, taken[0].time, arrived=arrived)
+        return taken[0].time, [peaks(block.samples) for block in taken], touches, due
 
 
 def _signal(first: float, step: float, columns: list[list[float]]) -> dict[str, Any]:
