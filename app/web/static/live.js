@@ -270,6 +270,7 @@
     row.dataset.start = touch.start;
     row.dataset.end = touch.end;
     row.dataset.model = touch.model;
+    row.dataset.latencyMs = touch.latency_ms;
     row.dataset.labels = JSON.stringify(Object.fromEntries(labels.map((l) => [l.target, l.value])));
     cell(row, String(view.touches.length), "num");
     cell(row, `${touch.start.toFixed(2)}–${touch.end.toFixed(2)}`, "num");
