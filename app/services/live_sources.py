@@ -11,16 +11,22 @@ from __future__ import annotations
 import json
 import shutil
 import uuid
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
 
 from touchbench.app.errors import AppError, NotFoundError
 from touchbench.app.schemas.live import LiveReplay, LiveSource
-from touchbench.app.services.simulation import GESTURE_SECONDS, contact_mic_take
+from touchbench.app.services.simulation import (
+    GESTURE_SECONDS,
+    PLACES,
+    SAMPLERATE,
+    contact_mic_take,
+)
 from touchbench.drivers.errors import DriverError
 from touchbench.drivers.replay import FileReplaySource
-from touchbench.drivers.source import LIVE_BLOCK, RecordingSource, Source
+from touchbench.drivers.source import LIVE_BLOCK, Block, Source
 
 #: The folder of the work folder where uploaded replays are kept, one folder each.
 REPLAYS = "live-replays"
@@ -29,10 +35,11 @@ ABOUT = "replay.json"
 #: Blocks last at most this many seconds, so that touches are marked soon after they end
 #: whatever the sample rate (:data:`drivers.source.LIVE_BLOCK` samples at audio rates).
 BLOCK_SECONDS = 0.012
-#: The longest a simulated take can be per touch: its longest gesture and its longest quiet
-#: after it (:func:`app.services.simulation.contact_mic_take`), so its length is bounded
-#: before it is made.
-SECONDS_PER_TOUCH = max(high for _, high in GESTURE_SECONDS.values()) + 1.8
+#: The longest a simulated sensor's take can be per touch: the longest gesture, the longest
+#: quiet after it and the half seconds before and after
+#: (:func:`app.services.simulation.contact_mic_take`), so its length is bounded before it
+#: is made.
+SECONDS_PER_TOUCH = max(high for _, high in GESTURE_SECONDS.values()) + 1.8 + 1.0
 #: Read from a recording at a time while measuring it.
 MEASURE_BLOCK = 1 << 16
 
@@ -137,17 +144,43 @@ def open_source(work_dir: Path, spec: LiveSource, *, max_seconds: float) -> Sour
             )
         except DriverError as error:
             raise AppError(f"{replay.name}: {error}") from None
-    longest = spec.touches * SECONDS_PER_TOUCH + 1.0
+    longest = spec.touches * SECONDS_PER_TOUCH
     if longest > max_seconds:
         raise AppError(  # short: a WebSocket's close reason holds 123 bytes
             f"source.touches: {spec.touches} touches may last {longest:g} s, over the "
             f"{max_seconds:g} s of TOUCHBENCH_LIVE_SOURCE_SECONDS"
         )
-    session, _ = contact_mic_take(n_touches=spec.touches, seed=spec.seed)
-    recording = session.recording
-    source = RecordingSource(recording, block_length=block_length(recording.samplerate))
-    source.name = f"simulated sensor ({spec.touches} touches, seed {spec.seed})"
-    return source
+    return SimulatedSensor(touches=spec.touches, seed=spec.seed)
+
+
+class SimulatedSensor(Source):
+    """Three contact microphones at 44.1 kHz touched ``touches`` times: one simulated take
+    (:func:`app.services.simulation.contact_mic_take`) of one touch after another, each made
+    when its turn comes, so that memory holds one touch's seconds whatever the length.
+
+    Parameters
+    ----------
+    touches : int
+    seed : int
+        The take of touch ``i`` is drawn from ``seed * 1_000_003 + i``.
+    """
+
+    def __init__(self, *, touches: int, seed: int) -> None:
+        self.touches = touches
+        self.seed = seed
+        self.samplerate = float(SAMPLERATE)
+        self.n_channels = len(PLACES)
+        self.name = f"simulated sensor ({touches} touches, seed {seed})"
+
+    def blocks(self) -> Iterator[Block]:
+        length = block_length(self.samplerate)
+        offset = 0
+        for i in range(self.touches):
+            take, _ = contact_mic_take(n_touches=1, seed=self.seed * 1_000_003 + i)
+            samples = take.recording.samples
+            for start in range(0, samples.shape[1], length):
+                yield Block(samples[:, start : start + length], (offset + start) / self.samplerate)
+            offset += samples.shape[1]
 
 
 def peaks(samples: np.ndarray) -> list[float]:

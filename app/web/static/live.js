@@ -225,6 +225,8 @@
   }
 
   function switched(message) {
+    const line = $("live-source");
+    line.textContent = line.textContent.replace(message.from, message.switched);
     view.switches.push({ t: view.end, from: message.from, to: message.switched });
     const banner = $("live-switch");
     banner.hidden = false;

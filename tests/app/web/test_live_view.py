@@ -201,6 +201,28 @@ def test_the_champion_moved_mid_stream_shows_the_switch(
     server.client.post(f"/api/models/{MODEL}@1/promote").raise_for_status()
 
 
+def test_the_keyboard_starts_and_stops_a_session(
+    live_service: tuple[Server, Path], tab: Tab
+) -> None:
+    server, _ = live_service
+    page = open_view(tab, server, f"{MODEL}@1")
+    page.get_by_label("Touches").fill("100")  # minutes of real time: stopped long before
+    page.get_by_label("Seed").focus()
+    page.keyboard.press("Enter")  # submits the form
+    stop = page.get_by_role("button", name="Stop")
+    expect(stop).to_be_enabled(timeout=STREAM_TIMEOUT)
+    expect(page.locator("#live-touches")).to_have_attribute(
+        "data-state", "running", timeout=STREAM_TIMEOUT
+    )
+    stop.focus()
+    page.keyboard.press("Enter")
+    expect(page.locator("#live-touches")).to_have_attribute(
+        "data-state", "ended", timeout=STREAM_TIMEOUT
+    )
+    expect(page.locator("#live-status")).to_contain_text("Stopped: ")
+    expect(page.get_by_role("button", name="Start")).to_be_enabled()
+
+
 #: A page of another site: it tries to open the live view's stream and to upload a take.
 ATTACK = """<!doctype html>
 <html><head><meta charset="utf-8"><title>another site</title></head><body>
