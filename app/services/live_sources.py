@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from touchbench.app.errors import AppError, NotFoundError
+from touchbench.app.errors import USER_ERRORS, AppError, NotFoundError, client_words
 from touchbench.app.schemas.live import LiveReplay, LiveSource
 from touchbench.app.services.simulation import (
     GESTURE_SECONDS,
@@ -91,9 +91,9 @@ def save_replay(folder: Path, name: str, *, max_seconds: float, keep: int) -> Li
                 samplerate=source.samplerate,
                 channels=source.n_channels,
             )
-    except DriverError as error:
+    except USER_ERRORS as error:  # said of the client's file, never of the service's folder
         shutil.rmtree(folder, ignore_errors=True)
-        raise AppError(str(error).replace(str(folder / name), name)) from None
+        raise AppError(client_words(str(error), str(folder))) from None
     except BaseException:
         shutil.rmtree(folder, ignore_errors=True)
         raise
