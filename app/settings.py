@@ -160,6 +160,24 @@ class Settings(BaseSettings):
         "store which version its reference names now (one indexed query); 0: before every "
         "block.",
     )
+    live_source_seconds: float = Field(
+        default=600.0,
+        gt=0,
+        le=86400,
+        description="Longest source the service reads itself for a live session (the live "
+        "view's): a recording uploaded for replay, a simulated sensor's take.",
+    )
+    live_sources: int = Field(
+        default=4,
+        ge=1,
+        description="Live sessions per service process reading a source of the service's at "
+        "once (one source per connection).",
+    )
+    live_replays: int = Field(
+        default=20,
+        ge=1,
+        description="Recordings uploaded for replay that are kept (the oldest go first).",
+    )
 
     @field_validator("debug", mode="before")
     @classmethod

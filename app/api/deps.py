@@ -167,6 +167,7 @@ PREDICT_ROUTES = frozenset(
         ("POST", "/api/models/{model_ref}/predict/file"),
         ("POST", "/api/datasets"),
         ("POST", "/api/datasets/recordings"),
+        ("POST", "/api/live/recordings"),
     }
 )
 

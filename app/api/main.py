@@ -15,6 +15,7 @@ from touchbench.app.api.routes import (
     health,
     jobs,
     live,
+    live_replays,
     models,
     recordings,
     runs,
@@ -41,5 +42,6 @@ def install(app: FastAPI, settings: Settings) -> None:
         models.predictions,
         jobs.router,
         extractors.router,
+        live_replays.router,
     ):
         app.include_router(router, dependencies=protected, responses=errors.ERROR_RESPONSES)

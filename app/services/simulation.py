@@ -17,7 +17,7 @@ import soundfile
 
 from touchbench.drivers.oscillating import CONTACTS, simulate_link_trial
 from touchbench.drivers.oscillating import SAMPLERATE as LINK_RATE
-from touchbench.drivers.simulated import SimulatedTouch, simulate_session
+from touchbench.drivers.simulated import SimulatedSession, SimulatedTouch, simulate_session
 
 SAMPLERATE = 44100
 #: Microphone i sits nearest place i, so a touch there is heard on channel i.
@@ -25,14 +25,15 @@ PLACES = ("head", "left_arm", "right_arm")
 GESTURE_SECONDS = {"tap": (0.02, 0.1), "stroke": (0.3, 0.9)}
 
 
-def write_session(
-    folder: Path, name: str, *, n_touches: int, seed: int
-) -> tuple[Path, list[tuple[float, float, str, str]]]:
-    """One simulated 3-microphone session as a WAV file, and its true touches.
+def contact_mic_take(
+    *, n_touches: int, seed: int
+) -> tuple[SimulatedSession, list[tuple[float, float, str, str]]]:
+    """One simulated 3-microphone session in memory, and its true touches.
 
     Returns
     -------
-    path : Path
+    session : SimulatedSession
+        Its recording has shape (3, n_samples) at :data:`SAMPLERATE`.
     touches : list of (start, end, gesture, place)
     """
     rng = np.random.default_rng(seed)
@@ -62,6 +63,21 @@ def write_session(
         touches=touches,
         seed=seed,
     )
+    return session, labels
+
+
+def write_session(
+    folder: Path, name: str, *, n_touches: int, seed: int
+) -> tuple[Path, list[tuple[float, float, str, str]]]:
+    """One simulated 3-microphone session (:func:`contact_mic_take`) as a WAV file, and its
+    true touches.
+
+    Returns
+    -------
+    path : Path
+    touches : list of (start, end, gesture, place)
+    """
+    session, labels = contact_mic_take(n_touches=n_touches, seed=seed)
     path = folder / f"{name}.wav"
     soundfile.write(path, session.recording.samples.T, SAMPLERATE, subtype="FLOAT")
     return path, labels

@@ -21,6 +21,7 @@ from touchbench.app.web.routes import (
     compare,
     datasets,
     jobs,
+    live,
     models,
     pages,
     recordings,
@@ -31,6 +32,7 @@ from touchbench.app.web.routes import (
 def install(app: FastAPI, dependencies: Sequence[Any]) -> None:
     """Add the pages, the fragments (behind ``dependencies``) and the static files."""
     app.include_router(pages.router)
+    app.include_router(live.router)  # a page: no data, the socket checks the key
     for router in (
         datasets.router,
         runs.router,

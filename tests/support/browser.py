@@ -3,10 +3,16 @@
 from __future__ import annotations
 
 import base64
+import functools
 import os
 import re
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
+from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
+from typing import Any
 
 from playwright.sync_api import Page
 
@@ -53,3 +59,23 @@ def screen(tab: Tab, name: str) -> Path:
     path = ARTIFACTS / f"{name}.png"
     tab.page.screenshot(path=str(path))
     return path
+
+
+@contextmanager
+def static_site(folder: Path) -> Iterator[str]:
+    """A second web server on loopback (another port: another origin) serving ``folder``;
+    its URL."""
+
+    class Quiet(SimpleHTTPRequestHandler):
+        def log_message(self, format: str, *args: Any) -> None:
+            pass
+
+    httpd = ThreadingHTTPServer(("127.0.0.1", 0), functools.partial(Quiet, directory=str(folder)))
+    thread = threading.Thread(target=httpd.serve_forever, daemon=True)
+    thread.start()
+    try:
+        yield f"http://127.0.0.1:{httpd.server_address[1]}"
+    finally:
+        httpd.shutdown()
+        httpd.server_close()
+        thread.join()

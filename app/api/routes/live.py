@@ -10,6 +10,10 @@ closes with a reason on bad input: 1008 for a
 missing or wrong key or a model that cannot run live, 1007 for a malformed header or block,
 1009 for a block over the size limit, 1000 when the stream ended.
 
+A header with a ``source`` (``{"source": {"kind": "replay", "replay": ID}}`` or
+``{"source": {"kind": "simulated", "touches": 8}}``) instead of the stream's format asks the
+service to read that source itself (the live view): see :mod:`app.api.live_feed`.
+
 A session on ``NAME@ALIAS`` (or ``NAME``, the newest version) follows it: when the alias
 moves, the next touches are answered by the new version without the stream being
 dropped, and the server sends ``{"switched": "NAME@3", "from": "NAME@2"}`` first; a new
@@ -28,6 +32,16 @@ from fastapi import APIRouter, WebSocket, WebSocketDisconnect
 from starlette.concurrency import run_in_threadpool
 
 from touchbench.app.api.deps import KeyRefused, Service, key_name
+from touchbench.app.api.live_feed import (
+    INTERNAL,
+    INVALID,
+    NORMAL,
+    POLICY,
+    TOO_BIG,
+    serve_source,
+    source_spec,
+)
+from touchbench.app.api.live_feed import Closed as _Closed
 from touchbench.app.errors import USER_ERRORS
 from touchbench.app.schemas.models import Engine
 from touchbench.drivers.errors import DriverError
@@ -43,15 +57,6 @@ HEADER_TIMEOUT = 10.0
 #: Longest block, in seconds of audio.
 MAX_BLOCK_SECONDS = 10.0
 
-POLICY, INVALID, TOO_BIG, NORMAL, INTERNAL = 1008, 1007, 1009, 1000, 1011
-
-
-class _Closed(Exception):  # noqa: N818 (ends the session with a close frame)
-    def __init__(self, code: int, reason: str) -> None:
-        super().__init__(reason)
-        self.code = code
-        self.reason = reason[:120]  # a close reason is at most 123 bytes
-
 
 @router.websocket("/api/models/{model_ref}/live")
 async def live(websocket: WebSocket, model_ref: str) -> None:
@@ -60,6 +65,18 @@ async def live(websocket: WebSocket, model_ref: str) -> None:
     try:
         header = await _header(websocket)
         _check_key(service, websocket, header)
+        if "source" in header:  # the service reads the source itself: see live_feed
+            engine = _engine(header)
+
+            async def opened(samplerate: float, channels: int) -> LiveSession:
+                try:
+                    return await run_in_threadpool(
+                        _open, service, model_ref, samplerate, channels, engine
+                    )
+                except USER_ERRORS as error:
+                    raise _Closed(POLICY, str(error)) from None
+
+            await serve_source(websocket, service, source_spec(header), opened)
         samplerate, channels, sample_format = _stream_format(header)
         engine = _engine(header)
         try:

@@ -6,17 +6,13 @@ service's own origin keeps working."""
 
 from __future__ import annotations
 
-import functools
-import threading
 from collections.abc import Callable, Iterator
-from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
-from typing import Any
 
 import pytest
 from playwright.sync_api import Response, expect
 
-from tests.support.browser import Tab
+from tests.support.browser import Tab, static_site
 from tests.support.service import Server, cancelled_run
 from tests.support.synthetic import touch_arff
 
@@ -57,19 +53,8 @@ def foreign_site(tmp_path: Path) -> Iterator[str]:
     (site / "attack.html").write_text(ATTACK)
     touch_arff(site / "stolen.arff", n=30, seed=9)
 
-    class Quiet(SimpleHTTPRequestHandler):
-        def log_message(self, format: str, *args: Any) -> None:
-            pass
-
-    httpd = ThreadingHTTPServer(("127.0.0.1", 0), functools.partial(Quiet, directory=str(site)))
-    thread = threading.Thread(target=httpd.serve_forever, daemon=True)
-    thread.start()
-    try:
-        yield f"http://127.0.0.1:{httpd.server_address[1]}"
-    finally:
-        httpd.shutdown()
-        httpd.server_close()
-        thread.join()
+    with static_site(site) as url:
+        yield url
 
 
 def _attack(
