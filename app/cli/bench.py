@@ -443,6 +443,22 @@ def bench_command(
             show_default=False,
         ),
     ] = None,
+    ensemble: Annotated[
+        int | None,
+        typer.Option(
+            "--ensemble",
+            metavar="N",
+            help=(
+                "Add ensemble-N (1 <= N <= 100, one target): in each outer training fold, N "
+                "rounds of Caruana's greedy ensemble selection with replacement over the "
+                "run's entries, chosen on their out-of-fold predictions of 3 inner folds of "
+                "that training fold (never its test fold); the weights are shown. Computed "
+                "from fold predictions: costs about 3 more fits of every entry per outer "
+                "fold, shared with --stack."
+            ),
+            show_default=False,
+        ),
+    ] = None,
     independent: Annotated[
         bool,
         typer.Option(

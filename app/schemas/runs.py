@@ -373,6 +373,15 @@ class BenchRequest(Request):
         description="Add stack-topN: in each outer training fold the run's N best "
         "classifiers by inner cross-validation, stacked by logistic regression (one target).",
     )
+    ensemble: int | None = Field(
+        default=None,
+        ge=1,
+        le=100,
+        description="Add ensemble-N: in each outer training fold, N rounds of Caruana's "
+        "greedy ensemble selection (with replacement) over the run's entries, chosen on "
+        "their inner out-of-fold predictions of that training fold, computed from fold "
+        "predictions (one nominal target).",
+    )
     independent: bool = Field(
         default=False,
         description="Several targets: benchmark each target on its own with multi-class "

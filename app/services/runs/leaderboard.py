@@ -124,7 +124,7 @@ class RunLeaderboard:
             return None
         cut = [c for c, d in self.drops.items() if d.reason == "budget"]
         raced_out = sum(
-            self.run.n_tasks // max(len(self.run.classifiers), 1) - d.after_fold
+            self.run.config.tasks_per_entry(len(self.run.classifiers)) - d.after_fold
             for d in self.drops.values()
             if d.reason == "race"
         )
