@@ -142,6 +142,7 @@ def classifiers_command(
                         "onnx": exports_onnx(s),
                         "extras": [extra.name for extra in extras_of(s.requires)],
                         "installed": s.installed,
+                        "members": [member.id for member in s.members],
                     }
                     for s in specs
                 ],
@@ -185,6 +186,10 @@ def classifiers_command(
         ],
         whole=("extra",),
     )
+    for s in specs:
+        if s.members:  # an ensemble: what it is made of, and how a run comes by its folds
+            how = "in a multi-class run: from its members' fold predictions"
+            info(escape(f"{s.id}: {s.description} ({how})"))
     absent = list(dict.fromkeys(e for s in specs if not s.installed for e in extras_of(s.requires)))
     for extra in absent:
         info(escape(f"entries whose extra is marked ✗ are not installed: {extra.install}"))

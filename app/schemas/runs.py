@@ -78,6 +78,14 @@ class DropSchema(Schema):
     note: str = Field(description="`dropped after fold k (...)`, as every view says it.")
 
 
+class OriginSchema(Schema):
+    """How a run came by an entry's folds, when not by fitting an entry it asked for."""
+
+    kind: Literal["from fold predictions", "helper"]
+    entries: list[str] = Field(description="Its members, or the entries it serves.")
+    note: str = Field(description="`from fold predictions of xgb, hgb`, as every view says it.")
+
+
 class LeaderboardRowSchema(Schema):
     """One classifier's line; ``metrics.per_target`` holds a multi-target row's scores per
     target (target -> metric -> mean/std)."""
@@ -102,6 +110,11 @@ class LeaderboardRowSchema(Schema):
     )
     dropped: DropSchema | None = Field(
         default=None, description="Set when the classifier stopped before its last fold."
+    )
+    origin: OriginSchema | None = Field(
+        default=None,
+        description="Set when the run computed the entry from its members' fold predictions "
+        "(`from fold predictions`) or fitted it only as a member of those (`helper`).",
     )
 
 
