@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
-from sqlalchemy import select
+from sqlalchemy import delete, select
 from sqlalchemy.dialects.postgresql import insert as postgresql_insert
 from sqlalchemy.dialects.sqlite import insert as sqlite_insert
 from sqlalchemy.orm import Session
@@ -88,3 +88,15 @@ def attach_predictions(store: Store, run_id: int, results: Sequence[TaskResult])
         for result in results:
             if result.key in stored:
                 setattr(result, attribute, stored[result.key])
+
+
+def forget_inner_predictions(store: Store, run_id: int) -> None:
+    """Delete a run's inner predictions once every entry made of them is computed (a
+    finished run): they are about as large as the training folds, and only a stack or a
+    selection still to compute reads them; the test folds' stay."""
+    with store.session() as session:
+        session.execute(
+            delete(FoldPredictionsRow).where(
+                FoldPredictionsRow.run_id == run_id, FoldPredictionsRow.part == "inner"
+            )
+        )

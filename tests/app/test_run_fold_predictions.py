@@ -73,8 +73,7 @@ def test_a_finished_run_s_fold_predictions_rescore_and_vote_as_refitted(
     capsys: pytest.CaptureFixture[str], store_url: str, store: Store, tmp_path: Path
 ) -> None:
     """Every stored fold re-scores to its stored metrics exactly; the stored votes are what
-    a VotingClassifier of the same fitted members predicts, to the last bit; the inner
-    predictions a selection read are of the training fold's rows only."""
+    a VotingClassifier of the same fitted members predicts, to the last bit."""
     _imported(capsys, store_url, touch_arff(tmp_path / "touch.arff", n=150))
     board = _bench(
         capsys, store_url, "-c", "nb,logistic,voting-hard,voting", "--folds", "3", "--ensemble", "3"
@@ -111,14 +110,7 @@ def test_a_finished_run_s_fold_predictions_rescore_and_vote_as_refitted(
         assert result.confusion == found.confusion
         assert result.calibration == found.calibration
 
-    by_fold = {f.fold: f for f in folds}
-    # a selection reads its candidates' inner predictions: of the training rows only,
-    # every one once, never a row of the outer test fold
-    for key, predictions in inner.items():
-        fold = by_fold[key.fold]
-        assert sorted(predictions.indices) == sorted(fold.train), key
-        assert not set(predictions.indices) & set(fold.test)
-    assert {k.classifier for k in inner} == {"nb", "logistic", *run.config.helpers}
+    assert inner == {}  # a finished run keeps only its test folds' predictions
 
     X = problem.X
     with threadpool_limits(limits=1):  # as in the engine's workers
@@ -216,6 +208,16 @@ def test_a_run_killed_and_resumed_gives_the_same_ensembles(
         count_of(store_url, "SELECT count(*) FROM fold_predictions WHERE part = 'test'") == before
     )
 
+    # a selection reads its candidates' inner predictions (kept until the run ends): of
+    # the training rows only, each once, never a row of the outer test fold
+    _, folds = _problem_and_folds(store, 1)
+    inner = load_predictions(store, 1, part="inner")
+    assert {k.classifier for k in inner} == {"nb", "gate", "logistic", "rf-200", "svm-rbf"}
+    for key, predictions in inner.items():
+        fold = folds[key.fold]
+        assert sorted(predictions.indices) == sorted(fold.train), key
+        assert not set(predictions.indices) & set(fold.test)
+
     gate.open()
     resumed = subprocess.run(
         [*bench, "--resume", "1", "--json"], env=environment, capture_output=True, timeout=600
@@ -233,5 +235,6 @@ def test_a_run_killed_and_resumed_gives_the_same_ensembles(
         if key.classifier in ("ensemble-2", "voting-hard"):
             assert first[key].params == second[key].params
             assert _scores(first[key]) == _scores(second[key]), key
+    assert load_predictions(store, 1, part="inner") == {}  # gone once the run ended
     one, two = load_predictions(store, 1), load_predictions(store, 2)
     assert set(one) == set(two) and all(one[key].same_as(two[key]) for key in one)

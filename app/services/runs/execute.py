@@ -22,7 +22,7 @@ from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import load_dataset
 from touchbench.app.store.drops import forget_budget_cuts, record_drop
 from touchbench.app.store.ownership import process_owner
-from touchbench.app.store.predictions import attach_predictions
+from touchbench.app.store.predictions import attach_predictions, forget_inner_predictions
 from touchbench.app.store.runs import (
     RunInfo,
     add_spent,
@@ -190,6 +190,7 @@ def execute_run(
         beat.stop()
     status, error_text = _outcome(load_results(store, run.id))
     finish_run(store, run.id, status, error=error_text)
+    forget_inner_predictions(store, run.id)  # every fold ran: nothing left reads them
     ended = get_run(store, run.id)
     callbacks.on_end(ended)
     return ended
