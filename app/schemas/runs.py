@@ -29,7 +29,10 @@ class RunSchema(Schema):
     started_at: datetime | None = None
     finished_at: datetime | None = None
     tasks_done: int = Field(description="Tasks with a result (failed ones included).")
-    tasks: int = Field(description="Tasks in all: classifiers x folds x repeats.")
+    tasks: int = Field(
+        description="Tasks in all: (classifiers and the helpers of their ensembles) x folds "
+        "x repeats."
+    )
     tasks_failed: int = 0
     tasks_dropped: int = Field(
         default=0,
@@ -147,7 +150,8 @@ class MarkSummary(Schema):
 
 
 class FoldChoiceSchema(Schema):
-    """What a tuned twin or a stack chose on one outer training fold."""
+    """What a tuned twin, a stack or an ensemble selection (its weights) chose on one outer
+    training fold."""
 
     classifier: str
     repeat: int
@@ -279,6 +283,7 @@ _NOT_INDEPENDENT = {
     "tune": "compares each target's plain classifiers",
     "budget": "compares each target's plain classifiers",
     "stack": "compares each target's plain classifiers",
+    "ensemble": "compares each target's plain classifiers",
     "metric": "picks each target's best classifier by weighted F1",
     "baseline": "picks each target's best classifier by weighted F1",
     "race": "runs each target's classifiers to the end",
