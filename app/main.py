@@ -62,7 +62,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         placement = PredictionPlacement(models.known)
         app.state.service = Service(settings, store, dispatcher, models, placement)
         dispatcher.start()
-        threading.Thread(target=_warm_up, daemon=True, name="warm-up").start()
+        if settings.warm_up:
+            threading.Thread(target=_warm_up, daemon=True, name="warm-up").start()
         try:
             yield
         finally:

@@ -138,6 +138,11 @@ class Settings(BaseSettings):
         default=False,
         description="Put runs interrupted by a crash back in the queue when the service starts.",
     )
+    warm_up: bool = Field(
+        default=True,
+        description="Import the machine-learning stack in the background at start-up, so "
+        "that the first prediction does not wait for it.",
+    )
     work_dir: Path = Field(
         default_factory=lambda: Path(tempfile.gettempdir()) / "touchbench",
         description="Where uploaded recording sessions wait for their extraction job.",

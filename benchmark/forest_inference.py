@@ -2,8 +2,8 @@
 
 scikit-learn's ``ForestClassifier.predict_proba`` hands every tree to joblib and adds the
 trees' answers under a lock: right for thousands of rows, but on the one instance of a
-live touch or a served request that machinery costs about ten times the trees themselves
-(12 ms against 1.7 ms for 100 trees here).  :func:`forest_proba` walks the trees directly,
+live touch or a served request that machinery costs several times the trees themselves
+(`perf/serve.py` measures it).  :func:`forest_proba` walks the trees directly,
 computing what scikit-learn computes (each tree's leaf class fractions, normalised, then
 averaged), and declines (``None``) whenever its shortcut would not be exactly that.
 """

@@ -76,7 +76,9 @@ def peak_kib() -> int:
 
 
 def write_bag(folder: Path, minutes: float, storage: str) -> Path:
-    from tests.drivers.bagfiles import mp3_stream, pieces, write_audio_bag
+    from tests.support.bagfiles import mp3_stream
+from tests.support.bagfiles import pieces
+from tests.support.bagfiles import write_audio_bag
 
     rng = np.random.default_rng(0)
     seconds = round(minutes * 60)

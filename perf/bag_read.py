@@ -27,7 +27,7 @@ import soundfile
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from tests.drivers.bagfiles import write_audio_bag
+from tests.support.bagfiles import write_audio_bag
 from touchbench.drivers.replay import FileReplaySource
 
 RATE = 44100

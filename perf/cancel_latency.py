@@ -48,7 +48,7 @@ def main() -> None:
     parser.add_argument("--db", default=None, help="store URL (default: a temporary SQLite)")
     args = parser.parse_args()
 
-    from tests.app.synthetic import touch_arff
+    from tests.support.synthetic import touch_arff
 
     folder = Path(tempfile.mkdtemp(prefix="touchbench-cancel-perf-"))
     db = args.db or f"sqlite:///{folder / 'touchbench.db'}"

@@ -35,7 +35,7 @@ sys.path.insert(0, str(ROOT))
 
 from fastapi.testclient import TestClient  # noqa: E402
 
-from tests.app.synthetic import touch_arff  # noqa: E402
+from tests.support.synthetic import touch_arff  # noqa: E402
 from touchbench.app.main import create_app  # noqa: E402
 from touchbench.app.schemas.datasets import ImportRequest  # noqa: E402
 from touchbench.app.services.datasets import import_file  # noqa: E402

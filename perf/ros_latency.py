@@ -9,7 +9,7 @@ Run from the repository root (ROS 1 installed, as scripts/install.sh does)::
 A random forest (``cc:rf``, 100 trees per target) is trained on the ``uc3m-audio``
 features of simulated 3-microphone sessions (44.1 kHz).  A rosmaster of its own is
 started on a free port, ``touchbench ros`` runs pinned to one core (``taskset``), and a
-peer node (tests/drivers/ros_peer.py, on the other cores) publishes a fresh session as
+peer node (tests/support/ros_peer.py, on the other cores) publishes a fresh session as
 ``AudioData`` messages of ``--block`` samples (F32LE, described by a latched
 ``AudioInfo``), paced in real time as a microphone would, and listens to ``/touch``.
 
@@ -49,7 +49,8 @@ import soundfile
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from tests.drivers.ros_peer import Peer, rosmaster
+from tests.support.ros_peer import Peer
+from tests.support.ros_peer import rosmaster
 from touchbench.app.schemas.extraction import ExtractRequest
 from touchbench.app.schemas.models import Engine, ExportRequest, TrainRequest
 from touchbench.app.services.export import export_model

@@ -57,7 +57,7 @@ def free_port() -> int:
 def data_file(folder: Path) -> Path:
     if MINI.exists():
         return MINI
-    from tests.app.synthetic import touch_arff
+    from tests.support.synthetic import touch_arff
 
     return touch_arff(folder / "synthetic.arff", n=2777)
 

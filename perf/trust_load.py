@@ -33,7 +33,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from perf.serve import free_port, percentile, wait_until_up  # noqa: E402 (after the path is set)
-from tests.app.synthetic import touch_arff  # noqa: E402
+from tests.support.synthetic import touch_arff  # noqa: E402
 
 
 def start_service(db: str, folder: Path) -> tuple[subprocess.Popen[bytes], str]:

@@ -1,4 +1,4 @@
-"""SIGTERM to pytest tears fixtures down (tests/termination.py), so no test leaves servers."""
+"""SIGTERM to pytest tears fixtures down (tests/support/termination.py): no server is left."""
 
 from __future__ import annotations
 
@@ -63,6 +63,6 @@ def test_sigterm_tears_fixtures_down_only_with_the_plugin(tmp_path: Path) -> Non
         assert _alive(orphan), "without the plugin the fixture's process outlives pytest"
     finally:
         os.kill(orphan, signal.SIGKILL)
-    cleaned = _child_after_sigterm(tmp_path, "-p", "tests.termination")
+    cleaned = _child_after_sigterm(tmp_path, "-p", "tests.support.termination")
     time.sleep(0.2)
     assert not _alive(cleaned)

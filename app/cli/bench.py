@@ -215,9 +215,9 @@ def _costs(
             f"{REFERENCE_FEATURES} features x {REFERENCE_CLASSES} classes; --dataset "
             "NAME scales it to a data set"
         )
-    from touchbench.app.store.datasets import load_schema
+    from touchbench.app.services.datasets import dataset_schema
 
-    info, schema, _ = load_schema(get_state(ctx).store, dataset)
+    info, schema = dataset_schema(get_state(ctx).store, dataset)
     classes = max((len(t.values) for t in schema.targets), default=1)
     shape = Shape(info.n_instances, info.n_features, max(classes, 1))
     note = (

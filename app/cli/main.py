@@ -31,7 +31,7 @@ EXIT_UNEXPECTED = EXIT_FAILED
 
 #: Every sub-command, in the order ``touchbench --help`` lists them: its name, the module whose
 #: ``register`` adds it, and its one-line help (its help's first paragraph, which
-#: tests/app/test_cli_startup.py holds equal).  A module is imported when one of its commands
+#: tests/app/cli/test_startup.py holds equal).  A module is imported when one of its commands
 #: is chosen, so that each command pays only for what it uses.
 COMMANDS = (
     Subcommand(

@@ -102,7 +102,7 @@ def train_command(
 def models_command(ctx: typer.Context, as_json: JsonOption = False) -> None:
     """List trained models, a row per version, with their aliases (artifacts are not read)."""
     from touchbench.app.schemas.models import ModelList
-    from touchbench.app.store.models import list_models
+    from touchbench.app.services.registry import list_models
 
     models = list_models(get_state(ctx).store)
     if as_json:
@@ -221,7 +221,7 @@ def delete_model_command(
     ],
 ) -> None:
     """Delete a trained model (one version: NAME alone is its newest)."""
-    from touchbench.app.store.models import delete_model
+    from touchbench.app.services.registry import delete_model
 
     gone = delete_model(get_state(ctx).store, model_ref)
     info(f"deleted model {gone.id} '{gone.label}'")

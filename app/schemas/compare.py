@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 from pydantic import Field
 
 from touchbench.app.schemas.base import Schema
-from touchbench.benchmark.evaluation.bayesian import BayesianComparison
+
+if TYPE_CHECKING:  # the test's module loads SciPy's distributions: not for a schema
+    from touchbench.benchmark.evaluation.bayesian import BayesianComparison
 
 
 class ClassifierRank(Schema):

@@ -381,6 +381,29 @@ def _groups(store: Store, dataset_id: int, schema: Schema) -> GroupsDescription 
 # -------------------------------------------------------------------------------- describe
 
 
+def find_dataset(store: Store, ref: str | int) -> DatasetInfo:
+    """The data set ``ref`` names (a name or an id), without reading its instances.
+
+    Raises
+    ------
+    app.errors.NotFoundError
+        No such data set.
+    """
+    return stored.find_dataset(store, ref)
+
+
+def dataset_schema(store: Store, ref: str | int) -> tuple[DatasetInfo, Schema]:
+    """The data set ``ref`` names and its attributes, without reading its instances.
+
+    Raises
+    ------
+    app.errors.NotFoundError
+        No such data set.
+    """
+    info, schema, _ = stored.load_schema(store, ref)
+    return info, schema
+
+
 def describe_dataset(store: Store, ref: str | int) -> DatasetDescription:
     """Schema, per-attribute missing counts and ranges, class distribution per target.
 

@@ -1,10 +1,10 @@
 """Progress of a long answer (a learning curve, an ablation) told at most so often.
 
 Such an answer hears of every finished task, but its summary so far is built from every
-result yet (quadratic over the job) and is written to the job's row each time: a learning
-curve of 20 classifiers x 20 fractions x 10 folds spent ~170 s of CPU on 4,000 summaries
-of 33 KB each.  Told at most every :data:`PROGRESS_SECONDS`, that work follows the job's
-duration, not its number of tasks squared.
+result yet (quadratic over the job) and is written to the job's row each time, so a large
+learning curve spent most of its CPU on summaries.  Told at most every
+:data:`PROGRESS_SECONDS`, that work follows the job's duration, not its number of tasks
+squared.
 """
 
 from __future__ import annotations

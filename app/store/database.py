@@ -104,8 +104,8 @@ class Store:
         """The first row of a read-only ``statement`` with bound ``params``, or ``None``.
 
         Run on the driver's own cursor, compiled once per statement: for a lookup on an
-        index SQLAlchemy's execution machinery costs ten times the query itself (0.29 against
-        0.024 ms on SQLite), and the service asks one on every prediction.
+        index SQLAlchemy's execution machinery costs several times the query itself, and the
+        service asks one on every prediction.
         """
         compiled = self._compiled.get(statement)
         if compiled is None:

@@ -1,7 +1,7 @@
 """Reading a store through its database driver alone, without SQLAlchemy.
 
-``touchbench datasets`` reads one table; importing SQLAlchemy costs it more than all else
-(about 0.25 s of CPU time against 0.4 s in all, ``perf/startup.py``).  A store is read here
+``touchbench datasets`` reads one table; importing SQLAlchemy would cost it more than all
+else (``perf/startup.py`` measures it).  A store is read here
 through a DB-API connection: the :class:`~app.store.database.Store`'s own (pooled, any
 database) or, for a SQLite file at the newest revision, one that :mod:`sqlite3` opens
 read-only (:func:`sqlite_file`).  Anything else about the URL or the file (not there yet,

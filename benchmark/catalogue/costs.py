@@ -3,8 +3,8 @@
 A catalogue entry's ``cost`` (``"fast"``/``"slow"``) is measured on a few thousand instances
 and a hundred features; the cost of most families grows with the instances, the features
 and the classes at different powers: a gradient-boosted model fits one tree per class per
-round (``xgb`` on 800 x 17,600 features x 20 classes took over 600 s per fold although it is
-``fast`` at the reference shape), a kernel SVM grows with the square of the instances, a
+round (``xgb`` is ``fast`` at the reference shape and among the slowest on thousands of
+features and tens of classes), a kernel SVM grows with the square of the instances, a
 nearest-neighbour search with the product of training and test rows, naive Bayes barely at
 all.  :func:`estimate_seconds` scales the entry's reference seconds by the family's powers;
 the engine orders a round cheap first by it and the total budget predicts a task's cost with

@@ -81,7 +81,7 @@ HGB_PARAMS: dict[str, Any] = {"max_iter": 300, "learning_rate": 0.1}
 
 def xgboost_classifier(**params: Any) -> BaseEstimator:
     """XGBoost behind a label encoder, so that folds missing a class still fit."""
-    from xgboost import XGBClassifier  # imported on use: it costs every worker 0.5 s
+    from xgboost import XGBClassifier  # imported on use: slow to import in every worker
 
     return LabelEncodedClassifier(XGBClassifier(**params))
 
@@ -574,7 +574,7 @@ _SINGLE: tuple[ClassifierSpec, ...] = (
         family="boosting",
         description="Gradient boosting of depth-3 trees, 100 stages",
         cost="slow",
-        suites=ALL_ONLY,  # 11 s a fold on Mini, below xgb and hgb: the default suite's 5 min
+        suites=ALL_ONLY,  # slower than xgb and hgb and scores below them: out of the default
     ),
     _spec(
         "xgb",
@@ -1239,7 +1239,7 @@ SPECS: tuple[ClassifierSpec, ...] = (
         id="stacking",
         description=describe_members("stack", [_BY_ID[member] for member in _STACKED])
         + ", all kept, on their inner out-of-fold class scores",
-        suites=ALL_ONLY,  # 17 s a fold on Mini, below soft voting: the default suite's 5 min
+        suites=ALL_ONLY,  # costlier than soft voting and scores below it: out of the default
     ),
     # Time series: the windows of a sequence data set (benchmark.sequence)
     _spec(

@@ -25,7 +25,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.stats import t as student_t
 
 from touchbench.benchmark.errors import ConfigurationError
 
@@ -116,6 +115,10 @@ def correlated_ttest(
     variance = float(better.var(ddof=1))
     scale = math.sqrt((1.0 / n + test_train_ratio) * variance)
     if scale > 0:
+        # imported here: SciPy's distributions take longer to load than every page that
+        # imports this module for its types takes to answer
+        from scipy.stats import t as student_t
+
         p_left = float(student_t.sf(rope, n - 1, loc=mean, scale=scale))
         p_right = float(student_t.cdf(-rope, n - 1, loc=mean, scale=scale))
     else:

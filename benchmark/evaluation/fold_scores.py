@@ -106,7 +106,7 @@ def _regression(
 def _multitarget(
     problem: Problem, predictions: FoldPredictions, recordings: Recordings | None
 ) -> FoldScores:
-    from touchbench.benchmark.multitarget import multitarget_scores
+    from touchbench.benchmark.evaluation.multitarget import multitarget_scores
 
     assert predictions.labels is not None
     Y_test, Y_pred = problem.Y[predictions.indices], predictions.labels

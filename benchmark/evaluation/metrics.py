@@ -14,7 +14,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.stats import rankdata
 
 #: The multi-class metrics of every fold, in display order.
 MULTICLASS_METRICS: tuple[str, ...] = (
@@ -229,6 +228,10 @@ def weighted_roc_auc(y_true: np.ndarray, proba: np.ndarray) -> float:
         are present.  Absent classes have zero weight, as in scikit-learn's
         ``roc_auc_score(average="weighted", multi_class="ovr")``.
     """
+    # imported here: loading SciPy's statistics would slow every command and page that
+    # only reads scores
+    from scipy.stats import rankdata
+
     n = y_true.size
     present = np.unique(y_true)
     if present.size < 2:

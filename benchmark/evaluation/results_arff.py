@@ -14,16 +14,29 @@ import math
 from collections.abc import Mapping, Sequence
 from datetime import datetime
 from importlib import metadata
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
-from touchbench.benchmark.catalogue import CATALOGUE, ClassifierSpec
 from touchbench.benchmark.dataset import Attribute, Dataset, Schema
 from touchbench.benchmark.errors import ConfigurationError
 from touchbench.benchmark.results import TaskResult
 
 RELATION = "InstanceResultListener"
+
+
+class SchemeSpec(Protocol):
+    """What the results file says of a classifier (a catalogue entry's spec has it)."""
+
+    @property
+    def weka_name(self) -> str | None: ...
+
+    @property
+    def weka_options(self) -> str: ...
+
+    @property
+    def params(self) -> Mapping[str, Any]: ...
+
 
 #: Nominal key attributes, in WEKA's order.
 KEY_ATTRIBUTES = (
@@ -104,7 +117,7 @@ def results_to_dataset(
     results: Sequence[TaskResult],
     *,
     dataset_name: str,
-    specs: Mapping[str, ClassifierSpec] | None = None,
+    specs: Mapping[str, SchemeSpec],
     timestamp: datetime | None = None,
     scheme_names: str = "weka",
 ) -> Dataset:
@@ -116,8 +129,9 @@ def results_to_dataset(
         Results of a multi-class run (failed tasks are skipped).
     dataset_name : str
         ``Key_Dataset`` (WEKA writes the relation name).
-    specs : mapping of str to ClassifierSpec, optional
-        Specs of classifiers that are not in the catalogue.
+    specs : mapping of str to SchemeSpec
+        The specs of the run's classifiers by id (the catalogue's, and those of
+        configurations made for the run); a classifier without one is written by its id.
     timestamp : datetime, optional
         ``Date_time`` of every row (WEKA's ``yyyymmdd.HHMM`` number); default now.
     scheme_names : {"weka", "id"}
@@ -141,7 +155,6 @@ def results_to_dataset(
     """
     if scheme_names not in ("weka", "id"):
         raise ConfigurationError(f"scheme_names must be 'weka' or 'id', got '{scheme_names}'")
-    known = {**CATALOGUE, **(specs or {})}
     ok = [r for r in results if r.ok]
     if any(_is_multitarget(r) for r in ok):
         raise ConfigurationError(
@@ -150,7 +163,7 @@ def results_to_dataset(
     ok.sort(key=lambda r: (r.key.repeat, r.key.fold, r.key.classifier))
     version = _version()
     schemes = {
-        c: _scheme(c, known.get(c), scheme_names)
+        c: _scheme(c, specs.get(c), scheme_names)
         for c in dict.fromkeys(r.key.classifier for r in ok)
     }
     labels = {
@@ -263,7 +276,7 @@ def weka_measures(result: TaskResult) -> dict[str, float]:
     return {name: float(value) for name, value in out.items()}
 
 
-def _scheme(classifier: str, spec: ClassifierSpec | None, style: str) -> tuple[str, str]:
+def _scheme(classifier: str, spec: SchemeSpec | None, style: str) -> tuple[str, str]:
     """``Key_Scheme`` and ``Key_Scheme_options`` of a classifier."""
     if style == "weka" and spec is not None and spec.weka_name:
         return spec.weka_name, spec.weka_options

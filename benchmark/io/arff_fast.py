@@ -221,7 +221,7 @@ def _parse(block: bytes, plan: PlainPlan, encoding: str, threads: bool) -> Any |
 
 
 # Arrow arrays are read through their buffers: pyarrow's own conversion to numpy of an
-# array with nulls imports pandas, 50 MB for what a bitmap says.
+# array with nulls imports pandas, a large import for what a bitmap says.
 
 
 def _numbers(array: Any) -> np.ndarray:

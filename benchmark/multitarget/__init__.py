@@ -9,9 +9,14 @@ one (n_samples, n_classes[t]) matrix per target.
 
 from __future__ import annotations
 
+from touchbench.benchmark.evaluation.multitarget import (
+    LOSS_METRICS,
+    MULTILABEL_METRICS,
+    MULTITARGET_METRICS,
+    multitarget_scores,
+)
 from touchbench.benchmark.multitarget._base import MultiTargetClassifier
 from touchbench.benchmark.multitarget._target_classifier import TargetClassifier
-from touchbench.benchmark.multitarget._targets import TargetError
 from touchbench.benchmark.multitarget.bayesian_chain import BayesianClassifierChain
 from touchbench.benchmark.multitarget.chains import ClassifierChain, ProbabilisticClassifierChain
 from touchbench.benchmark.multitarget.combination import (
@@ -20,12 +25,6 @@ from touchbench.benchmark.multitarget.combination import (
     PrunedSets,
 )
 from touchbench.benchmark.multitarget.ensembles import EnsembleClassifierChains, EnsemblePrunedSets
-from touchbench.benchmark.multitarget.metrics import (
-    LOSS_METRICS,
-    MULTILABEL_METRICS,
-    MULTITARGET_METRICS,
-    multitarget_scores,
-)
 from touchbench.benchmark.multitarget.multilabel import MultiLabelAdapter
 from touchbench.benchmark.multitarget.rakeld import RAkELd
 from touchbench.benchmark.multitarget.registry import (
@@ -39,6 +38,7 @@ from touchbench.benchmark.multitarget.registry import (
 )
 from touchbench.benchmark.multitarget.relevance import ClassRelevance
 from touchbench.benchmark.multitarget.superclass import SuperClassClassifier
+from touchbench.benchmark.targets import TargetError
 
 __all__ = [
     "DEFAULT_BASES",

@@ -9,7 +9,7 @@ from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.utils import Tags
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from touchbench.benchmark.multitarget._targets import TargetError, validate_targets
+from touchbench.benchmark.targets import TargetError, validate_targets
 
 
 def check_at_least_one(name: str, value: int) -> None:

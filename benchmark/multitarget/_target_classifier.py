@@ -14,7 +14,7 @@ from sklearn.base import BaseEstimator, ClassifierMixin, clone
 from sklearn.pipeline import Pipeline
 from sklearn.utils.validation import check_is_fitted, has_fit_parameter
 
-from touchbench.benchmark.multitarget._targets import one_hot
+from touchbench.benchmark.targets import one_hot
 
 
 class TargetClassifier(ClassifierMixin, BaseEstimator):

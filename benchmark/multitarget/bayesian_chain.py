@@ -9,12 +9,12 @@ import numpy as np
 from sklearn.utils import check_random_state
 
 from touchbench.benchmark.multitarget._network import TargetNetwork
-from touchbench.benchmark.multitarget._targets import TargetError
 from touchbench.benchmark.multitarget.dependence import (
     maximum_spanning_tree,
     mutual_information_matrix,
     orient_tree,
 )
+from touchbench.benchmark.targets import TargetError
 
 
 class BayesianClassifierChain(TargetNetwork):

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from touchbench.benchmark.multitarget._network import TargetNetwork, chain_order
-from touchbench.benchmark.multitarget._targets import one_hot
+from touchbench.benchmark.targets import one_hot
 
 
 class ClassifierChain(TargetNetwork):

@@ -10,7 +10,7 @@ from sklearn.base import clone
 
 from touchbench.benchmark.multitarget._base import MultiTargetClassifier
 from touchbench.benchmark.multitarget._target_classifier import TargetClassifier
-from touchbench.benchmark.multitarget._targets import all_binary, combination_marginals
+from touchbench.benchmark.targets import all_binary, combination_marginals
 
 
 class LabelCombination(MultiTargetClassifier):

@@ -10,9 +10,9 @@ import numpy as np
 from sklearn.utils import check_random_state
 
 from touchbench.benchmark.multitarget._base import MultiTargetClassifier, check_at_least_one
-from touchbench.benchmark.multitarget._targets import TargetError
 from touchbench.benchmark.multitarget.chains import ClassifierChain
 from touchbench.benchmark.multitarget.combination import PrunedSets
+from touchbench.benchmark.targets import TargetError
 
 _SEED_LIMIT = 2**31 - 1
 

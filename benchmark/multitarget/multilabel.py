@@ -22,7 +22,7 @@ from sklearn.utils import check_random_state
 
 from touchbench.benchmark.multitarget._base import MultiTargetClassifier
 from touchbench.benchmark.multitarget._target_classifier import TargetClassifier
-from touchbench.benchmark.multitarget._targets import (
+from touchbench.benchmark.targets import (
     TargetError,
     all_binary,
     one_hot,

@@ -9,8 +9,8 @@ import numpy as np
 from sklearn.utils import check_random_state
 
 from touchbench.benchmark.multitarget._base import MultiTargetClassifier, check_at_least_one
-from touchbench.benchmark.multitarget._targets import random_partition
 from touchbench.benchmark.multitarget.combination import NearestSetReplacement
+from touchbench.benchmark.targets import random_partition
 
 
 class PartitionedCombinations(MultiTargetClassifier):

@@ -17,7 +17,6 @@ from typing import Any
 from touchbench.benchmark.catalogue import ClassifierSpec, build_pipeline, get_spec
 from touchbench.benchmark.errors import ConfigurationError
 from touchbench.benchmark.multitarget._base import MultiTargetClassifier
-from touchbench.benchmark.multitarget._targets import all_binary
 from touchbench.benchmark.multitarget.bayesian_chain import BayesianClassifierChain
 from touchbench.benchmark.multitarget.chains import ClassifierChain, ProbabilisticClassifierChain
 from touchbench.benchmark.multitarget.combination import (
@@ -31,6 +30,7 @@ from touchbench.benchmark.multitarget.rakeld import RAkELd
 from touchbench.benchmark.multitarget.relevance import ClassRelevance
 from touchbench.benchmark.multitarget.superclass import SuperClassClassifier
 from touchbench.benchmark.sequence import SequenceLayout
+from touchbench.benchmark.targets import all_binary
 
 #: Factory signature: (base estimator or preprocessor, random_state, n_classes) -> estimator.
 Factory = Callable[[Any, int | None, Sequence[int] | None], MultiTargetClassifier]

@@ -1,26 +1,21 @@
-"""Stores for the app tests: every test that takes ``store_url`` runs twice, on a fresh
-SQLite file and on a fresh schema of a real PostgreSQL server."""
+"""Stores and services for the app tests: every test that takes ``store_url`` runs twice, on
+a fresh SQLite file and on a fresh schema of a real PostgreSQL server; ``make_server`` starts
+real services (uvicorn on loopback) on it."""
 
 from __future__ import annotations
 
 import os
 import uuid
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
 from sqlalchemy import create_engine, text
 from sqlalchemy.engine import make_url
 
+from tests.support.service import Server, servers
+from tests.support.stores import DEFAULT_POSTGRES, emptied, psycopg_url
 from touchbench.app.store.database import Store
-
-DEFAULT_POSTGRES = "postgresql://postgres:postgres@127.0.0.1:5432/test"
-
-
-def _psycopg_url(url: str) -> str:
-    return (
-        "postgresql+psycopg://" + url.split("://", 1)[1] if url.startswith("postgresql://") else url
-    )
 
 
 @pytest.fixture(scope="session")
@@ -29,7 +24,7 @@ def postgres_database() -> Iterator[str]:
     server = os.environ.get("TOUCHBENCH_TEST_POSTGRES_URL", DEFAULT_POSTGRES)
     if not server:
         pytest.skip("no PostgreSQL server could be started here (scripts/postgres.sh failed)")
-    admin = create_engine(_psycopg_url(server), isolation_level="AUTOCOMMIT")
+    admin = create_engine(psycopg_url(server), isolation_level="AUTOCOMMIT")
     name = f"touchbench_test_{os.getpid()}_{uuid.uuid4().hex[:6]}"
     try:
         with admin.connect() as connection:
@@ -37,7 +32,7 @@ def postgres_database() -> Iterator[str]:
     except Exception as error:  # no server: the PostgreSQL leg cannot run
         admin.dispose()
         pytest.skip(f"no PostgreSQL server at {server}: {str(error).splitlines()[0]}")
-    url = make_url(_psycopg_url(server)).set(database=name).render_as_string(hide_password=False)
+    url = make_url(psycopg_url(server)).set(database=name).render_as_string(hide_password=False)
     yield url
     with admin.connect() as connection:
         connection.execute(text(f'DROP DATABASE IF EXISTS "{name}" WITH (FORCE)'))
@@ -52,18 +47,25 @@ def store_url(request: pytest.FixtureRequest, tmp_path: Path) -> str:
     return emptied(request.getfixturevalue("postgres_database"))
 
 
-def emptied(url: str) -> str:
-    """``url``, a PostgreSQL database, once its tables are all dropped."""
-    engine = create_engine(url, isolation_level="AUTOCOMMIT")
-    with engine.connect() as connection:
-        connection.execute(text("DROP SCHEMA public CASCADE"))
-        connection.execute(text("CREATE SCHEMA public"))
-    engine.dispose()
-    return url
-
-
 @pytest.fixture
 def store(store_url: str) -> Iterator[Store]:
     opened = Store(store_url)
     yield opened
     opened.dispose()
+
+
+@pytest.fixture
+def make_server(store_url: str, tmp_path: Path) -> Iterator[Callable[..., Server]]:
+    """Builds (and at the end stops) services on the test's store (SQLite, PostgreSQL)."""
+    yield from servers(store_url, tmp_path)
+
+
+@pytest.fixture
+def make_sqlite_server(tmp_path: Path) -> Iterator[Callable[..., Server]]:
+    """Builds services on a SQLite file of the test's own."""
+    yield from servers(f"sqlite:///{tmp_path / 'touchbench.db'}", tmp_path)
+
+
+@pytest.fixture
+def server(make_server: Callable[..., Server]) -> Server:
+    return make_server()

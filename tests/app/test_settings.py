@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.app.cli_runner import run_cli
+from tests.support.cli_runner import run_cli
 from touchbench.app import environment
 from touchbench.app.cli.requests import option_of
 from touchbench.app.settings import Settings, SettingsError, get_settings, variable
@@ -59,8 +59,8 @@ def test_the_cli_reads_the_debug_switch_as_the_settings_do(
     "environment_",
     [
         {},
-        {"TOUCHBENCH_PLUGINS": "tests.gate"},
-        {"touchbench_plugins": "tests.gate, tests.memory_hog"},
+        {"TOUCHBENCH_PLUGINS": "tests.support.gate"},
+        {"touchbench_plugins": "tests.support.gate, tests.support.memory_hog"},
         {"TOUCHBENCH_PLUGINS": "a", "Touchbench_Plugins": "b"},
         {"TOUCHBENCH_PLUGINS": ""},
     ],

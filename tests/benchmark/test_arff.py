@@ -10,12 +10,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from touchbench.benchmark.dataset import Attribute, Dataset, Schema, resolve_targets
+from tests.support.arff_texts import (
+    CANONICAL,
+    HEADER,
+    MESSY,
+    NAN,
+    random_dataset,
+)
+from touchbench.benchmark.dataset import Attribute, Dataset, Schema
 from touchbench.benchmark.errors import DataFormatError
 from touchbench.benchmark.io.arff import dumps_arff, loads_arff, read_arff, write_arff
 from touchbench.benchmark.io.dates import DateFormat
-
-NAN = np.nan
 
 
 def epoch(
@@ -301,9 +306,6 @@ def _error(text: str | bytes) -> DataFormatError:
     return error
 
 
-HEADER = "@relation r\n@attribute a numeric\n@attribute b {x,y}\n@data\n"
-
-
 @pytest.mark.parametrize(
     ("text", "message", "line", "attribute"),
     [
@@ -415,37 +417,6 @@ def test_missing_file_and_directory(tmp_path: Path) -> None:
 
 
 # -------------------------------------------------------------------------------- writing
-
-CANONICAL = r"""@relation 'canonical: -C 2'
-
-@attribute 'a b' {x,'y z','it\'s',''}
-@attribute c {0,1}
-@attribute n numeric
-@attribute r REAL
-@attribute s string
-@attribute d date 'yyyy-MM-dd HH:mm'
-
-@data
-x,0,3,-0.5,hello,'2020-01-02 03:04'
-'y z',1,1e-300,1.5e+20,'a,b','1969-07-20 20:17'
-'it\'s',?,?,?,?,?,{0.5}
-'',1,123456789,Infinity,'line\nbreak\ttab\\ \"q\" 100\% \001',?
-"""
-
-MESSY = r"""% the same data as CANONICAL, written differently
-@RELATION "canonical: -C 2"
-@ATTRIBUTE "a b" { x , "y z" , "it's" , "" }
-@attribute 'c' {'0', '1'}
-@attribute n NUMERIC
-@attribute r REAL
-@attribute s STRING
-@attribute d date "yyyy-MM-dd HH:mm"
-@data
-'x', '0', 3.0, -.5, "hello", "2020-01-02 03:04"  % a comment
-"y z" 1 1.0e-300 15e19 "a,b" '1969-07-20 20:17'
-"it's",?,?,?,?,?,{0.50}
-"", "1", 123456789.000, Infinity, "line\nbreak\ttab\\ \"q\" 100% \1", ?
-"""
 
 
 def test_canonical_file_is_written_back_exactly() -> None:
@@ -568,98 +539,9 @@ def test_writing_an_invalid_nominal_code_is_an_error() -> None:
     assert caught.value.attribute == "b"
 
 
-_TRICKY = [
-    "a",
-    "Z",
-    "0",
-    "-",
-    ".",
-    " ",
-    ",",
-    "'",
-    '"',
-    "\\",
-    "%",
-    "{",
-    "}",
-    "?",
-    "@",
-    "\n",
-    "\r",
-    "\t",
-    "\x00",
-    "\x01",
-    "\x0b",
-    "\x7f",
-    "\x85",
-    "\xa0",
-    "\u00e9",
-    "\u20ac",
-    "\u2028",
-    "\U0001f600",
-]
-
-
-def _tricky_text(rng: np.random.Generator) -> str:
-    return "".join(rng.choice(_TRICKY, size=int(rng.integers(0, 6))))
-
-
-_KINDS = ("numeric", "nominal", "string", "date")
-_DATE_PATTERNS = (None, "yyyy-MM-dd HH:mm:ss.SSS", "d/M/yyyy'T'H:m:s.SSSZ")
-
-
-def _random_dataset(rng: np.random.Generator) -> Dataset:
-    n_rows = int(rng.integers(0, 6))
-    attributes: list[Attribute] = []
-    columns: list[np.ndarray] = []
-    names: set[str] = set()
-    for _ in range(int(rng.integers(2, 7))):
-        name = _tricky_text(rng)
-        while name in names:
-            name += "x"
-        names.add(name)
-        kind = _KINDS[int(rng.integers(len(_KINDS)))]
-        if kind == "numeric":
-            pool = [0.0, -0.0, 1.0, -2.5, 1e300, 5e-324, NAN, math.inf, 1 / 7, 12345678901.0]
-            column = np.array(rng.choice(pool, size=n_rows))
-            declared = "numeric" if rng.random() < 0.5 else "REAL"
-            attributes.append(Attribute(name, "numeric", (), declared))
-        elif kind == "date":
-            pattern = _DATE_PATTERNS[int(rng.integers(len(_DATE_PATTERNS)))]
-            column = rng.integers(-2_000_000_000, 4_000_000_000, size=n_rows).astype(float)
-            if pattern is not None:  # only patterns with S keep milliseconds
-                column += rng.integers(0, 1000, size=n_rows) / 1000
-            column[rng.random(n_rows) < 0.2] = NAN
-            attributes.append(Attribute(name, "date", (), "date", pattern))
-        else:
-            labels = list(dict.fromkeys(_tricky_text(rng) for _ in range(int(rng.integers(1, 5)))))
-            column = rng.integers(0, len(labels), size=n_rows).astype(float)
-            column[rng.random(n_rows) < 0.2] = NAN
-            if kind == "string":  # a string table lists values as they first appear
-                order = list(dict.fromkeys(int(c) for c in column if not np.isnan(c)))
-                labels = [labels[c] for c in order]
-                column = np.array([NAN if np.isnan(c) else order.index(int(c)) for c in column])
-                attributes.append(Attribute(name, "string", tuple(labels), "string"))
-            else:
-                attributes.append(Attribute(name, "nominal", tuple(labels), "nominal"))
-        columns.append(column)
-    relation = _tricky_text(rng)
-    targets = resolve_targets(None, [a.name for a in attributes], relation=relation)
-    weights = None
-    if rng.random() < 0.5:
-        weights = rng.choice([1.0, 0.5, 2.0, 0.0], size=n_rows)
-    values = np.column_stack(columns) if n_rows else np.empty((0, len(attributes)))
-    return Dataset(
-        Schema(relation, tuple(attributes), targets),
-        values,
-        weights=weights,
-        sparse=bool(rng.random() < 0.5),
-    )
-
-
 @pytest.mark.parametrize("seed", range(60))
 def test_random_datasets_survive_a_round_trip(seed: int) -> None:
-    dataset = _random_dataset(np.random.default_rng(seed))
+    dataset = random_dataset(np.random.default_rng(seed))
     text = dumps_arff(dataset)
     back = loads_arff(text)
     assert back.equals(dataset), text

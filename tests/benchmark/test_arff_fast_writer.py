@@ -12,7 +12,7 @@ import io
 import numpy as np
 import pytest
 
-from tests.benchmark.test_arff import CANONICAL, _random_dataset
+from tests.support.arff_texts import CANONICAL, random_dataset
 from touchbench.benchmark.dataset import Attribute, Dataset, Schema
 from touchbench.benchmark.errors import DataFormatError
 from touchbench.benchmark.io import arff_writer
@@ -88,7 +88,7 @@ def test_the_data_sets_of_the_reader_tests_are_written_alike(
 ) -> None:
     written = 0
     for seed in range(300):
-        dataset = dataclasses.replace(_random_dataset(np.random.default_rng(seed)), sparse=False)
+        dataset = dataclasses.replace(random_dataset(np.random.default_rng(seed)), sparse=False)
         by_rows, by_arrow = both_texts(dataset, monkeypatch)
         assert by_arrow == by_rows, f"seed {seed}"
         written += dataset.values.size > 0

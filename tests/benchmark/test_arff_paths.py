@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.app.test_cli_datasets import TOUCH_ARFF
-from tests.benchmark.test_arff import CANONICAL, HEADER, MESSY, _random_dataset
+from tests.support.arff_texts import CANONICAL, HEADER, MESSY, random_dataset
+from tests.support.synthetic import TOUCH_ARFF
 from touchbench.benchmark.dataset import Dataset
 from touchbench.benchmark.errors import DataFormatError
 from touchbench.benchmark.io import arff_reader
@@ -135,7 +135,7 @@ def test_the_arff_texts_of_the_tests_read_alike(text: str) -> None:
 
 @pytest.mark.parametrize("seed", range(40))
 def test_random_data_sets_read_alike(seed: int) -> None:
-    text = dumps_arff(_random_dataset(np.random.default_rng(seed)))
+    text = dumps_arff(random_dataset(np.random.default_rng(seed)))
     assert assert_all_parsers_agree(text)[0] == "data"
 
 

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.benchmark.test_model import dataset
+from tests.support.synthetic import nominal_dataset as dataset
 from touchbench.benchmark.artifacts import dumps_artifact, is_trusted_type, loads_artifact
 from touchbench.benchmark.errors import ConfigurationError
 from touchbench.benchmark.model import dumps_model, fit_model, loads_model, model_digest

@@ -18,7 +18,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_a_plugin_module_gives_its_specs() -> None:
-    specs = plugin_specs(["rf", "nb"], "tests.gate, ")
+    specs = plugin_specs(["rf", "nb"], "tests.support.gate, ")
     assert [spec.id for spec in specs] == ["gate", "gate-stubborn", "gate-cnn1d"]
 
 
@@ -27,7 +27,10 @@ def test_a_plugin_module_gives_its_specs() -> None:
     [
         ("tests.no_such_module", "plugin tests.no_such_module (in TOUCHBENCH_PLUGINS) cannot be"),
         ("tests", "plugin tests has no CLASSIFIERS sequence"),
-        ("tests.gate,tests.gate", "plugin tests.gate: classifier id 'gate' is taken"),
+        (
+            "tests.support.gate,tests.support.gate",
+            "plugin tests.support.gate: classifier id 'gate' is taken",
+        ),
     ],
 )
 def test_a_bad_plugin_is_refused_in_one_line(modules: str, message: str) -> None:
@@ -37,7 +40,7 @@ def test_a_bad_plugin_is_refused_in_one_line(modules: str, message: str) -> None
 
 def test_an_id_of_the_catalogue_cannot_be_taken() -> None:
     with pytest.raises(ConfigurationError, match="classifier id 'gate' is taken"):
-        plugin_specs(["gate"], "tests.gate")
+        plugin_specs(["gate"], "tests.support.gate")
 
 
 def _classifiers(tmp_path: Path, plugins: str) -> subprocess.CompletedProcess[str]:
@@ -52,7 +55,7 @@ def _classifiers(tmp_path: Path, plugins: str) -> subprocess.CompletedProcess[st
 
 
 def test_the_cli_lists_a_plugin_entry(tmp_path: Path) -> None:
-    listing = _classifiers(tmp_path, "tests.gate")
+    listing = _classifiers(tmp_path, "tests.support.gate")
     assert listing.returncode == 0, listing.stderr
     assert "gate" in {entry["id"] for entry in json.loads(listing.stdout)["classifiers"]}
 

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.grasp_table import FEATURES, OBJECTS, grasp_arff, grasp_csv, grasp_rows
+from tests.support.grasp_table import FEATURES, OBJECTS, grasp_arff, grasp_csv, grasp_rows
 from touchbench.benchmark.dataset import Dataset, Schema
 from touchbench.benchmark.errors import DataFormatError
 from touchbench.benchmark.io.arff import open_arff, read_arff

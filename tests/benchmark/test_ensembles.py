@@ -12,7 +12,6 @@ import signal
 import subprocess
 import sys
 import time
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -21,10 +20,9 @@ from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.naive_bayes import GaussianNB
 from threadpoolctl import threadpool_limits
 
-from tests.votes import prefit_vote
+from tests.support.ensembles import prefit_vote, resumable, small_problem, stand_in, vote
 from touchbench.benchmark.catalogue import ClassifierSpec, get_spec
 from touchbench.benchmark.catalogue.ensembles import selection_spec
-from touchbench.benchmark.catalogue.spec import Ensemble
 from touchbench.benchmark.catalogue.stacking import stacked_spec
 from touchbench.benchmark.errors import ConfigurationError
 from touchbench.benchmark.estimators import build_estimator, classifier_spec
@@ -55,18 +53,6 @@ class CountingNB(GaussianNB):
         return super().fit(X, y)
 
 
-class SlowNB(GaussianNB):
-    """Gaussian naive Bayes that takes ``seconds`` longer to fit (a run to kill midway)."""
-
-    def __init__(self, seconds: float = 0.0, priors: object = None, var_smoothing: float = 1e-9):
-        super().__init__(priors=priors, var_smoothing=var_smoothing)
-        self.seconds = seconds
-
-    def fit(self, X: np.ndarray, y: np.ndarray, sample_weight: object = None) -> SlowNB:
-        time.sleep(self.seconds)
-        return super().fit(X, y)
-
-
 class RowSpy(ClassifierMixin, BaseEstimator):
     """Writes the row ids (column 0) it is fitted on to a new file in ``folder``, then
     predicts by 1-nearest id: only memorising a row predicts its noise label."""
@@ -85,36 +71,6 @@ class RowSpy(ClassifierMixin, BaseEstimator):
     def predict(self, X: np.ndarray) -> np.ndarray:
         nearest = np.abs(X[:, [0]] - self.ids_[None, :]).argmin(axis=1)
         return self.y_[nearest]
-
-
-def stand_in(classifier_id: str, factory: type, probabilities: bool, **params: object):
-    return replace(
-        get_spec("nb-gaussian"),
-        id=classifier_id,
-        factory=factory,
-        params=params,
-        probabilities=probabilities,
-        handles_missing=False,  # imputed first, as the estimators here want
-        description=classifier_id,
-    )
-
-
-def vote(classifier_id: str, combine: str, *members: ClassifierSpec) -> ClassifierSpec:
-    return replace(
-        get_spec("voting"),
-        id=classifier_id,
-        params={"voting": combine},
-        probabilities=combine == "soft",
-        ensemble=Ensemble(tuple(members), combine),  # type: ignore[arg-type]
-    )
-
-
-def small_problem(n: int = 150, seed: int = 0) -> Problem:
-    rng = np.random.default_rng(seed)
-    y = np.arange(n) % 3
-    X = rng.normal(size=(n, 5)) + 1.0 * y[:, None] * np.array([1.0, 0.5, 0.0, -0.5, 0.2])
-    X[::13, 1] = np.nan
-    return Problem(X=X, Y=y[:, None], n_classes=(3,), target_names=("gesture",))
 
 
 @pytest.fixture(scope="module")
@@ -389,7 +345,8 @@ def test_ensemble_selection_is_refused_where_it_cannot_run(problem: Problem) -> 
 RUNNER = """
 import json, os, signal, sys
 from pathlib import Path
-from tests.benchmark.test_ensembles import resumable, small_problem
+from tests.support.ensembles import resumable
+from tests.support.ensembles import small_problem
 from touchbench.benchmark.predictions import encode
 from touchbench.benchmark.run.engine import run_tasks
 from touchbench.benchmark.run.folds import make_folds
@@ -420,18 +377,6 @@ run_tasks(problem, classifiers, folds, jobs=1, timeout=600, extra_specs=extra, e
 #: Results stored before the kill: the first fold's 4 members and 3 ensembles, then 2 of
 #: the second fold's members (one task at a time, a fold's ensembles as soon as it is done).
 KILLED_AFTER = 9
-
-
-def resumable(seconds: float) -> tuple[list[str], dict[str, ClassifierSpec]]:
-    """A run with a vote, a stack and a selection over a slow member."""
-    slow = stand_in("slow", SlowNB, True, seconds=seconds)
-    members = [slow, get_spec("logistic"), get_spec("ibk")]
-    extra = {
-        "slow": slow,
-        "vote": vote("vote", "soft", slow, get_spec("logistic"), get_spec("calibrated-nb")),
-        "stack-top2": stacked_spec(members, 2),
-    }
-    return ["slow", "logistic", "ibk", "vote", "stack-top2"], extra
 
 
 def _stored(folder: Path, with_predictions: bool) -> list[TaskResult]:

@@ -9,7 +9,7 @@ from sklearn.linear_model import LogisticRegression
 from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import StandardScaler
 
-from tests.benchmark.test_model import dataset
+from tests.support.synthetic import nominal_dataset as dataset
 from touchbench.benchmark.forest_inference import forest_proba
 from touchbench.benchmark.model import fit_model
 

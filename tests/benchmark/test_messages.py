@@ -9,7 +9,7 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 
-from tests.benchmark.test_problem import make
+from tests.support.problems import make_problem as make
 from touchbench.benchmark.catalogue import get_spec
 from touchbench.benchmark.catalogue.pipeline import check_sequence_input
 from touchbench.benchmark.catalogue.stacking import check_top_n

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from touchbench.benchmark.dataset import Attribute, Dataset, Schema
+from tests.support.synthetic import nominal_dataset
+from touchbench.benchmark.dataset import Dataset
 from touchbench.benchmark.errors import ConfigurationError
 from touchbench.benchmark.model import (
     TrainedModel,
@@ -16,31 +17,12 @@ from touchbench.benchmark.model import (
 )
 
 
-def dataset(n: int = 90, targets: int = 1) -> Dataset:
-    rng = np.random.default_rng(0)
-    gesture = np.arange(n) % 3
-    place = (np.arange(n) // 3) % 2
-    colour = (gesture + (rng.random(n) < 0.2)) % 2
-    level = 0.3 * rng.normal(size=n) + 6.0 * gesture + 2.0 * place
-    attributes = [
-        Attribute("gesture", "nominal", ("tap", "slap", "stroke")),
-        Attribute("place", "nominal", ("head", "arm")),
-        Attribute("colour", "nominal", ("red", "blue")),
-        Attribute("note", "string", ("a", "b")),
-        Attribute("level", "numeric", (), "numeric"),
-    ]
-    values = np.column_stack([gesture, place, colour, np.zeros(n), level]).astype(np.float64)
-    values[::10, 4] = np.nan
-    target_indices = (0,) if targets == 1 else (0, 1)
-    return Dataset(Schema("touch", tuple(attributes), target_indices), values)
-
-
 def features(data: Dataset) -> np.ndarray:
     return data.X
 
 
 def test_fit_predict_and_probabilities_of_a_catalogue_classifier() -> None:
-    data = dataset()
+    data = nominal_dataset()
     model = fit_model(data, "logistic", random_state=4)
     assert model.classifier == "logistic"
     assert model.params["random_state"] == 4 and model.params["C"] == 10.0
@@ -54,13 +36,13 @@ def test_fit_predict_and_probabilities_of_a_catalogue_classifier() -> None:
 
 
 def test_a_model_without_probabilities_says_so() -> None:
-    model = fit_model(dataset(), "svm-rbf")
+    model = fit_model(nominal_dataset(), "svm-rbf")
     with pytest.raises(NotImplementedError, match="classifier 'svm-rbf' gives no probabilities"):
-        model.predict_proba(dataset().X)
+        model.predict_proba(nominal_dataset().X)
 
 
 def test_multitarget_models_predict_every_target() -> None:
-    data = dataset(targets=2)
+    data = nominal_dataset(targets=2)
     model = fit_model(data, "cc:j48")
     predicted = model.predict(data.X)
     assert predicted.shape == (90, 2)
@@ -70,7 +52,7 @@ def test_multitarget_models_predict_every_target() -> None:
 
 
 def test_wrong_feature_count_is_refused() -> None:
-    model = fit_model(dataset(), "nb")
+    model = fit_model(nominal_dataset(), "nb")
     with pytest.raises(ConfigurationError, match="expects 4 feature columns"):
         model.predict(np.zeros((2, 5)))
 
@@ -84,7 +66,7 @@ def test_wrong_feature_count_is_refused() -> None:
     ],
 )
 def test_bad_training_requests(classifier: str, mutate: str | None, message: str) -> None:
-    data = dataset()
+    data = nominal_dataset()
     if mutate == "one_class":
         data.values[:, 0] = 1
     if mutate == "numeric_target":
@@ -94,7 +76,7 @@ def test_bad_training_requests(classifier: str, mutate: str | None, message: str
 
 
 def test_serialised_models_load_only_with_their_digest() -> None:
-    data = dataset()
+    data = nominal_dataset()
     model = fit_model(data, "j48")
     blob = dumps_model(model)
     digest = model_digest(blob)
@@ -126,7 +108,7 @@ def test_serialised_models_load_only_with_their_digest() -> None:
     ],
 )
 def test_codes_and_probabilities_in_one_pass_agree_with_predict(classifier: str) -> None:
-    data = dataset(targets=2 if ":" in classifier else 1)
+    data = nominal_dataset(targets=2 if ":" in classifier else 1)
     model = fit_model(data, classifier)
     codes, probabilities = model.predict_with_proba(data.X)
     np.testing.assert_array_equal(codes, model.predict(data.X))

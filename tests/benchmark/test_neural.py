@@ -19,7 +19,7 @@ import skops.io
 from sklearn.base import clone
 from sklearn.pipeline import Pipeline
 
-from tests.benchmark.test_sequences import sequence_dataset, shapes
+from tests.support.sequences import sequence_dataset, shapes
 from touchbench.benchmark.artifacts import dumps_artifact, loads_artifact
 from touchbench.benchmark.catalogue import build_pipeline, get_spec
 from touchbench.benchmark.catalogue.neural import (

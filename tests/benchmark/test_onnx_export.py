@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from sklearn.pipeline import Pipeline
 
-from tests.benchmark.test_model import dataset as nominal_dataset
+from tests.support.synthetic import nominal_dataset
 from touchbench.benchmark.catalogue import SPECS
 from touchbench.benchmark.dataset import Attribute, Dataset, Schema
 from touchbench.benchmark.errors import ConfigurationError

@@ -9,7 +9,7 @@ import json
 import numpy as np
 import pytest
 
-from tests.benchmark.test_model import dataset as nominal_dataset
+from tests.support.synthetic import nominal_dataset
 from touchbench.benchmark.dataset import Dataset
 from touchbench.benchmark.errors import ConfigurationError
 from touchbench.benchmark.estimators import build_estimator

@@ -5,26 +5,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from touchbench.benchmark.dataset import Attribute, Dataset, Schema
+from tests.support.problems import make_problem
 from touchbench.benchmark.errors import ConfigurationError
 from touchbench.benchmark.problem import problem_from_dataset
 
 NAN = np.nan
 
 
-def make(values: list[list[float]], targets: tuple[int, ...] = (0,), weights=None) -> Dataset:
-    attributes = (
-        Attribute("gesture", "nominal", ("tap", "slap")),
-        Attribute("note", "string", ("x",)),
-        Attribute("colour", "nominal", ("red", "green", "blue")),
-        Attribute("level", "numeric", (), "numeric"),
-        Attribute("when", "date", (), "date"),
-    )
-    return Dataset(Schema("r", attributes, targets), np.array(values, float), weights=weights)
-
-
 def test_usable_features_nominal_columns_and_dropped_instances() -> None:
-    data = make(
+    data = make_problem(
         [[0, 0, 2, 1.5, 100], [1, 0, NAN, 2.5, 200], [NAN, 0, 1, 3.5, 300]],
         weights=np.array([1.0, 2.0, 1.0]),
     )
@@ -44,16 +33,16 @@ def test_usable_features_nominal_columns_and_dropped_instances() -> None:
 
 
 def test_several_targets_make_a_multitarget_problem() -> None:
-    problem, _ = problem_from_dataset(make([[0, 0, 2, 1.0, 0], [1, 0, 1, 2.0, 0]], (0, 2)))
+    problem, _ = problem_from_dataset(make_problem([[0, 0, 2, 1.0, 0], [1, 0, 1, 2.0, 0]], (0, 2)))
     assert problem.kind == "multitarget" and problem.n_classes == (2, 3)
     assert problem.target_names == ("gesture", "colour")
 
 
 def test_a_numeric_target_makes_a_regression_and_a_date_target_is_refused() -> None:
-    problem, _ = problem_from_dataset(make([[0, 0, 2, 1.5, 0], [1, 0, 1, NAN, 0]], (3,)))
+    problem, _ = problem_from_dataset(make_problem([[0, 0, 2, 1.5, 0], [1, 0, 1, NAN, 0]], (3,)))
     assert problem.kind == "regression" and problem.n_classes == ()
     np.testing.assert_array_equal(problem.Y, [[1.5]])
     with pytest.raises(ConfigurationError, match="target 'when' is a date attribute"):
-        problem_from_dataset(make([[0, 0, 2, 1.0, 0]], (4,)))
+        problem_from_dataset(make_problem([[0, 0, 2, 1.0, 0]], (4,)))
     with pytest.raises(ConfigurationError, match="targets mix nominal and numeric"):
-        problem_from_dataset(make([[0, 0, 2, 1.0, 0]], (0, 3)))
+        problem_from_dataset(make_problem([[0, 0, 2, 1.0, 0]], (0, 3)))

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from tests.gate import CLASSIFIERS, Gate
+from tests.support.gate import CLASSIFIERS, Gate
 from touchbench.benchmark.catalogue.costs import Shape, cost_label, estimate_seconds
 from touchbench.benchmark.errors import ConfigurationError
 from touchbench.benchmark.estimators import classifier_spec

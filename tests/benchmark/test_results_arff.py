@@ -41,7 +41,9 @@ def test_export_reads_back_with_weka_attribute_names_and_one_row_per_success(
     results: list[TaskResult],
 ) -> None:
     moment = datetime(2017, 9, 22, 9, 48)
-    dataset = results_to_dataset(results, dataset_name="Sound_Gestures: -C 1", timestamp=moment)
+    dataset = results_to_dataset(
+        results, dataset_name="Sound_Gestures: -C 1", specs=CATALOGUE, timestamp=moment
+    )
     text = dumps_arff(dataset)
     assert text.startswith("@relation InstanceResultListener")
     back = loads_arff(text)
@@ -86,7 +88,7 @@ def test_export_reads_back_with_weka_attribute_names_and_one_row_per_success(
 
 
 def test_scheme_names_can_be_touchbench_ids(results: list[TaskResult]) -> None:
-    dataset = results_to_dataset(results, dataset_name="d", scheme_names="id")
+    dataset = results_to_dataset(results, dataset_name="d", specs=CATALOGUE, scheme_names="id")
     scheme = dataset.schema.attributes[dataset.schema.index("Key_Scheme")]
     assert scheme.values == ("touchbench.ibk", "touchbench.ibk3", "touchbench.nb")
     options = dataset.schema.attributes[dataset.schema.index("Key_Scheme_options")]
@@ -99,7 +101,7 @@ def test_scheme_names_can_be_touchbench_ids(results: list[TaskResult]) -> None:
 
 def test_entries_without_a_weka_command_keep_their_touchbench_name() -> None:
     result = TaskResult(TaskKey("rf", 0, 0), "ok", None, {}, [[3, 1], [1, 5]], 90, 10)
-    dataset = results_to_dataset([result], dataset_name="d")
+    dataset = results_to_dataset([result], dataset_name="d", specs=CATALOGUE)
     keys = {a.name: a.values for a in dataset.schema.attributes[:6]}
     assert keys["Key_Scheme"] == ("touchbench.rf",)
     assert keys["Key_Scheme_options"] == ("-id rf -n_estimators 100",)
@@ -139,7 +141,7 @@ def test_weka_measures_by_hand() -> None:
 def test_multitarget_results_are_refused() -> None:
     result = TaskResult(TaskKey("cc:nb", 0, 0), "ok", None, {}, [[[1, 0], [0, 1]]], 9, 1)
     with pytest.raises(ConfigurationError, match="multi-class runs only"):
-        results_to_dataset([result], dataset_name="d")
+        results_to_dataset([result], dataset_name="d", specs=CATALOGUE)
 
 
 @pytest.mark.shared
@@ -147,7 +149,7 @@ def test_attributes_match_wekas_own_results_file(
     shared_datasets: Path, results: list[TaskResult]
 ) -> None:
     weka = read_arff(shared_datasets / "uc3m-touch/mini/weka_results_gesture.arff")
-    ours = results_to_dataset(results, dataset_name="d")
+    ours = results_to_dataset(results, dataset_name="d", specs=CATALOGUE)
     theirs = [(a.name, a.kind) for a in weka.schema.attributes]
     mine = [(a.name, a.kind) for a in ours.schema.attributes]
     assert mine == theirs[: len(mine)]

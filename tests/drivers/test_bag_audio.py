@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.drivers.bagfiles import encode, mp3_stream, pieces, write_audio_bag
+from tests.support.bagfiles import encode, mp3_stream, pieces, write_audio_bag
 from touchbench.drivers.errors import DriverError
 from touchbench.drivers.mp3 import ChunkStream, frame_length, looks_like_mp3
 from touchbench.drivers.replay import FileReplaySource

@@ -9,7 +9,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from tests.drivers.bagfiles import BIOTAC_MSG, BIOTAC_TYPE, float_array, write_fields_bag
+from tests.support.bagfiles import BIOTAC_MSG, BIOTAC_TYPE, float_array, write_fields_bag
 from touchbench.drivers.bag_reader import topic_listing
 from touchbench.drivers.errors import DriverError
 from touchbench.drivers.replay import FileReplaySource

@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.drivers.csvfiles import write_biotac_csv
+from tests.support.csvfiles import write_biotac_csv
 from touchbench.drivers.errors import DriverError
 from touchbench.drivers.files import read_recording
 from touchbench.drivers.replay import FileReplaySource

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import soundfile
 
-from tests.drivers.bagfiles import write_audio_bag
+from tests.support.bagfiles import write_audio_bag
 from touchbench.drivers.errors import DriverError
 from touchbench.drivers.files import read_recording
 from touchbench.drivers.replay import FileReplaySource

@@ -9,7 +9,7 @@ from collections.abc import Iterator
 import numpy as np
 import pytest
 
-from tests.drivers.bagfiles import mp3_stream, pieces
+from tests.support.bagfiles import mp3_stream, pieces
 from touchbench.drivers.errors import DriverError
 from touchbench.drivers.ros_source import RosAudioSource, RosTaxelSource, info_topic_of
 from touchbench.drivers.ros_transport import AudioFormat, Kind, Message

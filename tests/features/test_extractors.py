@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.features.signals import sine
+from tests.support.signals import sine
 from touchbench.drivers.simulated import SimulatedTouch, simulate_session
 from touchbench.features.errors import FeatureError
 from touchbench.features.events import EVENT_KINDS, Detection, Event, detect_events, detect_snr

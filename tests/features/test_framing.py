@@ -3,7 +3,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.features.signals import sine
+from tests.support.signals import sine
 from touchbench.features.errors import FeatureError
 from touchbench.features.framing import fft_frequencies, frame, frame_count, power_spectrogram, stft
 

@@ -4,7 +4,7 @@ import librosa
 import numpy as np
 import pytest
 
-from tests.features.signals import sine, white_noise
+from tests.support.signals import sine, white_noise
 from touchbench.features.errors import FeatureError
 from touchbench.features.framing import frame, power_spectrogram
 from touchbench.features.mel import hz_to_mel, mel_filter_bank, mel_spectrogram, mel_to_hz, mfcc

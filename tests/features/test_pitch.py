@@ -3,7 +3,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.features.signals import sine, white_noise
+from tests.support.signals import sine, white_noise
 from touchbench.features.errors import FeatureError
 from touchbench.features.framing import fft_frequencies, frame, stft
 from touchbench.features.pitch import pitch_autocorrelation, pitch_fft, pitch_wavelet

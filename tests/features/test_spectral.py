@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from scipy.signal import find_peaks, peak_prominences
 
-from tests.features.signals import sine, white_noise
+from tests.support.signals import sine, white_noise
 from touchbench.features.errors import FeatureError
 from touchbench.features.framing import fft_frequencies, frame, stft
 from touchbench.features.spectral import (

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.features.signals import click_train
+from tests.support.signals import click_train
 from touchbench.drivers.simulated import SimulatedTouch, simulate_session
 from touchbench.features.errors import FeatureError
 from touchbench.features.event_streams import EventStream, open_event_stream

@@ -4,7 +4,7 @@ import librosa
 import numpy as np
 import pytest
 
-from tests.features.signals import sine, white_noise
+from tests.support.signals import sine, white_noise
 from touchbench.features.framing import frame
 from touchbench.features.temporal import peak_level, rms, zero_crossing_rate, zero_crossings
 

@@ -29,12 +29,12 @@ from touchbench.app.services.datasets import (
     delete_dataset,
     describe_dataset,
     export_dataset,
+    find_dataset,
     import_file,
     rename_dataset,
 )
 from touchbench.app.services.listing import count_datasets, list_datasets
 from touchbench.app.store.database import Store
-from touchbench.app.store.datasets import find_dataset
 
 router = APIRouter(prefix="/api/datasets", tags=["datasets"])
 

@@ -7,7 +7,6 @@ from typing import Annotated
 from fastapi import APIRouter, Query
 
 from touchbench.app.schemas.extraction import ExtractorList, ExtractorsRequest
-from touchbench.app.services.extractors import list_extractors
 
 router = APIRouter(prefix="/api/extractors", tags=["extraction"])
 
@@ -19,4 +18,8 @@ def extractors(
     """Every extractor and event detector with each option's type, default and meaning
     (the same object as ``touchbench extractors --json``); with ``samplerate``, the
     defaults that depend on the sample rate computed for it."""
+    # imported on first use: the extractors' modules load SciPy's signal tools and
+    # scikit-learn, which the service's start-up does not otherwise need
+    from touchbench.app.services.extractors import list_extractors
+
     return list_extractors(ExtractorsRequest(samplerate=samplerate))

@@ -36,8 +36,7 @@ from touchbench.app.schemas.models import (
     TrainRequest,
 )
 from touchbench.app.services.jobs import submit_export, submit_training
-from touchbench.app.services.loading import with_known_problem
-from touchbench.app.store.models import count_models, delete_model, get_model, list_models
+from touchbench.app.services.registry import count_models, delete_model, find_model, list_models
 
 router = APIRouter(prefix="/api/models", tags=["models"])
 #: Predictions of JSON instances: documented by FastAPI, answered by a direct handler (the
@@ -61,14 +60,14 @@ def models(store: StoreDep, page: PageDep, request: Request, response: Response)
     """The models, oldest first, a page of at most 1,000 (``X-Total-Count``, ``Link``)."""
     paginate(request, response, page, count_models(store))
     listed = list_models(store, page=page)
-    return ModelList(models=[with_known_problem(m).to_schema() for m in listed])
+    return ModelList(models=[m.to_schema() for m in listed])
 
 
 @router.get("/{model_ref}", response_model=ModelSchema)
 def model(model_ref: str, store: StoreDep) -> ModelSchema:
     """A model; ``onnx.problem`` says why its twin could not be loaded, once this service
     tried (its predictions with engine auto then run the model itself)."""
-    return with_known_problem(get_model(store, model_ref)).to_schema()
+    return find_model(store, model_ref).to_schema()
 
 
 @router.get(

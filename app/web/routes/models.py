@@ -9,7 +9,7 @@ from fastapi.responses import HTMLResponse
 
 from touchbench.app.schemas.status import FINAL
 from touchbench.app.services.lifecycle import count_jobs, list_jobs
-from touchbench.app.store.models import count_models, get_model, list_models
+from touchbench.app.services.registry import count_models, find_model, list_models
 from touchbench.app.web.deps import StoreDep
 from touchbench.app.web.listing import newest
 from touchbench.app.web.rendering import render
@@ -32,7 +32,7 @@ def models(store: StoreDep) -> HTMLResponse:
 def model(model: Ref, store: StoreDep) -> HTMLResponse:
     """What the model classifies, and one input per feature it needs (a number, or a
     choice of the labels it was trained with)."""
-    info = get_model(store, model)
+    info = find_model(store, model)
     return render(
         "fragments/model.html.j2",
         model=info.to_schema(),

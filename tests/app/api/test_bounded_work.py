@@ -18,14 +18,14 @@ import httpx
 import numpy as np
 import soundfile
 
-from tests.app.api.conftest import ROOT, Server
-from tests.app.synthetic import touch_arff
-from tests.app.web.conftest import figure_texts
+from tests.support.browser import figure_texts
+from tests.support.memory import DATA_URI, peak_rss_mb
+from tests.support.service import ROOT, Server
+from tests.support.synthetic import touch_arff
 from touchbench.app.reports import bounds
 
 #: Far above what a bounded service needs, far below what the issue measured (9.2 GB).
 PEAK_RSS_BOUND_MB = 1024
-DATA_URI = re.compile(r'src="(data:image/svg\+xml;base64,[^"]+)"')
 
 
 def many_targets_arff(path: Path, n_targets: int, *, n_instances: int = 2) -> Path:
@@ -36,15 +36,6 @@ def many_targets_arff(path: Path, n_targets: int, *, n_instances: int = 2) -> Pa
     lines += [",".join(["1"] * n_targets + [str(row)]) for row in range(n_instances)]
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path
-
-
-def peak_rss_mb(server: Server) -> float:
-    """The service process's peak resident memory (``VmHWM``), in MB."""
-    assert server.process is not None
-    status = Path(f"/proc/{server.process.pid}/status").read_text()
-    match = re.search(r"^VmHWM:\s+(\d+) kB", status, re.MULTILINE)
-    assert match, status
-    return int(match.group(1)) / 1024
 
 
 def _upload(api: httpx.Client, path: Path) -> httpx.Response:

@@ -18,8 +18,8 @@ import httpx
 import pytest
 import yaml
 
-from tests.app.api.conftest import ROOT, Server, finished, free_port
-from tests.app.synthetic import touch_arff
+from tests.support.service import ROOT, Server, finished, free_port
+from tests.support.synthetic import touch_arff
 from touchbench.app.settings import Settings
 
 COMPOSE = ROOT / "docker-compose.yml"

@@ -15,7 +15,7 @@ from fastapi import APIRouter, Depends, Header, Response
 from fastapi.testclient import TestClient
 from pydantic import SecretStr
 
-from tests.app.synthetic import touch_arff
+from tests.support.synthetic import touch_arff
 from touchbench.app.api.deps import ServiceDep, StoreDep, require_api_key
 from touchbench.app.api.direct import DirectRoute
 from touchbench.app.api.routes.models import predict_instances

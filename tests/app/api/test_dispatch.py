@@ -15,8 +15,8 @@ from pathlib import Path
 
 import pytest
 
-from tests.app.api.conftest import Server, finished
-from tests.app.synthetic import touch_arff
+from tests.support.service import Server, finished
+from tests.support.synthetic import touch_arff
 from touchbench.app.jobs import dispatcher as dispatching
 from touchbench.app.jobs.dispatcher import Dispatcher, dispatch_address
 from touchbench.app.schemas.datasets import ImportRequest

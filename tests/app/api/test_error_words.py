@@ -17,8 +17,8 @@ from typing import Any
 
 import httpx
 
-from tests.app.api.conftest import Server, finished
-from tests.app.synthetic import touch_arff
+from tests.support.service import Server, finished
+from tests.support.synthetic import touch_arff
 
 
 def _cli_words() -> re.Pattern[str]:

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.app.api.conftest import Server
+from tests.support.service import Server
 
 ROOT = Path(__file__).resolve().parents[3]
 HIDER = ROOT / "tests" / "without_extras"

@@ -20,10 +20,8 @@ from typing import Any
 import httpx
 import pytest
 
-from tests.app.api.conftest import ROOT, Server, _servers, finished
-from tests.app.api.test_bounded_work import DATA_URI, peak_rss_mb
-from tests.app.conftest import emptied
-from tests.app.hostile_inputs import (
+from tests.support.browser import figure_texts
+from tests.support.hostile_inputs import (
     RLO_NAME,
     deep_json,
     gap_csv,
@@ -33,8 +31,10 @@ from tests.app.hostile_inputs import (
     results_arff,
     timed_takes,
 )
-from tests.app.synthetic import touch_arff
-from tests.app.web.conftest import figure_texts
+from tests.support.memory import DATA_URI, peak_rss_mb
+from tests.support.service import ROOT, Server, finished, servers
+from tests.support.stores import emptied
+from tests.support.synthetic import touch_arff
 from touchbench.app.reports import bounds
 
 #: The most the service's peak memory may grow over its start while hostile requests are
@@ -83,7 +83,7 @@ def served(
         timeout=300,
     )
     assert extracted.returncode == 0, extracted.stderr
-    builder = _servers(url, folder)
+    builder = servers(url, folder)
     server = next(builder)()
     trained = server.client.post(
         "/api/models", json={"dataset": "takes", "classifier": "nb", "name": "takes-nb"}

@@ -10,9 +10,9 @@ from pathlib import Path
 import pytest
 from sqlalchemy import update
 
-from tests.app.api.conftest import Server, finished
-from tests.app.cli_runner import run_cli
-from tests.app.synthetic import touch_arff
+from tests.support.cli_runner import run_cli
+from tests.support.service import Server, finished
+from tests.support.synthetic import touch_arff
 from touchbench.app.errors import ConflictError
 from touchbench.app.store.database import Store
 from touchbench.app.store.jobs import (

@@ -14,9 +14,9 @@ import pytest
 from sqlalchemy import create_engine, text
 from sqlalchemy.engine import Engine, make_url
 
-from tests.app.api.conftest import Server, _servers, finished
-from tests.app.conftest import DEFAULT_POSTGRES, _psycopg_url
-from tests.app.synthetic import touch_arff
+from tests.support.service import Server, finished, servers
+from tests.support.stores import DEFAULT_POSTGRES, psycopg_url
+from tests.support.synthetic import touch_arff
 
 PASSWORD = f"pa55-{uuid.uuid4().hex}"
 
@@ -26,7 +26,7 @@ def admin() -> Iterator[Engine]:
     server = os.environ.get("TOUCHBENCH_TEST_POSTGRES_URL", DEFAULT_POSTGRES)
     if not server:
         pytest.skip("no PostgreSQL server for this test")
-    engine = create_engine(_psycopg_url(server), isolation_level="AUTOCOMMIT")
+    engine = create_engine(psycopg_url(server), isolation_level="AUTOCOMMIT")
     yield engine
     engine.dispose()
 
@@ -51,7 +51,7 @@ def secret_url(admin: Engine) -> Iterator[str]:
 
 @pytest.fixture
 def make_secret_server(secret_url: str, tmp_path: Path) -> Iterator[Callable[..., Server]]:
-    yield from _servers(secret_url, tmp_path)
+    yield from servers(secret_url, tmp_path)
 
 
 def _descendants(pid: int) -> list[int]:

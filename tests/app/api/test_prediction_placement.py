@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 from fastapi.testclient import TestClient
 
-from tests.app.synthetic import touch_arff
+from tests.support.synthetic import touch_arff
 from touchbench.app.api.deps import INLINE_SECONDS, PredictionPlacement, request_size
 from touchbench.app.main import create_app
 from touchbench.app.schemas.datasets import ImportRequest

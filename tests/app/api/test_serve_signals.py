@@ -18,7 +18,7 @@ from pathlib import Path
 import httpx
 import pytest
 
-from tests.app.api.conftest import Server
+from tests.support.service import Server
 
 #: Longest a stop may take before the test fails (the service needs about 5 s at most).
 STOP_TIMEOUT = 60.0

@@ -11,9 +11,9 @@ from typing import Any
 
 import pytest
 
-from tests.app.api.conftest import Server
-from tests.app.cli_runner import run_cli
-from tests.app.synthetic import touch_arff
+from tests.support.cli_runner import run_cli
+from tests.support.service import Server
+from tests.support.synthetic import touch_arff
 
 KEYS = {
     "read": "stateful-read-key-0001",

@@ -13,9 +13,8 @@ import pytest
 from websockets.exceptions import InvalidStatus
 from websockets.sync.client import connect
 
-from tests.app.api.conftest import Server, finished
-from tests.app.cli_runner import run_cli
-from tests.app.synthetic import touch_arff
+from tests.support.service import Server, cancelled_run
+from tests.support.synthetic import touch_arff
 
 FOREIGN = "http://127.0.0.1:9"  # another port of the same machine is another origin
 KEY = "trust-key-of-the-lab"
@@ -74,24 +73,6 @@ def test_allowed_hosts_are_answered_besides_loopback(
     for host in ("lab-pc.example.evil.example", "192.168.7.21", "evil.example"):
         answer = server.client.get("/api/runs", headers={"Host": host})
         _refused(answer, 400, "DisallowedHost", "headers.Host")
-
-
-def cancelled_run(capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path) -> int:
-    """A run of the gate classifier cancelled before any fold: resuming it changes it."""
-    path = touch_arff(tmp_path / "touch.arff", n=60)
-    assert run_cli(capsys, server.database_url, "import", str(path), "--name", "touch").code == 0
-    api, gate = server.client, server.gate
-    assert gate is not None
-    created = api.post(
-        "/api/runs",
-        json={"dataset": "touch", "target": "gesture", "classifiers": ["gate"], "folds": 3},
-    )
-    assert created.status_code == 202, created.text
-    run_id: int = created.json()["id"]
-    gate.wait_started(1)
-    assert api.post(f"/api/runs/{run_id}/cancel").status_code == 200
-    assert server.wait_for(f"/api/runs/{run_id}", finished)["status"] == "cancelled"
-    return run_id
 
 
 def test_state_changes_from_a_foreign_origin_are_refused_and_from_its_own_accepted(

@@ -18,8 +18,8 @@ from urllib.parse import unquote
 import httpx
 import pytest
 
-from tests.app.api.conftest import Server, _servers, finished
-from tests.app.conftest import emptied
+from tests.support.service import Server, finished, servers
+from tests.support.stores import emptied
 
 #: One more than ``csv.field_size_limit()``'s default.
 LONG_FIELD = "x" * 131_073
@@ -38,7 +38,7 @@ def served(
         url = f"sqlite:///{folder / 'touchbench.db'}"
     else:
         url = emptied(request.getfixturevalue("postgres_database"))
-    builder = _servers(url, folder)
+    builder = servers(url, folder)
     build = next(builder)
     server = build()
     wide = _wide_arff(folder / "wide.arff")

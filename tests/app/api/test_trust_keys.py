@@ -15,9 +15,9 @@ import httpx
 import pytest
 from websockets.sync.client import connect
 
-from tests.app.api.conftest import ROOT, Server, free_port
-from tests.app.cli_runner import run_cli
-from tests.app.synthetic import touch_arff
+from tests.support.cli_runner import run_cli
+from tests.support.service import ROOT, Server, free_port
+from tests.support.synthetic import touch_arff
 
 READ = "read-key-of-robot-1"
 PREDICT = "predict-key-of-arm-2"

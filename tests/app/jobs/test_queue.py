@@ -9,7 +9,7 @@ from pathlib import Path
 
 from sqlalchemy import update
 
-from tests.app.synthetic import touch_arff
+from tests.support.synthetic import touch_arff
 from touchbench.app.jobs.queue import Item, next_item, waiting
 from touchbench.app.schemas.run_config import RunConfig
 from touchbench.app.store.database import Store

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.app.cli_runner import run_cli
+from tests.support.cli_runner import run_cli
 
 BEFORE = Path(__file__).parent / "data" / "before-one-package"
 

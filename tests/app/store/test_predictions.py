@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from sqlalchemy import text
 
-from tests.app.rows import count_rows
-from tests.app.synthetic import touch_arff
+from tests.support.rows import count_rows
+from tests.support.synthetic import touch_arff
 from touchbench.app.schemas.run_config import RunConfig
 from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import add_dataset, dataset_digest

@@ -7,56 +7,13 @@ Screenshots of every step go to ``test-artifacts/web/<test name>/`` at the repos
 
 from __future__ import annotations
 
-import base64
-import os
-import re
 import shutil
 from collections.abc import Iterator
-from dataclasses import dataclass, field
-from pathlib import Path
 
 import pytest
-from playwright.sync_api import Browser, Page, sync_playwright
+from playwright.sync_api import Browser, sync_playwright
 
-from tests.app.api.conftest import (  # noqa: F401 (fixtures of the real service)
-    ROOT,
-    make_server,
-    make_sqlite_server,
-    server,
-)
-from tests.app.test_plots import svg_texts
-
-ARTIFACTS = ROOT / "test-artifacts" / "web"
-#: Debian's Chromium (scripts/install.sh installs it); TOUCHBENCH_CHROMIUM overrides.
-CHROMIUM = Path(os.environ.get("TOUCHBENCH_CHROMIUM", "/usr/bin/chromium"))
-DATA_SVG = re.compile(r"^data:image/svg\+xml;base64,(.+)$")
-
-
-@dataclass
-class Tab:
-    """A browser tab, the folder of its screenshots and what went wrong in it."""
-
-    page: Page
-    folder: Path
-    page_errors: list[str] = field(default_factory=list)
-    policy_violations: list[str] = field(default_factory=list)
-    shots: list[Path] = field(default_factory=list)
-
-    def shot(self, name: str) -> Path:
-        """A full-page screenshot, numbered in order, once images have loaded."""
-        self.page.wait_for_function("[...document.images].every(image => image.complete)")
-        path = self.folder / f"{len(self.shots) + 1:02d}-{name}.png"
-        self.page.screenshot(path=str(path), full_page=True)
-        self.shots.append(path)
-        return path
-
-
-def figure_texts(src: str | None) -> list[str]:
-    """The text strings of a figure the page shows as a ``data:`` SVG image."""
-    assert src is not None, "the figure has no source"
-    match = DATA_SVG.match(src)
-    assert match, f"not an SVG data URI: {src[:60]}"
-    return svg_texts(base64.b64decode(match.group(1)).decode("utf-8"))
+from tests.support.browser import ARTIFACTS, CHROMIUM, Tab
 
 
 @pytest.fixture(scope="session")

@@ -16,10 +16,9 @@ from typing import Any
 import pytest
 from playwright.sync_api import Response, expect
 
-from tests.app.api.conftest import Server
-from tests.app.api.test_trust import cancelled_run
-from tests.app.synthetic import touch_arff
-from tests.app.web.conftest import Tab
+from tests.support.browser import Tab
+from tests.support.service import Server, cancelled_run
+from tests.support.synthetic import touch_arff
 
 #: The attacker's page: it sends what a browser sends without asking (no-cors requests and
 #: a WebSocket handshake) and says how each went.

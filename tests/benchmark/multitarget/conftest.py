@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.benchmark.multitarget._helpers import META_FACTORIES, three_targets
+from tests.support.multitarget import META_FACTORIES, three_targets
 
 
 @pytest.fixture

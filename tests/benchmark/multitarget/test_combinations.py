@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.benchmark.multitarget._helpers import logistic, three_targets, tree
+from tests.support.multitarget import logistic, three_targets, tree
 from touchbench.benchmark.multitarget import (
     EnsemblePrunedSets,
     LabelCombination,

@@ -11,7 +11,7 @@ from sklearn.base import clone
 from sklearn.exceptions import NotFittedError
 from sklearn.utils.estimator_checks import check_estimator
 
-from tests.benchmark.multitarget._helpers import META_FACTORIES, logistic, three_targets, tree
+from tests.support.multitarget import META_FACTORIES, logistic, three_targets, tree
 from touchbench.benchmark.errors import ConfigurationError
 
 #: Checks of ``check_estimator`` that assume single-output classifiers.  Multi-target

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from sklearn.base import clone
 
-from tests.benchmark.multitarget._helpers import logistic
+from tests.support.multitarget import logistic
 from touchbench.benchmark.errors import ConfigurationError
 from touchbench.benchmark.multitarget import MultiLabelAdapter
 from touchbench.benchmark.multitarget.multilabel import (

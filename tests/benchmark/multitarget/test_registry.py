@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from sklearn.base import clone
 
-from tests.benchmark.multitarget._helpers import three_targets
+from tests.support.multitarget import three_targets
 from touchbench.benchmark.catalogue import CATALOGUE
 from touchbench.benchmark.errors import ConfigurationError
 from touchbench.benchmark.multitarget import (

@@ -9,7 +9,7 @@ from sklearn.impute import SimpleImputer
 from sklearn.pipeline import make_pipeline
 from sklearn.svm import SVC
 
-from tests.benchmark.multitarget._helpers import META_FACTORIES, logistic, three_targets
+from tests.support.multitarget import META_FACTORIES, logistic, three_targets
 from touchbench.benchmark.multitarget import (
     ClassRelevance,
     LabelCombination,
