@@ -19,6 +19,22 @@ full, and raced (``--race``, alpha 0.01).  Printed per data set:
 
 The data are ``../shared/datasets/uc3m-touch`` (see its README); without them the script
 says so and stops.
+
+Side by side with older code (issue 35: ensembles from fold predictions), ``--against
+WORKTREE`` runs, per data set and alternating, the older code's full run, then this code's
+full run, ``--race`` and ``--ensemble N``, each in a process of its own (the older code
+imported from WORKTREE, as ``benchmark`` before the one package, else ``touchbench``), and
+prints one Markdown row per data set for ``docs/racing.md``: wall ratios against the older
+full run, winners, how far the redefined ensembles' scores moved, whether the race kept every
+entry the full run does not mark significantly worse than its winner, and the selection's
+score against the best single entry and its cost against this code's full run::
+
+    git -C /work/main worktree add /work/wt/beb0232 beb0232
+    .venv/bin/python perf/racing.py --against /work/wt/beb0232 --tasks gesture \
+        [--rounds 2] [--ensemble 5] [--quick]
+
+``--quick`` (a busy machine: the script works, the figures are not final): the fast suite
+with ``voting`` and ``voting-hard``, 3 folds, 600 instances of each data set.
 """
 
 from __future__ import annotations
@@ -189,6 +205,17 @@ def main() -> int:
         "--dask", action="store_true", help="on a local Dask cluster of --jobs workers"
     )
     parser.add_argument(
+        "--against",
+        metavar="WORKTREE",
+        default=None,
+        help="side by side with the code of this worktree (issue 35's measurement)",
+    )
+    parser.add_argument("--ensemble", type=int, default=5, help="with --against: N")
+    parser.add_argument("--rounds", type=int, default=1, help="with --against: passes")
+    parser.add_argument("--quick", action="store_true", help="with --against: a quick check")
+    parser.add_argument("--keep", metavar="FILE", help="with --against: append each run's JSON")
+    parser.add_argument("--child", default=None, help=argparse.SUPPRESS)
+    parser.add_argument(
         "--save",
         metavar="FILE",
         default=None,
@@ -198,6 +225,10 @@ def main() -> int:
     if not args.regression and not DATASETS.is_dir():
         print(f"skipped: {DATASETS} is absent (the shared reference data sets)")
         return 0
+    if args.child:
+        return child(args)
+    if args.against:
+        return side_by_side(args)
     if args.dask:
         from distributed import LocalCluster
 
@@ -329,6 +360,199 @@ def main() -> int:
                 f"  budget {budget:.1f} s ({args.budget_fraction:g} x full): ended after "
                 f"{cut_wall:.1f} s, {len(cut)}/{len(full)} tasks, {len(cuts)} entries cut, "
                 f"full top 5 with every fold: {len(whole)}/5"
+            )
+    return 0
+
+
+#: Rows of ``--quick``: a subset of each data set, every k-th row.
+QUICK_ROWS = 600
+#: Added to ``--quick``'s fast suite.
+QUICK_ENSEMBLES = ("voting", "voting-hard")
+
+
+def child(args: argparse.Namespace) -> int:
+    """One measured run in this process, with whatever code ``PYTHONPATH`` names; prints
+    one JSON line: wall seconds, tasks, the leaderboard's rows (mean, mark against the
+    winner, origin), drops and the selection's weights."""
+    import importlib
+    import json
+
+    package = os.environ["RACING_PACKAGE"]  # "benchmark" (older code) or "touchbench.benchmark"
+    engine = importlib.import_module(f"{package}.run.engine")
+    folds_module = importlib.import_module(f"{package}.run.folds")
+    leaderboard = importlib.import_module(f"{package}.evaluation.leaderboard")
+    catalogue = importlib.import_module(f"{package}.catalogue")
+    estimators = importlib.import_module(f"{package}.estimators")
+    io = importlib.import_module(f"{package}.io.arff")
+    robot, task, mode = args.child.split(":")
+    data = io.read_arff(DATASETS / robot / "gesture_and_place.arff")
+    names = list(data.schema.target_names)
+    target = data.schema.target_indices[names.index(task)]
+    features = [i for i in range(data.schema.n_attributes) if i not in data.schema.target_indices]
+    rows = np.arange(data.values.shape[0])
+    if args.quick:
+        rows = rows[:: max(1, rows.size // QUICK_ROWS)][:QUICK_ROWS]
+    problem = engine.Problem(
+        X=data.values[np.ix_(rows, features)],
+        Y=data.values[rows][:, [target]].astype(np.int64),
+        n_classes=(len(data.schema.targets[names.index(task)].values),),
+        target_names=(task,),
+    )
+    suite_name = "fast" if args.quick else args.suite
+    ids = [i for i in catalogue.suite(suite_name) if not estimators.reads_sequences(i)]
+    if args.quick:  # the ensembles the issue redefines, whose cost and scores it measures
+        ids += [i for i in QUICK_ENSEMBLES if i not in ids]
+    folds = folds_module.make_folds(
+        problem.Y, n_folds=3 if args.quick else args.folds, seed=args.seed, target_names=(task,)
+    )[0]
+    options: dict[str, Any] = {}
+    if mode == "race":
+        options["race"] = engine.RaceRule("f1_weighted", args.alpha)
+    elif mode == "ensemble":
+        options["ensemble"] = args.ensemble
+    drops: list[Any] = []
+    start = time.perf_counter()
+    results = engine.run_tasks(
+        problem,
+        ids,
+        folds,
+        jobs=args.jobs,
+        timeout=TIMEOUT,
+        random_state=args.seed,
+        on_drop=drops.append,
+        **options,
+    )
+    wall = time.perf_counter() - start
+    board = leaderboard.build_leaderboard(
+        results, metric="f1_weighted", drops={d.classifier: d for d in drops}
+    )
+    weights = [r.params for r in results if r.key.classifier.startswith("ensemble-") and r.params]
+    # entries computed from fold predictions (this code; the older code fitted them all)
+    plan_run = getattr(engine, "plan_run", None)
+    computed = (
+        list(plan_run(problem, ids, ensemble=options.get("ensemble")).derived)
+        if plan_run is not None
+        else []
+    )
+    print(
+        json.dumps(
+            {
+                "wall": wall,
+                "tasks": len(results),
+                "failed": sum(1 for r in results if not r.ok),
+                "error": next((r.error for r in results if not r.ok), None),
+                "entries": len(ids),
+                "rows": [
+                    {
+                        "classifier": row.classifier,
+                        "mean": row.metrics.get("f1_weighted", (math.nan,))[0],
+                        "mark": row.mark,
+                        "dropped": row.dropped is not None,
+                    }
+                    for row in board.rows
+                ],
+                "weights": weights,
+                "computed": computed,
+            },
+            default=str,
+        )
+    )
+    return 0
+
+
+def _measure(args: argparse.Namespace, code: str, package: str, job: str) -> dict[str, Any]:
+    """A child run (``job`` = ROBOT:TASK:MODE) of the code in folder ``code``."""
+    import json
+    import subprocess
+
+    command = [sys.executable, __file__, "--child", job, "--jobs", str(args.jobs)]
+    command += ["--folds", str(args.folds), "--seed", str(args.seed), "--suite", args.suite]
+    command += ["--alpha", str(args.alpha), "--ensemble", str(args.ensemble)]
+    command += ["--quick"] if args.quick else []
+    environment = {
+        **os.environ,
+        "PYTHONPATH": code,
+        "RACING_PACKAGE": package,
+        "TOUCHBENCH_DATASETS": str(DATASETS.parent),
+    }
+    # in the code's folder: worker processes put their working directory on the path, and
+    # another worktree's top-level packages there would shadow the code measured
+    done = subprocess.run(
+        command, env=environment, capture_output=True, text=True, check=False, cwd=code
+    )
+    if done.returncode != 0:
+        raise SystemExit(f"{job} with {code} failed:\n{done.stderr[-3000:]}")
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def side_by_side(args: argparse.Namespace) -> int:
+    """Issue 35's table: the older code's full run against this code's full, raced and
+    selecting runs, alternating, per data set (one Markdown row each)."""
+    import json
+
+    older = str(Path(args.against).resolve())
+    package = "touchbench.benchmark" if (Path(older) / "touchbench").is_dir() else "benchmark"
+    here = str(Path(__file__).resolve().parents[1])
+    header = (
+        "| data | older full s | full s (ratio) | race s (ratio) | ensemble s (/ full) "
+        "| winner older / full / race | redefined ensembles moved | race kept the not-worse "
+        f"| ensemble-{args.ensemble} vs best single |"
+    )
+    print(header)
+    print("|" + "---|" * header.count(" | ") + "---|")
+    for robot in args.robots.split(","):
+        for task in args.tasks.split(","):
+            if "+" in task:
+                continue  # the selection and the votes are multi-class: one target
+            walls: dict[str, list[float]] = {}
+            last: dict[str, dict[str, Any]] = {}
+            order = [
+                ("older", older, package, "full"),
+                ("full", here, "touchbench.benchmark", "full"),
+                ("race", here, "touchbench.benchmark", "race"),
+                ("ensemble", here, "touchbench.benchmark", "ensemble"),
+            ]
+            for round_ in range(args.rounds):
+                for name, code, pkg, mode in order if round_ % 2 == 0 else order[::-1]:
+                    found = _measure(args, code, pkg, f"{robot}:{task}:{mode}")
+                    walls.setdefault(name, []).append(found["wall"])
+                    if args.keep:
+                        with open(args.keep, "a") as kept:
+                            kept.write(json.dumps({"run": f"{robot}:{task}:{name}", **found}))
+                            kept.write("\n")
+                    last[name] = found
+                    print(
+                        f"  {robot} {task} {name}: {found['wall']:.1f} s, {found['tasks']} tasks, "
+                        f"{found['failed']} failed {found['error'] or ''}",
+                        file=sys.stderr,
+                    )
+                    if found["failed"] == found["tasks"]:
+                        raise SystemExit(f"every task of {name} failed: {found['error']}")
+            wall = {name: float(np.median(values)) for name, values in walls.items()}
+            means = {n: {r["classifier"]: r for r in found["rows"]} for n, found in last.items()}
+            winners = {n: found["rows"][0]["classifier"] for n, found in last.items()}
+            moved = [
+                f"{c} {means['full'][c]['mean'] - means['older'][c]['mean']:+.4f}"
+                for c in last["full"]["computed"]
+                if c in means["older"]
+            ]
+            not_worse = [c for c, row in means["full"].items() if row["mark"] != "*"]
+            lost = [c for c in not_worse if means["race"].get(c, {}).get("dropped", True)]
+            selection = f"ensemble-{args.ensemble}"
+            chosen = means["ensemble"].get(selection, {}).get("mean", math.nan)
+            single = max(
+                (r["mean"] for c, r in means["ensemble"].items() if c != selection),
+                default=math.nan,
+            )
+            print(
+                f"| {robot} {task} | {wall['older']:.1f} "
+                f"| {wall['full']:.1f} ({wall['full'] / wall['older']:.2f}) "
+                f"| {wall['race']:.1f} ({wall['race'] / wall['older']:.2f}) "
+                f"| {wall['ensemble']:.1f} ({wall['ensemble'] / wall['full']:.2f}) "
+                f"| {winners['older']} / {winners['full']} / {winners['race']} "
+                f"| {', '.join(moved) or 'none'} "
+                f"| {'yes' if not lost else 'no: ' + ', '.join(lost)} "
+                f"| {chosen:.4f} vs {single:.4f} ({'>=' if chosen >= 0.88 else '<'} 0.88) |"
             )
     return 0
 

@@ -142,6 +142,7 @@ def classifiers_command(
                         "onnx": exports_onnx(s),
                         "extras": [extra.name for extra in extras_of(s.requires)],
                         "installed": s.installed,
+                        "members": [member.id for member in s.members],
                     }
                     for s in specs
                 ],
@@ -185,6 +186,10 @@ def classifiers_command(
         ],
         whole=("extra",),
     )
+    for s in specs:
+        if s.members:  # an ensemble: what it is made of, and how a run comes by its folds
+            how = "in a multi-class run: from its members' fold predictions"
+            info(escape(f"{s.id}: {s.description} ({how})"))
     absent = list(dict.fromkeys(e for s in specs if not s.installed for e in extras_of(s.requires)))
     for extra in absent:
         info(escape(f"entries whose extra is marked ✗ are not installed: {extra.install}"))
@@ -441,6 +446,22 @@ def bench_command(
                 "classifiers of the run best by a 3-fold inner CV, stacked by logistic "
                 "regression. Costs about 2 fits of every classifier of the run (each at its "
                 "own cost, a tuned twin with its search) plus N refits, per outer fold."
+            ),
+            show_default=False,
+        ),
+    ] = None,
+    ensemble: Annotated[
+        int | None,
+        typer.Option(
+            "--ensemble",
+            metavar="N",
+            help=(
+                "Add ensemble-N (1 <= N <= 100, one target): in each outer training fold, N "
+                "rounds of Caruana's greedy ensemble selection with replacement over the "
+                "run's entries, chosen on their out-of-fold predictions of 3 inner folds of "
+                "that training fold (never its test fold); the weights are shown. Computed "
+                "from fold predictions: costs about 3 more fits of every entry per outer "
+                "fold, shared with --stack."
             ),
             show_default=False,
         ),

@@ -61,8 +61,9 @@ def leaderboard_rows(
 
 
 def row_note(row: LeaderboardRow) -> str:
-    """Why a row stopped early and what failed, in one line; empty when neither."""
-    parts = []
+    """How the run came by a row (``from fold predictions of ...``, ``helper of ...``), why
+    it stopped early and what failed, in one line; empty when none of these."""
+    parts = [row.origin.describe()] if row.origin is not None else []
     if row.dropped is not None and row.dropped.reason == "not started":
         parts.append(row.dropped.describe())
     elif row.dropped is not None:
@@ -73,7 +74,9 @@ def row_note(row: LeaderboardRow) -> str:
 
 
 def _has_notes(board: Leaderboard) -> bool:
-    return any(row.n_failed or row.dropped is not None for row in board.rows)
+    return any(
+        row.n_failed or row.dropped is not None or row.origin is not None for row in board.rows
+    )
 
 
 def leaderboard_csv(
@@ -136,7 +139,7 @@ def leaderboard_markdown(
     for row, board_row in zip(leaderboard_rows(board, columns, besides), board.rows, strict=True):
         cells = [str(cell) for cell in row[: lead + len(columns)]]
         note = row_note(board_row)
-        if note and board_row.dropped is not None:
+        if note and (board_row.dropped is not None or board_row.origin is not None):
             cells[1] = f"{cells[1]} ({note})"
         lines.append("| " + " | ".join(cells) + " |")
     v, same, worse = board.summary

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Literal
 
+from pydantic import Field
+
 from touchbench.app.schemas.base import Schema
 
 if TYPE_CHECKING:  # the test's module loads SciPy's distributions: not for a schema
@@ -17,6 +19,11 @@ class ClassifierRank(Schema):
     average_rank: float
     mean_score: float | None
     scores: dict[str, float | None]
+    origin: str | None = Field(
+        default=None,
+        description="Set when a run computed it from fold predictions (or fitted it as a "
+        "helper): `from fold predictions of xgb, hgb (run 3)`.",
+    )
 
 
 class FriedmanOut(Schema):

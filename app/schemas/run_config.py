@@ -57,6 +57,17 @@ class ImportedScheme(_Stored):
     version: str = ""
 
 
+class OriginConfig(_Stored):
+    """How a run comes by an entry's folds when not by fitting an entry it asked for
+    (:class:`benchmark.results.Origin`)."""
+
+    kind: Literal["from fold predictions", "helper"] = Field(
+        description="`from fold predictions`: computed from its members' fold predictions; "
+        "`helper`: a member the run did not ask for, fitted once per fold for its ensembles."
+    )
+    entries: list[str] = Field(description="Its members, or the entries it serves.")
+
+
 class ExtraSpecsConfig(_Stored):
     """What a run adds to the catalogue: enough to build its extra classifier specs again
     (:func:`app.services.tuning.run_specs`)."""
@@ -66,6 +77,9 @@ class ExtraSpecsConfig(_Stored):
     )
     tune: TuneConfig | None = Field(default=None, description="Set when tuned twins were added.")
     stack: int | None = Field(default=None, description="TOP_N of the stack added, if any.")
+    ensemble: int | None = Field(
+        default=None, description="Rounds of the ensemble selection added (ensemble-N), if any."
+    )
 
 
 class RunConfig(ExtraSpecsConfig):
@@ -107,8 +121,18 @@ class RunConfig(ExtraSpecsConfig):
     fold_scheme: str | None = None
     n_tasks: int = 0
 
-    # Its classifiers (with ``weka``, ``tune`` and ``stack``).
+    # Its classifiers (with ``weka``, ``tune``, ``stack`` and ``ensemble``).
     suite: str | None = None
+    helpers: list[str] = Field(
+        default_factory=list,
+        description="Members of its ensembles that it did not ask for, fitted for them "
+        "(their tasks count in `n_tasks`).",
+    )
+    origins: dict[str, OriginConfig] = Field(
+        default_factory=dict,
+        description="Its entries computed from fold predictions and its helpers, as planned "
+        "(absent in runs of older versions, whose ensembles were fitted).",
+    )
 
     # How its leaderboard ranks, and what stops its entries early.
     metric: str | None = None
@@ -150,6 +174,11 @@ class RunConfig(ExtraSpecsConfig):
     def by_recording(self) -> bool:
         """Whether the run scores each recording's windows as one prediction."""
         return self.aggregate == "recording"
+
+    def tasks_per_entry(self, n_classifiers: int) -> int:
+        """Tasks of each entry of a run with ``n_classifiers`` classifiers (its helpers
+        have as many)."""
+        return self.n_tasks // max(n_classifiers + len(self.helpers), 1)
 
     @property
     def asked_folds(self) -> int | None:

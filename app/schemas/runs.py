@@ -34,7 +34,10 @@ class RunSchema(Schema):
     started_at: datetime | None = None
     finished_at: datetime | None = None
     tasks_done: int = Field(description="Tasks with a result (failed ones included).")
-    tasks: int = Field(description="Tasks in all: classifiers x folds x repeats.")
+    tasks: int = Field(
+        description="Tasks in all: (classifiers and the helpers of their ensembles) x folds "
+        "x repeats."
+    )
     tasks_failed: int = 0
     tasks_dropped: int = Field(
         default=0,
@@ -83,6 +86,14 @@ class DropSchema(Schema):
     note: str = Field(description="`dropped after fold k (...)`, as every view says it.")
 
 
+class OriginSchema(Schema):
+    """How a run came by an entry's folds, when not by fitting an entry it asked for."""
+
+    kind: Literal["from fold predictions", "helper"]
+    entries: list[str] = Field(description="Its members, or the entries it serves.")
+    note: str = Field(description="`from fold predictions of xgb, hgb`, as every view says it.")
+
+
 class LeaderboardRowSchema(Schema):
     """One classifier's line; ``metrics.per_target`` holds a multi-target row's scores per
     target (target -> metric -> mean/std)."""
@@ -107,6 +118,11 @@ class LeaderboardRowSchema(Schema):
     )
     dropped: DropSchema | None = Field(
         default=None, description="Set when the classifier stopped before its last fold."
+    )
+    origin: OriginSchema | None = Field(
+        default=None,
+        description="Set when the run computed the entry from its members' fold predictions "
+        "(`from fold predictions`) or fitted it only as a member of those (`helper`).",
     )
 
 
@@ -139,7 +155,8 @@ class MarkSummary(Schema):
 
 
 class FoldChoiceSchema(Schema):
-    """What a tuned twin or a stack chose on one outer training fold."""
+    """What a tuned twin, a stack or an ensemble selection (its weights) chose on one outer
+    training fold."""
 
     classifier: str
     repeat: int
@@ -272,6 +289,7 @@ _NOT_INDEPENDENT = {
     "tune": "compares each target's plain classifiers",
     "budget": "compares each target's plain classifiers",
     "stack": "compares each target's plain classifiers",
+    "ensemble": "compares each target's plain classifiers",
     "metric": "picks each target's best classifier by weighted F1",
     "baseline": "picks each target's best classifier by weighted F1",
     "race": "runs each target's classifiers to the end",
@@ -421,6 +439,15 @@ class BenchRequest(Request):
         le=20,
         description="Add stack-topN: in each outer training fold the run's N best "
         "classifiers by inner cross-validation, stacked by logistic regression (one target).",
+    )
+    ensemble: int | None = Field(
+        default=None,
+        ge=1,
+        le=100,
+        description="Add ensemble-N: in each outer training fold, N rounds of Caruana's "
+        "greedy ensemble selection (with replacement) over the run's entries, chosen on "
+        "their inner out-of-fold predictions of that training fold, computed from fold "
+        "predictions (one nominal target).",
     )
     independent: bool = Field(
         default=False,

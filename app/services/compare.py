@@ -49,7 +49,7 @@ from touchbench.benchmark.evaluation.score_table import (
     fold_score_table,
 )
 from touchbench.benchmark.evaluation.statistics import RankComparison, compare_classifiers
-from touchbench.benchmark.results import TaskResult
+from touchbench.benchmark.results import Origin, TaskResult
 
 BlockKind = Literal["datasets", "folds"]
 
@@ -120,6 +120,9 @@ class Comparison:
     pair : PairComparison or None
     notes : list of str
         What a reader should know (unfinished runs, folds as blocks...).
+    origins : dict of str to str
+        Classifiers some run computed from fold predictions (or fitted as helpers), and
+        how (:func:`entry_origins`).
     """
 
     runs: list[RunScores]
@@ -132,6 +135,7 @@ class Comparison:
     not_shared: list[str] = field(default_factory=list)
     pair: PairComparison | None = None
     notes: list[str] = field(default_factory=list)
+    origins: dict[str, str] = field(default_factory=dict)
 
 
 def default_metric(kinds: Sequence[str]) -> str:
@@ -268,6 +272,8 @@ def compare_runs(
             "the post-hoc tests (Nemenyi, Holm) as significant"
         )
     bayes = _pair(scores, shared, pair, rope, lower, notes) if pair else None
+    origins = entry_origins(runs, shared)
+    notes += [f"{name}: {note}" for name, note in origins.items()]
     return Comparison(
         runs=scores,
         metric=metric,
@@ -279,7 +285,27 @@ def compare_runs(
         not_shared=not_shared,
         pair=bayes,
         notes=notes,
+        origins=origins,
     )
+
+
+def entry_origins(runs: Sequence[RunInfo], classifiers: Sequence[str]) -> dict[str, str]:
+    """How the runs came by the folds of those of ``classifiers`` that some run computed
+    from fold predictions or fitted as a helper: ``from fold predictions of xgb, hgb (run
+    3)``, by classifier."""
+    found: dict[str, dict[str, list[int]]] = {}
+    for run in runs:
+        for name, origin in run.config.origins.items():
+            if name in classifiers:
+                note = Origin(origin.kind, tuple(origin.entries)).describe()
+                found.setdefault(name, {}).setdefault(note, []).append(run.id)
+    return {
+        name: "; ".join(
+            f"{note} (run{'s' if len(ids) > 1 else ''} {', '.join(map(str, ids))})"
+            for note, ids in notes.items()
+        )
+        for name, notes in found.items()
+    }
 
 
 def with_besides(runs: Sequence[RunInfo]) -> tuple[list[RunInfo], dict[int, list[RunInfo]]]:
@@ -400,6 +426,7 @@ def comparison_schema(comparison: Comparison) -> ComparisonOut:
                 classifier=name,
                 average_rank=float(rank),
                 mean_score=finite(float(mean)),
+                origin=comparison.origins.get(name),
                 scores={
                     block: finite(float(value))
                     for block, value in zip(table.blocks, table.column(name), strict=True)

@@ -1,4 +1,5 @@
-"""A run's tuned twins (its request's ``tune``) and stack (``stack``): which ids they add,
+"""A run's tuned twins (its request's ``tune``), stack (``stack``) and ensemble selection
+(``ensemble``): which ids they add,
 and the specs the engine needs to build them again from the run's stored config.
 """
 
@@ -69,16 +70,18 @@ def run_specs(config: ExtraSpecsConfig, classifiers: Sequence[str]) -> dict[str,
     ----------
     config : ExtraSpecsConfig
         What the run adds (its stored config, a :class:`app.schemas.run_config.RunConfig`):
-        ``weka`` (id -> WEKA command), ``tune`` and ``stack``.
+        ``weka`` (id -> WEKA command), ``tune``, ``stack`` and ``ensemble``.
     classifiers : sequence of str
-        The run's classifier ids.
+        The run's classifier ids (its stack and ensemble selection among them).
 
     The specs the caller brought (:mod:`app.services.own_specs`) are among them.
     """
     from touchbench.benchmark.catalogue import parse_weka_command
+    from touchbench.benchmark.catalogue.ensembles import selection_id, selection_spec
     from touchbench.benchmark.catalogue.stacking import stack_id, stacked_spec
     from touchbench.benchmark.catalogue.tuning import TUNED_SUFFIX, is_tuned_id, tuned_spec
     from touchbench.benchmark.estimators import classifier_spec
+    from touchbench.benchmark.run.members import VOTES
 
     specs: dict[str, ClassifierSpec] = dict(own_specs())
     for text in config.weka.values():
@@ -92,12 +95,36 @@ def run_specs(config: ExtraSpecsConfig, classifiers: Sequence[str]) -> dict[str,
             if is_tuned_id(base):
                 untuned = classifier_spec(base.removesuffix(TUNED_SUFFIX), specs)
                 specs[base] = tuned_spec(untuned, tune.budget_minutes)
+    added = {selection_id(config.ensemble)} if config.ensemble is not None else set()
     top_n = config.stack
     if top_n:
-        name = stack_id(top_n)
-        members = [classifier_spec(c, specs) for c in classifiers if c != name]
-        specs[name] = stacked_spec(members, top_n)
+        added.add(stack_id(top_n))
+    # the stack and the selection choose among the run's other entries, never each other:
+    # neither has inner predictions to be chosen by (the engine leaves them out too)
+    members = [classifier_spec(c, specs) for c in classifiers if c not in added] if added else []
+    if top_n:
+        specs[stack_id(top_n)] = stacked_spec(members, top_n)
+    if config.ensemble is not None:
+        candidates = [m for m in members if m.combine is None or m.combine in VOTES]
+        specs[selection_id(config.ensemble)] = selection_spec(candidates, config.ensemble)
     return specs
+
+
+def add_selection(ids: Sequence[str], rounds: int, *, kind: str) -> list[str]:
+    """``ids`` and the ensemble selection of ``rounds`` rounds over them (``ensemble-N``).
+
+    Raises
+    ------
+    FieldError
+        For ``ensemble``: a run that is not multi-class.
+    """
+    from touchbench.benchmark.catalogue.ensembles import selection_id
+
+    if kind != "multiclass":
+        raise FieldError(
+            "ensemble", "selects among multi-class classifiers: pick one nominal `target`"
+        )
+    return [*ids, selection_id(rounds)]
 
 
 def add_stack(ids: Sequence[str], top_n: int, *, multitarget: bool) -> list[str]:

@@ -12,9 +12,10 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
-from sqlalchemy import select
+from sqlalchemy import delete, select
 from sqlalchemy.dialects.postgresql import insert as postgresql_insert
 from sqlalchemy.dialects.sqlite import insert as sqlite_insert
+from sqlalchemy.orm import Session
 
 from touchbench.app.store.database import Store
 from touchbench.app.store.tables import FoldPredictionsRow
@@ -28,6 +29,13 @@ PARTS = {"test": "predictions", "inner": "inner_predictions"}
 def record_predictions(store: Store, run_id: int, result: TaskResult) -> None:
     """Write a finished task's fold predictions (nothing for a task without them); parts
     already recorded for the task are left as they are."""
+    with store.session() as session:
+        insert_predictions(session, run_id, result)
+
+
+def insert_predictions(session: Session, run_id: int, result: TaskResult) -> None:
+    """:func:`record_predictions` inside the caller's transaction (with the task's result,
+    so that a run killed between the two never keeps one without the other)."""
     rows = [
         {
             "run_id": run_id,
@@ -42,14 +50,13 @@ def record_predictions(store: Store, run_id: int, result: TaskResult) -> None:
     ]
     if not rows:
         return
-    with store.session() as session:
-        dialect = session.bind.dialect.name if session.bind is not None else ""
-        statement: Any
-        if dialect == "postgresql":
-            statement = postgresql_insert(FoldPredictionsRow).on_conflict_do_nothing()
-        else:
-            statement = sqlite_insert(FoldPredictionsRow).on_conflict_do_nothing()
-        session.execute(statement, rows)
+    dialect = session.bind.dialect.name if session.bind is not None else ""
+    statement: Any
+    if dialect == "postgresql":
+        statement = postgresql_insert(FoldPredictionsRow).on_conflict_do_nothing()
+    else:
+        statement = sqlite_insert(FoldPredictionsRow).on_conflict_do_nothing()
+    session.execute(statement, rows)
 
 
 def load_predictions(
@@ -81,3 +88,15 @@ def attach_predictions(store: Store, run_id: int, results: Sequence[TaskResult])
         for result in results:
             if result.key in stored:
                 setattr(result, attribute, stored[result.key])
+
+
+def forget_inner_predictions(store: Store, run_id: int) -> None:
+    """Delete a run's inner predictions once every entry made of them is computed (a
+    finished run): they are about as large as the training folds, and only a stack or a
+    selection still to compute reads them; the test folds' stay."""
+    with store.session() as session:
+        session.execute(
+            delete(FoldPredictionsRow).where(
+                FoldPredictionsRow.run_id == run_id, FoldPredictionsRow.part == "inner"
+            )
+        )

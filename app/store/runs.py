@@ -32,6 +32,7 @@ from touchbench.app.store.database import Store
 from touchbench.app.store.naming import is_row_id
 from touchbench.app.store.ownership import aware, mark_lost, owner_alive, process_owner
 from touchbench.app.store.paging import count_rows, paged
+from touchbench.app.store.predictions import insert_predictions
 from touchbench.app.store.states import LOST_AS, check_claim, check_resume, is_active
 from touchbench.app.store.tables import DatasetRow, EntryDropRow, FoldResultRow, RunRow, utcnow
 from touchbench.benchmark.results import TaskKey, TaskResult
@@ -395,7 +396,8 @@ def mark_lost_runs(store: Store) -> list[int]:
 
 
 def record_result(store: Store, run_id: int, result: TaskResult) -> None:
-    """Write one finished task; a task already recorded for the run is left as it is."""
+    """Write one finished task with its fold predictions, in one transaction; a task
+    already recorded for the run is left as it is."""
     values = {
         "run_id": run_id,
         "classifier": result.key.classifier,
@@ -421,6 +423,7 @@ def record_result(store: Store, run_id: int, result: TaskResult) -> None:
                 return
             statement = insert(FoldResultRow)
         session.execute(statement, [values])
+        insert_predictions(session, run_id, result)
 
 
 def finished_keys(store: Store, run_id: int) -> set[TaskKey]:
@@ -569,5 +572,5 @@ def _infos(session: Session, rows: Sequence[RunRow]) -> list[RunInfo]:
 
 def _skipped(row: RunRow, config: RunConfig, folds_run: Sequence[int]) -> int:
     """Tasks a run's dropped entries will not run: each entry's folds after its last."""
-    per_entry = config.n_tasks // max(len(row.classifiers), 1)
+    per_entry = config.tasks_per_entry(len(row.classifiers))
     return sum(max(per_entry - folds, 0) for folds in folds_run)

@@ -17,12 +17,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 from sklearn.base import BaseEstimator, ClassifierMixin
-from sklearn.ensemble import VotingClassifier
 from sklearn.naive_bayes import GaussianNB
-from sklearn.preprocessing import LabelEncoder
 from threadpoolctl import threadpool_limits
 
-from tests.support.ensembles import resumable, small_problem, stand_in, vote
+from tests.support.ensembles import prefit_vote, resumable, small_problem, stand_in, vote
 from touchbench.benchmark.catalogue import ClassifierSpec, get_spec
 from touchbench.benchmark.catalogue.ensembles import selection_spec
 from touchbench.benchmark.catalogue.stacking import stacked_spec
@@ -105,14 +103,8 @@ def test_a_vote_from_fold_predictions_is_the_voting_classifier_of_the_same_fitte
     X, y = problem.X, problem.Y[:, 0]
     with threadpool_limits(limits=1):  # as in the engine's workers
         for fold in folds:
-            fitted = [
-                (m.id, build_estimator(m.id, problem).fit(X[fold.train], y[fold.train]))
-                for m in spec.members
-            ]
-            combined = VotingClassifier(fitted, voting=spec.combine)  # type: ignore[arg-type]
-            combined.estimators_ = [model for _, model in fitted]
-            combined.le_ = LabelEncoder().fit(y[fold.train])
-            combined.classes_ = combined.le_.classes_
+            combined = prefit_vote(spec, problem, fold)
+            fitted = combined.estimators
             refitted = build_estimator(entry, problem).fit(X[fold.train], y[fold.train])
             ours = results[TaskKey(entry, 0, fold.fold)]
             assert ours.ok and ours.predictions is not None

@@ -1,5 +1,7 @@
 """Stand-in catalogue entries for the ensemble tests: slow or counting members, votes
-over them, and a small problem whose run can be resumed."""
+over them, and a small problem whose run can be resumed; and a scikit-learn
+VotingClassifier of members fitted once, not refitted (what a vote computed from its
+members' fold predictions must predict, to the last bit)."""
 
 from __future__ import annotations
 
@@ -7,12 +9,16 @@ import time
 from dataclasses import replace
 
 import numpy as np
+from sklearn.ensemble import VotingClassifier
 from sklearn.naive_bayes import GaussianNB
+from sklearn.preprocessing import LabelEncoder
 
 from touchbench.benchmark.catalogue import ClassifierSpec, get_spec
 from touchbench.benchmark.catalogue.spec import Ensemble
 from touchbench.benchmark.catalogue.stacking import stacked_spec
+from touchbench.benchmark.estimators import build_estimator
 from touchbench.benchmark.run.engine import Problem
+from touchbench.benchmark.run.folds import Fold
 
 
 def small_problem(n: int = 150, seed: int = 0) -> Problem:
@@ -67,3 +73,16 @@ def vote(classifier_id: str, combine: str, *members: ClassifierSpec) -> Classifi
         probabilities=combine == "soft",
         ensemble=Ensemble(tuple(members), combine),  # type: ignore[arg-type]
     )
+
+
+def prefit_vote(spec: ClassifierSpec, problem: Problem, fold: Fold) -> VotingClassifier:
+    """``spec``'s vote (soft or hard) of its members, each fitted on ``fold``'s training
+    rows as the engine fits it; call under ``threadpool_limits(limits=1)`` as its workers
+    run."""
+    X, y = problem.X[fold.train], problem.Y[fold.train, 0]
+    fitted = [(m.id, build_estimator(m.id, problem).fit(X, y)) for m in spec.members]
+    vote = VotingClassifier(fitted, voting=spec.combine)  # type: ignore[arg-type]
+    vote.estimators_ = [model for _, model in fitted]
+    vote.le_ = LabelEncoder().fit(y)
+    vote.classes_ = vote.le_.classes_
+    return vote

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import subprocess
+import time
+
 import pytest
 from sqlalchemy import create_engine, text
 
@@ -21,3 +24,27 @@ def count_rows(url: str, table: str) -> int:
 def stored_names(capsys: pytest.CaptureFixture[str], store_url: str) -> list[str]:
     listing = run_cli(capsys, store_url, "datasets", "--json").json()
     return [d["name"] for d in listing["datasets"]]
+
+
+def count_of(url: str, sql: str) -> int:
+    """The count a ``SELECT count(*) ...`` finds in the store at ``url``; 0 while its
+    tables do not exist yet (a run's process still creating them)."""
+    engine = create_engine(url.replace("postgresql://", "postgresql+psycopg://", 1))
+    try:
+        with engine.connect() as connection:
+            return int(connection.execute(text(sql)).scalar() or 0)
+    except Exception:
+        return 0
+    finally:
+        engine.dispose()
+
+
+def wait_for_count(
+    url: str, sql: str, at_least: int, child: subprocess.Popen[bytes], deadline: float
+) -> None:
+    """Wait until :func:`count_of` ``sql`` reaches ``at_least`` while ``child`` (the process
+    writing the rows) lives, until ``deadline`` (``time.monotonic()``) at most."""
+    while count_of(url, sql) < at_least:
+        assert child.poll() is None, child.stderr.read().decode() if child.stderr else ""
+        assert time.monotonic() < deadline, f"fewer than {at_least} rows by the deadline: {sql}"
+        time.sleep(0.05)

@@ -22,6 +22,7 @@ from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import load_dataset
 from touchbench.app.store.drops import forget_budget_cuts, record_drop
 from touchbench.app.store.ownership import process_owner
+from touchbench.app.store.predictions import attach_predictions, forget_inner_predictions
 from touchbench.app.store.runs import (
     RunInfo,
     add_spent,
@@ -105,12 +106,17 @@ def execute_run(
         )
         folds = fold_plan(prepared, options).folds
         race = race_rule(run)
-        # a race replays its decisions from the stored scores; a plain run needs their keys
-        previous = load_results(store, run.id) if race is not None else []
-        done = {r.key for r in previous} if race is not None else finished_keys(store, run.id)
+        extra_specs = run_specs(run.config, run.classifiers)
+        # a race replays its decisions from the stored scores, and the ensembles computed
+        # from fold predictions read their members' stored ones; a plain run needs the keys
+        computes = bool(run.config.origins) or run.config.ensemble is not None
+        previous = load_results(store, run.id) if race is not None or computes else []
+        if computes:
+            attach_predictions(store, run.id, previous)
+        done = {r.key for r in previous} if previous else finished_keys(store, run.id)
         # tasks in all and done, for the caller's progress: a drop takes its entry's later
         # folds off the total
-        counts = [len(run.classifiers) * len(folds), len(done)]
+        counts = [(len(run.classifiers) + len(run.config.helpers)) * len(folds), len(done)]
         callbacks.on_plan(*counts)
         forget_budget_cuts(store, run.id)
         budget = budget_left(run)
@@ -156,12 +162,13 @@ def execute_run(
                 on_result=persist,
                 max_memory=max_memory,
                 stop=stop.is_set,
-                extra_specs=run_specs(run.config, run.classifiers),
+                extra_specs=extra_specs,
                 race=race,
                 budget=budget,
                 previous=previous,
                 on_drop=dropped,
                 by_recording=run.config.by_recording,
+                ensemble=run.config.ensemble,
             )
         except RunStopped:
             finish_run(store, run.id, Status.CANCELLED)
@@ -183,6 +190,7 @@ def execute_run(
         beat.stop()
     status, error_text = _outcome(load_results(store, run.id))
     finish_run(store, run.id, status, error=error_text)
+    forget_inner_predictions(store, run.id)  # every fold ran: nothing left reads them
     ended = get_run(store, run.id)
     callbacks.on_end(ended)
     return ended

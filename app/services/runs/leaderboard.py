@@ -30,7 +30,7 @@ from touchbench.app.store.database import Store
 from touchbench.app.store.drops import load_drops
 from touchbench.app.store.runs import RunInfo, get_run, load_results
 from touchbench.benchmark.errors import ConfigurationError
-from touchbench.benchmark.results import Drop, TaskResult
+from touchbench.benchmark.results import Drop, Origin, TaskResult
 
 if TYPE_CHECKING:  # scipy.stats (significance) loads when a leaderboard is first built
     from touchbench.benchmark.evaluation.leaderboard import Leaderboard
@@ -93,6 +93,17 @@ class RunLeaderboard:
         """What the leaderboard of a run scored per recording, raced, budgeted or stopped
         says under its table."""
         notes = [PER_RECORDING_NOTE] if self.per_recording else []
+        helpers = self.run.config.helpers
+        if helpers:
+            spent = sum(
+                r.metrics.get("fit_time", 0.0) + r.metrics.get("predict_time", 0.0)
+                for r in self.results
+                if r.ok and r.key.classifier in helpers
+            )
+            notes.append(
+                f"fitted only as members of ensembles: {', '.join(helpers)} "
+                f"({spent:.1f} s of fitting and predicting in all)"
+            )
         notes += [part.note for part in (self.race(), self.budget()) if part is not None]
         unstarted = [c for c, d in self.drops.items() if d.reason == "not started"]
         if unstarted:
@@ -124,7 +135,7 @@ class RunLeaderboard:
             return None
         cut = [c for c, d in self.drops.items() if d.reason == "budget"]
         raced_out = sum(
-            self.run.n_tasks // max(len(self.run.classifiers), 1) - d.after_fold
+            self.run.config.tasks_per_entry(len(self.run.classifiers)) - d.after_fold
             for d in self.drops.values()
             if d.reason == "race"
         )
@@ -227,8 +238,17 @@ def run_leaderboard(
         baseline=baseline or run.config.baseline,
         groups=groups if others else None,
         drops=drops,
+        origins=run_origins(run),
     )
     return RunLeaderboard(run, board, results, tuple(others), drops)
+
+
+def run_origins(run: RunInfo) -> dict[str, Origin]:
+    """How the run came by the folds of its computed entries and helpers, as planned."""
+    return {
+        entry: Origin(origin.kind, tuple(origin.entries))
+        for entry, origin in run.config.origins.items()
+    }
 
 
 PerTargetSummary = dict[str, dict[str, dict[str, tuple[float, float]]]]

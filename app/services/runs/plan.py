@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 from touchbench.app.errors import FieldError
 from touchbench.app.schemas.run_config import (
     ExtraSpecsConfig,
+    OriginConfig,
     RaceConfig,
     RunConfig,
     TuneConfig,
@@ -176,7 +177,8 @@ def create_run(
     FieldError
         A field the data set refuses: a target it lacks, a metric of the other kind of
         problem, ``tune``,
-        ``stack`` or ``weka`` on numeric targets, a stack on several targets, a baseline
+        ``stack``, ``ensemble`` or ``weka`` on numeric targets, a stack or an ensemble
+        selection on several targets, a baseline
         that is not one of the run's classifiers, impossible folds, ``independent``.
     NotFoundError
         An unknown data set.
@@ -222,7 +224,7 @@ def plan_run(store: Store, request: BenchRequest) -> Plan:
         except ConfigurationError as error:
             raise FieldError("metric", str(error)) from None
     numeric = problem.kind == "regression"
-    for name in ("weka", "tune", "stack"):
+    for name in ("weka", "tune", "stack", "ensemble"):
         if numeric and getattr(request, name):
             raise FieldError(name, "works on classification runs; the targets here are numeric")
     ids = list(dict.fromkeys(request.classifiers or ()))
@@ -234,7 +236,7 @@ def plan_run(store: Store, request: BenchRequest) -> Plan:
             regression_size=problem.n_instances if numeric else None,
         )
     ids = list(dict.fromkeys([*ids, *commands]))
-    extras = _extra_specs(commands, request.tune, request.budget, request.stack)
+    extras = _extra_specs(commands, request.tune, request.budget, request.stack, request.ensemble)
     if request.tune:
         from touchbench.app.services.tuning import with_tuned_twins
 
@@ -243,7 +245,18 @@ def plan_run(store: Store, request: BenchRequest) -> Plan:
         from touchbench.app.services.tuning import add_stack
 
         ids = add_stack(ids, request.stack, multitarget=problem.kind == "multitarget")
-    check_classifiers(problem, ids, run_specs(extras, ids), asked=request.classifiers or ())
+    if request.ensemble is not None:
+        from touchbench.app.services.tuning import add_selection
+
+        ids = add_selection(ids, request.ensemble, kind=problem.kind)
+    try:
+        specs = run_specs(extras, ids)
+        check_classifiers(problem, ids, specs, asked=request.classifiers or ())
+        helpers, origins = plan_entries(problem, ids, specs, request.ensemble)
+    except ConfigurationError as error:
+        if request.ensemble is not None and _about_selection(error):
+            raise FieldError("ensemble", str(error)) from None
+        raise
     if request.baseline is not None and request.baseline not in ids:
         raise FieldError(
             "baseline",
@@ -276,7 +289,10 @@ def plan_run(store: Store, request: BenchRequest) -> Plan:
         weka=extras.weka,
         tune=extras.tune,
         stack=extras.stack,
-        n_tasks=len(ids) * len(plan.folds),
+        ensemble=extras.ensemble,
+        helpers=helpers,
+        origins=origins,
+        n_tasks=(len(ids) + len(helpers)) * len(plan.folds),
         n_instances=int(problem.X.shape[0]),
         grouped=problem.groups is not None,
         fold_scheme=plan.scheme,
@@ -310,11 +326,48 @@ def store_plan(
 
 
 def _extra_specs(
-    commands: Mapping[str, ClassifierSpec], tune: bool, budget: float | None, stack: int | None
+    commands: Mapping[str, ClassifierSpec],
+    tune: bool,
+    budget: float | None,
+    stack: int | None,
+    ensemble: int | None,
 ) -> ExtraSpecsConfig:
     """The parts of a run's config that say how to build its extra specs again."""
     return ExtraSpecsConfig(
         weka={spec_id: spec.weka_command for spec_id, spec in commands.items()},
         tune=TuneConfig(budget_minutes=budget) if tune else None,
         stack=stack,
+        ensemble=ensemble,
     )
+
+
+def plan_entries(
+    problem: Problem,
+    ids: Sequence[str],
+    specs: Mapping[str, ClassifierSpec],
+    ensemble: int | None,
+) -> tuple[list[str], dict[str, OriginConfig]]:
+    """The helpers of a run (members of its ensembles it did not ask for) and how it comes
+    by the folds of its computed entries and helpers (:meth:`RunPlan.origins`).
+
+    Raises
+    ------
+    ConfigurationError
+        Members that the problem refuses, or that make a cycle; an ensemble selection
+        without an entry to choose among.
+    """
+    from touchbench.benchmark.run.members import plan_run as plan_members
+
+    planned = plan_members(problem, ids, extra_specs=specs, ensemble=ensemble)
+    origins = {
+        entry: OriginConfig(kind=origin.kind, entries=list(origin.entries))
+        for entry, origin in planned.origins().items()
+    }
+    return list(planned.helpers), origins
+
+
+def _about_selection(error: ConfigurationError) -> bool:
+    """Whether the catalogue refused the ensemble selection itself (its rounds, no entry
+    to choose among), as its messages say."""
+    text = str(error)
+    return "ensemble selection" in text or text.startswith("`ensemble`")

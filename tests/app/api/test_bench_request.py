@@ -68,6 +68,12 @@ REFUSALS: list[tuple[dict[str, Any], str, str]] = [
     ({"race_alpha": 0.05}, "race_alpha", "is only meaningful with `race`"),
     ({"budget_total": -1}, "budget_total", "greater than 0"),
     ({"independent": True, "race": True}, "race", "is not used with `independent`"),
+    # ensemble selection
+    ({"ensemble": 0}, "ensemble", "greater than or equal to 1"),
+    ({"ensemble": 101}, "ensemble", "less than or equal to 100"),
+    ({"ensemble": 2}, "ensemble", "selects among multi-class classifiers: pick one nominal"),
+    ({"dataset": "contact", "classifiers": ["ridge"], "ensemble": 2}, "ensemble", "numeric"),
+    ({"independent": True, "ensemble": 2}, "ensemble", "is not used with `independent`"),
 ]
 
 
@@ -128,3 +134,24 @@ def test_every_refusal_names_its_field_and_leaves_no_run(
     page = api.get(f"/fragments/runs/{run['id']}/leaderboard").text
     assert zeror["dropped"]["note"] in page and board["race"]["note"] in page
     assert 'class="dropped"' in page
+
+    # an ensemble selection and a vote from fold predictions: their origin in the API's
+    # leaderboard and on the web page, the selection's weights per fold
+    selecting = api.post(
+        "/api/runs",
+        json={**BASE, "dataset": 1, "target": "gesture", "classifiers": ["nb", "voting-hard"],
+              "ensemble": 2},
+    )  # fmt: skip
+    assert selecting.status_code == 202, selecting.text
+    run = server.wait_for(f"/api/runs/{selecting.json()['id']}", finished)
+    assert run["status"] == "done" and run["config"]["ensemble"] == 2
+    assert run["config"]["helpers"] == ["logistic", "rf-200", "svm-rbf"]
+    assert run["classifiers"] == ["nb", "voting-hard", "ensemble-2"]
+    board = api.get(f"/api/runs/{run['id']}/leaderboard").json()
+    rows = {row["classifier"]: row for row in board["leaderboard"]}
+    assert rows["ensemble-2"]["origin"]["note"] == "from fold predictions of nb, voting-hard"
+    assert rows["rf-200"]["origin"]["note"] == "helper of voting-hard"
+    assert rows["nb"]["origin"] is None and rows["ensemble-2"]["n_ok"] == 3
+    assert {choice["classifier"] for choice in board["choices"]} == {"ensemble-2"}
+    page = api.get(f"/fragments/runs/{run['id']}/leaderboard").text
+    assert "from fold predictions of nb, voting-hard" in page and "helper of voting-hard" in page

@@ -13,10 +13,10 @@ import time
 from pathlib import Path
 
 import pytest
-from sqlalchemy import create_engine, text
 
 from tests.support.cli_runner import run_cli
 from tests.support.gate import Gate
+from tests.support.rows import count_of, wait_for_count
 from tests.support.synthetic import touch_arff
 from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import add_dataset, dataset_digest
@@ -194,17 +194,6 @@ def test_one_class_target_and_unknown_run_exit_2(
     assert resume.code == 2 and "no run '999'" in resume.err
 
 
-def _count(url: str, sql: str) -> int:
-    engine = create_engine(url.replace("postgresql://", "postgresql+psycopg://", 1))
-    try:
-        with engine.connect() as connection:
-            return int(connection.execute(text(sql)).scalar() or 0)
-    except Exception:
-        return 0
-    finally:
-        engine.dispose()
-
-
 def test_a_killed_run_resumes_without_repeating_or_duplicating(
     capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
 ) -> None:
@@ -218,29 +207,26 @@ def test_a_killed_run_resumes_without_repeating_or_duplicating(
     )
     gate.let_through(3)
     deadline = time.monotonic() + 120
-    while _count(store_url, "SELECT count(*) FROM fold_results") < 13:
-        assert child.poll() is None, child.stderr.read().decode() if child.stderr else ""
-        assert time.monotonic() < deadline, "the run recorded nothing in two minutes"
-        time.sleep(0.05)
+    wait_for_count(store_url, "SELECT count(*) FROM fold_results", 13, child, deadline)
     gate.wait_started(4)
     os.kill(child.pid, signal.SIGKILL)
     child.wait()
-    assert _count(store_url, "SELECT count(*) FROM fold_results") == 13
-    first_ids = _count(store_url, "SELECT max(id) FROM fold_results")
+    assert count_of(store_url, "SELECT count(*) FROM fold_results") == 13
+    first_ids = count_of(store_url, "SELECT max(id) FROM fold_results")
 
     gate.open()
     resumed = subprocess.run(
         [*bench, "--resume", "1", "--json"], env=environment, capture_output=True, timeout=600
     )
     assert resumed.returncode == 0, resumed.stderr.decode()
-    assert _count(store_url, "SELECT count(*) FROM fold_results") == 30
-    distinct = _count(
+    assert count_of(store_url, "SELECT count(*) FROM fold_results") == 30
+    distinct = count_of(
         store_url,
         "SELECT count(*) FROM (SELECT DISTINCT classifier, repeat, fold FROM fold_results) t",
     )
     assert distinct == 30
     # rows written before the kill are kept, not rewritten
-    assert _count(store_url, f"SELECT count(*) FROM fold_results WHERE id <= {first_ids}") == 13
+    assert count_of(store_url, f"SELECT count(*) FROM fold_results WHERE id <= {first_ids}") == 13
     board = json.loads(resumed.stdout)["leaderboard"]
     assert {row["classifier"] for row in board} == {"zeror", "gate", "nb"}
     assert all(row["n_ok"] == 10 for row in board)
