@@ -8,10 +8,9 @@ from pathlib import Path
 
 import pytest
 
-from tests.app.api.test_datasets import _upload as upload
 from tests.support.cli_runner import run_cli
 from tests.support.grasp_table import OBJECTS, grasp_csv
-from tests.support.service import Server, finished
+from tests.support.service import Server, finished, upload
 
 
 def test_a_run_leaving_one_object_out_says_so_everywhere(

@@ -9,8 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.app.cli.test_datasets_bad_input import one_error_line
-from tests.support.cli_runner import run_cli
+from tests.support.cli_runner import one_error_line, run_cli
 from tests.support.grasp_table import FEATURES, OBJECTS, grasp_csv
 from touchbench.app.services.runs import RunOptions, fold_plan, prepare_problem
 from touchbench.app.store.database import Store
