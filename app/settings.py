@@ -152,6 +152,12 @@ class Settings(BaseSettings):
         ge=1,
         description="Loaded models kept in memory per service process for predictions.",
     )
+    ranking_cache: int = Field(
+        default=8,
+        ge=1,
+        description="Run leaderboards kept ranked in memory per service process for the web "
+        "page (each version of a run's results is ranked once).",
+    )
     live_follow_seconds: float = Field(
         default=1.0,
         ge=0,

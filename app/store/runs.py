@@ -416,23 +416,31 @@ def finished_keys(store: Store, run_id: int) -> set[TaskKey]:
         return {TaskKey(*key) for key in _keys(session, run_id)}
 
 
-def load_results(store: Store, run_id: int) -> list[TaskResult]:
-    with store.session() as session:
-        rows = session.execute(  # columns, not ORM objects: a large run loads several times faster
-            select(
-                FoldResultRow.classifier,
-                FoldResultRow.repeat,
-                FoldResultRow.fold,
-                FoldResultRow.status,
-                FoldResultRow.error,
-                FoldResultRow.metrics,
-                FoldResultRow.confusion,
-                FoldResultRow.n_train,
-                FoldResultRow.n_test,
-            )
-            .where(FoldResultRow.run_id == run_id)
-            .order_by(FoldResultRow.classifier, FoldResultRow.repeat, FoldResultRow.fold)
+def load_results(
+    store: Store, run_id: int, *, classifiers: Sequence[str] | None = None
+) -> list[TaskResult]:
+    """The run's fold results, by classifier, repeat and fold; of ``classifiers`` only when
+    given (a page that draws a few of a run's thousands)."""
+    query = (
+        select(
+            FoldResultRow.classifier,
+            FoldResultRow.repeat,
+            FoldResultRow.fold,
+            FoldResultRow.status,
+            FoldResultRow.error,
+            FoldResultRow.metrics,
+            FoldResultRow.confusion,
+            FoldResultRow.n_train,
+            FoldResultRow.n_test,
         )
+        .where(FoldResultRow.run_id == run_id)
+        .order_by(FoldResultRow.classifier, FoldResultRow.repeat, FoldResultRow.fold)
+    )
+    if classifiers is not None:
+        query = query.where(FoldResultRow.classifier.in_(list(classifiers)))
+    with store.session() as session:
+        # columns, not ORM objects: a large run loads several times faster
+        rows = session.execute(query)
         results = []
         for classifier, repeat, fold, status, error, stored, confusion, n_train, n_test in rows:
             metrics = dict(stored)
@@ -475,6 +483,8 @@ def _stored_metrics(result: TaskResult) -> dict[str, Any]:
 
 def _undefined_as_nan(scores: dict[str, Any]) -> dict[str, Any]:
     """Scores as read: null (an undefined score) back to NaN."""
+    if None not in scores.values():  # most rows: no copy
+        return scores
     return {name: math.nan if value is None else value for name, value in scores.items()}
 
 

@@ -1,14 +1,21 @@
 """A run's leaderboard from its stored results: ranked, marked against a baseline, with runs
 beside it, per-target scores and what the race, the budget or a stop left out.
+
+The web page asks for the same run's leaderboard again and again (its fragments, each
+sort, each visitor): :func:`ranked_run` ranks a run once per version of its results and
+keeps the ranking without the fold results, so that a run of thousands of classifiers (an
+imported results file) costs its statistics once, not on every fragment.
 """
 
 from __future__ import annotations
 
 # Imports inside functions: start-up time: the statistics (scipy) load when a leaderboard
 # is first built, not when the API's routes or the listing commands import this module.
-from collections.abc import Sequence
+import threading
+from collections import OrderedDict
+from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, TypeVar, cast
 
 import numpy as np
 
@@ -35,6 +42,8 @@ from touchbench.benchmark.results import Drop, TaskResult
 if TYPE_CHECKING:  # scipy.stats (significance) loads when a leaderboard is first built
     from touchbench.benchmark.evaluation.leaderboard import Leaderboard
 
+
+T = TypeVar("T")
 
 #: Why a run has no results yet, when it is under way (:data:`app.schemas.status.UNFINISHED`).
 _UNDER_WAY = {
@@ -229,6 +238,121 @@ def run_leaderboard(
         drops=drops,
     )
     return RunLeaderboard(run, board, results, tuple(others), drops)
+
+
+@dataclass(frozen=True)
+class RankedRun:
+    """A run's leaderboard as the web page shows it: the ranking and its report, without
+    the fold results they were computed from (:func:`ranked_run` keeps these).
+
+    Attributes
+    ----------
+    run : RunInfo
+        The run as it was when ranked.
+    board : Leaderboard
+    besides : tuple of Beside
+    drops : dict of str to Drop
+    report : LeaderboardSchema
+        :meth:`RunLeaderboard.report` of the ranking.
+    """
+
+    run: RunInfo
+    board: Leaderboard
+    besides: tuple[Beside, ...]
+    drops: dict[str, Drop]
+    report: LeaderboardSchema
+
+    def notes(self) -> list[str]:
+        """What the leaderboard's notes say (:meth:`RunLeaderboard.notes`)."""
+        return list(self.report.notes)
+
+
+def run_version(run: RunInfo) -> tuple[Hashable, ...]:
+    """What tells one state of a run's results from another: a run stored anew under a
+    freed id differs by its creation time, a run that gains, fails or drops a fold by its
+    counts, a resumed or finished one by its status."""
+    return (
+        run.id,
+        run.created_at,
+        run.status,
+        run.n_results,
+        run.n_failed,
+        run.n_dropped,
+        run.finished_at,
+    )
+
+
+class _Kept:
+    """What was computed last of runs, by store, run version and what was asked; what is
+    asked for again while it is computed waits for it rather than computing it twice."""
+
+    def __init__(self) -> None:
+        self._kept: OrderedDict[Hashable, Any] = OrderedDict()
+        self._computing: dict[Hashable, threading.Lock] = {}
+        self._lock = threading.Lock()
+
+    def get(self, key: Hashable, compute: Callable[[], T], size: int) -> T:
+        with self._lock:
+            if key in self._kept:
+                self._kept.move_to_end(key)
+                return cast(T, self._kept[key])
+            computing = self._computing.setdefault(key, threading.Lock())
+        with computing:
+            with self._lock:
+                if key in self._kept:
+                    return cast(T, self._kept[key])
+            try:
+                made = compute()
+            finally:
+                with self._lock:
+                    self._computing.pop(key, None)
+            with self._lock:
+                self._kept[key] = made
+                while len(self._kept) > size:
+                    self._kept.popitem(last=False)
+            return made
+
+
+_KEPT = _Kept()
+
+
+def kept(store: Store, runs: Sequence[RunInfo], asked: Hashable, compute: Callable[[], T]) -> T:
+    """What ``compute`` makes of ``runs`` (a run and the runs beside it) for ``asked``,
+    computed once per version of their results (:func:`run_version`) and kept for the
+    next pages: the setting ``ranking_cache`` says how many a service process keeps.
+    Nothing is kept when ``compute`` raises."""
+    from touchbench.app.settings import get_settings
+
+    key = (store.url, tuple(run_version(run) for run in runs), asked)
+    return _KEPT.get(key, compute, get_settings().ranking_cache)
+
+
+def ranked_run(
+    store: Store,
+    run_id: int | str,
+    *,
+    metric: str | None = None,
+    baseline: str | None = None,
+    beside: Sequence[int | str] = (),
+) -> RankedRun:
+    """A run's leaderboard as :func:`run_leaderboard` makes it, computed once per version
+    of the run's results and of the runs ``beside`` it (:func:`kept`).
+
+    Raises
+    ------
+    NoResultsError, ConfigurationError
+        As :func:`run_leaderboard`; nothing is kept then.
+    """
+    run = get_run(store, run_id)
+    others = [get_run(store, ref) for ref in dict.fromkeys(beside)]
+
+    def compute() -> RankedRun:
+        ranked = run_leaderboard(
+            store, run.id, metric=metric, baseline=baseline, beside=[o.id for o in others]
+        )
+        return RankedRun(ranked.run, ranked.board, ranked.besides, ranked.drops, ranked.report())
+
+    return kept(store, [run, *others], ("ranking", metric, baseline), compute)
 
 
 PerTargetSummary = dict[str, dict[str, dict[str, tuple[float, float]]]]

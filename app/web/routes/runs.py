@@ -4,7 +4,10 @@ the form that starts a run.
 
 A run may have thousands of classifiers (an imported results file): its fragments show the
 first of them and a count, as data set pages do (:mod:`app.reports.bounds`), and its
-plots draw the best of them with a note; the JSON API and the CLI give every one.
+plots draw the best of them with a note; the JSON API and the CLI give every one.  The work
+is bounded too: the ranking is computed once per version of the run's results
+(:func:`~app.services.runs.ranked_run`), and a plot reads the fold results of the
+classifiers it draws only.
 """
 
 from __future__ import annotations
@@ -26,17 +29,17 @@ from touchbench.app.schemas.status import FINAL, RESUMABLE, Status
 from touchbench.app.services.answers import run_answers
 from touchbench.app.services.lifecycle import count_runs, get_run, list_runs
 from touchbench.app.services.listing import count_datasets, list_datasets
-from touchbench.app.services.runs import NoResultsError, run_leaderboard
+from touchbench.app.services.runs import NoResultsError, kept, ranked_run
 from touchbench.app.web.deps import StoreDep
 from touchbench.app.web.listing import newest
-from touchbench.app.web.rendering import draw, render
+from touchbench.app.web.rendering import Plot, draw, render
 from touchbench.app.web.routes.pages import Ref
 
 # The plots and the statistics (matplotlib, scipy) load with the first fragment that needs
 # them, so that the service starts at once.
 if TYPE_CHECKING:
     from touchbench.app.services.report import RunView
-    from touchbench.app.services.runs import RunLeaderboard
+    from touchbench.app.services.runs import RankedRun
 
 router = APIRouter(prefix="/fragments/runs", include_in_schema=False)
 
@@ -98,7 +101,7 @@ def leaderboard(
     ``beside``: other runs' classifiers too (a paper's imported results), t-tested where
     the folds pair and by their means where they do not."""
     try:
-        ranked = run_leaderboard(
+        ranked = ranked_run(
             store,
             run_id,
             metric=metric or None,
@@ -112,7 +115,7 @@ def leaderboard(
         run=ranked.run,
         board=ranked.board,
         table=_table(ranked, chosen_baseline=baseline or None),
-        tables=[_first_rows(table) for table in run_tables(ranked.report())],
+        tables=[_first_rows(table) for table in run_tables(ranked.report)],
         answers=run_answer_tables(run_answers(store, run_id)),
         notes=ranked.notes(),
     )
@@ -122,17 +125,27 @@ def leaderboard(
 def plots(run_id: int, store: StoreDep, metric: Metric = None) -> HTMLResponse:
     """Every fold's score, per-target scores and class counts."""
     from touchbench.app.reports import figures
-    from touchbench.app.services.report import run_view
+    from touchbench.app.services.report import page_view
 
     run = get_run(store, run_id)
     if run.n_results == 0:
         return render("fragments/plots.html.j2", plots=[])
-    view = run_view(store, run.id, metric=metric or None)
-    drawn = [draw(f"{view.metric} of every fold", partial(figures.folds_figure, view))]
-    if view.per_target is not None:
-        drawn.append(draw("Accuracy per target", partial(figures.targets_figure, view)))
-    drawn.append(draw("Instances per class", partial(figures.classes_figure, view)))
-    return render("fragments/plots.html.j2", plots=drawn)
+
+    def drawn() -> list[Plot]:
+        ranked = ranked_run(store, run.id, metric=metric or None)
+        own = set(ranked.run.classifiers)
+        best = [row.classifier for row in ranked.board.rows if row.classifier in own]
+        view = page_view(store, ranked, best[: bounds.DRAWN])
+        plots = [draw(f"{view.metric} of every fold", partial(figures.folds_figure, view))]
+        if view.per_target is not None:
+            plots.append(draw("Accuracy per target", partial(figures.targets_figure, view)))
+        plots.append(draw("Instances per class", partial(figures.classes_figure, view)))
+        return plots
+
+    # drawn once per version of the run's results, as its ranking is
+    return render(
+        "fragments/plots.html.j2", plots=kept(store, [run], ("plots", metric or None), drawn)
+    )
 
 
 @router.get("/{run_id}/classifiers/{classifier}", response_class=HTMLResponse)
@@ -142,17 +155,18 @@ def classifier(
     """A classifier's confusion matrix, its scores and its folds beside the baseline's."""
     from touchbench.app.reports import figures
     from touchbench.app.reports.leaderboard import mean_std
-    from touchbench.app.services.report import run_view
+    from touchbench.app.services.report import page_view
 
-    view = run_view(store, run_id, metric=metric or None, baseline=baseline or None)
-    if classifier not in view.run.classifiers:
+    ranked = ranked_run(store, run_id, metric=metric or None, baseline=baseline or None)
+    if classifier not in ranked.run.classifiers:
         raise NotFoundError(
-            f"run {view.run.id} has no classifier '{classifier}' "
-            f"(classifiers: {bounds.names(view.run.classifiers)})"
+            f"run {ranked.run.id} has no classifier '{classifier}' "
+            f"(classifiers: {bounds.names(ranked.run.classifiers)})"
         )
-    row = view.board.row(classifier)
-    reference = view.board.baseline or classifier
+    reference = ranked.board.baseline or classifier
     shown = list(dict.fromkeys([classifier, reference]))
+    view = page_view(store, ranked, shown)
+    row = view.board.row(classifier)
     return render(
         "fragments/classifier.html.j2",
         view=view,
@@ -210,7 +224,7 @@ def _folds(view: RunView, shown: list[str]) -> dict[str, Any]:
     }
 
 
-def _table(ranked: RunLeaderboard, *, chosen_baseline: str | None) -> dict[str, Any]:
+def _table(ranked: RankedRun, *, chosen_baseline: str | None) -> dict[str, Any]:
     """The leaderboard's header (metric columns sortable), rows, and the pickers' options;
     with runs beside it, where each row comes from and how it is compared."""
     from touchbench.app.reports.leaderboard import (
