@@ -106,7 +106,8 @@ class DepthScan:
     def _string_rest(self, data: bytes, at: int) -> int:
         """Where the string open at ``at`` of ``data`` closes (the index after its quote),
         or -1 when it runs to the end (then still open, escaped if a backslash ends it)."""
-        end = _STRING_BODY.match(data, at).end()  # type: ignore[union-attr] (always matches)
+        match = _STRING_BODY.match(data, at)
+        end = match.end() if match is not None else at  # it always matches (maybe empty)
         if end < len(data) and data[end : end + 1] == b'"':
             self._in_string = self._escaped = False
             return end + 1

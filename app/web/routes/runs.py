@@ -183,12 +183,17 @@ def classifier(
 
 
 def _how_sure(view: RunView, classifier: str) -> dict[str, Any] | None:
-    """The classifier's per-class tables and its calibration (none for a regression)."""
+    """The classifier's per-class tables and its calibration (none for a regression or an
+    imported run)."""
     from touchbench.app.reports import figures
     from touchbench.app.reports.certainty_tables import calibrations, class_tables
     from touchbench.app.services.certainty import certainty_of
+    from touchbench.app.services.imported import is_imported
 
-    if view.run.kind == "regression" or not view.board.row(classifier).n_ok:
+    # an imported results file keeps no confusion matrices or probabilities
+    if view.run.kind == "regression" or is_imported(view.run):
+        return None
+    if not view.board.row(classifier).n_ok:
         return None
     certainty = certainty_of(view, [classifier])
     [entry] = certainty.classifiers
