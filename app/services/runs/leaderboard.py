@@ -11,9 +11,11 @@ from __future__ import annotations
 
 # Imports inside functions: start-up time: the statistics (scipy) load when a leaderboard
 # is first built, not when the API's routes or the listing commands import this module.
+import gc
 import threading
 from collections import OrderedDict
-from collections.abc import Callable, Hashable, Sequence
+from collections.abc import Callable, Hashable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeVar, cast
 
@@ -302,7 +304,8 @@ class _Kept:
                 if key in self._kept:
                     return cast(T, self._kept[key])
             try:
-                made = compute()
+                with _no_collection_pauses():
+                    made = compute()
             finally:
                 with self._lock:
                     self._computing.pop(key, None)
@@ -314,6 +317,37 @@ class _Kept:
 
 
 _KEPT = _Kept()
+_PAUSED = [0]  # computations under way that paused the collector
+_PAUSED_LOCK = threading.Lock()
+
+
+@contextmanager
+def _no_collection_pauses() -> Iterator[None]:
+    """No full garbage collection while a run is ranked, and what was made moved out of the
+    collector's reach afterwards.
+
+    A full collection holds every thread of the service (its predictions too) for as long
+    as it takes to go through the heap, and ranking a run of thousands of classifiers
+    allocates enough to start several; what is then kept would make every later one
+    longer.  So the collector waits while a ranking (or a plot) is computed; then the
+    young generations alone are collected (the cycles it left), and what survives is
+    frozen (:func:`gc.freeze`): reference counting still frees it when it is dropped (a
+    ranking holds no reference cycle).
+    """
+    with _PAUSED_LOCK:
+        _PAUSED[0] += 1
+        gc.disable()
+    try:
+        yield
+    finally:
+        with _PAUSED_LOCK:
+            _PAUSED[0] -= 1
+            if not _PAUSED[0]:
+                # the young generations only (what was made meanwhile, not the heap): the
+                # cycles a computation left (a figure's) go before the rest is frozen
+                gc.collect(1)
+                gc.freeze()
+                gc.enable()
 
 
 def kept(store: Store, runs: Sequence[RunInfo], asked: Hashable, compute: Callable[[], T]) -> T:
