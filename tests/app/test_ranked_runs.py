@@ -5,6 +5,8 @@ PostgreSQL."""
 
 from __future__ import annotations
 
+import gc
+import weakref
 from pathlib import Path
 
 import pytest
@@ -83,3 +85,26 @@ def test_a_page_reads_the_results_of_the_classifiers_it_draws_only(
     # the fold table still has a column per classifier of the run, in ranking order
     table = view.fold_scores()
     assert list(table.classifiers)[:3] == best and len(table.classifiers) == 40
+
+
+class _Node:
+    """An object in a reference cycle (as a figure's artists are)."""
+
+    def __init__(self) -> None:
+        self.me = self
+
+
+def test_a_computation_leaves_the_collector_on_and_no_cycle_frozen(
+    store: Store, imported: int
+) -> None:
+    run = get_run(store, imported)
+    left: list[weakref.ref[_Node]] = []
+
+    def compute() -> str:
+        assert not gc.isenabled()  # no full collection's pause while it computes
+        left.append(weakref.ref(_Node()))  # garbage in a cycle: only the collector frees it
+        return "made"
+
+    assert kept(store, [run], "cycle", compute) == "made"
+    assert gc.isenabled()
+    assert left[0]() is None  # collected before what survived was frozen
