@@ -223,6 +223,42 @@ def get_run(store: Store, run_id: int | str) -> RunInfo:
         return _infos(session, [_row(session, run_id)])[0]
 
 
+def results_version(store: Store, run_id: int | str) -> tuple[Any, ...]:
+    """What tells one state of a run's results from another, read without the run's
+    configuration or classifiers (light for a run of thousands): its id and creation time
+    (a run stored anew under a freed id differs), its status and end, its results and
+    failures counted, and its dropped entries with their folds.
+
+    Raises
+    ------
+    NotFoundError
+        No such run.
+    """
+    text = str(run_id)
+    with store.session() as session:
+        found = None
+        if is_row_id(text):
+            found = session.execute(
+                select(RunRow.id, RunRow.created_at, RunRow.status, RunRow.finished_at).where(
+                    RunRow.id == int(text)
+                )
+            ).one_or_none()
+        if found is None:
+            _row(session, run_id)  # says which runs there are
+            raise NotFoundError(f"no run '{text}'")
+        results = session.execute(
+            select(func.count(), func.sum(case((FoldResultRow.status != "ok", 1), else_=0))).where(
+                FoldResultRow.run_id == found.id
+            )
+        ).one()
+        drops = session.execute(
+            select(func.count(), func.sum(EntryDropRow.after_fold)).where(
+                EntryDropRow.run_id == found.id
+            )
+        ).one()
+        return (*found, results[0], results[1] or 0, drops[0], drops[1] or 0)
+
+
 def list_runs(
     store: Store,
     *,

@@ -13,6 +13,7 @@ import pytest
 
 from tests.app.hostile_inputs import results_arff
 from tests.app.synthetic import touch_arff
+from touchbench.app.errors import NotFoundError
 from touchbench.app.schemas.datasets import ImportRequest
 from touchbench.app.schemas.imported import ImportResultsRequest
 from touchbench.app.services.datasets import import_file
@@ -20,7 +21,7 @@ from touchbench.app.services.imported import import_results
 from touchbench.app.services.report import page_view
 from touchbench.app.services.runs import kept, ranked_run, run_leaderboard
 from touchbench.app.store.database import Store
-from touchbench.app.store.runs import get_run, record_result
+from touchbench.app.store.runs import record_result
 from touchbench.benchmark.results import TaskKey, TaskResult
 
 
@@ -59,7 +60,6 @@ def test_a_ranking_is_computed_once_per_version_of_the_results(store: Store, imp
 
 
 def test_nothing_is_kept_when_the_computation_fails(store: Store, imported: int) -> None:
-    run = get_run(store, imported)
     calls: list[int] = []
 
     def failing() -> int:
@@ -68,10 +68,13 @@ def test_nothing_is_kept_when_the_computation_fails(store: Store, imported: int)
 
     for _ in range(2):
         with pytest.raises(ValueError):
-            kept(store, [run], "failing", failing)
+            kept(store, [imported], "failing", failing)
     assert len(calls) == 2
-    assert kept(store, [run], "failing", lambda: 7) == 7
-    assert kept(store, [run], "failing", lambda: 8) == 7
+    assert kept(store, [imported], "failing", lambda: 7) == 7
+    assert kept(store, [imported], "failing", lambda: 8) == 7
+    assert kept(store, [str(imported)], "failing", lambda: 9) == 7  # the same run
+    with pytest.raises(NotFoundError, match="no run '999'"):
+        kept(store, [999], "failing", lambda: 10)
 
 
 def test_a_page_reads_the_results_of_the_classifiers_it_draws_only(
@@ -97,7 +100,6 @@ class _Node:
 def test_a_computation_leaves_the_collector_on_and_no_cycle_frozen(
     store: Store, imported: int
 ) -> None:
-    run = get_run(store, imported)
     left: list[weakref.ref[_Node]] = []
 
     def compute() -> str:
@@ -105,6 +107,6 @@ def test_a_computation_leaves_the_collector_on_and_no_cycle_frozen(
         left.append(weakref.ref(_Node()))  # garbage in a cycle: only the collector frees it
         return "made"
 
-    assert kept(store, [run], "cycle", compute) == "made"
+    assert kept(store, [imported], "cycle", compute) == "made"
     assert gc.isenabled()
     assert left[0]() is None  # collected before what survived was frozen

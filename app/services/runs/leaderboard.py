@@ -37,7 +37,7 @@ from touchbench.app.services.runs.ranking import check_metric, run_metric
 from touchbench.app.services.runs.stopping import RACE_TEST, never_started
 from touchbench.app.store.database import Store
 from touchbench.app.store.drops import load_drops
-from touchbench.app.store.runs import RunInfo, get_run, load_results
+from touchbench.app.store.runs import RunInfo, get_run, load_results, results_version
 from touchbench.benchmark.errors import ConfigurationError
 from touchbench.benchmark.results import Drop, TaskResult
 
@@ -269,21 +269,6 @@ class RankedRun:
         return list(self.report.notes)
 
 
-def run_version(run: RunInfo) -> tuple[Hashable, ...]:
-    """What tells one state of a run's results from another: a run stored anew under a
-    freed id differs by its creation time, a run that gains, fails or drops a fold by its
-    counts, a resumed or finished one by its status."""
-    return (
-        run.id,
-        run.created_at,
-        run.status,
-        run.n_results,
-        run.n_failed,
-        run.n_dropped,
-        run.finished_at,
-    )
-
-
 class _Kept:
     """What was computed last of runs, by store, run version and what was asked; what is
     asked for again while it is computed waits for it rather than computing it twice."""
@@ -350,14 +335,20 @@ def _no_collection_pauses() -> Iterator[None]:
                 gc.enable()
 
 
-def kept(store: Store, runs: Sequence[RunInfo], asked: Hashable, compute: Callable[[], T]) -> T:
+def kept(store: Store, runs: Sequence[int | str], asked: Hashable, compute: Callable[[], T]) -> T:
     """What ``compute`` makes of ``runs`` (a run and the runs beside it) for ``asked``,
-    computed once per version of their results (:func:`run_version`) and kept for the
-    next pages: the setting ``ranking_cache`` says how many a service process keeps.
-    Nothing is kept when ``compute`` raises."""
+    computed once per version of their results (:func:`~app.store.runs.results_version`,
+    one light query a run) and kept for the next pages: the setting ``ranking_cache``
+    says how many a service process keeps.  Nothing is kept when ``compute`` raises.
+
+    Raises
+    ------
+    NotFoundError
+        No such run.
+    """
     from touchbench.app.settings import get_settings
 
-    key = (store.url, tuple(run_version(run) for run in runs), asked)
+    key = (store.url, tuple(results_version(store, run) for run in runs), asked)
     return _KEPT.get(key, compute, get_settings().ranking_cache)
 
 
@@ -370,23 +361,21 @@ def ranked_run(
     beside: Sequence[int | str] = (),
 ) -> RankedRun:
     """A run's leaderboard as :func:`run_leaderboard` makes it, computed once per version
-    of the run's results and of the runs ``beside`` it (:func:`kept`).
+    of the run's results and of the runs ``beside`` it (:func:`kept`): a page asking
+    again costs a light query per run, not the run's configuration read again.
 
     Raises
     ------
     NoResultsError, ConfigurationError
         As :func:`run_leaderboard`; nothing is kept then.
     """
-    run = get_run(store, run_id)
-    others = [get_run(store, ref) for ref in dict.fromkeys(beside)]
+    others = list(dict.fromkeys(beside))
 
     def compute() -> RankedRun:
-        ranked = run_leaderboard(
-            store, run.id, metric=metric, baseline=baseline, beside=[o.id for o in others]
-        )
+        ranked = run_leaderboard(store, run_id, metric=metric, baseline=baseline, beside=others)
         return RankedRun(ranked.run, ranked.board, ranked.besides, ranked.drops, ranked.report())
 
-    return kept(store, [run, *others], ("ranking", metric, baseline), compute)
+    return kept(store, [run_id, *others], ("ranking", metric, baseline), compute)
 
 
 PerTargetSummary = dict[str, dict[str, dict[str, tuple[float, float]]]]

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 # Imports inside functions: start-up time: matplotlib, the catalogue and the reports load
 # when a fragment that draws or lists them is first asked for, not when the service starts.
+from collections.abc import Callable
 from dataclasses import replace
 from functools import partial
 from typing import TYPE_CHECKING, Annotated, Any
@@ -127,12 +128,8 @@ def plots(run_id: int, store: StoreDep, metric: Metric = None) -> HTMLResponse:
     from touchbench.app.reports import figures
     from touchbench.app.services.report import page_view
 
-    run = get_run(store, run_id)
-    if run.n_results == 0:
-        return render("fragments/plots.html.j2", plots=[])
-
     def drawn() -> list[Plot]:
-        ranked = ranked_run(store, run.id, metric=metric or None)
+        ranked = ranked_run(store, run_id, metric=metric or None)
         own = set(ranked.run.classifiers)
         best = [row.classifier for row in ranked.board.rows if row.classifier in own]
         view = page_view(store, ranked, best[: bounds.DRAWN])
@@ -143,9 +140,11 @@ def plots(run_id: int, store: StoreDep, metric: Metric = None) -> HTMLResponse:
         return plots
 
     # drawn once per version of the run's results, as its ranking is
-    return render(
-        "fragments/plots.html.j2", plots=kept(store, [run], ("plots", metric or None), drawn)
-    )
+    try:
+        plots = kept(store, [run_id], ("plots", metric or None), drawn)
+    except NoResultsError:
+        plots = []
+    return render("fragments/plots.html.j2", plots=plots)
 
 
 @router.get("/{run_id}/classifiers/{classifier}", response_class=HTMLResponse)
@@ -243,7 +242,9 @@ def _table(ranked: RankedRun, *, chosen_baseline: str | None) -> dict[str, Any]:
     run, board, besides = ranked.run, ranked.board, ranked.besides
     columns = metric_columns(run, board)
     metrics = sorted({name for row in board.rows for name in row.metrics})
-    rows = _first_and_baseline(leaderboard_rows(board, columns, besides), board.baseline)
+    # the rows shown only are formatted (a run may have thousands)
+    shown = _first_and_baseline(board.rows, board.baseline, at="classifier")
+    rows = bounds.Shown(leaderboard_rows(board, columns, besides, rows=shown.items), shown.more)
     baselines = [row.classifier for row in board.rows if row.n_ok]
     return {
         "header": leaderboard_header(board, columns, besides),
@@ -263,13 +264,20 @@ def _table(ranked: RankedRun, *, chosen_baseline: str | None) -> dict[str, Any]:
 
 
 def _first_and_baseline(
-    rows: list[Any], baseline: str | None, *, at: int | None = 1
+    rows: list[Any], baseline: str | None, *, at: int | str | None = 1
 ) -> bounds.Shown[Any]:
-    """The first :data:`~app.reports.bounds.CLASSIFIERS` of ``rows`` (classifiers, or
-    table rows naming one in cell ``at``), and the baseline's after them when it ranks
-    lower: the row every mark is against stays on the page."""
+    """The first :data:`~app.reports.bounds.CLASSIFIERS` of ``rows`` (classifiers, table
+    rows naming one in cell ``at``, or leaderboard rows naming one in attribute ``at``),
+    and the baseline's after them when it ranks lower: the row every mark is against
+    stays on the page."""
     shown = bounds.first(rows, bounds.CLASSIFIERS)
-    named = (lambda row: row) if at is None else (lambda row: row[at])
+    named: Callable[[Any], Any]
+    if at is None:
+        named = lambda row: row  # noqa: E731
+    elif isinstance(at, str):
+        named = lambda row: getattr(row, at)  # noqa: E731
+    else:
+        named = lambda row: row[at]  # noqa: E731
     if baseline is not None and shown.more and all(named(r) != baseline for r in shown.items):
         extra = [row for row in rows[bounds.CLASSIFIERS :] if named(row) == baseline]
         return bounds.Shown(shown.items + extra, shown.more - len(extra))
