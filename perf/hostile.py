@@ -36,7 +36,7 @@ sys.path.insert(0, str(ROOT))
 
 from perf.serve import free_port, percentile, wait_until_up  # noqa: E402 (after the path)
 from perf.trust_load import peak_rss_mb, train, upload  # noqa: E402
-from tests.app import hostile_inputs as hostile  # noqa: E402
+from tests.support import hostile_inputs as hostile  # noqa: E402
 from tests.support.synthetic import touch_arff  # noqa: E402
 
 GOAL_MB = 300

@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from tests.app.hostile_inputs import results_arff
-from tests.app.synthetic import touch_arff
+from tests.support.hostile_inputs import results_arff
+from tests.support.synthetic import touch_arff
 from touchbench.app.errors import NotFoundError
 from touchbench.app.schemas.datasets import ImportRequest
 from touchbench.app.schemas.imported import ImportResultsRequest

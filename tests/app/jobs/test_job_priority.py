@@ -9,8 +9,8 @@ import os
 from collections.abc import Callable
 from pathlib import Path
 
-from tests.app.api.conftest import Server
-from tests.app.synthetic import touch_arff
+from tests.support.service import Server
+from tests.support.synthetic import touch_arff
 
 JOB_PROCESS = b"touchbench.app.jobs.process"
 
