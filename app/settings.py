@@ -130,6 +130,14 @@ class Settings(BaseSettings):
         "them, however many `touchbench serve --workers` starts).",
     )
     run_jobs: int = Field(default=1, ge=1, description="Engine worker processes per run.")
+    job_nice: int = Field(
+        default=10,
+        ge=0,
+        le=19,
+        description="How much lower than the service's the CPU priority of a job's worker "
+        "process is (its niceness raised by this much; its engine processes inherit it), so "
+        "that heavy runs and jobs do not starve the service's predictions; 0: the same.",
+    )
     dask_scheduler: str | None = Field(
         default=None,
         description="tcp://host:port of a Dask scheduler: runs' tasks go there instead.",
@@ -151,6 +159,12 @@ class Settings(BaseSettings):
         default=8,
         ge=1,
         description="Loaded models kept in memory per service process for predictions.",
+    )
+    ranking_cache: int = Field(
+        default=8,
+        ge=1,
+        description="Run leaderboards kept ranked in memory per service process for the web "
+        "page (each version of a run's results is ranked once).",
     )
     live_follow_seconds: float = Field(
         default=1.0,

@@ -2,7 +2,7 @@
 the service's peak memory and another client's one-instance prediction latency during it,
 beside the same latency on the idle service just before (the two windows alternate).
 
-    .venv/bin/python perf/hostile.py [--quick] [--seconds 8] [--db URL]
+    .venv/bin/python perf/hostile.py [--quick] [--seconds 8] [--db URL] [--only pages]
 
 Goal: every case under 300 MB over idle and its p99 within 2x of the idle p99.  Memory is
 the service process's resident set sampled every 10 ms during the case (its growth over
@@ -241,7 +241,9 @@ def issue_cases(
 
 
 def run_pages(client: httpx.Client, folder: Path) -> list[tuple[str, Callable[[], object]]]:
-    """The fragments of an imported run of 3,000 classifiers."""
+    """The page and fragments of an imported run of 3,000 classifiers.  The first request
+    of the leaderboard and of the plots ranks the run (once per version of its results,
+    kept for the next): its window holds that one computation and the kept answers."""
     paper = touch_arff(folder / "paper.arff", n=90, with_place=False)
     assert post_file(client, "/api/datasets", paper, name="paper") == 201
     results = hostile.results_arff(folder / "results.arff", n_classifiers=3000)
@@ -259,6 +261,13 @@ def run_pages(client: httpx.Client, folder: Path) -> list[tuple[str, Callable[[]
         (
             "3,000-classifier run, plots",
             lambda: client.get(f"/fragments/runs/{run}/plots").status_code,
+        ),
+        (
+            "3,000-classifier run, page and progress",
+            lambda: (
+                client.get(f"/runs/{run}").status_code,
+                client.get(f"/fragments/runs/{run}/progress").status_code,
+            ),
         ),
     ]
 
@@ -353,6 +362,15 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="short windows, smaller inputs")
     parser.add_argument("--seconds", type=float, help="of each window (default 8, quick 3)")
     parser.add_argument("--db", help="a store URL (default: SQLite in a temporary folder)")
+    parser.add_argument(
+        "--only",
+        action="append",
+        choices=["inputs", "pages", "sequences", "others"],
+        help="these groups of cases only (repeatable; default all)",
+    )
+    parser.add_argument(
+        "--repeat", type=int, default=1, help="replay the cases this many times, in turn"
+    )
     args = parser.parse_args()
     seconds = args.seconds or (3.0 if args.quick else 8.0)
     rows = []
@@ -366,10 +384,19 @@ def main() -> None:
                 touch = upload(client, touch_arff(folder / "touch.arff", n=300, with_place=False))
                 model = train(client, touch)
                 train_named(client, "takes", "nb", "takes-nb")
-                cases = issue_cases(client, folder, args.quick)
-                cases += run_pages(client, folder)
-                cases.append(sequences_case(client, folder, args.quick))
-                cases += others_cases(client, db, folder)
+                groups: dict[str, Callable[[], list[tuple[str, Callable[[], object]]]]] = {
+                    "inputs": lambda: issue_cases(client, folder, args.quick),
+                    "pages": lambda: run_pages(client, folder),
+                    "sequences": lambda: [sequences_case(client, folder, args.quick)],
+                    "others": lambda: others_cases(client, db, folder),
+                }
+                cases = [
+                    case
+                    for name, build in groups.items()
+                    if not args.only or name in args.only
+                    for case in build()
+                ]
+                cases *= args.repeat
                 window(url, process.pid, model, 1.0)  # warm: the model loaded
                 idle_hwm = peak_rss_mb(process.pid)  # after every case's set-up
                 for name, replay in cases:

@@ -11,10 +11,10 @@ exactly.  A body too short to pass any limit is not scanned at all (a one-instan
 prediction pays nothing).  Anything else (a body that is not JSON, a field of the wrong
 type) is left to the validation that follows, which says what is wrong where.
 
-Before any of that, :func:`depth_problem` finds a JSON body nested deeper than
+Before any of that, :class:`DepthScan` finds a JSON body nested deeper than
 :data:`MAX_DEPTH` (a parser recurses once per level: 100,000 ``[`` are 200 KB that no
-parser should follow); the service's body limit refuses such a body (422) before any
-route parses it.
+parser should follow); the service's body limit refuses such a body (422) at the chunk
+where it passes the limit, before the rest is read and before any route parses it.
 """
 
 from __future__ import annotations
@@ -38,30 +38,92 @@ _FLAT_OBJECT = re.compile(r'\{(?:[^"{}\[\]]++|"(?:[^"\\]++|\\.)*+")*+\}')
 MAX_DEPTH = 64
 #: A JSON string, escapes included (possessive: a long string is one step of the engine).
 _STRING = re.compile(rb'"(?:[^"\\]++|\\.)*+"')
-_OPENING = np.frombuffer(b"[{", dtype=np.uint8)
-_CLOSING = np.frombuffer(b"]}", dtype=np.uint8)
+#: What follows a string's opening quote up to its closing quote (or the data's end).
+_STRING_BODY = re.compile(rb'(?:[^"\\]++|\\.)*+')
+#: Bytes of a chunk scanned before the rest of it.
+_FIRST_PIECE = 4096
+
+
+class DepthScan:
+    """The nesting of a JSON body followed chunk by chunk as it streams in, so that a body
+    nested deeper than ``max_depth`` is refused at the chunk where it passes the limit,
+    before the rest is read and before any parser sees it.
+
+    Each chunk costs a regular expression (strings stepped over, brackets inside them do
+    not count) and array operations over its brackets: linear in its bytes, whatever it
+    holds.  A string that a chunk leaves open is carried to the next (with a backslash
+    that ends the chunk).  The last chunk of a body with too few brackets to pass the limit
+    is not scanned at all (a one-instance prediction pays nothing).
+    """
+
+    def __init__(self, max_depth: int = MAX_DEPTH) -> None:
+        self.max_depth = max_depth
+        self.depth = 0
+        self.seen = 0
+        self._in_string = False
+        self._escaped = False
+
+    def feed(self, chunk: bytes, *, last: bool = False) -> str | None:
+        """What is wrong once ``chunk`` is read (the body nests too deep), else None."""
+        if last and not self._in_string and self.depth + _openings(chunk) <= self.max_depth:
+            self.seen += len(chunk)
+            return None
+        # a small piece first: a body deep from its first bytes is refused after them
+        for piece in (chunk[:_FIRST_PIECE], chunk[_FIRST_PIECE:]):
+            self.seen += len(piece)
+            problem = self._scan(piece) if piece else None
+            if problem is not None:
+                return problem
+        return None
+
+    def _scan(self, chunk: bytes) -> str | None:
+        at = 0
+        if self._in_string:
+            at = self._string_rest(chunk, 1 if self._escaped else 0)
+            if at < 0:
+                return None
+        bare = _STRING.sub(b"", chunk[at:])
+        opened = bare.find(b'"')  # the whole strings are gone: this one stays open
+        if opened >= 0:
+            self._string_rest(bare, opened + 1)  # carried to the next chunk
+            bare = bare[:opened]
+        if not bare:
+            return None
+        codes = np.frombuffer(bare, dtype=np.uint8)
+        opening = (codes == ord("[")) | (codes == ord("{"))
+        closing = (codes == ord("]")) | (codes == ord("}"))
+        steps = opening.astype(np.int32) - closing
+        depths = self.depth + np.cumsum(steps, dtype=np.int64)
+        deepest = int(depths.max())
+        self.depth = int(depths[-1])
+        if deepest <= self.max_depth:
+            return None
+        return (
+            f"JSON nested deeper than the {self.max_depth} levels allowed (objects and lists "
+            f"in one another; refused within its first {self.seen:,} bytes)"
+        )
+
+    def _string_rest(self, data: bytes, at: int) -> int:
+        """Where the string open at ``at`` of ``data`` closes (the index after its quote),
+        or -1 when it runs to the end (then still open, escaped if a backslash ends it)."""
+        match = _STRING_BODY.match(data, at)
+        end = match.end() if match is not None else at  # it always matches (maybe empty)
+        if end < len(data) and data[end : end + 1] == b'"':
+            self._in_string = self._escaped = False
+            return end + 1
+        self._in_string = True
+        self._escaped = end < len(data)  # stopped before a lone backslash, the last byte
+        return -1
 
 
 def depth_problem(body: bytes, *, max_depth: int = MAX_DEPTH) -> str | None:
-    """What is wrong with a JSON body whose objects and lists nest deeper than
-    ``max_depth``; None when they do not.
+    """What is wrong with a whole JSON body whose objects and lists nest deeper than
+    ``max_depth`` (:class:`DepthScan` over one chunk); None when they do not."""
+    return DepthScan(max_depth).feed(body, last=True)
 
-    Brackets inside strings do not count; the scan is a regular expression and array
-    operations over the body's brackets, so its cost follows the body's size, and a body
-    with fewer brackets than the limit is not scanned at all.
-    """
-    if body.count(b"[") + body.count(b"{") <= max_depth:
-        return None
-    bare = np.frombuffer(_STRING.sub(b'""', body), dtype=np.uint8)
-    brackets = np.flatnonzero(np.isin(bare, _OPENING) | np.isin(bare, _CLOSING))
-    steps = np.where(np.isin(bare[brackets], _OPENING), 1, -1).astype(np.int32)
-    deepest = int(np.cumsum(steps, dtype=np.int32).max())
-    if deepest <= max_depth:
-        return None
-    return (
-        f"JSON nested {deepest:,} levels deep, deeper than the {max_depth} allowed (objects "
-        "and lists in one another)"
-    )
+
+def _openings(data: bytes) -> int:
+    return data.count(b"[") + data.count(b"{")
 
 
 class _NotCountedError(Exception):

@@ -17,7 +17,7 @@ from fastapi.exceptions import RequestValidationError
 from pydantic import ValidationError
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from touchbench.app.api.counting import depth_problem
+from touchbench.app.api.counting import DepthScan
 from touchbench.app.api.errors import UploadTooLarge, error_body
 from touchbench.app.errors import USER_ERRORS, AppError, client_words
 from touchbench.app.schemas.base import Request
@@ -43,7 +43,7 @@ class JsonTooLarge(UploadTooLarge):
 class BodyLimit:
     """ASGI middleware: a request body over ``limit`` bytes (``json_limit`` for a JSON
     body) is refused with 413, and a JSON body nested too deep with 422
-    (:func:`app.api.counting.depth_problem`).
+    (:class:`app.api.counting.DepthScan`), at the chunk where it passes the limit.
 
     A declared ``Content-Length`` over the limit is refused before any byte is read; a
     body without one is counted as it arrives and refused as soon as it passes the limit,
@@ -88,6 +88,7 @@ class BodyLimit:
         """Gather a JSON body, refuse it when too large or too deep, else hand it on."""
         chunks: list[bytes] = []
         size = 0
+        depth = DepthScan()
         while True:
             message = await receive()
             if message["type"] != "http.request":  # the client went away: say so onwards
@@ -98,13 +99,16 @@ class BodyLimit:
             if size > self.json_limit:
                 await _answer(send, 413, "UploadTooLarge", str(JsonTooLarge(self.json_limit)))
                 return
-            if not message.get("more_body", False):
+            more = message.get("more_body", False)
+            # the depth as the bytes come, before any parser: a deep body is refused at its
+            # first chunks, not gathered
+            problem = depth.feed(chunks[-1], last=not more)
+            if problem is not None:
+                await _answer(send, 422, "ValidationError", f"body: {problem}")
+                return
+            if not more:
                 break
         body = b"".join(chunks)
-        problem = depth_problem(body)
-        if problem is not None:
-            await _answer(send, 422, "ValidationError", f"body: {problem}")
-            return
         whole = {"type": "http.request", "body": body, "more_body": False}
         await self.app(scope, _replayed(whole, receive), send)
 

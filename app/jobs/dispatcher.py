@@ -49,7 +49,7 @@ class Dispatcher:
     ----------
     store : Store
     settings : Settings
-        ``job_workers``, ``run_jobs``, ``dask_scheduler``.
+        ``job_workers``, ``run_jobs``, ``job_nice``, ``dask_scheduler``.
     """
 
     def __init__(self, store: Store, settings: Settings) -> None:
@@ -113,6 +113,8 @@ class Dispatcher:
             "touchbench.app.jobs.process",
             "--jobs",
             str(self.settings.run_jobs),
+            "--nice",
+            str(self.settings.job_nice),
         ]
         if self.settings.dask_scheduler:
             command += ["--scheduler", self.settings.dask_scheduler]

@@ -4,10 +4,12 @@ The store's URL comes from ``TOUCHBENCH_DATABASE_URL``, as the dispatcher passes
 command line is readable by any user on the host, and the URL may hold a password.  A
 person running the module by hand may give ``--db URL`` instead.
 
-It claims the item (another process claiming it first is not an error: it exits quietly),
-carries it out, records how it ended, and exits.  It ends itself, mid-run included, once
-the service that started it has died, so that a crashed service leaves no orphan work; the
-run is then found ``interrupted`` and can be resumed.
+It first lowers its CPU priority (``--nice``, the setting ``job_nice``: its engine
+processes inherit it), so that a heavy run shares the cores with the service's predictions
+rather than starving them.  It claims the item (another process claiming it first is not
+an error: it exits quietly), carries it out, records how it ended, and exits.  It ends
+itself, mid-run included, once the service that started it has died, so that a crashed
+service leaves no orphan work; the run is then found ``interrupted`` and can be resumed.
 """
 
 from __future__ import annotations
@@ -38,12 +40,17 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("--jobs", type=int, default=1)
     parser.add_argument("--scheduler", default=None)
+    parser.add_argument(
+        "--nice", type=int, default=0, help="Raise this process's niceness by this much."
+    )
     parser.add_argument("kind", choices=["run", "job"])
     parser.add_argument("id", type=int)
     args = parser.parse_args(argv)
     url = args.db or os.environ.get(DATABASE_URL_VARIABLE)
     if not url:
         parser.error(f"no store: set {DATABASE_URL_VARIABLE} or pass --db")
+    if args.nice > 0:  # before the imports and the work: all of it at the lower priority
+        os.nice(args.nice)
     threading.Thread(target=_exit_with_parent, args=(os.getppid(),), daemon=True).start()
     # A cancel interrupts the work as Ctrl-C does (app.services.jobs), and so does the
     # service stopping it with SIGTERM: the item is recorded cancelled or interrupted, not

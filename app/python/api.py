@@ -31,14 +31,13 @@ from touchbench.app.schemas.extraction import ExtractRequest
 from touchbench.app.schemas.models import TrainRequest
 from touchbench.app.schemas.runs import BenchHereRequest, BenchRequest
 from touchbench.app.services.bench import bench_here
-from touchbench.app.services.datasets import delete_dataset
+from touchbench.app.services.datasets import delete_dataset, read_dataset
 from touchbench.app.services.extraction import extract_and_store
 from touchbench.app.services.models import check_training
 from touchbench.app.services.models import train as train_model
 from touchbench.app.services.own_specs import own_specs_added
 from touchbench.app.services.runs import create_run
 from touchbench.app.store.database import Store
-from touchbench.app.store.datasets import load_dataset
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -179,7 +178,7 @@ def extract(
         **given,
     )
     summary = extract_and_store(opened, request)
-    frame = frame_of(load_dataset(opened, summary.id))
+    frame = frame_of(read_dataset(opened, summary.id))
     frame.attrs["dataset"] = summary.name
     return frame
 

@@ -20,13 +20,8 @@ import numpy as np
 
 from touchbench.app.errors import FieldError, NotFoundError
 from touchbench.app.schemas.datasets import ImportRequest
-from touchbench.app.services.datasets import import_file
+from touchbench.app.services.datasets import add_made_dataset, dataset_schema, import_file
 from touchbench.app.store.database import Store
-from touchbench.app.store.datasets import (
-    add_dataset,
-    dataset_digest,
-    load_schema,
-)
 from touchbench.benchmark.dataset import Attribute, Dataset, Schema, shortlist
 from touchbench.benchmark.io.columns import ColumnChoice, ColumnError, plan_columns
 
@@ -94,7 +89,7 @@ def stored_data(
             return result.name, result.created
         if isinstance(data, Path) or any(sep in str(data) for sep in ("/", "\\", ".arff", ".csv")):
             raise NotFoundError(f"data: no file '{data}'")
-        info, schema, _ = load_schema(store, str(data))  # a stored data set: NotFoundError
+        info, schema = dataset_schema(store, str(data))  # a stored data set: NotFoundError
         if groups is not None or ignore:
             raise FieldError(
                 "groups" if groups else "ignore",
@@ -233,7 +228,7 @@ def _store_frame(
     if target is None:
         raise FieldError("target", "is required with a DataFrame: name the column to predict")
     dataset = frame_dataset(frame, target, groups, ignore, relation=name or "dataframe")
-    info, created = add_dataset(store, dataset, sha256=dataset_digest(dataset), name=name)
+    info, created = add_made_dataset(store, dataset, name=name)
     return info.name, created
 
 

@@ -36,17 +36,22 @@ def leaderboard_header(
 
 
 def leaderboard_rows(
-    board: Leaderboard, columns: Sequence[str], besides: Sequence[Beside] = ()
+    board: Leaderboard,
+    columns: Sequence[str],
+    besides: Sequence[Beside] = (),
+    *,
+    rows: Sequence[LeaderboardRow] | None = None,
 ) -> list[tuple[Any, ...]]:
     """Rank, classifier, (with runs beside: the run it comes from,) mark and
     ``mean ± std`` per column, ready for a table; a notes column when a row failed or
     stopped early (``dropped after fold 3 (p ..., mean so far ...), 3 folds``).  With runs
     beside, a classifier that only compares by its mean has ``=`` (means only) where a
-    mark would be."""
+    mark would be.  ``rows``: these of the board's only (a page showing the first), with
+    the columns of the whole board."""
     origins = row_runs(besides)
     notes = _has_notes(board)  # once: each row asking made the table quadratic
     out = []
-    for row in board.rows:
+    for row in board.rows if rows is None else rows:
         cells: list[Any] = [row.rank, row.classifier]
         if besides:
             cells.append(origins.get(row.classifier, "this"))

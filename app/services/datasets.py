@@ -392,6 +392,31 @@ def find_dataset(store: Store, ref: str | int) -> DatasetInfo:
     return stored.find_dataset(store, ref)
 
 
+def add_made_dataset(
+    store: Store, dataset: Dataset, *, name: str | None = None
+) -> tuple[DatasetInfo, bool]:
+    """Store a data set made in memory (a DataFrame's, a pair of arrays'), known by the
+    digest of its schema and values, so that storing it again finds the first.
+
+    Returns
+    -------
+    tuple of (DatasetInfo, bool)
+        The stored data set, and whether it was stored now (False: it was there).
+    """
+    return stored.add_dataset(store, dataset, sha256=stored.dataset_digest(dataset), name=name)
+
+
+def read_dataset(store: Store, ref: str | int) -> Dataset:
+    """A stored data set whole, values as WEKA encodes them.
+
+    Raises
+    ------
+    app.errors.NotFoundError
+        No such data set.
+    """
+    return stored.load_dataset(store, ref)
+
+
 def dataset_schema(store: Store, ref: str | int) -> tuple[DatasetInfo, Schema]:
     """The data set ``ref`` names and its attributes, without reading its instances.
 

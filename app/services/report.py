@@ -17,13 +17,14 @@ from touchbench.app.services.answers import RunAnswers, latest_learning_curve, r
 from touchbench.app.services.compare import Comparison, compare_runs, with_besides
 from touchbench.app.services.runs import (
     PerTargetSummary,
+    RankedRun,
     RunLeaderboard,
     per_target_summary,
     run_leaderboard,
 )
 from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import load_schema
-from touchbench.app.store.runs import RunInfo, get_run
+from touchbench.app.store.runs import RunInfo, get_run, load_results
 from touchbench.benchmark.errors import BenchmarkError, ConfigurationError
 from touchbench.benchmark.evaluation.score_table import MissingPolicy, ScoreTable, fold_score_table
 from touchbench.benchmark.results import TaskResult
@@ -188,7 +189,21 @@ def run_view(
     """A run with its leaderboard (marks against ``baseline``, default the best; with the
     classifiers of the runs ``beside`` it), results and class labels."""
     ranked = run_leaderboard(store, run_ref, metric=metric, baseline=baseline, beside=beside)
-    run, board, results = ranked.run, ranked.board, ranked.results
+    return _view(store, ranked, ranked.results)
+
+
+def page_view(store: Store, ranked: RankedRun, classifiers: Sequence[str]) -> RunView:
+    """A ranked run (:func:`~app.services.runs.ranked_run`) with the fold results of
+    ``classifiers`` only: what a page that draws a few of a run's classifiers needs, read
+    without the thousands of others (an imported results file)."""
+    results = load_results(store, ranked.run.id, classifiers=classifiers)
+    return _view(store, ranked, results)
+
+
+def _view(store: Store, ranked: RunLeaderboard | RankedRun, results: list[TaskResult]) -> RunView:
+    """``ranked`` with ``results``, the class labels of its targets and, for a multi-target
+    run, the per-target scores of the classifiers ``results`` has."""
+    run, board = ranked.run, ranked.board
     _, schema, _ = load_schema(store, run.dataset_id)
     labels = {}
     for target in run.targets:

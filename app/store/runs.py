@@ -237,6 +237,42 @@ def get_run(store: Store, run_id: int | str) -> RunInfo:
         return _infos(session, [_row(session, run_id)])[0]
 
 
+def results_version(store: Store, run_id: int | str) -> tuple[Any, ...]:
+    """What tells one state of a run's results from another, read without the run's
+    configuration or classifiers (light for a run of thousands): its id and creation time
+    (a run stored anew under a freed id differs), its status and end, its results and
+    failures counted, and its dropped entries with their folds.
+
+    Raises
+    ------
+    NotFoundError
+        No such run.
+    """
+    text = str(run_id)
+    with store.session() as session:
+        found = None
+        if is_row_id(text):
+            found = session.execute(
+                select(RunRow.id, RunRow.created_at, RunRow.status, RunRow.finished_at).where(
+                    RunRow.id == int(text)
+                )
+            ).one_or_none()
+        if found is None:
+            _row(session, run_id)  # says which runs there are
+            raise NotFoundError(f"no run '{text}'")
+        results = session.execute(
+            select(func.count(), func.sum(case((FoldResultRow.status != "ok", 1), else_=0))).where(
+                FoldResultRow.run_id == found.id
+            )
+        ).one()
+        drops = session.execute(
+            select(func.count(), func.sum(EntryDropRow.after_fold)).where(
+                EntryDropRow.run_id == found.id
+            )
+        ).one()
+        return (*found, results[0], results[1] or 0, drops[0], drops[1] or 0)
+
+
 def list_runs(
     store: Store,
     *,
@@ -432,23 +468,31 @@ def finished_keys(store: Store, run_id: int) -> set[TaskKey]:
         return {TaskKey(*key) for key in _keys(session, run_id)}
 
 
-def load_results(store: Store, run_id: int) -> list[TaskResult]:
-    with store.session() as session:
-        rows = session.execute(  # columns, not ORM objects: a large run loads several times faster
-            select(
-                FoldResultRow.classifier,
-                FoldResultRow.repeat,
-                FoldResultRow.fold,
-                FoldResultRow.status,
-                FoldResultRow.error,
-                FoldResultRow.metrics,
-                FoldResultRow.confusion,
-                FoldResultRow.n_train,
-                FoldResultRow.n_test,
-            )
-            .where(FoldResultRow.run_id == run_id)
-            .order_by(FoldResultRow.classifier, FoldResultRow.repeat, FoldResultRow.fold)
+def load_results(
+    store: Store, run_id: int, *, classifiers: Sequence[str] | None = None
+) -> list[TaskResult]:
+    """The run's fold results, by classifier, repeat and fold; of ``classifiers`` only when
+    given (a page that draws a few of a run's thousands)."""
+    query = (
+        select(
+            FoldResultRow.classifier,
+            FoldResultRow.repeat,
+            FoldResultRow.fold,
+            FoldResultRow.status,
+            FoldResultRow.error,
+            FoldResultRow.metrics,
+            FoldResultRow.confusion,
+            FoldResultRow.n_train,
+            FoldResultRow.n_test,
         )
+        .where(FoldResultRow.run_id == run_id)
+        .order_by(FoldResultRow.classifier, FoldResultRow.repeat, FoldResultRow.fold)
+    )
+    if classifiers is not None:
+        query = query.where(FoldResultRow.classifier.in_(list(classifiers)))
+    with store.session() as session:
+        # columns, not ORM objects: a large run loads several times faster
+        rows = session.execute(query)
         results = []
         for classifier, repeat, fold, status, error, stored, confusion, n_train, n_test in rows:
             metrics = dict(stored)
@@ -491,6 +535,8 @@ def _stored_metrics(result: TaskResult) -> dict[str, Any]:
 
 def _undefined_as_nan(scores: dict[str, Any]) -> dict[str, Any]:
     """Scores as read: null (an undefined score) back to NaN."""
+    if None not in scores.values():  # most rows: no copy
+        return scores
     return {name: math.nan if value is None else value for name, value in scores.items()}
 
 

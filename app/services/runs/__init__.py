@@ -9,7 +9,8 @@ One module per reason to change:
 - :mod:`.plan`: a request checked against its data set and stored (:func:`create_run`);
 - :mod:`.execute`: a stored run carried out (:func:`execute_run`);
 - :mod:`.stopping`: entries stopped early by a race, a budget or a stop;
-- :mod:`.leaderboard`: a run's leaderboard from its stored results (:func:`run_leaderboard`);
+- :mod:`.leaderboard`: a run's leaderboard from its stored results (:func:`run_leaderboard`),
+  ranked once per version of a run's results for the web page (:func:`ranked_run`);
 - :mod:`.independent`: each target of a multi-target data set benchmarked on its own.
 
 The names below are the package's public face, what adapters and other services import.
@@ -20,8 +21,11 @@ from touchbench.app.services.runs.independent import IndependentResult, independ
 from touchbench.app.services.runs.leaderboard import (
     NoResultsError,
     PerTargetSummary,
+    RankedRun,
     RunLeaderboard,
+    kept,
     per_target_summary,
+    ranked_run,
     run_leaderboard,
 )
 from touchbench.app.services.runs.memory import task_memory
@@ -35,6 +39,7 @@ __all__ = [
     "IndependentResult",
     "NoResultsError",
     "PerTargetSummary",
+    "RankedRun",
     "RunCancelled",
     "RunLeaderboard",
     "RunOptions",
@@ -45,8 +50,10 @@ __all__ = [
     "execute_run",
     "fold_plan",
     "independent_runs",
+    "kept",
     "per_target_summary",
     "prepare_problem",
+    "ranked_run",
     "run_leaderboard",
     "task_memory",
 ]

@@ -1,14 +1,23 @@
 """A run's leaderboard from its stored results: ranked, marked against a baseline, with runs
 beside it, per-target scores and what the race, the budget or a stop left out.
+
+The web page asks for the same run's leaderboard again and again (its fragments, each
+sort, each visitor): :func:`ranked_run` ranks a run once per version of its results and
+keeps the ranking without the fold results, so that a run of thousands of classifiers (an
+imported results file) costs its statistics once, not on every fragment.
 """
 
 from __future__ import annotations
 
 # Imports inside functions: start-up time: the statistics (scipy) load when a leaderboard
 # is first built, not when the API's routes or the listing commands import this module.
-from collections.abc import Sequence
+import gc
+import threading
+from collections import OrderedDict
+from collections.abc import Callable, Hashable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, TypeVar, cast
 
 import numpy as np
 
@@ -28,13 +37,15 @@ from touchbench.app.services.runs.ranking import check_metric, run_metric
 from touchbench.app.services.runs.stopping import RACE_TEST, never_started
 from touchbench.app.store.database import Store
 from touchbench.app.store.drops import load_drops
-from touchbench.app.store.runs import RunInfo, get_run, load_results
+from touchbench.app.store.runs import RunInfo, get_run, load_results, results_version
 from touchbench.benchmark.errors import ConfigurationError
 from touchbench.benchmark.results import Drop, Origin, TaskResult
 
 if TYPE_CHECKING:  # scipy.stats (significance) loads when a leaderboard is first built
     from touchbench.benchmark.evaluation.leaderboard import Leaderboard
 
+
+T = TypeVar("T")
 
 #: Why a run has no results yet, when it is under way (:data:`app.schemas.status.UNFINISHED`).
 _UNDER_WAY = {
@@ -249,6 +260,142 @@ def run_origins(run: RunInfo) -> dict[str, Origin]:
         entry: Origin(origin.kind, tuple(origin.entries))
         for entry, origin in run.config.origins.items()
     }
+
+
+@dataclass(frozen=True)
+class RankedRun:
+    """A run's leaderboard as the web page shows it: the ranking and its report, without
+    the fold results they were computed from (:func:`ranked_run` keeps these).
+
+    Attributes
+    ----------
+    run : RunInfo
+        The run as it was when ranked.
+    board : Leaderboard
+    besides : tuple of Beside
+    drops : dict of str to Drop
+    report : LeaderboardSchema
+        :meth:`RunLeaderboard.report` of the ranking.
+    """
+
+    run: RunInfo
+    board: Leaderboard
+    besides: tuple[Beside, ...]
+    drops: dict[str, Drop]
+    report: LeaderboardSchema
+
+    def notes(self) -> list[str]:
+        """What the leaderboard's notes say (:meth:`RunLeaderboard.notes`)."""
+        return list(self.report.notes)
+
+
+class _Kept:
+    """What was computed last of runs, by store, run version and what was asked; what is
+    asked for again while it is computed waits for it rather than computing it twice."""
+
+    def __init__(self) -> None:
+        self._kept: OrderedDict[Hashable, Any] = OrderedDict()
+        self._computing: dict[Hashable, threading.Lock] = {}
+        self._lock = threading.Lock()
+
+    def get(self, key: Hashable, compute: Callable[[], T], size: int) -> T:
+        with self._lock:
+            if key in self._kept:
+                self._kept.move_to_end(key)
+                return cast(T, self._kept[key])
+            computing = self._computing.setdefault(key, threading.Lock())
+        with computing:
+            with self._lock:
+                if key in self._kept:
+                    return cast(T, self._kept[key])
+            try:
+                with _no_collection_pauses():
+                    made = compute()
+            finally:
+                with self._lock:
+                    self._computing.pop(key, None)
+            with self._lock:
+                self._kept[key] = made
+                while len(self._kept) > size:
+                    self._kept.popitem(last=False)
+            return made
+
+
+_KEPT = _Kept()
+_PAUSED = [0]  # computations under way that paused the collector
+_PAUSED_LOCK = threading.Lock()
+
+
+@contextmanager
+def _no_collection_pauses() -> Iterator[None]:
+    """No full garbage collection while a run is ranked, and what was made moved out of the
+    collector's reach afterwards.
+
+    A full collection holds every thread of the service (its predictions too) for as long
+    as it takes to go through the heap, and ranking a run of thousands of classifiers
+    allocates enough to start several; what is then kept would make every later one
+    longer.  So the collector waits while a ranking (or a plot) is computed; then the
+    young generations alone are collected (the cycles it left), and what survives is
+    frozen (:func:`gc.freeze`): reference counting still frees it when it is dropped (a
+    ranking holds no reference cycle).
+    """
+    with _PAUSED_LOCK:
+        _PAUSED[0] += 1
+        gc.disable()
+    try:
+        yield
+    finally:
+        with _PAUSED_LOCK:
+            _PAUSED[0] -= 1
+            if not _PAUSED[0]:
+                # the young generations only (what was made meanwhile, not the heap): the
+                # cycles a computation left (a figure's) go before the rest is frozen
+                gc.collect(1)
+                gc.freeze()
+                gc.enable()
+
+
+def kept(store: Store, runs: Sequence[int | str], asked: Hashable, compute: Callable[[], T]) -> T:
+    """What ``compute`` makes of ``runs`` (a run and the runs beside it) for ``asked``,
+    computed once per version of their results (:func:`~app.store.runs.results_version`,
+    one light query a run) and kept for the next pages: the setting ``ranking_cache``
+    says how many a service process keeps.  Nothing is kept when ``compute`` raises.
+
+    Raises
+    ------
+    NotFoundError
+        No such run.
+    """
+    from touchbench.app.settings import get_settings
+
+    key = (store.url, tuple(results_version(store, run) for run in runs), asked)
+    return _KEPT.get(key, compute, get_settings().ranking_cache)
+
+
+def ranked_run(
+    store: Store,
+    run_id: int | str,
+    *,
+    metric: str | None = None,
+    baseline: str | None = None,
+    beside: Sequence[int | str] = (),
+) -> RankedRun:
+    """A run's leaderboard as :func:`run_leaderboard` makes it, computed once per version
+    of the run's results and of the runs ``beside`` it (:func:`kept`): a page asking
+    again costs a light query per run, not the run's configuration read again.
+
+    Raises
+    ------
+    NoResultsError, ConfigurationError
+        As :func:`run_leaderboard`; nothing is kept then.
+    """
+    others = list(dict.fromkeys(beside))
+
+    def compute() -> RankedRun:
+        ranked = run_leaderboard(store, run_id, metric=metric, baseline=baseline, beside=others)
+        return RankedRun(ranked.run, ranked.board, ranked.besides, ranked.drops, ranked.report())
+
+    return kept(store, [run_id, *others], ("ranking", metric, baseline), compute)
 
 
 PerTargetSummary = dict[str, dict[str, dict[str, tuple[float, float]]]]

@@ -55,12 +55,12 @@ def model(model: Ref, store: StoreDep) -> HTMLResponse:
 
 def _score(store: Store, found: ModelInfo) -> str:
     """The version's classifier's mean score in the run it came from (``-``: none)."""
-    from touchbench.app.services.runs import NoResultsError, run_leaderboard
+    from touchbench.app.services.runs import NoResultsError, ranked_run
 
     if found.run_id is None:
         return "-"
     try:
-        board = run_leaderboard(store, found.run_id).board
+        board = ranked_run(store, found.run_id).board
         mean = board.row(found.classifier).metrics[board.metric][0]
     except (AppError, BenchmarkError, NoResultsError, KeyError):
         return "-"

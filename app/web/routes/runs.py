@@ -4,13 +4,17 @@ the form that starts a run.
 
 A run may have thousands of classifiers (an imported results file): its fragments show the
 first of them and a count, as data set pages do (:mod:`app.reports.bounds`), and its
-plots draw the best of them with a note; the JSON API and the CLI give every one.
+plots draw the best of them with a note; the JSON API and the CLI give every one.  The work
+is bounded too: the ranking is computed once per version of the run's results
+(:func:`~app.services.runs.ranked_run`), and a plot reads the fold results of the
+classifiers it draws only.
 """
 
 from __future__ import annotations
 
 # Imports inside functions: start-up time: matplotlib, the catalogue and the reports load
 # when a fragment that draws or lists them is first asked for, not when the service starts.
+from collections.abc import Callable
 from dataclasses import replace
 from functools import partial
 from typing import TYPE_CHECKING, Annotated, Any
@@ -27,10 +31,10 @@ from touchbench.app.schemas.status import FINAL, RESUMABLE, Status
 from touchbench.app.services.answers import run_answers
 from touchbench.app.services.lifecycle import count_runs, get_run, list_runs
 from touchbench.app.services.listing import count_datasets, list_datasets
-from touchbench.app.services.runs import NoResultsError, run_leaderboard
+from touchbench.app.services.runs import NoResultsError, kept, ranked_run
 from touchbench.app.web.deps import StoreDep
 from touchbench.app.web.listing import newest
-from touchbench.app.web.rendering import draw, render
+from touchbench.app.web.rendering import Plot, draw, render
 from touchbench.app.web.request_form import form_fields, grouped
 from touchbench.app.web.routes.pages import Ref
 
@@ -38,7 +42,7 @@ from touchbench.app.web.routes.pages import Ref
 # them, so that the service starts at once.
 if TYPE_CHECKING:
     from touchbench.app.services.report import RunView
-    from touchbench.app.services.runs import RunLeaderboard
+    from touchbench.app.services.runs import RankedRun
 
 router = APIRouter(prefix="/fragments/runs", include_in_schema=False)
 
@@ -121,7 +125,7 @@ def leaderboard(
     ``beside``: other runs' classifiers too (a paper's imported results), t-tested where
     the folds pair and by their means where they do not."""
     try:
-        ranked = run_leaderboard(
+        ranked = ranked_run(
             store,
             run_id,
             metric=metric or None,
@@ -135,7 +139,7 @@ def leaderboard(
         run=ranked.run,
         board=ranked.board,
         table=_table(ranked, chosen_baseline=baseline or None),
-        tables=[_first_rows(table) for table in run_tables(ranked.report())],
+        tables=[_first_rows(table) for table in run_tables(ranked.report)],
         answers=run_answer_tables(run_answers(store, run_id)),
         notes=ranked.notes(),
     )
@@ -145,30 +149,45 @@ def leaderboard(
 def plots(run_id: int, store: StoreDep, metric: Metric = None) -> HTMLResponse:
     """Every fold's score, per-target scores and class counts."""
     from touchbench.app.reports import figures
-    from touchbench.app.services.report import run_view
+    from touchbench.app.services.report import page_view
 
-    run = get_run(store, run_id)
-    if run.n_results == 0:
-        return render("fragments/plots.html.j2", plots=[])
-    view = run_view(store, run.id, metric=metric or None)
-    drawn = [draw(f"{view.metric} of every fold", partial(figures.folds_figure, view))]
-    if view.per_target is not None:
-        drawn.append(draw("Accuracy per target", partial(figures.targets_figure, view)))
-    drawn.append(draw("Instances per class", partial(figures.classes_figure, view)))
-    return render("fragments/plots.html.j2", plots=drawn)
+    def drawn() -> list[Plot]:
+        ranked = ranked_run(store, run_id, metric=metric or None)
+        own = set(ranked.run.classifiers)
+        best = [row.classifier for row in ranked.board.rows if row.classifier in own]
+        view = page_view(store, ranked, best[: bounds.DRAWN])
+        plots = [draw(f"{view.metric} of every fold", partial(figures.folds_figure, view))]
+        if view.per_target is not None:
+            plots.append(draw("Accuracy per target", partial(figures.targets_figure, view)))
+        plots.append(draw("Instances per class", partial(figures.classes_figure, view)))
+        return plots
+
+    # drawn once per version of the run's results, as its ranking is
+    try:
+        plots = kept(store, [run_id], ("plots", metric or None), drawn)
+    except NoResultsError:
+        plots = []
+    return render("fragments/plots.html.j2", plots=plots)
 
 
 @router.get("/{run_id}/calibration", response_class=HTMLResponse)
 def calibration(run_id: int, store: StoreDep) -> HTMLResponse:
-    """Every classifier's calibration (table) and the best ones' reliability diagram; why
-    there is none for a regression or an imported run (no predictions kept)."""
-    from touchbench.app.services.report import run_view
+    """The calibration of the classifiers the plots draw (a table) and their reliability
+    diagram; why there is none for a regression or an imported run (no predictions kept)."""
+    from touchbench.app.services.report import page_view
 
-    run = get_run(store, run_id)
-    if run.n_results == 0:
-        return render("fragments/calibration.html.j2", sure=None)
-    view = run_view(store, run.id)
-    return render("fragments/calibration.html.j2", sure=_calibration(view))
+    def made() -> dict[str, Any]:
+        ranked = ranked_run(store, run_id)
+        own = set(ranked.run.classifiers)
+        best = [row.classifier for row in ranked.board.rows if row.classifier in own]
+        return _calibration(page_view(store, ranked, best[: bounds.DRAWN]))
+
+    # computed once per version of the run's results, as its ranking is
+    try:
+        sure = kept(store, [run_id], ("calibration",), made)
+    except NoResultsError:
+        sure = None
+    return render("fragments/calibration.html.j2", sure=sure)
 
 
 def _calibration(view: RunView) -> dict[str, Any]:
@@ -225,17 +244,18 @@ def classifier(
     """A classifier's confusion matrix, its scores and its folds beside the baseline's."""
     from touchbench.app.reports import figures
     from touchbench.app.reports.leaderboard import mean_std
-    from touchbench.app.services.report import run_view
+    from touchbench.app.services.report import page_view
 
-    view = run_view(store, run_id, metric=metric or None, baseline=baseline or None)
-    if classifier not in view.run.classifiers:
+    ranked = ranked_run(store, run_id, metric=metric or None, baseline=baseline or None)
+    if classifier not in ranked.run.classifiers:
         raise NotFoundError(
-            f"run {view.run.id} has no classifier '{classifier}' "
-            f"(classifiers: {bounds.names(view.run.classifiers)})"
+            f"run {ranked.run.id} has no classifier '{classifier}' "
+            f"(classifiers: {bounds.names(ranked.run.classifiers)})"
         )
-    row = view.board.row(classifier)
-    reference = view.board.baseline or classifier
+    reference = ranked.board.baseline or classifier
     shown = list(dict.fromkeys([classifier, reference]))
+    view = page_view(store, ranked, shown)
+    row = view.board.row(classifier)
     return render(
         "fragments/classifier.html.j2",
         view=view,
@@ -252,12 +272,17 @@ def classifier(
 
 
 def _how_sure(view: RunView, classifier: str) -> dict[str, Any] | None:
-    """The classifier's per-class tables and its calibration (none for a regression)."""
+    """The classifier's per-class tables and its calibration (none for a regression or an
+    imported run)."""
     from touchbench.app.reports import figures
     from touchbench.app.reports.certainty_tables import calibrations, class_tables
     from touchbench.app.services.certainty import certainty_of
+    from touchbench.app.services.imported import is_imported
 
-    if view.run.kind == "regression" or not view.board.row(classifier).n_ok:
+    # an imported results file keeps no confusion matrices or probabilities
+    if view.run.kind == "regression" or is_imported(view.run):
+        return None
+    if not view.board.row(classifier).n_ok:
         return None
     certainty = certainty_of(view, [classifier])
     [entry] = certainty.classifiers
@@ -293,7 +318,7 @@ def _folds(view: RunView, shown: list[str]) -> dict[str, Any]:
     }
 
 
-def _table(ranked: RunLeaderboard, *, chosen_baseline: str | None) -> dict[str, Any]:
+def _table(ranked: RankedRun, *, chosen_baseline: str | None) -> dict[str, Any]:
     """The leaderboard's header (metric columns sortable), rows, and the pickers' options;
     with runs beside it, where each row comes from and how it is compared."""
     from touchbench.app.reports.leaderboard import (
@@ -307,7 +332,9 @@ def _table(ranked: RunLeaderboard, *, chosen_baseline: str | None) -> dict[str, 
     run, board, besides = ranked.run, ranked.board, ranked.besides
     columns = metric_columns(run, board)
     metrics = sorted({name for row in board.rows for name in row.metrics})
-    rows = _first_and_baseline(leaderboard_rows(board, columns, besides), board.baseline)
+    # the rows shown only are formatted (a run may have thousands)
+    shown = _first_and_baseline(board.rows, board.baseline, at="classifier")
+    rows = bounds.Shown(leaderboard_rows(board, columns, besides, rows=shown.items), shown.more)
     baselines = [row.classifier for row in board.rows if row.n_ok]
     return {
         "header": leaderboard_header(board, columns, besides),
@@ -327,13 +354,20 @@ def _table(ranked: RunLeaderboard, *, chosen_baseline: str | None) -> dict[str, 
 
 
 def _first_and_baseline(
-    rows: list[Any], baseline: str | None, *, at: int | None = 1
+    rows: list[Any], baseline: str | None, *, at: int | str | None = 1
 ) -> bounds.Shown[Any]:
-    """The first :data:`~app.reports.bounds.CLASSIFIERS` of ``rows`` (classifiers, or
-    table rows naming one in cell ``at``), and the baseline's after them when it ranks
-    lower: the row every mark is against stays on the page."""
+    """The first :data:`~app.reports.bounds.CLASSIFIERS` of ``rows`` (classifiers, table
+    rows naming one in cell ``at``, or leaderboard rows naming one in attribute ``at``),
+    and the baseline's after them when it ranks lower: the row every mark is against
+    stays on the page."""
     shown = bounds.first(rows, bounds.CLASSIFIERS)
-    named = (lambda row: row) if at is None else (lambda row: row[at])
+    named: Callable[[Any], Any]
+    if at is None:
+        named = lambda row: row  # noqa: E731
+    elif isinstance(at, str):
+        named = lambda row: getattr(row, at)  # noqa: E731
+    else:
+        named = lambda row: row[at]  # noqa: E731
     if baseline is not None and shown.more and all(named(r) != baseline for r in shown.items):
         extra = [row for row in rows[bounds.CLASSIFIERS :] if named(row) == baseline]
         return bounds.Shown(shown.items + extra, shown.more - len(extra))

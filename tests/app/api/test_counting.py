@@ -4,12 +4,13 @@ to the validation."""
 
 from __future__ import annotations
 
+import itertools
 import json
 
 import pytest
 from fastapi.exceptions import RequestValidationError
 
-from touchbench.app.api.counting import check_counts, limited_lists
+from touchbench.app.api.counting import DepthScan, check_counts, depth_problem, limited_lists
 from touchbench.app.schemas.models import PredictRequest
 
 LISTS = {"instances": 5}
@@ -49,3 +50,56 @@ def test_bodies_within_the_limits_or_not_the_object_expected_pass_through() -> N
     _accepted({"instances": "not a list", "other": [1] * 100})
     for broken in (b"", b"[1, 2]", b'{"instances": [1, 2', b'{"instances" [1]}', b"\xff\xfe"):
         _accepted(broken + b" " * 100)  # long enough to be scanned
+
+
+# -- depth, as the chunks stream in ------------------------------------------------------------
+
+#: Brackets, quotes and backslashes inside strings, wherever a chunk may end.
+NESTED = {"a": "[[[[", "b": [[{"c": '"]]]\\'}, "\\"], [[[['x"[', 1]]]]], "d": "{"}
+DEEP_WITH_STRINGS = json.dumps(NESTED).encode()
+
+
+def _depth(value: object) -> int:
+    if isinstance(value, dict):
+        return 1 + max((_depth(v) for v in value.values()), default=0)
+    if isinstance(value, list):
+        return 1 + max((_depth(v) for v in value), default=0)
+    return 0
+
+
+def _fed(body: bytes, cuts: list[int], max_depth: int) -> str | None:
+    scan = DepthScan(max_depth)
+    edges = [0, *cuts, len(body)]
+    for i, (start, end) in enumerate(itertools.pairwise(edges)):
+        problem = scan.feed(body[start:end], last=i == len(edges) - 2)
+        if problem is not None:
+            return problem
+    return None
+
+
+@pytest.mark.parametrize("max_depth", [4, 5, 6])
+def test_the_depth_is_the_same_however_the_body_is_cut(max_depth: int) -> None:
+    deepest = _depth(NESTED)
+    assert deepest == 6  # the object, "b"'s list, then [[[[ around 'x"['
+    for one in range(len(DEEP_WITH_STRINGS) + 1):
+        for two in range(one, len(DEEP_WITH_STRINGS) + 1, 7):
+            problem = _fed(DEEP_WITH_STRINGS, [one, two], max_depth)
+            assert (problem is not None) == (deepest > max_depth), (one, two, problem)
+    assert (depth_problem(DEEP_WITH_STRINGS, max_depth=max_depth) is not None) == (
+        deepest > max_depth
+    )
+
+
+def test_a_deep_body_is_refused_at_its_first_chunk() -> None:
+    scan = DepthScan()
+    problem = scan.feed(b'{"instances": [' + b"[" * 65_536)
+    assert problem is not None and "deeper than the 64 levels allowed" in problem
+    assert "within its first 4,096 bytes" in problem  # a small piece first
+
+
+def test_brackets_in_a_string_left_open_by_a_chunk_do_not_count() -> None:
+    scan = DepthScan(max_depth=2)
+    assert scan.feed(b'{"a": "' + b"[" * 100 + b"\\") is None
+    assert scan.feed(b'"' + b"[" * 100 + b'", "b": [1]') is None
+    assert scan.feed(b"}") is None
+    assert scan.depth == 0

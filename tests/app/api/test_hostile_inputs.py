@@ -218,7 +218,10 @@ def test_a_100000_deep_json_body_is_refused_with_422(served: Server) -> None:
     for path in ("/api/models/takes-nb/predict", "/api/models", "/api/runs"):
         answer = served.client.post(path, content=deep_json(100_000), headers=headers)
         assert answer.status_code == 422, (path, answer.text[:500])
-        assert "JSON nested 100,002 levels deep, deeper than the 64 allowed" in answer.text
+        assert "JSON nested deeper than the 64 levels allowed" in answer.text
+        # refused at the chunk that passed the limit, not once the whole body was read
+        read = re.search(r"within its first ([\d,]+) bytes", answer.text)
+        assert read is not None and int(read[1].replace(",", "")) < len(deep_json(100_000))
     # brackets inside strings are not nesting
     flat = b'{"instances": [{"a": "' + b"[" * 1000 + b'"}]}'
     answer = served.client.post("/api/models/takes-nb/predict", content=flat, headers=headers)
@@ -297,6 +300,21 @@ def test_a_run_of_3000_classifiers_shows_the_first_and_a_count(
     assert any(f"first {bounds.DRAWN} of 3,000 classifiers" in text for text in texts), texts
     drawn = {text for text in texts if re.fullmatch(r"c\d{4}", text)}
     assert len(drawn) == bounds.DRAWN
+
+    # asked again (ranked and drawn once per version of the run's results): the same
+    assert served.client.get(f"/fragments/runs/{run}/leaderboard").text == board.text
+    assert served.client.get(f"/fragments/runs/{run}/plots").text == plots.text
+
+    # the run's page, its progress and a classifier's fragment (an imported run: no
+    # confusion matrix nor calibration, said as such) are bounded too
+    page = served.client.get(f"/runs/{run}")
+    assert page.status_code == 200 and len(page.content) < 20_000
+    progress = served.client.get(f"/fragments/runs/{run}/progress")
+    assert progress.status_code == 200, progress.text[:2000]
+    assert "3000 classifiers" in progress.text and len(progress.content) < 20_000
+    last = served.client.get(f"/fragments/runs/{run}/classifiers/c2999")
+    assert last.status_code == 200, last.text[:2000]
+    assert "no confusion matrix" in last.text and len(last.content) < 1_000_000
 
     # everything is still in the JSON
     everything = served.client.get(f"/api/runs/{run}/leaderboard").json()

@@ -1,0 +1,1 @@
+"""The web page's routes: its pages, and the fragments they load (behind the key)."""

@@ -1,0 +1,112 @@
+"""A run's ranking for the web page, computed once per version of its results and kept
+(:func:`app.services.runs.ranked_run`), and pages that read the fold results of the
+classifiers they draw only (:func:`app.services.report.page_view`), on SQLite and
+PostgreSQL."""
+
+from __future__ import annotations
+
+import gc
+import weakref
+from pathlib import Path
+
+import pytest
+
+from tests.support.hostile_inputs import results_arff
+from tests.support.synthetic import touch_arff
+from touchbench.app.errors import NotFoundError
+from touchbench.app.schemas.datasets import ImportRequest
+from touchbench.app.schemas.imported import ImportResultsRequest
+from touchbench.app.services.datasets import import_file
+from touchbench.app.services.imported import import_results
+from touchbench.app.services.report import page_view
+from touchbench.app.services.runs import kept, ranked_run, run_leaderboard
+from touchbench.app.store.database import Store
+from touchbench.app.store.runs import record_result
+from touchbench.benchmark.results import TaskKey, TaskResult
+
+
+@pytest.fixture
+def imported(store: Store, tmp_path: Path) -> int:
+    """A run of 40 classifiers imported from a results file."""
+    data = touch_arff(tmp_path / "paper.arff", n=90, with_place=False)
+    import_file(store, ImportRequest(file=data, name="paper"))
+    results = results_arff(tmp_path / "results.arff", n_classifiers=40)
+    return import_results(store, ImportResultsRequest(file=results, dataset="paper")).id
+
+
+def test_a_ranking_is_computed_once_per_version_of_the_results(store: Store, imported: int) -> None:
+    first = ranked_run(store, imported)
+    assert ranked_run(store, imported) is first
+    # what it kept is what the leaderboard says
+    fresh = run_leaderboard(store, imported)
+    assert [r.classifier for r in first.board.rows] == [r.classifier for r in fresh.board.rows]
+    assert first.report == fresh.report()
+    assert len(first.board.rows) == 40
+
+    by_kappa = ranked_run(store, imported, metric="kappa")
+    assert by_kappa is not first and by_kappa.board.metric == "kappa"
+    assert ranked_run(store, imported, metric="kappa") is by_kappa
+
+    # one more fold result: another version, ranked again with it
+    best = first.board.rows[-1].classifier
+    metrics = {"accuracy": 1.0, "f1_weighted": 1.0, "kappa": 1.0}
+    record_result(
+        store, imported, TaskResult(TaskKey(best, 1, 0), "ok", None, metrics, None, 81, 9)
+    )
+    again = ranked_run(store, imported)
+    assert again is not first
+    assert again.run.n_results == first.run.n_results + 1
+    assert again.board.row(best).n_ok == first.board.row(best).n_ok + 1
+
+
+def test_nothing_is_kept_when_the_computation_fails(store: Store, imported: int) -> None:
+    calls: list[int] = []
+
+    def failing() -> int:
+        calls.append(1)
+        raise ValueError("no")
+
+    for _ in range(2):
+        with pytest.raises(ValueError):
+            kept(store, [imported], "failing", failing)
+    assert len(calls) == 2
+    assert kept(store, [imported], "failing", lambda: 7) == 7
+    assert kept(store, [imported], "failing", lambda: 8) == 7
+    assert kept(store, [str(imported)], "failing", lambda: 9) == 7  # the same run
+    with pytest.raises(NotFoundError, match="no run '999'"):
+        kept(store, [999], "failing", lambda: 10)
+
+
+def test_a_page_reads_the_results_of_the_classifiers_it_draws_only(
+    store: Store, imported: int
+) -> None:
+    ranked = ranked_run(store, imported)
+    best = [row.classifier for row in ranked.board.rows[:3]]
+    view = page_view(store, ranked, best)
+    assert {r.key.classifier for r in view.results} == set(best)
+    assert len(view.results) == 3 * 10
+    # the fold table still has a column per classifier of the run, in ranking order
+    table = view.fold_scores()
+    assert list(table.classifiers)[:3] == best and len(table.classifiers) == 40
+
+
+class _Node:
+    """An object in a reference cycle (as a figure's artists are)."""
+
+    def __init__(self) -> None:
+        self.me = self
+
+
+def test_a_computation_leaves_the_collector_on_and_no_cycle_frozen(
+    store: Store, imported: int
+) -> None:
+    left: list[weakref.ref[_Node]] = []
+
+    def compute() -> str:
+        assert not gc.isenabled()  # no full collection's pause while it computes
+        left.append(weakref.ref(_Node()))  # garbage in a cycle: only the collector frees it
+        return "made"
+
+    assert kept(store, [imported], "cycle", compute) == "made"
+    assert gc.isenabled()
+    assert left[0]() is None  # collected before what survived was frozen
