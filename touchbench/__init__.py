@@ -16,7 +16,8 @@ used.
 
 from __future__ import annotations
 
-from typing import Any
+# Nothing is imported here, not even typing: Ctrl-C while Python loads this package, before
+# the CLI can hear it, would print a traceback. __init__.pyi gives type checkers the names.
 
 #: The Python API, loaded when first used (``import touchbench`` stays cheap): name -> module.
 #: No import of them here, not even for type checkers: every part of touchbench imports
@@ -34,7 +35,7 @@ _LAZY = {
 __all__ = ["Client", "Leaderboard", "ServiceError", "bench", "extract", "simulate", "train"]
 
 
-def __getattr__(name: str) -> Any:
+def __getattr__(name: str) -> object:
     """``touchbench.bench`` and the rest of the Python API, imported on first use."""
     module = _LAZY.get(name)
     if module is None:

@@ -11,6 +11,7 @@ refused field is one :class:`app.errors.FieldError` naming it.  What was made is
 
 from __future__ import annotations
 
+# Imports inside functions: start-up time: the simulators load with the first simulate().
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path

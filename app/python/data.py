@@ -12,6 +12,7 @@ are set aside by the same rule an imported file's are
 
 from __future__ import annotations
 
+# Imports inside functions: start-up time: pandas loads when a DataFrame is read or made.
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any

@@ -11,6 +11,8 @@ leaves scaling to the estimator (a ``Pipeline`` of the caller's own does it if w
 
 from __future__ import annotations
 
+# Imports inside functions: start-up time: cloudpickle and scikit-learn load with the first
+# estimator of the caller's own.
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 

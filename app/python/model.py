@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+# Imports inside functions: start-up time: pandas loads with the first DataFrame predicted.
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 

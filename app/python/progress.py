@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+# Imports inside functions: start-up time: tqdm's notebook widgets load with the first bar.
 import warnings
 from typing import Any
 

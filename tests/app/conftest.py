@@ -69,3 +69,15 @@ def make_sqlite_server(tmp_path: Path) -> Iterator[Callable[..., Server]]:
 @pytest.fixture
 def server(make_server: Callable[..., Server]) -> Server:
     return make_server()
+
+
+@pytest.fixture(autouse=True)
+def _command_options_end_with_the_test() -> Iterator[None]:
+    """A test that builds a request as a command does (``build_request``, outside the CLI's
+    ``main``, which runs each command in a context of its own) names the options in the
+    test's context: they end with the test, as a command's end with its call."""
+    from touchbench.app.cli import requests
+
+    token = requests._options.set(requests._options.get())
+    yield
+    requests._options.reset(token)

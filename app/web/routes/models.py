@@ -3,6 +3,8 @@ that move them, its ONNX twin, and the forms that predict with it."""
 
 from __future__ import annotations
 
+# Imports inside functions: start-up time: the leaderboards' statistics load with the first
+# model page that shows a score.
 from functools import partial
 
 from fastapi import APIRouter

@@ -60,7 +60,7 @@ RUN_GROUPS = (
         ),
     ),
     ("racing and budget", ("race", "race_alpha", "budget_total")),
-    ("tuning and stacking", ("tune", "budget", "stack")),
+    ("tuning, stacking and ensembles", ("tune", "budget", "stack", "ensemble")),
     ("limits", ("timeout", "max_memory_mb")),
 )  # fmt: skip
 
