@@ -115,6 +115,10 @@ class SoundDeviceSource(Source):
     sample_format : {"int16", "int32", "float32"}
         What PortAudio delivers (scaled to full scale -1 to 1 here); 16-bit by default,
         the format every sound card has.
+    latency : {"low", "high"} or float, optional
+        PortAudio's suggested input latency (seconds, or the device's default low or high
+        one): a higher one gives the callback more room on a busy machine before the
+        device overflows; by default the device's low latency, for live prediction.
     """
 
     def __init__(
@@ -127,12 +131,14 @@ class SoundDeviceSource(Source):
         queue_seconds: float = 5.0,
         seconds: float | None = None,
         sample_format: str = "int16",
+        latency: str | float | None = None,
     ) -> None:
         if sample_format not in _SCALES:
             raise DriverError(
                 f"sample_format must be one of {', '.join(_SCALES)}, got '{sample_format}'"
             )
         self.sample_format = sample_format
+        self.latency = latency
         sd = portaudio()
         found = find_device(device)
         self.device = found
@@ -190,6 +196,7 @@ class SoundDeviceSource(Source):
                     samplerate=self.samplerate,
                     blocksize=self.block_length,
                     dtype=self.sample_format,
+                    latency=self.latency,
                     callback=self._callback,
                 )
                 self._stream.start()
