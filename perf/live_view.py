@@ -39,6 +39,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))  # the tests' helpers start the service
 CHROMIUM = Path(os.environ.get("TOUCHBENCH_CHROMIUM", "/usr/bin/chromium"))
 
 
