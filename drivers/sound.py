@@ -115,10 +115,6 @@ class SoundDeviceSource(Source):
     sample_format : {"int16", "int32", "float32"}
         What PortAudio delivers (scaled to full scale -1 to 1 here); 16-bit by default,
         the format every sound card has.
-    latency : {"low", "high"} or float, optional
-        PortAudio's suggested input latency (seconds, or the device's default low or high
-        one): a higher one gives the callback more room on a busy machine before the
-        device overflows; by default the device's low latency, for live prediction.
     """
 
     def __init__(
@@ -131,14 +127,12 @@ class SoundDeviceSource(Source):
         queue_seconds: float = 5.0,
         seconds: float | None = None,
         sample_format: str = "int16",
-        latency: str | float | None = None,
     ) -> None:
         if sample_format not in _SCALES:
             raise DriverError(
                 f"sample_format must be one of {', '.join(_SCALES)}, got '{sample_format}'"
             )
         self.sample_format = sample_format
-        self.latency = latency
         sd = portaudio()
         found = find_device(device)
         self.device = found
@@ -167,6 +161,7 @@ class SoundDeviceSource(Source):
         self._queue: queue.Queue[tuple[np.ndarray, float] | None] = queue.Queue(maxsize=depth)
         self.dropped = 0  # blocks the consumer was too slow for (queue full)
         self.xruns = 0  # callbacks whose input PortAudio reports as overflowed
+        self._received = 0  # frames the callback was handed within the take
         self._lock = threading.Lock()
         self._stream: Any = None
         self._sd = sd
@@ -177,6 +172,11 @@ class SoundDeviceSource(Source):
         return self.dropped + self.xruns
 
     def _callback(self, data: np.ndarray, frames: int, when: Any, status: Any) -> None:
+        # past the take's end the stream runs on until it is closed: what it then delivers,
+        # or loses, was never asked for and counts for nothing
+        if self.limit is not None and self._received >= self.limit:
+            return
+        self._received += frames
         if status.input_overflow:
             with self._lock:
                 self.xruns += 1
@@ -196,7 +196,6 @@ class SoundDeviceSource(Source):
                     samplerate=self.samplerate,
                     blocksize=self.block_length,
                     dtype=self.sample_format,
-                    latency=self.latency,
                     callback=self._callback,
                 )
                 self._stream.start()

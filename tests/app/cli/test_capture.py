@@ -84,11 +84,7 @@ def test_capture_returns_the_raw_file_samples(device: tuple[Path, np.ndarray]) -
     script = (
         "import numpy as np\n"
         "from touchbench.drivers.sound import SoundDeviceSource\n"
-        # the file plugin delivers as fast as it can: the high latency's room keeps a busy
-        # machine (the other test workers) from overflowing it
-        "with SoundDeviceSource(\n"
-        "    'replay', samplerate=44100, channels=3, seconds=2.0, latency='high'\n"
-        ") as s:\n"
+        "with SoundDeviceSource('replay', samplerate=44100, channels=3, seconds=2.0) as s:\n"
         "    blocks = list(s.blocks())\n"
         "x = np.concatenate([b.samples for b in blocks], axis=1)\n"
         "print(x.shape[1], s.overflows, all(b.arrived is not None for b in blocks))\n"
