@@ -7,19 +7,15 @@ origin can start none of these on the same (keyless) service."""
 
 from __future__ import annotations
 
-import functools
 import re
-import threading
 from collections.abc import Iterator
-from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pytest
 from playwright.sync_api import Response, expect
 
-from tests.support.browser import Tab, figure_texts, screen
+from tests.support.browser import Tab, figure_texts, screen, static_site
 from tests.support.service import Server, finished, servers
 from tests.support.synthetic import touch_arff
 from touchbench.app.schemas.runs import BenchRequest
@@ -203,20 +199,8 @@ async function attack(service, run) {
 def foreign_site(tmp_path: Path) -> Iterator[str]:
     """A second web server on loopback (another port: another origin) serving the page."""
     (tmp_path / "attack.html").write_text(ATTACK)
-
-    class Quiet(SimpleHTTPRequestHandler):
-        def log_message(self, format: str, *args: Any) -> None:
-            pass
-
-    httpd = ThreadingHTTPServer(("127.0.0.1", 0), functools.partial(Quiet, directory=str(tmp_path)))
-    thread = threading.Thread(target=httpd.serve_forever, daemon=True)
-    thread.start()
-    try:
-        yield f"http://127.0.0.1:{httpd.server_address[1]}"
-    finally:
-        httpd.shutdown()
-        httpd.server_close()
-        thread.join()
+    with static_site(tmp_path) as url:
+        yield url
 
 
 def test_a_page_on_another_origin_can_start_nothing(
