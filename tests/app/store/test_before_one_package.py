@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from tests.support.cli_runner import run_cli
+from tests.support.predictions import assert_same_predictions
 
 BEFORE = Path(__file__).parent / "data" / "before-one-package"
 
@@ -31,7 +32,7 @@ def test_a_model_stored_before_the_move_predicts_as_it_did(
     predicted = run_cli(capsys, old_store, "predict", model, str(data), "--json")
     assert predicted.code == 0, predicted.err
     expected = json.loads((BEFORE / f"predictions-{model}.json").read_text())
-    assert predicted.json()["predictions"] == expected
+    assert_same_predictions(predicted.json()["predictions"], expected)
 
 
 def test_the_old_store_lists_its_models(capsys: pytest.CaptureFixture[str], old_store: str) -> None:
