@@ -20,10 +20,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import lfilter
 
 from touchbench.drivers.errors import DriverError
 from touchbench.drivers.recording import Recording
+
+# Imports inside functions: start-up time: the service names the simulated sources among its
+# live sources, and scipy.signal, the largest import of a service's start, would load unused
 
 SAMPLERATE = 3200.0
 MOTOR_HZ = 170.0
@@ -94,6 +96,8 @@ def simulate_link_trial(contact: str, *, duration: float = 3.0, seed: int = 0) -
 
 def _resonate(x: np.ndarray, frequency: float, damping: float) -> np.ndarray:
     """``x`` through a two-pole resonator at ``frequency`` Hz with ``damping`` ratio."""
+    from scipy.signal import lfilter
+
     radius = np.exp(-2 * np.pi * frequency * damping / SAMPLERATE)
     angle = 2 * np.pi * frequency / SAMPLERATE
     return np.asarray(

@@ -23,11 +23,12 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.stats import chi2, norm, rankdata, studentized_range
-from scipy.stats import f as f_distribution
 
 from touchbench.benchmark.errors import ConfigurationError
 from touchbench.benchmark.evaluation.score_table import ScoreTable
+
+# Imports inside functions: start-up time: the service's run, fold and compare routes name
+# these tests, and scipy.stats, the largest import of a service's start, would load unused
 
 
 @dataclass(frozen=True)
@@ -167,6 +168,8 @@ def rank_scores(scores: np.ndarray, *, lower_is_better: bool = False) -> np.ndar
         )
     if np.isnan(scores).any():
         raise ConfigurationError("scores have missing cells: complete the table first")
+    from scipy.stats import rankdata
+
     return np.asarray(rankdata(scores if lower_is_better else -scores, axis=1), dtype=np.float64)
 
 
@@ -194,6 +197,9 @@ def friedman_test(ranks: np.ndarray, *, correct_ties: bool = False) -> FriedmanR
         correction = 1.0 - ties / (n * k * (k * k - 1))
         statistic = statistic / correction if correction > 0 else 0.0
     df, df_denominator = k - 1, (k - 1) * (n - 1)
+    from scipy.stats import chi2
+    from scipy.stats import f as f_distribution
+
     p_value = float(chi2.sf(statistic, df))
     denominator = n * (k - 1) - statistic
     if denominator <= 1e-12 * n * k:
@@ -211,6 +217,8 @@ def studentized_range_q(k: int, alpha: float) -> float:
     _check_alpha(alpha)
     if k < 2:
         raise ConfigurationError(f"the Nemenyi test needs at least 2 classifiers, got {k}")
+    from scipy.stats import studentized_range
+
     return float(studentized_range.ppf(1.0 - alpha, k, math.inf) / math.sqrt(2.0))
 
 
@@ -238,6 +246,8 @@ def nemenyi_p_values(average_ranks: np.ndarray, n_blocks: int) -> np.ndarray:
     k = average_ranks.size
     _check_size((n_blocks, k))
     q = np.abs(average_ranks[:, None] - average_ranks[None, :]) / _rank_standard_error(k, n_blocks)
+    from scipy.stats import studentized_range
+
     p_values = np.asarray(studentized_range.sf(q * math.sqrt(2.0), k, math.inf))
     np.fill_diagonal(p_values, 1.0)
     return np.minimum(p_values, 1.0)
@@ -277,6 +287,8 @@ def holm_test(
     _check_size((n_blocks, k))
     others = [i for i in range(k) if i != control]
     z = (average_ranks[control] - average_ranks[others]) / _rank_standard_error(k, n_blocks)
+    from scipy.stats import norm
+
     p = 2.0 * norm.sf(np.abs(z))
     order = np.argsort(p, kind="stable")
     m = len(others)
