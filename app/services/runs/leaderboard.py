@@ -328,16 +328,15 @@ _PAUSED_LOCK = threading.Lock()
 
 @contextmanager
 def _no_collection_pauses() -> Iterator[None]:
-    """No full garbage collection while a run is ranked, and what was made moved out of the
-    collector's reach afterwards.
+    """No full garbage collection while a run is ranked.
 
     A full collection holds every thread of the service (its predictions too) for as long
     as it takes to go through the heap, and ranking a run of thousands of classifiers
-    allocates enough to start several; what is then kept would make every later one
-    longer.  So the collector waits while a ranking (or a plot) is computed; then the
-    young generations alone are collected (the cycles it left), and what survives is
-    frozen (:func:`gc.freeze`): reference counting still frees it when it is dropped (a
-    ranking holds no reference cycle).
+    allocates enough to start several.  So the collector waits while a ranking (or a plot)
+    is computed; then the young generations alone are collected (the cycles it left).
+    Nothing is frozen (:func:`gc.freeze`): that would take the whole process's objects out
+    of the collector's reach, other requests' cycles in flight among them, which would then
+    never be freed.
     """
     with _PAUSED_LOCK:
         _PAUSED[0] += 1
@@ -349,9 +348,8 @@ def _no_collection_pauses() -> Iterator[None]:
             _PAUSED[0] -= 1
             if not _PAUSED[0]:
                 # the young generations only (what was made meanwhile, not the heap): the
-                # cycles a computation left (a figure's) go before the rest is frozen
+                # cycles a computation left (a figure's)
                 gc.collect(1)
-                gc.freeze()
                 gc.enable()
 
 

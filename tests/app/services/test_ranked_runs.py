@@ -97,7 +97,7 @@ class _Node:
         self.me = self
 
 
-def test_a_computation_leaves_the_collector_on_and_no_cycle_frozen(
+def test_a_computation_leaves_the_collector_on_and_its_cycles_freed(
     store: Store, imported: int
 ) -> None:
     left: list[weakref.ref[_Node]] = []
@@ -110,3 +110,16 @@ def test_a_computation_leaves_the_collector_on_and_no_cycle_frozen(
     assert kept(store, [imported], "cycle", compute) == "made"
     assert gc.isenabled()
     assert left[0]() is None  # collected before what survived was frozen
+
+
+def test_a_cycle_alive_during_a_computation_is_freed_once_dropped(
+    store: Store, imported: int
+) -> None:
+    """What other requests hold while a run is ranked stays in the collector's reach: a
+    cycle of theirs dropped afterwards is freed (nothing frozen)."""
+    held = _Node()  # another request's, in flight while the ranking is computed
+    watched = weakref.ref(held)
+    assert kept(store, [imported], "held", lambda: "made") == "made"
+    del held
+    gc.collect()
+    assert watched() is None
