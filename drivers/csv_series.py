@@ -24,8 +24,11 @@ and column where there is one.
 
 from __future__ import annotations
 
+import bisect
+import copy
 import csv
 import itertools
+from array import array
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -144,9 +147,9 @@ def read_csv_series(
     if repeats.any():
         repeated = (
             f"{int(repeats.sum())} row(s) repeat the row before, stamp and values (from line "
-            f"{int(lines[repeats][0])}): left out as logged twice"
+            f"{lines[int(np.flatnonzero(repeats)[0])]}): left out as logged twice"
         )
-        values, samples, lines = values[~repeats], samples[~repeats], lines[~repeats]
+        values, samples, lines = values[~repeats], samples[~repeats], lines.without(repeats)
     _check_stamps(path, names[time], values[:, time], lines)
     times, unit = stamps_in_seconds(values[:, time], time_unit)
     rate, samples, notes = _on_even_grid(
@@ -189,15 +192,54 @@ def stamps_in_seconds(stamps: np.ndarray, unit: str = "auto") -> tuple[np.ndarra
 ROWS_PER_BLOCK = 4096
 
 
-def _read_table(path: Path, limits: ReadLimits) -> tuple[list[str] | None, np.ndarray, np.ndarray]:
+class LineNumbers:
+    """Each row's line number in its file, kept as runs of consecutive lines: a file of one
+    row per line costs two numbers, whatever its length; a blank line or a quoted field
+    over several lines starts another run.
+    """
+
+    def __init__(self) -> None:
+        self._starts = array("q")  # the row that starts each run
+        self._firsts = array("q")  # that row's line
+        self._count = 0
+        self.last = 0  # the line of the last row appended (0: none yet)
+        self._rows: np.ndarray | None = None  # rows kept by `without`, shape (n_kept,)
+
+    def append(self, line: int) -> None:
+        """The next row is on ``line``."""
+        if line != self.last + 1 or not self._count:
+            self._starts.append(self._count)
+            self._firsts.append(line)
+        self.last = line
+        self._count += 1
+
+    def __len__(self) -> int:
+        return self._count if self._rows is None else int(self._rows.size)
+
+    def __getitem__(self, row: int) -> int:
+        """The line of row ``row`` (of the rows kept)."""
+        if self._rows is not None:
+            row = int(self._rows[row])
+        run = bisect.bisect_right(self._starts, row) - 1
+        return int(self._firsts[run] + row - self._starts[run])
+
+    def without(self, dropped: np.ndarray) -> LineNumbers:
+        """The line numbers of the rows not ``dropped`` (a boolean mask over the rows)."""
+        kept = copy.copy(self)  # the runs are shared: nothing is appended once read
+        rows = np.flatnonzero(~dropped)
+        kept._rows = rows if self._rows is None else self._rows[rows]
+        return kept
+
+
+def _read_table(path: Path, limits: ReadLimits) -> tuple[list[str] | None, np.ndarray, LineNumbers]:
     """The header (None if the first row is numbers), every cell as a float of shape
-    (n_rows, n_columns), and each row's line number, shape (n_rows,).
+    (n_rows, n_columns), and each row's line number.
 
     A trailing empty field (a delimiter at the end of the row) is removed.  Rows are
     converted as they are read, so memory holds the numbers, not the text; a line longer
     than ``limits.line_chars``, or more values than ``limits.cells``, is refused there.
     """
-    numbers: list[int] = []
+    numbers = LineNumbers()
     try:
         with path.open(newline="", encoding="utf-8-sig") as handle:
             dialect = csv.excel_tab if path.suffix.lower() == ".tsv" else csv.excel
@@ -229,13 +271,13 @@ def _read_table(path: Path, limits: ReadLimits) -> tuple[list[str] | None, np.nd
     except (OSError, UnicodeDecodeError) as error:
         raise DriverError(f"{path}: cannot read as text: {error}") from None
     except csv.Error as error:  # a field over csv.field_size_limit(), a stray quote
-        line = numbers[-1] + 1 if numbers else 1
+        line = numbers.last + 1
         raise DriverError(f"{path}:{line}: cannot read as CSV ({error})") from None
     if block:
         blocks.append(np.array(block))
     if not blocks:
         raise DriverError(f"{path}: the recording has no samples")
-    return header, np.concatenate(blocks), np.array(numbers, dtype=np.int64)
+    return header, np.concatenate(blocks), numbers
 
 
 def _trimmed(row: list[str], width: int | None = None) -> list[str]:
@@ -310,7 +352,7 @@ def _repeated_rows(values: np.ndarray) -> np.ndarray:
     return repeats
 
 
-def _check_stamps(path: Path, name: str, stamps: np.ndarray, lines: np.ndarray) -> None:
+def _check_stamps(path: Path, name: str, stamps: np.ndarray, lines: LineNumbers) -> None:
     """Refuse a stamp of shape (n,) that is NaN or infinite, naming its line."""
     bad = ~np.isfinite(stamps)
     if bad.any():
@@ -325,7 +367,7 @@ def _on_even_grid(
     path: Path,
     name: str,
     times: np.ndarray,
-    lines: np.ndarray,
+    lines: LineNumbers,
     samples: np.ndarray,
     samplerate: float | None,
     limits: ReadLimits,

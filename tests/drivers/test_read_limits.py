@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from touchbench.drivers.csv_series import read_csv_series
 from touchbench.drivers.errors import DriverError
 from touchbench.drivers.files import read_recording
 from touchbench.drivers.limits import LineTooLongError, ReadLimits, bounded_lines
@@ -70,3 +71,22 @@ def test_the_values_read_are_bounded(tmp_path: Path) -> None:
     with pytest.raises(DriverError, match=r"wide\.csv:11: 11 samples x 10 channel\(s\)"):
         read_recording(path, samplerate=10.0, limits=ReadLimits(cells=100))
     assert read_recording(path, samplerate=10.0, limits=ReadLimits(cells=200)).n_channels == 10
+
+
+def test_lines_are_named_across_blank_lines_quoted_lines_and_repeats(tmp_path: Path) -> None:
+    """Each row's line is told after blank lines, a quoted field over two lines and a row
+    logged twice (the line numbers are kept as runs, not one per row)."""
+    path = tmp_path / "t.csv"
+    path.write_text(
+        'time,x,"y"\n'  # line 1
+        "0.00,1,0\n"
+        "\n"
+        "0.01,2,0\n"  # line 4
+        '0.02,3,"0\n"\n'  # lines 5 and 6: a quoted field over two lines
+        "0.03,4,0\n"  # line 7
+        "0.03,4,0\n"  # line 8: logged twice, left out
+        "\n\n"
+        "0.02,5,0\n"  # line 11: backwards
+    )
+    with pytest.raises(DriverError, match=r"^.*t\.csv:11: column 'time': the time does not rise"):
+        read_csv_series(path, channels=["x"])
