@@ -27,6 +27,12 @@ LEAVE_ONE_GROUP_OUT: Split = "leave-one-group-out"
 IMPORTED = "imported"
 
 
+def entry_tasks(n_tasks: int, n_entries: int) -> int:
+    """Tasks of each of a run's ``n_entries`` entries (its classifiers and helpers) when it
+    has ``n_tasks`` in all."""
+    return n_tasks // max(n_entries, 1)
+
+
 class _Stored(BaseModel):
     """A part of a stored configuration: immutable, and lenient towards keys it does not
     know (written by another version), which it keeps."""
@@ -178,7 +184,7 @@ class RunConfig(ExtraSpecsConfig):
     def tasks_per_entry(self, n_classifiers: int) -> int:
         """Tasks of each entry of a run with ``n_classifiers`` classifiers (its helpers
         have as many)."""
-        return self.n_tasks // max(n_classifiers + len(self.helpers), 1)
+        return entry_tasks(self.n_tasks, n_classifiers + len(self.helpers))
 
     @property
     def asked_folds(self) -> int | None:

@@ -11,8 +11,10 @@ from __future__ import annotations
 from touchbench.app.schemas.jobs import JobSchema
 from touchbench.app.schemas.listing import Page
 from touchbench.app.store import jobs as stored_jobs
+from touchbench.app.store import run_progress as stored_progress
 from touchbench.app.store import runs as stored_runs
 from touchbench.app.store.database import Store
+from touchbench.app.store.run_progress import RunProgress
 from touchbench.app.store.runs import RunInfo
 
 
@@ -36,6 +38,17 @@ def get_run(store: Store, run_id: int | str) -> RunInfo:
     NotFoundError
     """
     return stored_runs.get_run(store, run_id)
+
+
+def run_progress(store: Store, run_id: int | str) -> RunProgress:
+    """A run's status and its tasks counted by state, read light for a page that polls it:
+    what it reads does not grow with the run's classifiers or results.
+
+    Raises
+    ------
+    NotFoundError
+    """
+    return stored_progress.run_progress(store, run_id)
 
 
 def cancel_run(store: Store, run_id: int | str) -> RunInfo:

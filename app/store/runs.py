@@ -86,24 +86,13 @@ class RunInfo:
 
     @property
     def fold_scheme(self) -> str:
-        """How the folds were made (``stratified k-fold``, ``group k-fold``...); runs stored
-        before it was recorded are described from their kind and whether they had groups."""
-        if self.config.fold_scheme:
-            return self.config.fold_scheme
-        stratified = "stratified " if self.kind == "multiclass" else ""
-        return stratified + ("group " if self.config.grouped else "") + "k-fold"
+        """How the folds were made (``stratified k-fold``, ``group k-fold``...)."""
+        return fold_scheme(self.kind, self.config)
 
     @property
     def folds_text(self) -> str:
-        """How the folds were made, as every view says it: ``stratified 10-fold``,
-        ``group 5-fold x 3 repeats``, ``leave-one-group-out, 7 groups``."""
-        config = self.config
-        if config.split == LEAVE_ONE_GROUP_OUT:
-            return f"leave-one-group-out, {config.folds} groups"
-        if config.folds is None or "k-fold" not in self.fold_scheme:  # an imported run's
-            return self.fold_scheme
-        repeats = f" x {config.repeats} repeats" if config.repeats and config.repeats > 1 else ""
-        return self.fold_scheme.replace("k-fold", f"{config.folds}-fold") + repeats
+        """How the folds were made, as every view says it (:func:`folds_text`)."""
+        return folds_text(self.kind, self.config)
 
     def is_alive(self) -> bool:
         """Whether a live process is executing the run (``running`` or ``cancelling``)."""
@@ -142,6 +131,27 @@ class RunInfo:
 
     def to_json(self) -> dict[str, Any]:
         return self.schema().to_json()
+
+
+def fold_scheme(kind: str, config: RunConfig) -> str:
+    """How a run's folds were made (``stratified k-fold``, ``group k-fold``...); runs stored
+    before it was recorded are described from their kind and whether they had groups."""
+    if config.fold_scheme:
+        return config.fold_scheme
+    stratified = "stratified " if kind == "multiclass" else ""
+    return stratified + ("group " if config.grouped else "") + "k-fold"
+
+
+def folds_text(kind: str, config: RunConfig) -> str:
+    """How a run's folds were made, as every view says it: ``stratified 10-fold``,
+    ``group 5-fold x 3 repeats``, ``leave-one-group-out, 7 groups``."""
+    if config.split == LEAVE_ONE_GROUP_OUT:
+        return f"leave-one-group-out, {config.folds} groups"
+    scheme = fold_scheme(kind, config)
+    if config.folds is None or "k-fold" not in scheme:  # an imported run's
+        return scheme
+    repeats = f" x {config.repeats} repeats" if config.repeats and config.repeats > 1 else ""
+    return scheme.replace("k-fold", f"{config.folds}-fold") + repeats
 
 
 def create_run(
@@ -553,11 +563,17 @@ def _row(session: Session, run_id: int | str) -> RunRow:
     text = str(run_id)
     row = session.get(RunRow, int(text)) if is_row_id(text) else None
     if row is None:
-        last = session.scalar(select(func.max(RunRow.id)))
-        known = f"runs are 1..{last}" if last else "the store has no runs yet"
-        shown = text if len(text) <= 40 else text[:39] + "…"
-        raise NotFoundError(f"no run '{shown}' ({known})")
+        raise no_run(session, run_id)
     return row
+
+
+def no_run(session: Session, run_id: int | str) -> NotFoundError:
+    """The error that says ``run_id`` is no run, and which runs there are."""
+    text = str(run_id)
+    last = session.scalar(select(func.max(RunRow.id)))
+    known = f"runs are 1..{last}" if last else "the store has no runs yet"
+    shown = text if len(text) <= 40 else text[:39] + "…"
+    return NotFoundError(f"no run '{shown}' ({known})")
 
 
 def _infos(session: Session, rows: Sequence[RunRow]) -> list[RunInfo]:

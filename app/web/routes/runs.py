@@ -29,7 +29,7 @@ from touchbench.app.reports.run_tables import RunTable, run_tables
 from touchbench.app.schemas.runs import BenchRequest
 from touchbench.app.schemas.status import FINAL, RESUMABLE, Status
 from touchbench.app.services.answers import run_answers
-from touchbench.app.services.lifecycle import count_runs, get_run, list_runs
+from touchbench.app.services.lifecycle import count_runs, get_run, list_runs, run_progress
 from touchbench.app.services.listing import count_datasets, list_datasets
 from touchbench.app.services.runs import NoResultsError, kept, ranked_run
 from touchbench.app.web.deps import StoreDep
@@ -103,7 +103,7 @@ def run_form(
 @router.get("/{run_id}/progress", response_class=HTMLResponse)
 def progress(run_id: int, store: StoreDep) -> HTMLResponse:
     """Status and tasks done; polled every second until the run is over."""
-    run = get_run(store, run_id).schema()
+    run = run_progress(store, run_id)
     return render(
         "fragments/progress.html.j2",
         run=run,

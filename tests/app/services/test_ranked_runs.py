@@ -8,8 +8,11 @@ from __future__ import annotations
 import gc
 import weakref
 from pathlib import Path
+from typing import Any
 
 import pytest
+from sqlalchemy import Result, event
+from sqlalchemy.orm import ORMExecuteState, Session
 
 from tests.support.hostile_inputs import results_arff
 from tests.support.synthetic import touch_arff
@@ -18,9 +21,11 @@ from touchbench.app.schemas.datasets import ImportRequest
 from touchbench.app.schemas.imported import ImportResultsRequest
 from touchbench.app.services.datasets import import_file
 from touchbench.app.services.imported import import_results
+from touchbench.app.services.lifecycle import get_run, run_progress
 from touchbench.app.services.report import page_view
 from touchbench.app.services.runs import kept, ranked_run, run_leaderboard
 from touchbench.app.store.database import Store
+from touchbench.app.store.run_progress import RunProgress
 from touchbench.app.store.runs import record_result
 from touchbench.benchmark.results import TaskKey, TaskResult
 
@@ -123,3 +128,49 @@ def test_a_cycle_alive_during_a_computation_is_freed_once_dropped(
     del held
     gc.collect()
     assert watched() is None
+
+
+def test_a_run_s_progress_reads_the_same_whatever_its_size(store: Store, tmp_path: Path) -> None:
+    """The progress a page polls every second: as many statements, and as much read, for
+    a run of 30 classifiers as for one of 1,000 (counted by SQL aggregates)."""
+    data = touch_arff(tmp_path / "paper.arff", n=90, with_place=False)
+    import_file(store, ImportRequest(file=data, name="paper"))
+    runs = {
+        n: import_results(
+            store,
+            ImportResultsRequest(
+                file=results_arff(tmp_path / f"results{n}.arff", n_classifiers=n), dataset="paper"
+            ),
+        ).id
+        for n in (30, 1000)
+    }
+    read: dict[int, list[int]] = {}  # run's classifiers -> characters of each answer
+
+    def reads(n: int) -> RunProgress:
+        def measured(state: ORMExecuteState) -> Result[Any]:
+            answer = state.invoke_statement().freeze()
+            read[n].append(sum(len(str(value)) for row in answer() for value in row))
+            return answer()
+
+        read[n] = []
+        event.listen(Session, "do_orm_execute", measured, retval=True)
+        try:
+            return run_progress(store, runs[n])
+        finally:
+            event.remove(Session, "do_orm_execute", measured)
+
+    small, large = reads(30), reads(1000)
+    assert len(read[30]) == len(read[1000]) == 3  # the run, its results, its drops
+    assert sum(read[1000]) <= sum(read[30]) + 20  # a few more digits in its counts
+    for n, progress in ((30, small), (1000, large)):
+        whole = get_run(store, runs[n])
+        assert (progress.n_results, progress.n_failed, progress.n_dropped) == (10 * n, 0, 0)
+        assert (progress.n_tasks, progress.n_classifiers) == (whole.n_tasks, n)
+        assert progress.folds_text == whole.folds_text
+        assert (progress.dataset_name, progress.status, progress.origin) == (
+            "paper",
+            "done",
+            "imported",
+        )
+    with pytest.raises(NotFoundError, match="no run '999'"):
+        run_progress(store, 999)
