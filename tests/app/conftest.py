@@ -1,6 +1,14 @@
 """Stores and services for the app tests: every test that takes ``store_url`` runs twice, on
 a fresh SQLite file and on a fresh schema of a real PostgreSQL server; ``make_server`` starts
-real services (uvicorn on loopback) on it."""
+real services (uvicorn on loopback) on it.
+
+Which leg when: a test whose subject is the store's behaviour (transactions, concurrency,
+locking, round trips of stored values, kill -9 and resume, ids and versions never reused,
+nothing half-written, jobs dispatched between processes, migrations) takes ``store_url``,
+``store``, ``make_server`` or ``server`` and runs on both. A test that only puts things in a
+store while its subject is something else (validation, refusals and their words, keys and
+origins, pages and plots, live prediction, scoring, fold logic, parsing bounds, fuzzing)
+takes the ``sqlite_`` twin and runs on SQLite only."""
 
 from __future__ import annotations
 
@@ -41,15 +49,31 @@ def postgres_database() -> Iterator[str]:
 
 @pytest.fixture(params=["sqlite", "postgresql"])
 def store_url(request: pytest.FixtureRequest, tmp_path: Path) -> str:
-    """URL of an empty store, on SQLite then on PostgreSQL."""
+    """URL of an empty store, on SQLite then on PostgreSQL: for tests of the store's own
+    behaviour (see the module's docstring)."""
     if request.param == "sqlite":
         return f"sqlite:///{tmp_path / 'touchbench.db'}"
     return emptied(request.getfixturevalue("postgres_database"))
 
 
 @pytest.fixture
+def sqlite_store_url(tmp_path: Path) -> str:
+    """URL of an empty SQLite store, the one leg for tests whose subject is not the store
+    (the store only holds what they need); what the store itself does runs on ``store_url``."""
+    return f"sqlite:///{tmp_path / 'touchbench.db'}"
+
+
+@pytest.fixture
 def store(store_url: str) -> Iterator[Store]:
     opened = Store(store_url)
+    yield opened
+    opened.dispose()
+
+
+@pytest.fixture
+def sqlite_store(sqlite_store_url: str) -> Iterator[Store]:
+    """A store on SQLite only, for tests whose subject is not the store."""
+    opened = Store(sqlite_store_url)
     yield opened
     opened.dispose()
 
@@ -61,14 +85,21 @@ def make_server(store_url: str, tmp_path: Path) -> Iterator[Callable[..., Server
 
 
 @pytest.fixture
-def make_sqlite_server(tmp_path: Path) -> Iterator[Callable[..., Server]]:
-    """Builds services on a SQLite file of the test's own."""
-    yield from servers(f"sqlite:///{tmp_path / 'touchbench.db'}", tmp_path)
+def make_sqlite_server(sqlite_store_url: str, tmp_path: Path) -> Iterator[Callable[..., Server]]:
+    """Builds services on a SQLite file of the test's own: for tests whose subject is not
+    the store (what the store itself does runs on ``make_server``, both stores)."""
+    yield from servers(sqlite_store_url, tmp_path)
 
 
 @pytest.fixture
 def server(make_server: Callable[..., Server]) -> Server:
     return make_server()
+
+
+@pytest.fixture
+def sqlite_server(make_sqlite_server: Callable[..., Server]) -> Server:
+    """A service on SQLite only, for tests whose subject is not the store."""
+    return make_sqlite_server()
 
 
 @pytest.fixture(autouse=True)

@@ -189,9 +189,9 @@ def _problem(response: httpx.Response) -> str | None:
     return None
 
 
-def test_no_error_names_a_cli_flag_or_command(server: Server, tmp_path: Path) -> None:
-    stored = _prepare(server, tmp_path)
-    document = server.client.get("/openapi.json").json()
+def test_no_error_names_a_cli_flag_or_command(sqlite_server: Server, tmp_path: Path) -> None:
+    stored = _prepare(sqlite_server, tmp_path)
+    document = sqlite_server.client.get("/openapi.json").json()
     problems: list[str] = []
     sent = 0
     operations = list(_operations(document))
@@ -215,12 +215,14 @@ def test_no_error_names_a_cli_flag_or_command(server: Server, tmp_path: Path) ->
                 for files, fields in _form_bodies(document, schema, stored)
             )
         for request in requests:
-            response = server.client.request(method.upper(), url, **request)
+            response = sqlite_server.client.request(method.upper(), url, **request)
             sent += 1
             if path.endswith("/rename") and response.is_success:
                 back = {"name": PATH_VALUES["dataset"]}
                 renamed = response.json()["name"]
-                assert server.client.post(f"/api/datasets/{renamed}/rename", json=back).is_success
+                assert sqlite_server.client.post(
+                    f"/api/datasets/{renamed}/rename", json=back
+                ).is_success
             problem = _problem(response)
             if problem is not None:
                 shown = request.get("content") or request.get("data")

@@ -6,6 +6,9 @@ answer is one 4xx JSON error naming the client's own file, line or field (or a b
 page), and the service's peak memory (VmHWM) stays far from what the issue measured.
 
 One service per store serves every test of the module (each test uses names of its own).
+What is parsed and bounded does not depend on the store: those tests take the service on
+SQLite only (``on_sqlite``); what is written and named (names refused, a run imported with
+its versions of results) is tried on both stores.
 """
 
 from __future__ import annotations
@@ -96,6 +99,11 @@ def served(
         pass
 
 
+#: A test whose subject is not the store (parsing and its bounds) takes the SQLite service
+#: only; the module's one service on SQLite serves it and the tests on both stores.
+on_sqlite = pytest.mark.parametrize("served", ["sqlite"], indirect=True)
+
+
 def _refusal(response: httpx.Response, status: int, *words: str) -> dict[str, Any]:
     """The JSON error of a refused request: its status, one line, the words expected."""
     assert response.status_code == status, (response.status_code, response.text[:2000])
@@ -121,6 +129,7 @@ def _within_bound(server: Server) -> None:
 # -- 1. work bounded by the input's size -----------------------------------------------------
 
 
+@on_sqlite
 def test_a_150_byte_csv_whose_stamps_jump_is_refused_naming_the_line_and_the_gap(
     served: Server, tmp_path: Path
 ) -> None:
@@ -143,6 +152,7 @@ def test_a_150_byte_csv_whose_stamps_jump_is_refused_naming_the_line_and_the_gap
     assert len(answered.json()["predictions"]) == 4
 
 
+@on_sqlite
 def test_a_nan_stamp_is_refused_with_its_line(served: Server, tmp_path: Path) -> None:
     _refusal(
         _predict_file(served, nan_stamp_csv(tmp_path / "nan.csv")),
@@ -151,6 +161,7 @@ def test_a_nan_stamp_is_refused_with_its_line(served: Server, tmp_path: Path) ->
     )
 
 
+@on_sqlite
 def test_a_20_mb_csv_of_one_line_is_refused_as_it_streams_in(
     served: Server, tmp_path: Path
 ) -> None:
@@ -184,6 +195,7 @@ def _upload_session(server: Server, labels: Path, *recordings: Path) -> httpx.Re
         )
 
 
+@on_sqlite
 def test_a_labels_file_is_read_row_by_row_and_bounded(served: Server, tmp_path: Path) -> None:
     take = timed_takes(tmp_path / "takes", n_takes=1)[0][0]
     jobs = served.client.get("/api/jobs").json()["jobs"]
@@ -213,6 +225,7 @@ def test_a_labels_file_is_read_row_by_row_and_bounded(served: Server, tmp_path: 
 # -- 7. JSON bodies: depth and size ------------------------------------------------------------
 
 
+@on_sqlite
 def test_a_100000_deep_json_body_is_refused_with_422(served: Server) -> None:
     headers = {"content-type": "application/json"}
     for path in ("/api/models/takes-nb/predict", "/api/models", "/api/runs"):
@@ -229,6 +242,7 @@ def test_a_100000_deep_json_body_is_refused_with_422(served: Server) -> None:
     _within_bound(served)
 
 
+@on_sqlite
 def test_a_json_body_over_its_limit_is_refused_with_413(served: Server) -> None:
     body = b'{"instances": [' + b'{"a": 1.0},' * (2 << 20) + b'{"a": 1.0}]}'
     answer = served.client.post(

@@ -23,9 +23,9 @@ from touchbench.app.store.database import Store
 
 
 @pytest.fixture
-def live_model(tmp_path: Path, store_url: str) -> tuple[str, Path]:
+def live_model(tmp_path: Path, sqlite_store_url: str) -> tuple[str, Path]:
     """A model trained on extracted sessions, and a session it never saw."""
-    store = Store(store_url)
+    store = Store(sqlite_store_url)
     try:
         recordings, rows = [], []
         for seed in range(3):
@@ -43,12 +43,12 @@ def live_model(tmp_path: Path, store_url: str) -> tuple[str, Path]:
 
 def test_live_over_a_websocket_says_what_live_says(
     capsys: pytest.CaptureFixture[str],
-    make_server: Callable[..., Server],
+    make_sqlite_server: Callable[..., Server],
     live_model: tuple[str, Path],
     tmp_path: Path,
 ) -> None:
     name, unseen = live_model
-    server = make_server(api_key="live-key-of-the-lab")
+    server = make_sqlite_server(api_key="live-key-of-the-lab")
     rate, channels, blocks = pcm_blocks(unseen)
     messages, code, reason = stream(
         ws_url(server, name),
@@ -79,10 +79,10 @@ def test_live_over_a_websocket_says_what_live_says(
 
 
 def test_bad_streams_are_closed_with_a_reason(
-    make_server: Callable[..., Server], live_model: tuple[str, Path]
+    make_sqlite_server: Callable[..., Server], live_model: tuple[str, Path]
 ) -> None:
     name, _ = live_model
-    server = make_server(api_key="live-key-of-the-lab")
+    server = make_sqlite_server(api_key="live-key-of-the-lab")
     url = ws_url(server, name)
     key = {"X-API-Key": "live-key-of-the-lab"}
     good = {"samplerate": 44100, "channels": 3, "format": "S16LE"}

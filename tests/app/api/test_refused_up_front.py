@@ -1,6 +1,6 @@
 """What a job would refuse is refused before the job exists: a recordings upload with a bad
 extractor, event detection or name; training under a taken name, from a run without
-results, on a target without any known value.  On SQLite and PostgreSQL, over HTTP."""
+results, on a target without any known value.  On SQLite, over HTTP."""
 
 from __future__ import annotations
 
@@ -47,32 +47,36 @@ def _upload_session(server: Server, **fields: str) -> httpx.Response:
     )
 
 
-def test_a_recordings_upload_is_refused_before_any_job(server: Server, tmp_path: Path) -> None:
+def test_a_recordings_upload_is_refused_before_any_job(
+    sqlite_server: Server, tmp_path: Path
+) -> None:
     path = touch_arff(tmp_path / "touch.arff", n=30)
     with path.open("rb") as handle:
-        assert server.client.post("/api/datasets", files={"file": (path.name, handle)}).is_success
+        assert sqlite_server.client.post(
+            "/api/datasets", files={"file": (path.name, handle)}
+        ).is_success
 
-    message = _error(_upload_session(server, events="nope"), 422, "body.events")
+    message = _error(_upload_session(sqlite_server, events="nope"), 422, "body.events")
     assert message.startswith("unknown event detection 'nope' (known: ")
-    message = _error(_upload_session(server, extractor="nope"), 422, "body.extractor")
+    message = _error(_upload_session(sqlite_server, extractor="nope"), 422, "body.extractor")
     assert message.startswith("unknown extractor 'nope' (known: uc3m-audio, ")
-    message = _error(_upload_session(server, segment="2"), 422, "body.segment")
+    message = _error(_upload_session(sqlite_server, segment="2"), 422, "body.segment")
     assert message == "only applies to `events` 'none', not 'snr'"
-    _error(_upload_session(server, samplerate="-5"), 422, "body.samplerate")
-    _error(_upload_session(server, name="42"), 422, "body.name")
-    message = _error(_upload_session(server, fields="pdc"), 422, "body.fields")
+    _error(_upload_session(sqlite_server, samplerate="-5"), 422, "body.samplerate")
+    _error(_upload_session(sqlite_server, name="42"), 422, "body.name")
+    message = _error(_upload_session(sqlite_server, fields="pdc"), 422, "body.fields")
     assert message == "needs `topic`: the bag topic the fields belong to"
-    _error(_upload_session(server, sample_format="U8"), 422, "body.sample_format")
-    _error(_upload_session(server, channels="0"), 422, "body.channels")
-    message = _error(_upload_session(server, name="touch"), 409)
+    _error(_upload_session(sqlite_server, sample_format="U8"), 422, "body.sample_format")
+    _error(_upload_session(sqlite_server, channels="0"), 422, "body.channels")
+    message = _error(_upload_session(sqlite_server, name="touch"), 409)
     assert message.startswith("a dataset named 'touch' already exists (id 1)")
 
-    assert _jobs(server) == []
-    assert not list((server.work_dir / "uploads").glob("*/*")), "an upload was kept"
+    assert _jobs(sqlite_server) == []
+    assert not list((sqlite_server.work_dir / "uploads").glob("*/*")), "an upload was kept"
 
 
-def test_training_is_refused_before_any_job(server: Server, tmp_path: Path) -> None:
-    api = server.client
+def test_training_is_refused_before_any_job(sqlite_server: Server, tmp_path: Path) -> None:
+    api = sqlite_server.client
     for path in (touch_arff(tmp_path / "touch.arff", n=60), tmp_path / "half.arff"):
         if path.name == "half.arff":
             path.write_text(UNLABELLED_PLACE, encoding="utf-8")
@@ -83,14 +87,14 @@ def test_training_is_refused_before_any_job(server: Server, tmp_path: Path) -> N
         json={"dataset": "touch", "classifier": "nb", "target": "gesture", "name": "mine"},
     )
     assert trained.status_code == 202, trained.text
-    job = server.wait_for(f"/api/jobs/{trained.json()['job']}", finished)
+    job = sqlite_server.wait_for(f"/api/jobs/{trained.json()['job']}", finished)
     assert job["status"] == "done", job
     assert job["params"]["name"] == "mine" and job["params"]["target"] == "gesture"
 
     at = api.post("/api/models", json={"dataset": "touch", "classifier": "nb", "name": "mine@2"})
     assert _error(at, 422, "body.name").startswith("a model name cannot hold '@'")
 
-    store = Store(server.database_url)
+    store = Store(sqlite_server.database_url)
     try:  # a run that failed before any result (written as failed: no worker takes it)
         with store.session() as session:
             row = RunRow(
@@ -132,4 +136,4 @@ def test_training_is_refused_before_any_job(server: Server, tmp_path: Path) -> N
     alone = api.post("/api/models", json={"classifier": "nb"})
     assert _error(alone, 422, "body.dataset").startswith("is required")
 
-    assert [job["id"] for job in _jobs(server)] == [trained.json()["job"]]
+    assert [job["id"] for job in _jobs(sqlite_server)] == [trained.json()["job"]]

@@ -16,9 +16,9 @@ from tests.support.synthetic import touch_arff
 
 
 def test_the_api_key_guards_everything_but_health_and_docs(
-    make_server: Callable[..., Server],
+    make_sqlite_server: Callable[..., Server],
 ) -> None:
-    server = make_server(api_key="s3cret-key-of-the-lab")
+    server = make_sqlite_server(api_key="s3cret-key-of-the-lab")
     bare = httpx.Client(base_url=server.url, timeout=30)
     try:
         assert bare.get("/healthz").status_code == 200
@@ -51,8 +51,8 @@ def test_serve_listens_beyond_loopback_only_with_a_key(
     assert "TOUCHBENCH_API_KEY is not set" in refused.err and "--insecure" in refused.err
 
 
-def test_openapi_describes_every_route_with_models(server: Server) -> None:
-    document = server.client.get("/openapi.json").json()
+def test_openapi_describes_every_route_with_models(sqlite_server: Server) -> None:
+    document = sqlite_server.client.get("/openapi.json").json()
     paths = document["paths"]
     for path in (
         "/healthz",
@@ -82,7 +82,7 @@ def test_openapi_describes_every_route_with_models(server: Server) -> None:
 
 
 def test_schemathesis_finds_no_server_error(
-    capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_server: Server, tmp_path: Path
 ) -> None:
     import schemathesis
     from hypothesis import HealthCheck, Phase, settings
@@ -92,9 +92,9 @@ def test_schemathesis_finds_no_server_error(
         response_schema_conformance,
     )
 
-    run_cli(capsys, server.database_url, "import", str(touch_arff(tmp_path / "touch.arff")))
-    run_cli(capsys, server.database_url, "train", "touch", "-c", "nb", "--target", "gesture")
-    schema = schemathesis.openapi.from_url(f"{server.url}/openapi.json")
+    run_cli(capsys, sqlite_server.database_url, "import", str(touch_arff(tmp_path / "touch.arff")))
+    run_cli(capsys, sqlite_server.database_url, "train", "touch", "-c", "nb", "--target", "gesture")
+    schema = schemathesis.openapi.from_url(f"{sqlite_server.url}/openapi.json")
     failures: list[str] = []
     checks = (not_a_server_error, response_schema_conformance, content_type_conformance)
     for operation in schema.get_all_operations():

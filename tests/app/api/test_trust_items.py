@@ -1,9 +1,10 @@
 """Issue 21, items 4 to 9 and the CORS preflight, tried on a real ``touchbench serve`` as a
 hostile client would: each answer is one 4xx JSON error naming the client's own file or
-field, and nothing is half-written in the store (SQLite and PostgreSQL).
+field, and nothing is half-written in the store. The subject is what a client is told, not
+the store: the tests run on SQLite only.
 
-One service per store serves every test of the module (each test uses names of its own),
-so that the cases cost one start-up, not one each.
+One service serves every test of the module (each test uses names of its own), so that the
+cases cost one start-up, not one each.
 """
 
 from __future__ import annotations
@@ -19,7 +20,6 @@ import httpx
 import pytest
 
 from tests.support.service import Server, finished, servers
-from tests.support.stores import emptied
 
 #: One more than ``csv.field_size_limit()``'s default.
 LONG_FIELD = "x" * 131_073
@@ -27,18 +27,12 @@ LONG_FIELD = "x" * 131_073
 N_WIDE = 99
 
 
-@pytest.fixture(scope="module", params=["sqlite", "postgresql"])
-def served(
-    request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
-) -> Iterator[Server]:
-    """A service with a data set ``wide`` (99 numeric features, a class) and its model
-    ``wide-nb``."""
-    folder = tmp_path_factory.mktemp(f"served-{request.param}")
-    if request.param == "sqlite":
-        url = f"sqlite:///{folder / 'touchbench.db'}"
-    else:
-        url = emptied(request.getfixturevalue("postgres_database"))
-    builder = servers(url, folder)
+@pytest.fixture(scope="module")
+def served(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
+    """A service on SQLite only (the subject is not the store) with a data set ``wide`` (99
+    numeric features, a class) and its model ``wide-nb``."""
+    folder = tmp_path_factory.mktemp("served-sqlite")
+    builder = servers(f"sqlite:///{folder / 'touchbench.db'}", folder)
     build = next(builder)
     server = build()
     wide = _wide_arff(folder / "wide.arff")

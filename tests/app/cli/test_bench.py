@@ -1,4 +1,5 @@
-"""`touchbench classifiers / bench / runs / leaderboard`, on SQLite and PostgreSQL."""
+"""`touchbench classifiers / bench / runs / leaderboard`: a stored run and a killed run's resume
+on SQLite and PostgreSQL, the views and refusals on SQLite."""
 
 from __future__ import annotations
 
@@ -95,12 +96,12 @@ def test_bench_json_leaderboard_and_stored_run(
 
 
 def test_leaderboard_formats(
-    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, tmp_path: Path
 ) -> None:
-    imported(capsys, store_url, touch_arff(tmp_path / "touch.arff"))
+    imported(capsys, sqlite_store_url, touch_arff(tmp_path / "touch.arff"))
     run_id = run_cli(
         capsys,
-        store_url,
+        sqlite_store_url,
         "bench",
         "touch",
         "--target",
@@ -111,19 +112,19 @@ def test_leaderboard_formats(
         "3",
         "--json",
     ).json()["run_id"]
-    as_csv = run_cli(capsys, store_url, "leaderboard", str(run_id), "--format", "csv")
+    as_csv = run_cli(capsys, sqlite_store_url, "leaderboard", str(run_id), "--format", "csv")
     rows = list(csv.DictReader(io.StringIO(as_csv.out)))
     assert [r["classifier"] for r in rows] == ["nb", "zeror"]
     assert float(rows[0]["f1_weighted_mean"]) > float(rows[1]["f1_weighted_mean"])
-    markdown = run_cli(capsys, store_url, "leaderboard", str(run_id), "--format", "markdown")
+    markdown = run_cli(capsys, sqlite_store_url, "leaderboard", str(run_id), "--format", "markdown")
     assert "| 1 | nb |" in markdown.out and "(v/ /*)" in markdown.out
-    table = run_cli(capsys, store_url, "leaderboard", str(run_id), "--baseline", "zeror")
+    table = run_cli(capsys, sqlite_store_url, "leaderboard", str(run_id), "--baseline", "zeror")
     assert table.code == 0 and "nb" in table.out
     by_accuracy = run_cli(
-        capsys, store_url, "leaderboard", str(run_id), "--metric", "accuracy", "--json"
+        capsys, sqlite_store_url, "leaderboard", str(run_id), "--metric", "accuracy", "--json"
     ).json()
     assert by_accuracy["metric"] == "accuracy"
-    arff = run_cli(capsys, store_url, "leaderboard", str(run_id), "--format", "arff")
+    arff = run_cli(capsys, sqlite_store_url, "leaderboard", str(run_id), "--format", "arff")
     results = loads_arff(arff.out)
     names = [a.name for a in results.schema.attributes]
     assert names[:4] == ["Key_Dataset", "Key_Run", "Key_Fold", "Key_Scheme"]
@@ -142,28 +143,28 @@ def test_bad_benchmark_requests_exit_2(
     args: list[str],
     expected: str,
     capsys: pytest.CaptureFixture[str],
-    store_url: str,
+    sqlite_store_url: str,
     tmp_path: Path,
 ) -> None:
-    imported(capsys, store_url, touch_arff(tmp_path / "touch.arff", n=30))
+    imported(capsys, sqlite_store_url, touch_arff(tmp_path / "touch.arff", n=30))
     base = ["bench", "touch", "--target", "gesture", "--classifiers", "zeror"]
     if "--target" in args:
         base = ["bench", "touch", "--classifiers", "zeror"]
     if "--classifiers" in args:
         base = ["bench", "touch", "--target", "gesture"]
-    result = run_cli(capsys, store_url, *base, *args)
+    result = run_cli(capsys, sqlite_store_url, *base, *args)
     assert result.code == 2, result.err
     assert len(result.err.strip().splitlines()) == 1
     assert expected in result.err
 
 
 def test_too_many_folds_fall_back_with_a_warning(
-    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, tmp_path: Path
 ) -> None:
-    imported(capsys, store_url, touch_arff(tmp_path / "touch.arff", n=30))
+    imported(capsys, sqlite_store_url, touch_arff(tmp_path / "touch.arff", n=30))
     result = run_cli(
         capsys,
-        store_url,
+        sqlite_store_url,
         "bench",
         "touch",
         "--target",
@@ -176,21 +177,23 @@ def test_too_many_folds_fall_back_with_a_warning(
     )
     assert result.code == 0, result.err
     assert "only 10 instance(s): using 10 folds instead of 40" in " ".join(result.err.split())
-    run = run_cli(capsys, store_url, "runs", "--json").json()["runs"][0]
+    run = run_cli(capsys, sqlite_store_url, "runs", "--json").json()["runs"][0]
     assert (run["config"]["folds"], run["config"]["folds_requested"], run["tasks"]) == (10, 40, 10)
 
 
 def test_one_class_target_and_unknown_run_exit_2(
-    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, tmp_path: Path
 ) -> None:
     imported(
-        capsys, store_url, touch_arff(tmp_path / "touch.arff", one_class=True, with_place=False)
+        capsys,
+        sqlite_store_url,
+        touch_arff(tmp_path / "touch.arff", one_class=True, with_place=False),
     )
-    one = run_cli(capsys, store_url, "bench", "touch", "--classifiers", "zeror")
+    one = run_cli(capsys, sqlite_store_url, "bench", "touch", "--classifiers", "zeror")
     assert one.code == 2 and "single class" in one.err
-    unknown = run_cli(capsys, store_url, "leaderboard", "999")
+    unknown = run_cli(capsys, sqlite_store_url, "leaderboard", "999")
     assert unknown.code == 2 and "no run '999'" in unknown.err
-    resume = run_cli(capsys, store_url, "bench", "--resume", "999")
+    resume = run_cli(capsys, sqlite_store_url, "bench", "--resume", "999")
     assert resume.code == 2 and "no run '999'" in resume.err
 
 
@@ -233,16 +236,16 @@ def test_a_killed_run_resumes_without_repeating_or_duplicating(
 
 
 def test_an_empty_dataset_cannot_be_benchmarked(
-    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, tmp_path: Path
 ) -> None:
     # `import` refuses a file without instances, so the empty data set is stored directly.
-    store = Store(store_url)
+    store = Store(sqlite_store_url)
     empty = loads_arff("@relation e\n@attribute a numeric\n@attribute c {x,y}\n@data\n")
     add_dataset(store, empty, sha256=dataset_digest(empty))
     store.dispose()
-    result = run_cli(capsys, store_url, "bench", "e", "-c", "zeror")
+    result = run_cli(capsys, sqlite_store_url, "bench", "e", "-c", "zeror")
     assert result.code == 2 and "dataset 'e' has no instances" in result.err
-    assert run_cli(capsys, store_url, "runs", "--json").json() == {"runs": []}
+    assert run_cli(capsys, sqlite_store_url, "runs", "--json").json() == {"runs": []}
 
 
 def test_classifiers_say_the_cost_on_a_data_sets_shape(

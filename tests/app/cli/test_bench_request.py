@@ -1,6 +1,6 @@
-"""`touchbench bench` builds one request (BenchRequest) from its options, on SQLite and
-PostgreSQL: what a run cannot honour is refused naming its option, in one line, exit 2,
-before a run row exists; what it takes is stored with the run."""
+"""`touchbench bench` builds one request (BenchRequest) from its options: what a run
+cannot honour is refused naming its option, in one line, exit 2, before a run row exists
+(on SQLite); what it takes is stored with the run (on SQLite and PostgreSQL)."""
 
 from __future__ import annotations
 
@@ -17,15 +17,26 @@ from touchbench.app.services.runs import NoResultsError, create_run, run_leaderb
 from touchbench.app.store.database import Store
 
 
-@pytest.fixture
-def db(capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path) -> str:
+def _imported(capsys: pytest.CaptureFixture[str], url: str, tmp_path: Path) -> str:
     for path, name in (
         (touch_arff(tmp_path / "touch.arff", n=60), "touch"),
         (position_arff(tmp_path / "contact.arff"), "contact"),
     ):
-        result = run_cli(capsys, store_url, "import", str(path), "--name", name)
+        result = run_cli(capsys, url, "import", str(path), "--name", name)
         assert result.code == 0, result.err
-    return store_url
+    return url
+
+
+@pytest.fixture
+def db(capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path) -> str:
+    """The two data sets, on SQLite then on PostgreSQL: for what the run stores."""
+    return _imported(capsys, store_url, tmp_path)
+
+
+@pytest.fixture
+def sqlite_db(capsys: pytest.CaptureFixture[str], sqlite_store_url: str, tmp_path: Path) -> str:
+    """The two data sets on SQLite only: for what is refused before a run exists."""
+    return _imported(capsys, sqlite_store_url, tmp_path)
 
 
 def _refused(result: CliResult, line: str) -> None:
@@ -48,29 +59,29 @@ INDEPENDENT_DROPS = [
 
 @pytest.mark.parametrize(("extra", "option", "reason"), INDEPENDENT_DROPS)
 def test_what_independent_runs_cannot_honour_is_refused_naming_the_option(
-    capsys: pytest.CaptureFixture[str], db: str, extra: list[str], option: str, reason: str
+    capsys: pytest.CaptureFixture[str], sqlite_db: str, extra: list[str], option: str, reason: str
 ) -> None:
-    result = run_cli(capsys, db, "bench", "touch", "--independent", "-c", "zeror,nb", *extra)
+    result = run_cli(capsys, sqlite_db, "bench", "touch", "--independent", "-c", "zeror,nb", *extra)
     assert result.code == 2, result.err
     assert result.err.startswith(f"touchbench: error: {option}: is not used with --independent")
     assert reason in result.err and len(result.err.strip().splitlines()) == 1, result.err
-    assert count_rows(db, "runs") == 0
+    assert count_rows(sqlite_db, "runs") == 0
 
 
 def test_the_issues_independent_command_is_refused_at_its_first_dropped_option(
-    capsys: pytest.CaptureFixture[str], db: str
+    capsys: pytest.CaptureFixture[str], sqlite_db: str
 ) -> None:
     args = ["--weka", "J48", "--position", "f0,f1", "--budget", "5"]
-    result = run_cli(capsys, db, "bench", "touch", "--independent", *args)
+    result = run_cli(capsys, sqlite_db, "bench", "touch", "--independent", *args)
     _refused(
         result,
         "--weka: is not used with --independent, which runs the catalogue's multi-class "
         "classifiers on each target",
     )
-    regression = run_cli(capsys, db, "bench", "contact", "--independent", "-c", "ridge")
+    regression = run_cli(capsys, sqlite_db, "bench", "contact", "--independent", "-c", "ridge")
     assert regression.code == 2
     assert regression.err.startswith("touchbench: error: --independent: compares targets")
-    assert count_rows(db, "runs") == 0
+    assert count_rows(sqlite_db, "runs") == 0
 
 
 @pytest.mark.parametrize(
@@ -96,13 +107,15 @@ def test_the_issues_independent_command_is_refused_at_its_first_dropped_option(
     ],
 )
 def test_run_options_out_of_bounds_are_refused_before_a_run_exists(
-    capsys: pytest.CaptureFixture[str], db: str, extra: list[str], line: str
+    capsys: pytest.CaptureFixture[str], sqlite_db: str, extra: list[str], line: str
 ) -> None:
-    result = run_cli(capsys, db, "bench", "touch", "--target", "gesture", "-c", "zeror,nb", *extra)
+    result = run_cli(
+        capsys, sqlite_db, "bench", "touch", "--target", "gesture", "-c", "zeror,nb", *extra
+    )
     assert result.code == 2, result.err
     assert result.err.startswith(f"touchbench: error: {line}"), result.err
     assert len(result.err.strip().splitlines()) == 1 and "Traceback" not in result.err
-    assert count_rows(db, "runs") == 0
+    assert count_rows(sqlite_db, "runs") == 0
 
 
 @pytest.mark.parametrize(
@@ -114,12 +127,12 @@ def test_run_options_out_of_bounds_are_refused_before_a_run_exists(
     ],
 )
 def test_what_a_regression_cannot_take_names_its_option(
-    capsys: pytest.CaptureFixture[str], db: str, extra: list[str], line: str
+    capsys: pytest.CaptureFixture[str], sqlite_db: str, extra: list[str], line: str
 ) -> None:
-    result = run_cli(capsys, db, "bench", "contact", "-c", "ridge,linear", *extra)
+    result = run_cli(capsys, sqlite_db, "bench", "contact", "-c", "ridge,linear", *extra)
     assert result.code == 2, result.err
     assert result.err.startswith(f"touchbench: error: {line}"), result.err
-    assert count_rows(db, "runs") == 0
+    assert count_rows(sqlite_db, "runs") == 0
 
 
 def test_a_resumed_run_keeps_its_options_and_refuses_new_ones(
@@ -144,7 +157,7 @@ def test_a_resumed_run_keeps_its_options_and_refuses_new_ones(
 
 
 def test_independent_runs_take_the_request_and_check_every_target_first(
-    capsys: pytest.CaptureFixture[str], db: str, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_db: str, tmp_path: Path
 ) -> None:
     lopsided = tmp_path / "lopsided.arff"
     rows = "".join(f"{i},{'ab'[i % 2]},p\n" for i in range(12))
@@ -152,31 +165,33 @@ def test_independent_runs_take_the_request_and_check_every_target_first(
         "@relation 'lopsided: -C -2'\n@attribute x numeric\n@attribute a {a,b}\n"
         f"@attribute b {{p,q}}\n@data\n{rows}"
     )
-    assert run_cli(capsys, db, "import", str(lopsided)).code == 0
-    refused = run_cli(capsys, db, "bench", "lopsided", "--independent", "-c", "zeror", "-k", "3")
+    assert run_cli(capsys, sqlite_db, "import", str(lopsided)).code == 0
+    refused = run_cli(
+        capsys, sqlite_db, "bench", "lopsided", "--independent", "-c", "zeror", "-k", "3"
+    )
     assert refused.code == 2 and "target 'b' has a single class" in refused.err, refused.err
-    assert count_rows(db, "runs") == 0  # not even target a's run
+    assert count_rows(sqlite_db, "runs") == 0  # not even target a's run
     done = run_cli(
-        capsys, db, "bench", "touch", "--independent", "-c", "zeror,nb", "-k", "3", "-r", "2"
+        capsys, sqlite_db, "bench", "touch", "--independent", "-c", "zeror,nb", "-k", "3", "-r", "2"
     )
     assert done.code == 0, done.err
-    runs = run_cli(capsys, db, "runs", "--json").json()["runs"]
+    runs = run_cli(capsys, sqlite_db, "runs", "--json").json()["runs"]
     assert [r["targets"] for r in runs] == [["gesture"], ["place"]]
     assert all((r["config"]["folds"], r["config"]["repeats"]) == (3, 2) for r in runs)
     assert all(r["config"]["timeout"] == 600 for r in runs)  # the request's default
 
 
 def test_a_run_without_results_says_how_to_carry_it_out_in_the_adapters_words(
-    capsys: pytest.CaptureFixture[str], db: str
+    capsys: pytest.CaptureFixture[str], sqlite_db: str
 ) -> None:
-    store = Store(db)
+    store = Store(sqlite_db)
     try:
         request = BenchRequest(dataset="touch", target="gesture", classifiers=["nb"], folds=3)
         run = create_run(store, request)
-        queued = run_cli(capsys, db, "leaderboard", str(run.id))
+        queued = run_cli(capsys, sqlite_db, "leaderboard", str(run.id))
         _refused(queued, f"run {run.id} has no results yet (it waits for a worker)")
-        assert run_cli(capsys, db, "cancel", str(run.id)).code == 0
-        cancelled = run_cli(capsys, db, "leaderboard", str(run.id))
+        assert run_cli(capsys, sqlite_db, "cancel", str(run.id)).code == 0
+        cancelled = run_cli(capsys, sqlite_db, "leaderboard", str(run.id))
         _refused(
             cancelled,
             f"run {run.id} has no results yet (it is cancelled; "

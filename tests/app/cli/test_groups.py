@@ -1,7 +1,7 @@
 """Tables from other labs on the command line: `import --groups COLUMN --ignore COLUMNS` stores
 the group column as the instances' groups and leaves ignored columns out, `show` says so,
-and choices that do not fit the file are refused in one line with nothing stored; on SQLite
-and PostgreSQL."""
+and choices that do not fit the file are refused in one line with nothing stored, on SQLite;
+a refusal after blocks were written, and an import found again, on SQLite and PostgreSQL."""
 
 from __future__ import annotations
 
@@ -46,11 +46,19 @@ def load(store_url: str, name: str) -> Dataset:
 
 
 def test_the_group_column_is_stored_as_groups_and_ignored_columns_are_left_out(
-    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, tmp_path: Path
 ) -> None:
     path = grasp_csv(tmp_path / "grasps.csv")
     imported = run_cli(
-        capsys, store_url, "import", str(path), "--groups", "object", "--ignore", "trial", "--json"
+        capsys,
+        sqlite_store_url,
+        "import",
+        str(path),
+        "--groups",
+        "object",
+        "--ignore",
+        "trial",
+        "--json",
     )
     assert imported.code == 0, imported.err
     result = imported.json()
@@ -58,13 +66,13 @@ def test_the_group_column_is_stored_as_groups_and_ignored_columns_are_left_out(
     assert result["groups"] == {"count": 8, "column": "object"}
     assert "columns left out: trial" in result["notes"]
 
-    shown = run_cli(capsys, store_url, "show", "grasps", "--json").json()
+    shown = run_cli(capsys, sqlite_store_url, "show", "grasps", "--json").json()
     assert shown["groups"] == {"count": 8, "column": "object"}
     assert [a["name"] for a in shown["attributes"]] == [*FEATURES, "slipped"]
-    text = run_cli(capsys, store_url, "show", "grasps")
+    text = run_cli(capsys, sqlite_store_url, "show", "grasps")
     assert text.code == 0 and "groups: 8, from column 'object'" in text.err
 
-    dataset = load(store_url, "grasps")
+    dataset = load(sqlite_store_url, "grasps")
     assert dataset.schema.feature_names == FEATURES
     assert dataset.schema.group_column == "object"
     assert dataset.groups is not None
@@ -83,15 +91,15 @@ def test_the_group_column_is_stored_as_groups_and_ignored_columns_are_left_out(
 
 
 def test_an_arff_group_attribute_is_stored_as_groups(
-    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, tmp_path: Path
 ) -> None:
     path = grasp_arff(tmp_path / "grasps.arff", kind="string")
     imported = run_cli(
-        capsys, store_url, "import", str(path), "--groups", "object", "--ignore", "trial"
+        capsys, sqlite_store_url, "import", str(path), "--groups", "object", "--ignore", "trial"
     )
     assert imported.code == 0, imported.err
     assert "groups: 8, from column 'object'" in imported.err
-    dataset = load(store_url, "grasps")
+    dataset = load(sqlite_store_url, "grasps")
     assert dataset.schema.feature_names == FEATURES
     assert dataset.groups is not None and set(dataset.groups.tolist()) == set(OBJECTS)
 
@@ -142,18 +150,18 @@ def test_other_columns_set_aside_make_another_data_set(
 )
 def test_column_choices_that_do_not_fit_are_one_line_and_store_nothing(
     capsys: pytest.CaptureFixture[str],
-    store_url: str,
+    sqlite_store_url: str,
     tmp_path: Path,
     options: list[str],
     expected: list[str],
 ) -> None:
     path = grasp_csv(tmp_path / "grasps.csv")
-    one_error_line(run_cli(capsys, store_url, "import", str(path), *options), *expected)
+    one_error_line(run_cli(capsys, sqlite_store_url, "import", str(path), *options), *expected)
     arff = grasp_arff(tmp_path / "grasps.arff")
     words = [text.replace("grasps.csv", "grasps.arff") for text in expected]
-    one_error_line(run_cli(capsys, store_url, "import", str(arff), *options), *words)
-    assert stored_names(capsys, store_url) == []
-    assert rows_in_store(store_url) == (0, 0, 0)
+    one_error_line(run_cli(capsys, sqlite_store_url, "import", str(arff), *options), *words)
+    assert stored_names(capsys, sqlite_store_url) == []
+    assert rows_in_store(sqlite_store_url) == (0, 0, 0)
 
 
 def test_an_instance_without_a_group_far_into_a_large_file_stores_nothing(
@@ -182,7 +190,7 @@ def test_an_instance_without_a_group_far_into_a_large_file_stores_nothing(
     assert rows_in_store(store_url) == (0, 0, 0)
 
 
-def test_an_extracted_data_set_says_its_groups_are_the_recordings(store_url: str) -> None:
+def test_an_extracted_data_set_says_its_groups_are_the_recordings(sqlite_store_url: str) -> None:
     schema = Schema(
         "touch: -C 1",
         (Attribute("gesture", "nominal", ("tap", "slap")), Attribute("rms", "numeric")),
@@ -193,7 +201,7 @@ def test_an_extracted_data_set_says_its_groups_are_the_recordings(store_url: str
         np.array([[0, 0.1], [1, 0.2], [0, 0.3], [1, 0.4]]),
         groups=np.array(["a.wav", "a.wav", "b.wav", "c.wav"], dtype=object),
     )
-    store = Store(store_url)
+    store = Store(sqlite_store_url)
     try:
         stored.add_dataset(store, dataset, sha256="0" * 64, name="touch")
         groups = describe_dataset(store, "touch").groups

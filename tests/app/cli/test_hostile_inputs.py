@@ -45,22 +45,17 @@ def cli(db: str, *args: str, **settings: str) -> tuple[int, float, str, str]:
     return done.returncode, peak, said[-1] if said else "", done.stdout
 
 
-@pytest.fixture
-def sqlite_url(tmp_path: Path) -> str:
-    return f"sqlite:///{tmp_path / 'touchbench.db'}"
-
-
 def _extract(db: str, *recordings: Path, **settings: str) -> tuple[int, float, str, str]:
     paths = [str(path) for path in recordings]
     return cli(db, "extract", *paths, "-e", "window", "-O", "length=2", **settings)
 
 
 def test_a_150_byte_csv_whose_stamps_jump_exits_2_naming_the_line_and_the_gap(
-    sqlite_url: str, tmp_path: Path
+    sqlite_store_url: str, tmp_path: Path
 ) -> None:
     path = gap_csv(tmp_path / "gap.csv")
     assert path.stat().st_size < 200
-    code, peak, said, _ = _extract(sqlite_url, path)
+    code, peak, said, _ = _extract(sqlite_store_url, path)
     assert code == 2, said
     assert said.startswith("touchbench: error: ")
     assert "gap.csv:7: column 'time' jumps 3000 s over the line before" in said
@@ -69,30 +64,30 @@ def test_a_150_byte_csv_whose_stamps_jump_exits_2_naming_the_line_and_the_gap(
     assert peak < PEAK_BOUND_MB
 
     # a million seconds: the same refusal, no MemoryError
-    code, peak, said, _ = _extract(sqlite_url, gap_csv(tmp_path / "far.csv", jump=1e6))
+    code, peak, said, _ = _extract(sqlite_store_url, gap_csv(tmp_path / "far.csv", jump=1e6))
     assert code == 2 and "far.csv:7: column 'time' jumps 1e+06 s" in said
     assert peak < PEAK_BOUND_MB
 
 
-def test_a_nan_stamp_exits_2_with_its_line(sqlite_url: str, tmp_path: Path) -> None:
-    code, _, said, _ = _extract(sqlite_url, nan_stamp_csv(tmp_path / "nan.csv"))
+def test_a_nan_stamp_exits_2_with_its_line(sqlite_store_url: str, tmp_path: Path) -> None:
+    code, _, said, _ = _extract(sqlite_store_url, nan_stamp_csv(tmp_path / "nan.csv"))
     assert code == 2, said
     assert "nan.csv:4: column 'time': nan is not a time (NaN or infinite)" in said
 
 
-def test_a_one_line_csv_is_refused_as_it_streams_in(sqlite_url: str, tmp_path: Path) -> None:
+def test_a_one_line_csv_is_refused_as_it_streams_in(sqlite_store_url: str, tmp_path: Path) -> None:
     path = one_line_csv(tmp_path / "one-line.csv", megabytes=20)
-    code, peak, said, _ = cli(sqlite_url, "extract", str(path), "--samplerate", "100")
+    code, peak, said, _ = cli(sqlite_store_url, "extract", str(path), "--samplerate", "100")
     assert code == 2, said
     assert "one-line.csv:1: a line longer than 1,048,576 characters" in said
     # the line is never held whole: the peak is the interpreter's, not the file's
     assert peak < 400
 
 
-def test_a_cell_limit_bounds_what_resampling_makes(sqlite_url: str, tmp_path: Path) -> None:
+def test_a_cell_limit_bounds_what_resampling_makes(sqlite_store_url: str, tmp_path: Path) -> None:
     # a gap within the gap limit, but a grid over the values a recording may hold
     path = gap_csv(tmp_path / "gap.csv", jump=20.0)
-    code, _, said, _ = _extract(sqlite_url, path, max_cells="20000")
+    code, _, said, _ = _extract(sqlite_store_url, path, max_cells="20000")
     assert code == 2, said
     assert "would make 20,007 samples x 2 channel(s) of 8 stamps, more than the 20,000" in said
     assert "TOUCHBENCH_MAX_CELLS" in said
@@ -115,12 +110,12 @@ def test_whole_tactile_recordings_extract_as_sequences_with_the_default_limits(
 
 
 def test_a_sequence_over_the_values_limit_names_the_recording_not_the_labels(
-    sqlite_url: str, tmp_path: Path
+    sqlite_store_url: str, tmp_path: Path
 ) -> None:
     recordings, labels = tactile_sequences(tmp_path / "biotac", n_recordings=4)
     arguments = ["--labels", str(labels), "-e", "sequence", "--events", "none"]
     code, _, said, _ = cli(
-        sqlite_url,
+        sqlite_store_url,
         "extract",
         *map(str, recordings),
         *arguments,
@@ -134,7 +129,7 @@ def test_a_sequence_over_the_values_limit_names_the_recording_not_the_labels(
     assert "100,000 values a data set may hold" in said and "labels.csv" not in said
 
     code, _, said, _ = cli(
-        sqlite_url,
+        sqlite_store_url,
         "extract",
         *map(str, recordings),
         *arguments,

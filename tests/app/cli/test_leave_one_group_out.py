@@ -1,4 +1,4 @@
-"""Leave-one-group-out on the command line, on SQLite and PostgreSQL: `bench --folds logo`
+"""Leave-one-group-out on the command line, on SQLite: `bench --folds logo`
 makes one fold per group of an imported table (its `--groups` column), never with a group on
 both sides, says so in every view, and is refused in one line where it means nothing."""
 
@@ -19,34 +19,38 @@ from touchbench.app.store.runs import get_run
 
 @pytest.mark.parametrize("spelling", ["logo", "leave-one-group-out"])
 def test_leave_one_group_out_has_a_fold_per_group_and_every_view_says_so(
-    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path, spelling: str
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, tmp_path: Path, spelling: str
 ) -> None:
     path = grasp_csv(tmp_path / "grasps.csv")
     imported = run_cli(
-        capsys, store_url, "import", str(path), "--groups", "object", "--ignore", "trial"
+        capsys, sqlite_store_url, "import", str(path), "--groups", "object", "--ignore", "trial"
     )
     assert imported.code == 0, imported.err
     bench = run_cli(
-        capsys, store_url, "bench", "grasps", "-c", "nb,zeror", "--folds", spelling, "--json"
+        capsys, sqlite_store_url, "bench", "grasps", "-c", "nb,zeror", "--folds", spelling, "--json"
     )
     assert bench.code == 0, bench.err
     board = bench.json()
     assert board["folds"] == f"leave-one-group-out, {len(OBJECTS)} groups"
     assert {row["n_ok"] for row in board["leaderboard"]} == {len(OBJECTS)}
 
-    run = run_cli(capsys, store_url, "runs", "--json").json()["runs"][0]
+    run = run_cli(capsys, sqlite_store_url, "runs", "--json").json()["runs"][0]
     assert run["config"]["split"] == "leave-one-group-out"
     assert (run["config"]["folds"], run["config"]["repeats"]) == (len(OBJECTS), 1)
     assert run["tasks"] == 2 * len(OBJECTS) and run["folds"] == board["folds"]
-    table = run_cli(capsys, store_url, "leaderboard", str(run["id"]))
+    table = run_cli(capsys, sqlite_store_url, "leaderboard", str(run["id"]))
     assert f"leave-one-group-out, {len(OBJECTS)} groups" in " ".join(table.out.split())
-    markdown = run_cli(capsys, store_url, "leaderboard", str(run["id"]), "--format", "markdown")
+    markdown = run_cli(
+        capsys, sqlite_store_url, "leaderboard", str(run["id"]), "--format", "markdown"
+    )
     assert f"leave-one-group-out, {len(OBJECTS)} groups, ranked by" in markdown.out
     # every instance tested once, by the fold of its own group
-    classes = run_cli(capsys, store_url, "classes", str(run["id"]), "-c", "nb", "--json").json()
+    classes = run_cli(
+        capsys, sqlite_store_url, "classes", str(run["id"]), "-c", "nb", "--json"
+    ).json()
     assert np.sum(classes["classifiers"][0]["targets"][0]["confusion"]) == len(OBJECTS) * 10
 
-    store = Store(store_url)
+    store = Store(sqlite_store_url)
     try:
         stored = get_run(store, run["id"])
         dataset = load_dataset(store, "grasps")
@@ -68,11 +72,11 @@ def test_leave_one_group_out_has_a_fold_per_group_and_every_view_says_so(
 
 
 def test_k_fold_views_name_k(
-    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, tmp_path: Path
 ) -> None:
     path = grasp_csv(tmp_path / "grasps.csv")
-    assert run_cli(capsys, store_url, "import", str(path), "--ignore", "trial").code == 0
-    bench = run_cli(capsys, store_url, "bench", "grasps", "-c", "nb", "-k", "4", "--json")
+    assert run_cli(capsys, sqlite_store_url, "import", str(path), "--ignore", "trial").code == 0
+    bench = run_cli(capsys, sqlite_store_url, "bench", "grasps", "-c", "nb", "-k", "4", "--json")
     assert bench.code == 0, bench.err
     assert bench.json()["folds"] == "stratified 4-fold"
 
@@ -89,7 +93,7 @@ def test_k_fold_views_name_k(
 )
 def test_leave_one_group_out_where_it_means_nothing_is_one_line_and_stores_no_run(
     capsys: pytest.CaptureFixture[str],
-    store_url: str,
+    sqlite_store_url: str,
     tmp_path: Path,
     grouped: bool,
     options: list[str],
@@ -97,6 +101,8 @@ def test_leave_one_group_out_where_it_means_nothing_is_one_line_and_stores_no_ru
 ) -> None:
     path = grasp_csv(tmp_path / "grasps.csv")
     columns = ["--groups", "object", "--ignore", "trial"] if grouped else ["--ignore", "trial"]
-    assert run_cli(capsys, store_url, "import", str(path), *columns).code == 0
-    one_error_line(run_cli(capsys, store_url, "bench", "grasps", "-c", "nb", *options), *expected)
-    assert run_cli(capsys, store_url, "runs", "--json").json()["runs"] == []
+    assert run_cli(capsys, sqlite_store_url, "import", str(path), *columns).code == 0
+    one_error_line(
+        run_cli(capsys, sqlite_store_url, "bench", "grasps", "-c", "nb", *options), *expected
+    )
+    assert run_cli(capsys, sqlite_store_url, "runs", "--json").json()["runs"] == []

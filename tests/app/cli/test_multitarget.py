@@ -11,9 +11,9 @@ from tests.support.synthetic import touch_arff
 
 
 @pytest.fixture
-def two_targets(capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path) -> Path:
+def two_targets(capsys: pytest.CaptureFixture[str], sqlite_store_url: str, tmp_path: Path) -> Path:
     path = touch_arff(tmp_path / "touch.arff", n=120)
-    assert run_cli(capsys, store_url, "import", str(path)).code == 0
+    assert run_cli(capsys, sqlite_store_url, "import", str(path)).code == 0
     return path
 
 
@@ -33,10 +33,18 @@ def test_classifiers_lists_meta_base_configurations(
 
 
 def test_bench_on_two_targets_reports_meka_metrics(
-    capsys: pytest.CaptureFixture[str], store_url: str, two_targets: Path
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, two_targets: Path
 ) -> None:
     result = run_cli(
-        capsys, store_url, "bench", "touch", "-c", "cr:nb,bcc:j48,lc:j48", "-k", "3", "--json"
+        capsys,
+        sqlite_store_url,
+        "bench",
+        "touch",
+        "-c",
+        "cr:nb,bcc:j48,lc:j48",
+        "-k",
+        "3",
+        "--json",
     )
     assert result.code == 0, result.err
     report = result.json()
@@ -53,11 +61,11 @@ def test_bench_on_two_targets_reports_meka_metrics(
 
 
 def test_independent_runs_each_target_and_multiplies(
-    capsys: pytest.CaptureFixture[str], store_url: str, two_targets: Path
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, two_targets: Path
 ) -> None:
     result = run_cli(
         capsys,
-        store_url,
+        sqlite_store_url,
         "bench",
         "touch",
         "--independent",
@@ -76,17 +84,19 @@ def test_independent_runs_each_target_and_multiplies(
         * (best["place"]["metrics"]["accuracy"]["mean"])
     )
     assert report["product"]["accuracy"] == pytest.approx(product)
-    runs = run_cli(capsys, store_url, "runs", "--json").json()["runs"]
+    runs = run_cli(capsys, sqlite_store_url, "runs", "--json").json()["runs"]
     assert sorted(r["targets"][0] for r in runs) == ["gesture", "place"]
 
 
 def test_train_and_predict_a_multi_target_model(
-    capsys: pytest.CaptureFixture[str], store_url: str, two_targets: Path
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, two_targets: Path
 ) -> None:
-    trained = run_cli(capsys, store_url, "train", "touch", "-c", "bcc:j48", "--json")
+    trained = run_cli(capsys, sqlite_store_url, "train", "touch", "-c", "bcc:j48", "--json")
     assert trained.code == 0, trained.err
     assert trained.json()["targets"] == ["gesture", "place"]
-    predicted = run_cli(capsys, store_url, "predict", "touch-bcc:j48", str(two_targets), "--json")
+    predicted = run_cli(
+        capsys, sqlite_store_url, "predict", "touch-bcc:j48", str(two_targets), "--json"
+    )
     assert predicted.code == 0, predicted.err
     first = predicted.json()["predictions"][0]
     assert first["gesture"] in {"tap", "slap", "stroke"} and first["place"] in {"head", "arm"}
@@ -96,17 +106,17 @@ def test_train_and_predict_a_multi_target_model(
 
 
 def test_multi_target_bad_input_exits_2(
-    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path, two_targets: Path
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, tmp_path: Path, two_targets: Path
 ) -> None:
     single = touch_arff(tmp_path / "single.arff", with_place=False, seed=5)
-    assert run_cli(capsys, store_url, "import", str(single), "--name", "single").code == 0
+    assert run_cli(capsys, sqlite_store_url, "import", str(single), "--name", "single").code == 0
     numeric = tmp_path / "n.arff"
     numeric.write_text(
         "@relation 'n: -C 2'\n@attribute a numeric\n@attribute b numeric\n"
         "@attribute x numeric\n@data\n1,2,3\n2,3,4\n",
         encoding="utf-8",
     )
-    assert run_cli(capsys, store_url, "import", str(numeric)).code == 0
+    assert run_cli(capsys, sqlite_store_url, "import", str(numeric)).code == 0
     cases = [
         (["bench", "single", "-c", "bcc:rf"], "multi-target method"),
         (["bench", "touch", "-c", "bcc:rff"], "did you mean 'rf'"),
@@ -116,8 +126,8 @@ def test_multi_target_bad_input_exits_2(
         (["bench", "touch", "--independent", "--target", "place"], "--independent"),
     ]
     for args, expected in cases:
-        result = run_cli(capsys, store_url, *args)
+        result = run_cli(capsys, sqlite_store_url, *args)
         assert result.code == 2, (args, result.err)
         assert len(result.err.strip().splitlines()) == 1, result.err
         assert expected in result.err, (args, result.err)
-    assert run_cli(capsys, store_url, "runs", "--json").json() == {"runs": []}
+    assert run_cli(capsys, sqlite_store_url, "runs", "--json").json() == {"runs": []}

@@ -1,6 +1,6 @@
-"""``bench --race`` and ``--budget-total`` from the command line, on SQLite and PostgreSQL:
-bad values refused in one line, a raced run's drop in every view, and a race interrupted by
-Ctrl-C that resumes to the leaderboard of an uninterrupted one."""
+"""``bench --race`` and ``--budget-total`` from the command line: bad values
+refused in one line and a raced run's drop in every view, on SQLite; a race interrupted by
+Ctrl-C that resumes to the leaderboard of an uninterrupted one, on SQLite and PostgreSQL."""
 
 from __future__ import annotations
 
@@ -45,14 +45,20 @@ BENCH_TWICE = (
     ],
 )
 def test_bad_race_and_budget_values_are_refused_in_one_line(
-    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path, args: list[str], words: str
+    capsys: pytest.CaptureFixture[str],
+    sqlite_store_url: str,
+    tmp_path: Path,
+    args: list[str],
+    words: str,
 ) -> None:
-    run_cli(capsys, store_url, "import", str(touch_arff(tmp_path / "t.arff")), "--name", "touch")
-    result = run_cli(capsys, store_url, "bench", "touch", "-c", "zeror,nb", *args)
+    run_cli(
+        capsys, sqlite_store_url, "import", str(touch_arff(tmp_path / "t.arff")), "--name", "touch"
+    )
+    result = run_cli(capsys, sqlite_store_url, "bench", "touch", "-c", "zeror,nb", *args)
     assert result.code == 2
     lines = result.err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith(f"touchbench: error: {words}"), result.err
-    assert scalar(store_url, "SELECT count(*) FROM runs") == 0
+    assert scalar(sqlite_store_url, "SELECT count(*) FROM runs") == 0
 
 
 def _rows(board: dict[str, Any]) -> list[tuple[Any, ...]]:
@@ -72,14 +78,16 @@ def _rows(board: dict[str, Any]) -> list[tuple[Any, ...]]:
 
 
 def test_a_raced_run_says_what_it_dropped_in_every_view(
-    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, tmp_path: Path
 ) -> None:
     path = touch_arff(tmp_path / "t.arff", n=150)
-    run_cli(capsys, store_url, "import", str(path), "--name", "touch")
-    bench = run_cli(capsys, store_url, "bench", "touch", "-c", "zeror,nb,j48", *RACE, "-j", "2")
+    run_cli(capsys, sqlite_store_url, "import", str(path), "--name", "touch")
+    bench = run_cli(
+        capsys, sqlite_store_url, "bench", "touch", "-c", "zeror,nb,j48", *RACE, "-j", "2"
+    )
     assert bench.code == 0, bench.err
     assert "dropped after fold 3" in bench.out and "raced at alpha 0.01" in bench.err
-    board = run_cli(capsys, store_url, "leaderboard", "1", "--json").json()
+    board = run_cli(capsys, sqlite_store_url, "leaderboard", "1", "--json").json()
     assert board["race"]["alpha"] == 0.01 and board["race"]["dropped"] == 1
     assert board["budget"] is None
     zeror = next(row for row in board["leaderboard"] if row["classifier"] == "zeror")
@@ -89,16 +97,16 @@ def test_a_raced_run_says_what_it_dropped_in_every_view(
     assert zeror["dropped"]["leader"] == board["baseline"]
     assert all(row["dropped"] is None for row in board["leaderboard"] if row is not zeror)
     # the stored run: 3 + 5 + 5 results, one drop record
-    assert scalar(store_url, "SELECT count(*) FROM fold_results") == 13
-    assert scalar(store_url, "SELECT after_fold FROM entry_drops") == 3
-    markdown = run_cli(capsys, store_url, "leaderboard", "1", "-f", "markdown").out
+    assert scalar(sqlite_store_url, "SELECT count(*) FROM fold_results") == 13
+    assert scalar(sqlite_store_url, "SELECT after_fold FROM entry_drops") == 3
+    markdown = run_cli(capsys, sqlite_store_url, "leaderboard", "1", "-f", "markdown").out
     assert "zeror (dropped after fold 3 (p " in markdown and "raced at alpha 0.01" in markdown
-    csv = run_cli(capsys, store_url, "leaderboard", "1", "-f", "csv").out
+    csv = run_cli(capsys, sqlite_store_url, "leaderboard", "1", "-f", "csv").out
     assert "dropped_after_fold" in csv.splitlines()[0] and ',3,"dropped after fold 3 (p ' in csv
-    arff = run_cli(capsys, store_url, "leaderboard", "1", "-f", "arff").out
+    arff = run_cli(capsys, sqlite_store_url, "leaderboard", "1", "-f", "arff").out
     assert arff.startswith("% raced at alpha 0.01") and "% zeror: dropped after fold 3" in arff
     report = tmp_path / "report.html"
-    assert run_cli(capsys, store_url, "report", "1", "-o", str(report)).code == 0
+    assert run_cli(capsys, sqlite_store_url, "report", "1", "-o", str(report)).code == 0
     html = report.read_text(encoding="utf-8")
     assert "dropped after fold 3" in html and "raced at alpha 0.01" in html
 
@@ -113,12 +121,14 @@ def _execute(url: str, statement: str) -> None:
 
 
 def test_a_budget_that_fits_cuts_nothing_and_a_resume_gets_what_is_left(
-    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, tmp_path: Path
 ) -> None:
-    run_cli(capsys, store_url, "import", str(touch_arff(tmp_path / "t.arff")), "--name", "touch")
+    run_cli(
+        capsys, sqlite_store_url, "import", str(touch_arff(tmp_path / "t.arff")), "--name", "touch"
+    )
     bench = run_cli(
-        capsys, store_url, "bench", "touch", "-c", "zeror,nb", "--target", "gesture", "-k", "3",
-        "--budget-total", "60", "--json",
+        capsys, sqlite_store_url, "bench", "touch", "-c", "zeror,nb", "--target", "gesture",
+        "-k", "3", "--budget-total", "60", "--json",
     )  # fmt: skip
     assert bench.code == 0, bench.err
     board = bench.json()
@@ -132,17 +142,17 @@ def test_a_budget_that_fits_cuts_nothing_and_a_resume_gets_what_is_left(
     assert board["race"] is None
     # the run, interrupted once its budget was spent with nb's folds still to run: the
     # resume gets what is left of the budget (nothing), not the whole budget again
-    _execute(store_url, "DELETE FROM fold_results WHERE classifier = 'nb'")
-    _execute(store_url, "UPDATE runs SET status = 'interrupted', seconds_spent = 3600")
-    resumed = run_cli(capsys, store_url, "bench", "--resume", "1", "--json")
+    _execute(sqlite_store_url, "DELETE FROM fold_results WHERE classifier = 'nb'")
+    _execute(sqlite_store_url, "UPDATE runs SET status = 'interrupted', seconds_spent = 3600")
+    resumed = run_cli(capsys, sqlite_store_url, "bench", "--resume", "1", "--json")
     assert resumed.code == 0, resumed.err
     budget = resumed.json()["budget"]
     assert budget["cut"] == ["nb"] and budget["tasks_not_run"] == 3
     assert budget["minutes_spent"] >= 60
-    assert scalar(store_url, "SELECT count(*) FROM fold_results") == 3
-    listed = run_cli(capsys, store_url, "runs", "--json").json()["runs"][0]
+    assert scalar(sqlite_store_url, "SELECT count(*) FROM fold_results") == 3
+    listed = run_cli(capsys, sqlite_store_url, "runs", "--json").json()["runs"][0]
     assert (listed["tasks_done"], listed["tasks_dropped"], listed["tasks"]) == (3, 3, 6)
-    assert "3 done, 3 dropped / 6" in run_cli(capsys, store_url, "runs").out
+    assert "3 done, 3 dropped / 6" in run_cli(capsys, sqlite_store_url, "runs").out
 
 
 def test_a_race_interrupted_by_ctrl_c_resumes_to_the_uninterrupted_leaderboard(
@@ -188,16 +198,18 @@ def test_a_race_interrupted_by_ctrl_c_resumes_to_the_uninterrupted_leaderboard(
 
 
 def test_a_race_on_data_that_allow_fewer_folds_is_refused_before_it_exists(
-    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, tmp_path: Path
 ) -> None:
     path = tmp_path / "tiny.arff"
     rows = "".join(f"{i},{label}\n" for i, label in enumerate("xxyyzz"))
     path.write_text(f"@relation tiny\n@attribute a numeric\n@attribute c {{x,y,z}}\n@data\n{rows}")
-    run_cli(capsys, store_url, "import", str(path))
-    result = run_cli(capsys, store_url, "bench", "tiny", "-c", "zeror,nb", "--race", "-k", "3")
+    run_cli(capsys, sqlite_store_url, "import", str(path))
+    result = run_cli(
+        capsys, sqlite_store_url, "bench", "tiny", "-c", "zeror,nb", "--race", "-k", "3"
+    )
     assert result.code == 2
     assert result.err.strip() == (
         "touchbench: error: --race: needs at least 3 folds in all, and the data allow 2 (the "
         "smallest class has only 2 instance(s): using 2 folds instead of 3)"
     )
-    assert scalar(store_url, "SELECT count(*) FROM runs") == 0
+    assert scalar(sqlite_store_url, "SELECT count(*) FROM runs") == 0

@@ -1,7 +1,8 @@
-"""``touchbench.bench`` and ``touchbench.train`` from Python, on SQLite and PostgreSQL: every kind
+"""``touchbench.bench`` and ``touchbench.train`` from Python, on SQLite: every kind
 of data (a DataFrame, arrays, an ARFF file, a stored name), an estimator of the test's own
 beside catalogue ids, leave-one-group-out on a grouped table, bad input refused naming its
-column with nothing stored, and a run that the CLI then lists."""
+column with nothing stored, and a run that the CLI then lists; an interrupted run keeps
+what finished, on SQLite and PostgreSQL."""
 
 from __future__ import annotations
 
@@ -76,7 +77,7 @@ def stored_counts(store_url: str) -> tuple[int, int]:
 
 
 def test_a_dataframe_with_groups_left_out_one_at_a_time_and_an_estimator_of_our_own(
-    capsys: pytest.CaptureFixture[str], store_url: str
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str
 ) -> None:
     board = touchbench.bench(
         grasps(),
@@ -85,7 +86,7 @@ def test_a_dataframe_with_groups_left_out_one_at_a_time_and_an_estimator_of_our_
         folds="logo",
         groups="object",
         ignore=["trial"],
-        store=store_url,
+        store=sqlite_store_url,
         progress=False,
     )
     assert isinstance(board, touchbench.Leaderboard)
@@ -99,10 +100,10 @@ def test_a_dataframe_with_groups_left_out_one_at_a_time_and_an_estimator_of_our_
     assert "leave-one-group-out, 8 groups" in board._repr_html_()
 
     # the run is the CLI's too
-    listed = runs_listed(capsys, store_url)
+    listed = runs_listed(capsys, sqlite_store_url)
     assert [r["id"] for r in listed] == [board.run_id]
     assert listed[0]["classifiers"] == ["nb", "zeror", "NearestMean", "knn3"]
-    store = Store(store_url)
+    store = Store(sqlite_store_url)
     try:
         run = get_run(store, board.run_id)
         dataset = load_dataset(store, run.dataset_name)
@@ -120,30 +121,30 @@ def test_a_dataframe_with_groups_left_out_one_at_a_time_and_an_estimator_of_our_
 
 
 def test_arrays_an_arff_file_and_a_stored_name(
-    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, tmp_path: Path
 ) -> None:
     frame = grasps()
     X, y = frame[list(FEATURES)].to_numpy(), frame["slipped"].to_numpy()
-    pair = touchbench.bench((X, y), classifiers=["nb", "zeror"], folds=4, store=store_url,
+    pair = touchbench.bench((X, y), classifiers=["nb", "zeror"], folds=4, store=sqlite_store_url,
                             progress=False)  # fmt: skip
     assert pair.schema.folds == "stratified 4-fold" and pair.schema.targets == ["y"]
     assert pair.best == "nb"
 
     path = grasp_arff(tmp_path / "grasps.arff")
     arff = touchbench.bench(path, classifiers=["nb"], folds=3, groups="object",
-                            ignore=["trial"], store=store_url, progress=False)  # fmt: skip
+                            ignore=["trial"], store=sqlite_store_url, progress=False)  # fmt: skip
     assert arff.schema.dataset == "grasps" and arff.schema.folds == "stratified group 3-fold"
 
-    again = touchbench.bench("grasps", classifiers=["nb"], folds="logo", store=store_url,
+    again = touchbench.bench("grasps", classifiers=["nb"], folds="logo", store=sqlite_store_url,
                              progress=False)  # fmt: skip
     assert again.schema.folds == "leave-one-group-out, 8 groups"
-    assert [r["folds"] for r in runs_listed(capsys, store_url)] == [
+    assert [r["folds"] for r in runs_listed(capsys, sqlite_store_url)] == [
         "stratified 4-fold",
         "stratified group 3-fold",
         "leave-one-group-out, 8 groups",
     ]
 
-    model = touchbench.train("grasps", classifier="nb", store=store_url)
+    model = touchbench.train("grasps", classifier="nb", store=sqlite_store_url)
     predicted = model.predict(frame)
     assert predicted.shape == (80,) and set(predicted) <= {"yes", "no"}
     assert (predicted == frame["slipped"]).mean() > 0.8
@@ -167,7 +168,7 @@ def test_arrays_an_arff_file_and_a_stored_name(
     ],
 )
 def test_bad_input_is_one_exception_naming_the_column_and_stores_nothing(
-    store_url: str, change: str | None, options: dict, field: str, words: str
+    sqlite_store_url: str, change: str | None, options: dict, field: str, words: str
 ) -> None:
     frame = grasps()
     if change == "one value":
@@ -177,11 +178,11 @@ def test_bad_input_is_one_exception_naming_the_column_and_stores_nothing(
         frame.loc[3, "taxel2"] = "broken"
     asked = {"target": "slipped", "groups": "object", "ignore": ["trial"], **options}
     with pytest.raises(FieldError) as refused:
-        touchbench.bench(frame, classifiers=asked.pop("classifiers", ["nb"]), store=store_url,
-                         progress=False, **asked)  # fmt: skip
+        touchbench.bench(frame, classifiers=asked.pop("classifiers", ["nb"]),
+                         store=sqlite_store_url, progress=False, **asked)  # fmt: skip
     assert refused.value.field == field
     assert words in refused.value.message, refused.value.message
-    assert stored_counts(store_url) == (0, 0)
+    assert stored_counts(sqlite_store_url) == (0, 0)
 
 
 def test_leave_one_group_out_on_data_without_groups_is_a_field_error(tmp_path: Path) -> None:

@@ -1,5 +1,5 @@
 """`touchbench classes` and `calibration`: per-class scores, confusion matrices and the
-calibration of a run's classifiers from what each fold stored, on SQLite and PostgreSQL."""
+calibration of a run's classifiers from what each fold stored, on SQLite."""
 
 from __future__ import annotations
 
@@ -13,12 +13,12 @@ from tests.support.synthetic import position_arff, touch_arff
 
 
 @pytest.fixture
-def run(capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path) -> int:
+def run(capsys: pytest.CaptureFixture[str], sqlite_store_url: str, tmp_path: Path) -> int:
     path = touch_arff(tmp_path / "touch.arff", n=90)
-    assert run_cli(capsys, store_url, "import", str(path)).code == 0
+    assert run_cli(capsys, sqlite_store_url, "import", str(path)).code == 0
     result = run_cli(
         capsys,
-        store_url,
+        sqlite_store_url,
         "bench",
         "touch",
         "--target",
@@ -34,9 +34,9 @@ def run(capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path) -> i
 
 
 def test_classes_sum_the_folds_and_score_each_class(
-    capsys: pytest.CaptureFixture[str], store_url: str, run: int
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, run: int
 ) -> None:
-    result = run_cli(capsys, store_url, "classes", str(run), "--json")
+    result = run_cli(capsys, sqlite_store_url, "classes", str(run), "--json")
     assert result.code == 0, result.err
     certainty = result.json()
     assert certainty["targets"] == ["gesture"]
@@ -60,15 +60,15 @@ def test_classes_sum_the_folds_and_score_each_class(
     # an SVM without probabilities has a confusion matrix but no calibration, and says why
     assert entries["svm-rbf"]["calibration"] is None
     assert "without probabilities" in entries["svm-rbf"]["calibration_note"]
-    text = run_cli(capsys, store_url, "classes", str(run), "-c", "nb")
+    text = run_cli(capsys, sqlite_store_url, "classes", str(run), "-c", "nb")
     assert text.code == 0 and "stroke" in text.out and "expected calibration error" in text.err
 
 
 def test_calibration_draws_the_reliability_diagram(
-    capsys: pytest.CaptureFixture[str], store_url: str, run: int, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, run: int, tmp_path: Path
 ) -> None:
     svg = tmp_path / "reliability.svg"
-    result = run_cli(capsys, store_url, "calibration", str(run), "-o", str(svg))
+    result = run_cli(capsys, sqlite_store_url, "calibration", str(run), "-o", str(svg))
     assert result.code == 0, result.err
     text = svg.read_text(encoding="utf-8")
     assert text.lstrip().startswith("<?xml") and "<svg" in text
@@ -77,33 +77,44 @@ def test_calibration_draws_the_reliability_diagram(
 
 
 def test_bad_certainty_requests_are_one_line_exit_2(
-    capsys: pytest.CaptureFixture[str], store_url: str, run: int, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, run: int, tmp_path: Path
 ) -> None:
-    unknown = run_cli(capsys, store_url, "classes", str(run), "-c", "rf")
+    unknown = run_cli(capsys, sqlite_store_url, "classes", str(run), "-c", "rf")
     assert unknown.code == 2 and f"run {run} has no classifier 'rf'" in unknown.err
     assert len(unknown.err.strip().splitlines()) == 1
-    missing = run_cli(capsys, store_url, "calibration", "99")
+    missing = run_cli(capsys, sqlite_store_url, "calibration", "99")
     assert missing.code == 2 and "no run '99'" in missing.err
-    wrong = run_cli(capsys, store_url, "calibration", str(run), "-o", str(tmp_path / "x.txt"))
+    wrong = run_cli(
+        capsys, sqlite_store_url, "calibration", str(run), "-o", str(tmp_path / "x.txt")
+    )
     assert wrong.code == 2
     nothing = run_cli(
-        capsys, store_url, "calibration", str(run), "-c", "svm-rbf", "-o", str(tmp_path / "s.svg")
+        capsys,
+        sqlite_store_url,
+        "calibration",
+        str(run),
+        "-c",
+        "svm-rbf",
+        "-o",
+        str(tmp_path / "s.svg"),
     )
     assert nothing.code == 2 and "kept calibration bins" in nothing.err
     position = position_arff(tmp_path / "contact.arff", n=30)
-    assert run_cli(capsys, store_url, "import", str(position)).code == 0
+    assert run_cli(capsys, sqlite_store_url, "import", str(position)).code == 0
     regression = run_cli(
-        capsys, store_url, "bench", "contact", "-c", "ridge", "--folds", "3", "--json"
+        capsys, sqlite_store_url, "bench", "contact", "-c", "ridge", "--folds", "3", "--json"
     ).json()["run_id"]
-    refused = run_cli(capsys, store_url, "classes", str(regression))
+    refused = run_cli(capsys, sqlite_store_url, "classes", str(regression))
     assert refused.code == 2 and "is a regression" in refused.err
 
 
 def test_the_report_says_how_sure(
-    capsys: pytest.CaptureFixture[str], store_url: str, run: int, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, run: int, tmp_path: Path
 ) -> None:
     page = tmp_path / "report.html"
-    made = run_cli(capsys, store_url, "report", str(run), "-o", str(page), "--confusions", "2")
+    made = run_cli(
+        capsys, sqlite_store_url, "report", str(run), "-o", str(page), "--confusions", "2"
+    )
     assert made.code == 0, made.err
     html = page.read_text(encoding="utf-8")
     assert "How sure: per class and calibration" in html
@@ -113,10 +124,10 @@ def test_the_report_says_how_sure(
 
 
 def test_importance_explains_a_runs_classifier_on_its_folds(
-    capsys: pytest.CaptureFixture[str], store_url: str, run: int
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, run: int
 ) -> None:
     result = run_cli(
-        capsys, store_url, "importance", str(run), "-c", "nb", "--repeats", "1", "--json"
+        capsys, sqlite_store_url, "importance", str(run), "-c", "nb", "--repeats", "1", "--json"
     )
     assert result.code == 0, result.err
     found = result.json()
@@ -124,7 +135,7 @@ def test_importance_explains_a_runs_classifier_on_its_folds(
     names = [f["name"] for f in found["features"]]
     assert sorted(names) == ["f0", "f1", "f2", "f3", "mic"]
     assert names[0] == "f0"  # the synthetic gesture is f0's shift
-    bad = run_cli(capsys, store_url, "importance", str(run), "-c", "rf")
+    bad = run_cli(capsys, sqlite_store_url, "importance", str(run), "-c", "rf")
     assert bad.code == 2 and bad.err.startswith("touchbench: error: --classifier: 'rf' is not")
-    many = run_cli(capsys, store_url, "importance", str(run), "-c", "nb", "--repeats", "99")
+    many = run_cli(capsys, sqlite_store_url, "importance", str(run), "-c", "nb", "--repeats", "99")
     assert many.code == 2 and "--repeats" in many.err

@@ -23,7 +23,7 @@ from touchbench.drivers.replay import FileReplaySource
 
 
 @pytest.fixture
-def trained(tmp_path: Path, store: Store) -> tuple[str, Path]:
+def trained(tmp_path: Path, sqlite_store: Store) -> tuple[str, Path]:
     """A model trained on extracted sessions, and a session it never saw."""
     recordings, rows = [], []
     for seed in range(3):
@@ -31,21 +31,23 @@ def trained(tmp_path: Path, store: Store) -> tuple[str, Path]:
         recordings.append(wav)
         rows += [(wav.name, *touch) for touch in touches]
     labels = write_labels(tmp_path / "labels.csv", rows)
-    extract_and_store(store, ExtractRequest(recordings=recordings, labels=labels, name="touch"))
-    model = train(store, TrainRequest(dataset="touch", classifier="cc:rf"))
+    extract_and_store(
+        sqlite_store, ExtractRequest(recordings=recordings, labels=labels, name="touch")
+    )
+    model = train(sqlite_store, TrainRequest(dataset="touch", classifier="cc:rf"))
     unseen, _ = write_session(tmp_path, "unseen", n_touches=6, seed=99)
     return model.name, unseen
 
 
 def test_live_predicts_what_predict_says_of_the_extracted_instances(
-    store: Store, trained: tuple[str, Path]
+    sqlite_store: Store, trained: tuple[str, Path]
 ) -> None:
     name, unseen = trained
     offline = extract_dataset([unseen], labels=None, extractor="uc3m-audio").dataset
-    _, model = load_model(store, name)
+    _, model = load_model(sqlite_store, name)
     expected = predict(model, offline)
     with FileReplaySource(unseen, block_length=512) as source:
-        session = open_live(store, name, samplerate=source.samplerate, n_channels=3)
+        session = open_live(sqlite_store, name, samplerate=source.samplerate, n_channels=3)
         touches = [t for b in source.blocks() for t in session.feed(b.samples, b.time)]
         touches += session.finish()
     assert len(touches) == offline.n_instances == 6
@@ -62,10 +64,10 @@ def test_live_predicts_what_predict_says_of_the_extracted_instances(
 
 
 def test_the_recipe_travels_with_the_data_set_to_the_model(
-    store: Store, trained: tuple[str, Path]
+    sqlite_store: Store, trained: tuple[str, Path]
 ) -> None:
     name, _ = trained
-    info, _ = load_model(store, name)
+    info, _ = load_model(sqlite_store, name)
     recipe = info.extraction
     assert recipe is not None
     assert (recipe["extractor"], recipe["events"], recipe["n_channels"]) == ("uc3m-audio", "snr", 3)
@@ -73,17 +75,17 @@ def test_the_recipe_travels_with_the_data_set_to_the_model(
 
 
 def test_a_stream_unlike_the_training_recordings_is_refused(
-    store: Store, trained: tuple[str, Path]
+    sqlite_store: Store, trained: tuple[str, Path]
 ) -> None:
     name, _ = trained
     with pytest.raises(AppError, match=r"trained on 3-channel recordings .* source has 2"):
-        open_live(store, name, samplerate=44100.0, n_channels=2)
+        open_live(sqlite_store, name, samplerate=44100.0, n_channels=2)
     with pytest.raises(AppError, match=r"recordings at 44100 Hz, but the source runs at 48000"):
-        open_live(store, name, samplerate=48000.0, n_channels=3)
+        open_live(sqlite_store, name, samplerate=48000.0, n_channels=3)
 
 
 def test_a_model_of_an_imported_arff_refuses_live(
-    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, tmp_path: Path
 ) -> None:
     arff = tmp_path / "mini.arff"
     rows = "\n".join(f"{'tap' if i % 2 else 'slap'},{i * 0.1:.1f},{i % 3}" for i in range(20))
@@ -92,24 +94,26 @@ def test_a_model_of_an_imported_arff_refuses_live(
         f"@attribute b numeric\n@data\n{rows}\n"
     )
     wav, _ = write_session(tmp_path, "take", n_touches=2, seed=1)
-    assert run_cli(capsys, store_url, "import", str(arff), "--targets", "gesture").code == 0
-    assert run_cli(capsys, store_url, "train", "mini", "--classifier", "j48").code == 0
-    result = run_cli(capsys, store_url, "live", "--model", "mini-j48", "--replay", str(wav))
+    assert run_cli(capsys, sqlite_store_url, "import", str(arff), "--targets", "gesture").code == 0
+    assert run_cli(capsys, sqlite_store_url, "train", "mini", "--classifier", "j48").code == 0
+    result = run_cli(capsys, sqlite_store_url, "live", "--model", "mini-j48", "--replay", str(wav))
     assert result.code == 2 and result.err.count("\n") == 1
     assert "imported from a file, not extracted from recordings" in result.err
 
 
 def test_live_bad_input_is_one_line(
-    capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, tmp_path: Path
 ) -> None:
-    store = Store(store_url)
+    sqlite_store = Store(sqlite_store_url)
     try:
         wav, touches = write_session(tmp_path, "s", n_touches=6, seed=4)
         labels = write_labels(tmp_path / "l.csv", [(wav.name, *t) for t in touches])
-        extract_and_store(store, ExtractRequest(recordings=[wav], labels=labels, name="touch"))
-        train(store, TrainRequest(dataset="touch", classifier="j48", target="gesture"))
+        extract_and_store(
+            sqlite_store, ExtractRequest(recordings=[wav], labels=labels, name="touch")
+        )
+        train(sqlite_store, TrainRequest(dataset="touch", classifier="j48", target="gesture"))
     finally:
-        store.dispose()
+        sqlite_store.dispose()
     mono = tmp_path / "mono.wav"
     soundfile.write(mono, np.zeros(44100), 44100)
     odd = tmp_path / "take.xyz"
@@ -123,22 +127,22 @@ def test_live_bad_input_is_one_line(
     ]
     for args, message in cases:
         model = [] if "--model" in args else ["--model", "touch-j48"]
-        result = run_cli(capsys, store_url, "live", *model, *args)
+        result = run_cli(capsys, sqlite_store_url, "live", *model, *args)
         assert result.code == 2, (args, result.err)
         assert result.err.count("\n") == 1 and message in result.err, result.err
 
 
 def test_the_block_length_changes_when_touches_are_told_not_what_they_are(
-    capsys: pytest.CaptureFixture[str], store: Store, store_url: str, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_store: Store, sqlite_store_url: str, tmp_path: Path
 ) -> None:
     wav, touches = write_session(tmp_path, "s", n_touches=6, seed=4)
     labels = write_labels(tmp_path / "l.csv", [(wav.name, *t) for t in touches])
-    extract_and_store(store, ExtractRequest(recordings=[wav], labels=labels, name="touch"))
-    train(store, TrainRequest(dataset="touch", classifier="j48", target="gesture"))
+    extract_and_store(sqlite_store, ExtractRequest(recordings=[wav], labels=labels, name="touch"))
+    train(sqlite_store, TrainRequest(dataset="touch", classifier="j48", target="gesture"))
     seen = []
     for block in ("256", "512", "4096"):
         result = run_cli(
-            capsys, store_url, "live", "--model", "touch-j48", "--replay", str(wav),
+            capsys, sqlite_store_url, "live", "--model", "touch-j48", "--replay", str(wav),
             "--block", block, "--json",
         )  # fmt: skip
         assert result.code == 0, result.err
@@ -148,10 +152,10 @@ def test_the_block_length_changes_when_touches_are_told_not_what_they_are(
 
 
 def test_live_session_takes_a_recipe_given_explicitly(
-    store: Store, trained: tuple[str, Path]
+    sqlite_store: Store, trained: tuple[str, Path]
 ) -> None:
     name, unseen = trained
-    info, model = load_model(store, name)
+    info, model = load_model(sqlite_store, name)
     session = LiveSession(info, model, samplerate=44100.0, n_channels=3, extraction=info.extraction)
     samples, _ = soundfile.read(unseen, always_2d=True)
     touches = session.feed(samples.T, 10.0) + session.finish()

@@ -13,9 +13,9 @@ from tests.support.synthetic import touch_arff
 
 
 def test_the_page_shows_the_paper_beside_us_and_how_sure(
-    capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_server: Server, tmp_path: Path
 ) -> None:
-    db, api = server.database_url, server.client
+    db, api = sqlite_server.database_url, sqlite_server.client
     data = touch_arff(tmp_path / "touch.arff", n=60, with_place=False)
     assert run_cli(capsys, db, "import", str(data)).code == 0
     ours = run_cli(capsys, db, "bench", "touch", "-c", "j48,nb", "--folds", "3", "--json")
@@ -42,9 +42,9 @@ def test_the_page_shows_the_paper_beside_us_and_how_sure(
 
 
 def test_the_data_set_view_shows_its_newest_learning_curve(
-    capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_server: Server, tmp_path: Path
 ) -> None:
-    db, api = server.database_url, server.client
+    db, api = sqlite_server.database_url, sqlite_server.client
     data = touch_arff(tmp_path / "touch.arff", n=60, with_place=False)
     assert run_cli(capsys, db, "import", str(data)).code == 0
     before = api.get("/fragments/datasets/touch")

@@ -1,5 +1,5 @@
-"""The web page's answers as a client reads them, on a real service over SQLite and
-PostgreSQL: frames without data, fragments escaped and behind the same errors as the API,
+"""The web page's answers as a client reads them, on a real service over SQLite:
+frames without data, fragments escaped and behind the same errors as the API,
 the strict Content-Security-Policy and nothing the page would be refused under it, plots of
 every kind of run with their labels, figures drawn by threads at once."""
 
@@ -49,9 +49,9 @@ def _figures(html: str) -> list[list[str]]:
 
 
 def test_frames_fragments_escaping_errors_and_policy(
-    capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_server: Server, tmp_path: Path
 ) -> None:
-    db, api = server.database_url, server.client
+    db, api = sqlite_server.database_url, sqlite_server.client
     path = _markup_arff(tmp_path / "markup.arff")
     assert run_cli(capsys, db, "import", str(path), "--name", MARKUP_NAME).code == 0
     ref = api.get("/api/datasets").json()["datasets"][0]["id"]
@@ -98,9 +98,9 @@ def test_frames_fragments_escaping_errors_and_policy(
 
 
 def test_plots_of_every_kind_of_run_and_figures_drawn_at_once(
-    capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], sqlite_server: Server, tmp_path: Path
 ) -> None:
-    db, api = server.database_url, server.client
+    db, api = sqlite_server.database_url, sqlite_server.client
     data = touch_arff(tmp_path / "t.arff", n=60)
     assert run_cli(capsys, db, "import", str(data), "--name", "touch").code == 0
     single = _bench(capsys, db, "touch", "--target", "gesture", "-c", "nb,zeror,j48", "-k", "3")
@@ -117,7 +117,7 @@ def test_plots_of_every_kind_of_run_and_figures_drawn_at_once(
     assert queued.status_code == 202, queued.text
     stopped = queued.json()["id"]
     assert api.post(f"/api/runs/{stopped}/cancel").status_code == 200
-    assert server.wait_for(f"/api/runs/{stopped}", finished)["status"] == "cancelled"
+    assert sqlite_server.wait_for(f"/api/runs/{stopped}", finished)["status"] == "cancelled"
     resumable = api.get(f"/fragments/runs/{stopped}/progress").text
     assert "Resume" in resumable and "Train its best classifier" not in resumable
 
