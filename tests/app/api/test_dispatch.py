@@ -8,7 +8,7 @@ import os
 import subprocess
 import sys
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from datetime import datetime
 from itertools import pairwise
 from pathlib import Path
@@ -57,11 +57,11 @@ def test_two_service_processes_run_one_job_at_a_time_each_once(
 
 
 @pytest.fixture
-def sqlite_store(tmp_path: Path) -> Iterator[Store]:
-    store = Store(f"sqlite:///{tmp_path / 'touchbench.db'}")
-    import_file(store, ImportRequest(file=touch_arff(tmp_path / "t.arff", n=60), name="touch"))
-    yield store
-    store.dispose()
+def touch_store(sqlite_store: Store, tmp_path: Path) -> Store:
+    """A SQLite store holding the data set ``touch``."""
+    file = touch_arff(tmp_path / "t.arff", n=60)
+    import_file(sqlite_store, ImportRequest(file=file, name="touch"))
+    return sqlite_store
 
 
 def _wait_done(store: Store, run_id: int, timeout: float = 120.0) -> None:
@@ -72,13 +72,13 @@ def _wait_done(store: Store, run_id: int, timeout: float = 120.0) -> None:
 
 
 def test_the_leader_hears_a_wake_from_another_process_and_is_replaced_when_it_stops(
-    sqlite_store: Store, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    touch_store: Store, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     # Polling only every 10 minutes: a run is dispatched within the test only if the
     # wake-up reaches the leader.
     monkeypatch.setattr(dispatching, "POLL", 600.0)
-    settings = Settings(database_url=sqlite_store.url, job_workers=1, work_dir=tmp_path / "w")
-    first, second = Dispatcher(sqlite_store, settings), Dispatcher(sqlite_store, settings)
+    settings = Settings(database_url=touch_store.url, job_workers=1, work_dir=tmp_path / "w")
+    first, second = Dispatcher(touch_store, settings), Dispatcher(touch_store, settings)
     first.start()
     deadline = time.monotonic() + 30
     while not first.leading:
@@ -87,15 +87,15 @@ def test_the_leader_hears_a_wake_from_another_process_and_is_replaced_when_it_st
     second.start()
     try:
         request = BenchRequest(dataset="touch", classifiers=["nb"], target="gesture", folds=2)
-        run = create_run(sqlite_store, request)
+        run = create_run(touch_store, request)
         second.wake()
-        _wait_done(sqlite_store, run.id)
+        _wait_done(touch_store, run.id)
         assert not second.leading
 
         first.stop()
-        later = create_run(sqlite_store, request)
+        later = create_run(touch_store, request)
         second.wake()
-        _wait_done(sqlite_store, later.id)
+        _wait_done(touch_store, later.id)
         assert second.leading
     finally:
         first.stop()
@@ -132,23 +132,23 @@ time.sleep(120)
 
 @pytest.mark.skipif(os.getuid() != 0, reason="needs root to run a squatter as another user")
 def test_an_address_held_by_another_user_does_not_stop_dispatching(
-    sqlite_store: Store, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    touch_store: Store, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setattr(dispatching, "POLL", 600.0)  # only a wake-up dispatches in time
-    address = dispatch_address(sqlite_store)
+    address = dispatch_address(touch_store)
     assert address is not None
     squatter = subprocess.Popen(
         [sys.executable, "-c", SQUATTER, address[1:]], stdout=subprocess.PIPE, text=True
     )
-    settings = Settings(database_url=sqlite_store.url, job_workers=1, work_dir=tmp_path / "w")
-    dispatcher = Dispatcher(sqlite_store, settings)
+    settings = Settings(database_url=touch_store.url, job_workers=1, work_dir=tmp_path / "w")
+    dispatcher = Dispatcher(touch_store, settings)
     try:
         assert squatter.stdout is not None and squatter.stdout.readline().strip() == "bound"
         dispatcher.start()
         request = BenchRequest(dataset="touch", classifiers=["nb"], target="gesture", folds=2)
-        run = create_run(sqlite_store, request)
+        run = create_run(touch_store, request)
         dispatcher.wake()
-        _wait_done(sqlite_store, run.id)
+        _wait_done(touch_store, run.id)
         assert not dispatcher.leading  # the squatter still holds the address
     finally:
         dispatcher.stop()
