@@ -740,13 +740,16 @@ def _ranked(
     metric: str | None,
     baseline: str | None,
     beside: Sequence[int] = (),
+    aggregate: str | None = None,
 ) -> RunLeaderboard:
     """A run's leaderboard; a run without results says how to carry it out."""
     from touchbench.app.errors import AppError
     from touchbench.app.services.runs import NoResultsError, run_leaderboard
 
     try:
-        return run_leaderboard(store, run_id, metric=metric, baseline=baseline, beside=beside)
+        return run_leaderboard(
+            store, run_id, metric=metric, baseline=baseline, beside=beside, aggregate=aggregate
+        )
     except NoResultsError as missing:
         run = missing.run
         if missing.under_way:
@@ -817,6 +820,21 @@ def leaderboard_command(
             ),
         ),
     ] = None,
+    aggregate: Annotated[
+        str | None,
+        typer.Option(
+            "--aggregate",
+            metavar="window|recording",
+            help=(
+                "Score each recording's windows as one prediction (recording) or each "
+                "window (window), from the run's stored test-fold predictions: nothing is "
+                "fitted again. Default: as the run was scored. recording needs a data set "
+                "extracted from recordings, one label per recording, and a run that stored "
+                "its predictions (not an imported one)."
+            ),
+            show_default=False,
+        ),
+    ] = None,
     as_json: JsonOption = False,
 ) -> None:
     """Show a run's leaderboard with WEKA's significance marks (v better, * worse)."""
@@ -833,13 +851,15 @@ def leaderboard_command(
     )
 
     store = get_state(ctx).store
-    ranked = _ranked(store, run_id, metric, baseline, beside or ())
+    ranked = _ranked(store, run_id, metric, baseline, beside or (), aggregate)
     run, board = ranked.run, ranked.board
     columns = metric_columns(run, board)
     if output_format == "json":
         print_json(ranked.report().to_json())
     elif output_format == "csv":
-        sys.stdout.write(leaderboard_csv(board, columns, ranked.besides))
+        sys.stdout.write(
+            leaderboard_csv(board, columns, ranked.besides, aggregate=ranked.aggregate)
+        )
     elif output_format == "markdown":
         sys.stdout.write(leaderboard_markdown(run, board, columns, ranked.besides, ranked.notes()))
     elif output_format == "arff":

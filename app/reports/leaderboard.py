@@ -85,8 +85,15 @@ def _has_notes(board: Leaderboard) -> bool:
 
 
 def leaderboard_csv(
-    board: Leaderboard, columns: Sequence[str], besides: Sequence[Beside] = ()
+    board: Leaderboard,
+    columns: Sequence[str],
+    besides: Sequence[Beside] = (),
+    *,
+    aggregate: str = "window",
 ) -> str:
+    """One row per classifier: its mean and deviation per column, its folds, its mark and
+    a column ``aggregate`` saying what one prediction of the scores is (``window`` or
+    ``recording``)."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     origins = row_runs(besides)
@@ -94,7 +101,9 @@ def leaderboard_csv(
     for column in columns:
         header += [f"{column}_mean", f"{column}_std"]
     extra = ["run", "tested"] if besides else []
-    writer.writerow([*header, "n_ok", "n_failed", "p_value", "dropped_after_fold", "note", *extra])
+    writer.writerow(
+        [*header, "n_ok", "n_failed", "p_value", "dropped_after_fold", "note", "aggregate", *extra]
+    )
     for row in board.rows:
         cells: list[Any] = [row.rank, row.classifier, row.mark]
         for column in columns:
@@ -103,7 +112,8 @@ def leaderboard_csv(
         p_value = "" if math.isnan(row.p_value) else row.p_value
         after = "" if row.dropped is None else row.dropped.after_fold
         more = [origins.get(row.classifier, ""), row.tested] if besides else []
-        writer.writerow([*cells, row.n_ok, row.n_failed, p_value, after, row_note(row), *more])
+        note = row_note(row)
+        writer.writerow([*cells, row.n_ok, row.n_failed, p_value, after, note, aggregate, *more])
     return buffer.getvalue()
 
 

@@ -11,15 +11,18 @@ from pathlib import Path
 from typing import Annotated, Literal
 
 from fastapi import APIRouter, File, Form, Query, Request, Response, UploadFile, status
+from fastapi.exceptions import RequestValidationError
 from fastapi.responses import PlainTextResponse
 
 from touchbench.app.api.deps import PageDep, ServiceDep, StoreDep, paginate
 from touchbench.app.api.uploads import form_request, save_upload
+from touchbench.app.errors import FieldError
 from touchbench.app.schemas.ablation import AblationResult
 from touchbench.app.schemas.certainty import RunCertainty
 from touchbench.app.schemas.folds import FoldScoresSchema
 from touchbench.app.schemas.imported import ImportResultsRequest
 from touchbench.app.schemas.runs import (
+    Aggregate,
     BenchRequest,
     LeaderboardSchema,
     RunCreated,
@@ -116,12 +119,33 @@ def leaderboard(
     baseline: Annotated[str | None, Query(max_length=200)] = None,
     format: Annotated[Literal["json", "csv", "markdown", "arff"], Query()] = "json",
     beside: Annotated[list[int] | None, Query(max_length=20)] = None,
+    aggregate: Annotated[
+        Aggregate | None,
+        Query(
+            description="`recording`: each recording's windows scored as one prediction; "
+            "`window`: each window; from the run's stored test-fold predictions, nothing "
+            "fitted again (default: as the run was scored)."
+        ),
+    ] = None,
 ) -> LeaderboardSchema | PlainTextResponse:
     """The run's classifiers ranked by ``metric`` with WEKA's marks against ``baseline``
     (JSON: the same rows as ``touchbench leaderboard --json``); ``beside`` adds other runs'
     classifiers (same data set and target: a paper's imported results), t-tested where the
-    folds pair and by their means where they do not."""
-    ranked = run_leaderboard(store, run_id, metric=metric, baseline=baseline, beside=beside or ())
+    folds pair and by their means where they do not; ``aggregate`` scores the run's stored
+    predictions per recording or per window."""
+    try:
+        ranked = run_leaderboard(
+            store,
+            run_id,
+            metric=metric,
+            baseline=baseline,
+            beside=beside or (),
+            aggregate=aggregate,
+        )
+    except FieldError as error:  # the fields of this route are query parameters
+        raise RequestValidationError(
+            [{"type": "value_error", "loc": ("query", error.field), "msg": error.message}]
+        ) from None
     run, board = ranked.run, ranked.board
     if format == "json":
         return ranked.report()
@@ -133,7 +157,7 @@ def leaderboard(
 
     columns = metric_columns(run, board)
     if format == "csv":
-        text = leaderboard_csv(board, columns, ranked.besides)
+        text = leaderboard_csv(board, columns, ranked.besides, aggregate=ranked.aggregate)
     elif format == "markdown":
         text = leaderboard_markdown(run, board, columns, ranked.besides, ranked.notes())
     else:

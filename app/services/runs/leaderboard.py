@@ -16,13 +16,14 @@ import threading
 from collections import OrderedDict
 from collections.abc import Callable, Hashable, Iterator, Sequence
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, TypeVar, cast
 
 import numpy as np
 
 from touchbench.app.schemas.runs import (
     PER_RECORDING_NOTE,
+    Aggregate,
     BudgetSchema,
     FoldChoiceSchema,
     LeaderboardRowSchema,
@@ -87,6 +88,9 @@ class RunLeaderboard:
         compared; their results are in ``board`` but not in ``results``.
     drops : dict of str to Drop
         The classifiers that stopped before their last fold (raced or budgeted runs).
+    rescored : {"window", "recording"} or None
+        How ``results`` were scored again from the run's stored fold predictions, when not
+        as the run scored them (:mod:`.rescore`); ``None``: as the run scored them.
     """
 
     run: RunInfo
@@ -94,16 +98,28 @@ class RunLeaderboard:
     results: list[TaskResult]
     besides: tuple[Beside, ...]
     drops: dict[str, Drop]
+    rescored: Aggregate | None = field(default=None, kw_only=True)
+
+    @property
+    def aggregate(self) -> Aggregate:
+        """What one prediction of the leaderboard's scores is: a window or a recording."""
+        return self.rescored or self.run.config.aggregate
 
     @property
     def per_recording(self) -> bool:
-        """Whether the run scored each recording's windows as one prediction."""
-        return self.run.config.by_recording
+        """Whether the scores count each recording's windows as one prediction."""
+        return self.aggregate == "recording"
 
     def notes(self) -> list[str]:
         """What the leaderboard of a run scored per recording, raced, budgeted or stopped
         says under its table."""
         notes = [PER_RECORDING_NOTE] if self.per_recording else []
+        if self.rescored is not None:
+            notes.append(
+                f"re-scored per {self.rescored} from the run's stored test-fold predictions, "
+                f"nothing fitted again (the run scored per {self.run.config.aggregate}; the "
+                "costs are as measured then)"
+            )
         helpers = self.run.config.helpers
         if helpers:
             spent = sum(
@@ -199,7 +215,7 @@ class RunLeaderboard:
             beside=[b.schema() for b in self.besides],
             race=self.race(),
             budget=self.budget(),
-            aggregate="recording" if self.per_recording else "window",
+            aggregate=self.aggregate,
             notes=self.notes(),
         )
 
@@ -211,6 +227,7 @@ def run_leaderboard(
     metric: str | None = None,
     baseline: str | None = None,
     beside: Sequence[int | str] = (),
+    aggregate: str | None = None,
 ) -> RunLeaderboard:
     """A run's leaderboard from its stored results.
 
@@ -223,6 +240,11 @@ def run_leaderboard(
         Runs of the same data set and target whose classifiers are ranked too (an
         imported paper's results): t-tested where their folds pair with the run's, by
         their means otherwise (:mod:`app.services.beside`).
+    aggregate : {"window", "recording"}, optional
+        Score each window, or each recording's windows pooled into one prediction; default:
+        as each run scored.  The run and each run beside it that scored otherwise are
+        scored again from their stored test-fold predictions, without fitting
+        (:mod:`.rescore`).
 
     Raises
     ------
@@ -230,9 +252,14 @@ def run_leaderboard(
         The run has no result yet.
     ConfigurationError
         A metric of the other kind of problem; an unknown metric or baseline.
+    FieldError
+        For ``aggregate``: another value, or a run it cannot re-score
+        (:func:`~.rescore.rescored_results`).
     """
+    from touchbench.app.services.runs.rescore import check_aggregate, rescored_results
     from touchbench.benchmark.evaluation.leaderboard import build_leaderboard
 
+    asked = None if aggregate is None else check_aggregate(aggregate)
     run = get_run(store, run_id)
     results = load_results(store, run.id)
     if not results:
@@ -241,7 +268,16 @@ def run_leaderboard(
         check_metric(run.kind, metric, position=bool(run.config.position), run_id=run.id)
     metric = metric or run_metric(run)
     others = besides(run, [get_run(store, ref) for ref in dict.fromkeys(beside)])
-    ranked, groups = merged_results(results, [(b, load_results(store, b.run.id)) for b in others])
+    rescored = asked if asked is not None and asked != run.config.aggregate else None
+    if rescored is not None:
+        results = rescored_results(store, run, results, rescored)
+    theirs = []
+    for other in others:
+        stored = load_results(store, other.run.id)
+        if asked is not None and asked != other.run.config.aggregate:
+            stored = rescored_results(store, other.run, stored, asked)
+        theirs.append((other, stored))
+    ranked, groups = merged_results(results, theirs)
     drops = {**never_started(run, results), **load_drops(store, run.id)}
     board = build_leaderboard(
         ranked,
@@ -251,7 +287,7 @@ def run_leaderboard(
         drops=drops,
         origins=run_origins(run),
     )
-    return RunLeaderboard(run, board, results, tuple(others), drops)
+    return RunLeaderboard(run, board, results, tuple(others), drops, rescored=rescored)
 
 
 def run_origins(run: RunInfo) -> dict[str, Origin]:

@@ -1,0 +1,234 @@
+"""`touchbench leaderboard RUN --aggregate recording|window`: a finished run's leaderboard
+scored again from its stored test-fold predictions, without fitting anything, equal fold by
+fold to the run scored that way from the start; and refused in one line where it cannot
+be.  SQLite: the store only reads what runs stored (tests/app/services/
+test_fold_predictions.py reads the predictions back on both stores)."""
+
+from __future__ import annotations
+
+import csv
+import io
+from pathlib import Path
+from typing import Any
+
+import pytest
+from sqlalchemy import create_engine, text
+
+from tests.support.cli_runner import one_error_line, run_cli
+from tests.support.recordings import PER_RECORDING, recorded_windows, store_dataset
+from tests.support.synthetic import touch_arff
+from touchbench.app.services.runs import run_leaderboard
+from touchbench.app.store.database import Store
+from touchbench.app.store.runs import load_results
+from touchbench.benchmark.evaluation.metrics import COST_METRICS
+from touchbench.benchmark.results import TaskKey, TaskResult
+
+#: Deterministic classifiers: with probabilities (pooled), without them (votes), a tree and
+#: a vote computed from its members' fold predictions.
+CLASSIFIERS = "nb,ridge,zeror,j48,ibk,voting-hard"
+COSTS = {*COST_METRICS, "inner_time", "inner_cpu_time"}
+RESCORED = "re-scored per recording from the run's stored test-fold predictions"
+
+
+@pytest.fixture
+def db(tmp_path: Path) -> str:
+    url = f"sqlite:///{tmp_path / 'touchbench.db'}"
+    store_dataset(url, recorded_windows(), "takes")
+    return url
+
+
+@pytest.fixture
+def no_fitting(monkeypatch: pytest.MonkeyPatch) -> list[str]:
+    """The engine and every estimator refuse to run: what is asked of them is counted."""
+    asked: list[str] = []
+
+    def refuse(what: str) -> Any:
+        def refused(*args: Any, **kwargs: Any) -> Any:
+            asked.append(what)
+            raise AssertionError(f"{what} called: a leaderboard fitted again")
+
+        return refused
+
+    monkeypatch.setattr("touchbench.benchmark.run.engine.run_tasks", refuse("run_tasks"))
+    monkeypatch.setattr("touchbench.benchmark.run.task.build_estimator", refuse("build"))
+    monkeypatch.setattr("touchbench.benchmark.estimators.build_estimator", refuse("build"))
+    return asked
+
+
+def _bench(capsys: pytest.CaptureFixture[str], db: str, *options: str) -> int:
+    result = run_cli(
+        capsys, db, "bench", "takes", "-c", CLASSIFIERS, "-k", "4", "--seed", "3", "--json",
+        *options,
+    )  # fmt: skip
+    assert result.code == 0, result.err
+    return int(result.json()["run_id"])
+
+
+def _scores(result: TaskResult) -> dict[str, float]:
+    return {k: v for k, v in result.metrics.items() if k not in COSTS}
+
+
+def _assert_same_folds(ours: list[TaskResult], theirs: list[TaskResult]) -> None:
+    """Every fold of ``ours`` scores exactly as the same fold of ``theirs``."""
+    mine: dict[TaskKey, TaskResult] = {r.key: r for r in ours}
+    other: dict[TaskKey, TaskResult] = {r.key: r for r in theirs}
+    assert set(mine) == set(other) and len(mine) == 9 * 4  # 6 entries, 3 helpers of the vote
+    for key, result in mine.items():
+        assert result.ok, result.error
+        assert _scores(result) == _scores(other[key]), key  # exactly: same floats
+        assert result.confusion == other[key].confusion, key
+        assert result.calibration == other[key].calibration, key
+        assert result.per_target == other[key].per_target, key
+
+
+def _ranked(board: dict[str, Any]) -> list[tuple[Any, ...]]:
+    """Each row's rank, name, mark, p-value and scores (not its costs)."""
+    return [
+        (
+            row["rank"],
+            row["classifier"],
+            row["mark"],
+            row["p_value"],
+            {k: v for k, v in row["metrics"].items() if k not in COSTS},
+        )
+        for row in board["leaderboard"]
+    ]
+
+
+@pytest.fixture
+def two_runs(capsys: pytest.CaptureFixture[str], db: str) -> tuple[int, int]:
+    """Run 1 scored per window, run 2 per recording: the same tasks on the same folds."""
+    return _bench(capsys, db), _bench(capsys, db, "--aggregate", "recording")
+
+
+def test_rescored_runs_equal_runs_scored_so_from_the_start(
+    capsys: pytest.CaptureFixture[str],
+    db: str,
+    two_runs: tuple[int, int],
+    no_fitting: list[str],
+) -> None:
+    """A per-window run re-scored per recording is, fold by fold and metric by metric, the
+    same run made with `bench --aggregate recording` (same folds and seed), and the other
+    way round; nothing is fitted."""
+    windows, recordings = two_runs
+    store = Store(db)
+    try:
+        as_windows, as_recordings = load_results(store, windows), load_results(store, recordings)
+        rescored = run_leaderboard(store, windows, aggregate="recording")
+        assert rescored.rescored == "recording" and rescored.per_recording
+        _assert_same_folds(rescored.results, as_recordings)
+        back = run_leaderboard(store, recordings, aggregate="window")
+        assert back.rescored == "window" and not back.per_recording
+        _assert_same_folds(back.results, as_windows)
+        # asked as the run scored: its stored scores, nothing re-scored
+        same = run_leaderboard(store, windows, aggregate="window")
+        assert same.rescored is None and same.results == as_windows
+        # the costs stay as the run measured them
+        measured = {r.key: r.metrics["fit_time"] for r in as_windows if r.ok}
+        assert {r.key: r.metrics["fit_time"] for r in rescored.results} == measured
+    finally:
+        store.dispose()
+
+    def leaderboard(run: int, *options: str) -> str:
+        result = run_cli(capsys, db, "leaderboard", str(run), *options)
+        assert result.code == 0, result.err
+        return result.out + result.err
+
+    ours = run_cli(capsys, db, "leaderboard", str(windows), "--aggregate", "recording", "--json")
+    assert ours.code == 0, ours.err
+    board, theirs = ours.json(), run_cli(capsys, db, "leaderboard", str(recordings), "--json")
+    assert board["aggregate"] == theirs.json()["aggregate"] == "recording"
+    assert _ranked(board) == _ranked(theirs.json())  # the same ranks, marks and t-tests
+    assert board["notes"][0].startswith(PER_RECORDING) and board["notes"][1].startswith(RESCORED)
+    helpers = "fitted only as members of ensembles: logistic, rf-200, svm-rbf ("
+    assert [note.startswith(helpers) for note in board["notes"][2:]] == [True]
+    back_board = run_cli(
+        capsys, db, "leaderboard", str(recordings), "--aggregate", "window", "--json"
+    ).json()
+    plain = run_cli(capsys, db, "leaderboard", str(windows), "--json").json()
+    assert back_board["aggregate"] == "window" and _ranked(back_board) == _ranked(plain)
+    assert back_board["notes"][0].startswith("re-scored per window from the run's stored")
+
+    # every view says it
+    table = leaderboard(windows, "--aggregate", "recording")
+    assert "scored per recording" in table and PER_RECORDING in table
+    assert RESCORED in " ".join(table.split())
+    rows = list(
+        csv.DictReader(io.StringIO(leaderboard(windows, "--aggregate", "recording", "-f", "csv")))
+    )
+    assert {row["aggregate"] for row in rows} == {"recording"}
+    assert [row["classifier"] for row in rows] == [row[1] for row in _ranked(board)]
+    plain_rows = csv.DictReader(io.StringIO(leaderboard(windows, "-f", "csv")))
+    assert {row["aggregate"] for row in plain_rows} == {"window"}
+    markdown = leaderboard(windows, "--aggregate", "recording", "-f", "markdown")
+    assert PER_RECORDING in markdown and RESCORED in markdown
+    arff = leaderboard(windows, "--aggregate", "recording", "-f", "arff")
+    assert arff.startswith(f"% {PER_RECORDING}")
+    assert no_fitting == []
+
+
+@pytest.fixture
+def refused_runs(capsys: pytest.CaptureFixture[str], db: str, tmp_path: Path) -> dict[str, int]:
+    """Runs that cannot be scored per recording: on a data set without recordings, on one
+    with a recording of two labels, a run imported from a results file, and a run stored
+    before runs kept their fold predictions (its predictions deleted)."""
+    store_dataset(db, recorded_windows(mixed=True), "mixed")
+    path = touch_arff(tmp_path / "touch.arff", n=60, with_place=False)
+    assert run_cli(capsys, db, "import", str(path), "--name", "touch").code == 0
+    runs = {}
+    for name, dataset in (("ungrouped", "touch"), ("mixed", "mixed"), ("old", "takes")):
+        made = run_cli(capsys, db, "bench", dataset, "-c", "nb,zeror", "-k", "4", "--json")
+        assert made.code == 0, made.err
+        runs[name] = int(made.json()["run_id"])
+    exported = tmp_path / "results.arff"
+    exported.write_text(run_cli(capsys, db, "leaderboard", str(runs["old"]), "-f", "arff").out)
+    imported = run_cli(capsys, db, "import-results", str(exported), "--dataset", "takes", "--json")
+    assert imported.code == 0, imported.err
+    runs["imported"] = int(imported.json()["id"])
+    engine = create_engine(db)
+    try:
+        with engine.begin() as connection:
+            connection.execute(
+                text("DELETE FROM fold_predictions WHERE run_id = :run"), {"run": runs["old"]}
+            )
+    finally:
+        engine.dispose()
+    return runs
+
+
+def test_rescoring_is_refused_in_one_line_where_it_cannot_be(
+    capsys: pytest.CaptureFixture[str],
+    db: str,
+    refused_runs: dict[str, int],
+    no_fitting: list[str],
+) -> None:
+    runs = refused_runs
+    for name, words in (
+        ("ungrouped", "--aggregate: needs windows grouped by recording, and data set 'touch' "),
+        ("mixed", "--aggregate: 1 recording(s) hold windows of several values of 'gesture'"),
+        ("imported", f"--aggregate: run {runs['imported']} was imported: it holds its scores"),
+        ("old", f"--aggregate: run {runs['old']} has no stored fold predictions for 8 of its"),
+    ):
+        for form in ((), ("--json",), ("-f", "csv")):
+            refused = run_cli(
+                capsys, db, "leaderboard", str(runs[name]), "--aggregate", "recording", *form
+            )
+            line = one_error_line(refused, words)
+            assert refused.out == "", name
+        if name == "old":
+            assert "run the benchmark again to score it per recording" in line
+    bad = run_cli(capsys, db, "leaderboard", str(runs["old"]), "--aggregate", "take")
+    one_error_line(bad, "--aggregate: Input should be 'window' or 'recording'")
+    # as the runs scored, each still has its leaderboard
+    for run in runs.values():
+        shown = run_cli(capsys, db, "leaderboard", str(run), "--aggregate", "window", "--json")
+        assert shown.code == 0 and shown.json()["aggregate"] == "window", shown.err
+    assert no_fitting == []
+
+
+def test_leaderboard_help_tells_aggregate(capsys: pytest.CaptureFixture[str], db: str) -> None:
+    shown = run_cli(capsys, db, "leaderboard", "--help")
+    assert shown.code == 0
+    words = " ".join(shown.out.replace("│", " ").split())
+    assert "--aggregate" in words and "stored test-fold predictions" in words
+    assert "nothing is fitted again" in words
