@@ -18,6 +18,7 @@ from typing import Any
 
 from touchbench.benchmark.errors import ConfigurationError
 from touchbench.benchmark.extras import EXTRA_OF, require
+from touchbench.benchmark.skops_import import import_skops_io
 
 #: Format tag written into every artifact, checked on load.
 ARTIFACT_FORMAT = "touchbench-model/1"
@@ -66,9 +67,9 @@ def dumps_artifact(content: dict[str, Any]) -> bytes:
     content : dict
         JSON-like data and estimators; a ``format`` key is added.
     """
-    import skops.io
+    skops_io = import_skops_io()
 
-    return bytes(skops.io.dumps({"format": ARTIFACT_FORMAT, **content}))
+    return bytes(skops_io.dumps({"format": ARTIFACT_FORMAT, **content}))
 
 
 def loads_artifact(data: bytes) -> dict[str, Any]:
@@ -82,7 +83,7 @@ def loads_artifact(data: bytes) -> dict[str, Any]:
     MissingExtraError
         The model is made of a library of an extra that is not installed.
     """
-    import skops.io
+    skops_io = import_skops_io()
 
     if not zipfile.is_zipfile(io.BytesIO(data)):
         raise ConfigurationError(
@@ -91,7 +92,7 @@ def loads_artifact(data: bytes) -> dict[str, Any]:
         )
     try:
         data = _renamed_modules(data)
-        named = skops.io.get_untrusted_types(data=data)
+        named = skops_io.get_untrusted_types(data=data)
     except Exception as exc:
         raise ConfigurationError(f"the stored model cannot be read: {exc}") from None
     optional = {name.split(".", 1)[0] for name in named} & EXTRA_OF.keys()
@@ -103,7 +104,7 @@ def loads_artifact(data: bytes) -> dict[str, Any]:
             f"the stored model names types touchbench does not trust ({shown}); refusing to load it"
         )
     try:
-        content = skops.io.loads(data, trusted=named)
+        content = skops_io.loads(data, trusted=named)
     except Exception as exc:
         raise ConfigurationError(f"the stored model cannot be loaded: {exc}") from None
     if not isinstance(content, dict) or content.get("format") != ARTIFACT_FORMAT:
