@@ -23,6 +23,9 @@ from touchbench.app.store.datasets import load_dataset
 from touchbench.app.store.predictions import load_predictions
 from touchbench.app.store.runs import RunInfo
 from touchbench.benchmark.errors import ConfigurationError
+from touchbench.benchmark.evaluation.fold_scores import score_fold
+from touchbench.benchmark.evaluation.metrics import COST_METRICS
+from touchbench.benchmark.evaluation.recordings import check_one_label
 from touchbench.benchmark.results import TaskResult
 
 #: Aggregations a leaderboard may be re-scored to.
@@ -74,10 +77,6 @@ def rescored_results(
         several labels (:func:`~benchmark.evaluation.recordings.check_one_label`); a task
         of the run whose predictions were not stored (a run of an older version).
     """
-    from touchbench.benchmark.evaluation.fold_scores import score_fold
-    from touchbench.benchmark.evaluation.metrics import COST_METRICS
-    from touchbench.benchmark.evaluation.recordings import check_one_label
-
     if run.config.imported:
         raise FieldError(
             "aggregate",
