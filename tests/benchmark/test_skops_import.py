@@ -4,12 +4,9 @@ estimators as when imported plainly."""
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
+from tests.support.processes import run_script
 
 
 def test_skops_trusts_the_same_estimators_without_importing_sklearn_tests(
@@ -27,15 +24,7 @@ def test_skops_trusts_the_same_estimators_without_importing_sklearn_tests(
         "plain = [name for name in plain if name.startswith('sklearn.')]\n"
         "print(json.dumps({'loaded': loaded, 'trusted': trusted, 'plain': plain}))\n"
     )
-    done = subprocess.run(
-        [sys.executable, "-c", script],
-        capture_output=True,
-        text=True,
-        cwd=tmp_path,
-        env={**os.environ, "PYTHONPATH": str(ROOT)},
-        timeout=300,
-    )
-    assert done.returncode == 0, done.stderr[-2000:]
+    done = run_script(script, tmp_path)
     found = json.loads(done.stdout)
     assert found["loaded"] == []
     assert len(found["trusted"]) > 100 and found["trusted"] == found["plain"]

@@ -1,4 +1,5 @@
-"""A `touchbench bench` in a process of its own, and reading its store meanwhile."""
+"""A `touchbench bench` in a process of its own, and reading its store meanwhile; a Python
+script in a fresh interpreter."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 from typing import Any
 
 from sqlalchemy import create_engine, text
@@ -54,3 +56,18 @@ def wait_for_results(url: str, child: subprocess.Popen[bytes], at_least: int) ->
         assert child.poll() is None, child.stderr.read().decode() if child.stderr else ""
         assert time.monotonic() < deadline, "the run recorded nothing in two minutes"
         time.sleep(0.05)
+
+
+def run_script(script: str, cwd: Path) -> subprocess.CompletedProcess[str]:
+    """``script`` run by a fresh interpreter in ``cwd`` with this checkout importable; the
+    test fails with its stderr if it does not exit 0."""
+    done = subprocess.run(
+        [sys.executable, "-c", script],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+    return done

@@ -3,12 +3,9 @@ requests need (the statistics, the signal processing, the classifiers)."""
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[3]
+from tests.support.processes import run_script
 
 #: Loaded by the requests that use them, never by the application's routes at start.
 ON_DEMAND = ("scipy.stats", "scipy.signal", "sklearn", "xgboost", "pandas", "matplotlib", "torch")
@@ -20,13 +17,5 @@ def test_the_application_imports_no_library_a_request_may_not_need(tmp_path: Pat
         "import touchbench.app.api.main\n"
         f"print(' '.join(m for m in {ON_DEMAND!r} if m in sys.modules))\n"
     )
-    done = subprocess.run(
-        [sys.executable, "-c", script],
-        capture_output=True,
-        text=True,
-        cwd=tmp_path,
-        env={**os.environ, "PYTHONPATH": str(ROOT)},
-        timeout=120,
-    )
-    assert done.returncode == 0, done.stderr[-2000:]
+    done = run_script(script, tmp_path)
     assert done.stdout.split() == []
