@@ -8,6 +8,14 @@ import pytest
 
 pytest_plugins = ["tests.support.termination"]
 
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """The tests marked ``slow`` first, each group in its own order: pytest-xdist hands the
+    tests out in this order, and a slow test left to the end keeps the whole run waiting for
+    one worker."""
+    items.sort(key=lambda item: item.get_closest_marker("slow") is None)
+
+
 SHARED_DATASETS = Path(__file__).resolve().parents[1].parent / "shared" / "datasets"
 
 

@@ -246,7 +246,14 @@ def test_spec_to_json_is_plain_data() -> None:
 
 
 @pytest.mark.filterwarnings("ignore:Bins whose width are too small:UserWarning")
-@pytest.mark.parametrize("classifier_id", list(CATALOGUE))
+@pytest.mark.parametrize(
+    "classifier_id",
+    # the sequence entries compile their kernels (numba) at their first fit
+    [
+        pytest.param(i, marks=pytest.mark.slow) if s.needs_sequence else i
+        for i, s in CATALOGUE.items()
+    ],
+)
 def test_every_entry_fits_and_predicts_nominal_and_missing_inputs(classifier_id: str) -> None:
     X, y, nominal = tiny_data()
     spec = get_spec(classifier_id)

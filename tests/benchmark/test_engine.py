@@ -439,6 +439,7 @@ def test_a_stop_set_while_tasks_run_ends_the_run_at_the_next_check(
             os.kill(pid, 0)
 
 
+@pytest.mark.slow
 def test_both_backends_run_the_same_plan_to_the_same_results(
     problem, folds, dask_scheduler
 ) -> None:

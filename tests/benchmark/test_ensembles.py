@@ -393,6 +393,7 @@ def _stored(folder: Path, with_predictions: bool) -> list[TaskResult]:
 
 
 @pytest.mark.parametrize("with_predictions", [True, False], ids=["stored", "not stored"])
+@pytest.mark.slow
 def test_a_run_killed_and_resumed_gives_the_same_ensembles(
     tmp_path: Path, with_predictions: bool
 ) -> None:

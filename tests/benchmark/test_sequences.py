@@ -75,6 +75,7 @@ def test_a_sequence_data_set_round_trips_through_arff_with_its_shape() -> None:
     np.testing.assert_array_equal(panel(problem.X, problem.sequence.shape)[0], sequences)
 
 
+@pytest.mark.slow
 def test_flat_summaries_cannot_tell_the_shapes_apart_and_minirocket_can() -> None:
     sequences, y = shapes()
     flat = cross_val_score(

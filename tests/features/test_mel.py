@@ -31,6 +31,7 @@ def test_unnormalised_triangles_peak_at_one() -> None:
     assert np.all(bank.max(axis=1) > 0.95) and bank.max() <= 1.0
 
 
+@pytest.mark.slow
 def test_mfcc_agrees_with_librosa_under_identical_parameters() -> None:
     y = white_noise(16000, seed=4) * 0.1 + sine(440, samplerate=SAMPLERATE, n_samples=16000)
     power = power_spectrogram(frame(y, frame_length=FRAME, hop_length=HOP), window="hann")

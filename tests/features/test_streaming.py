@@ -136,6 +136,7 @@ def _streamed(recipe: Recipe, y: np.ndarray, samplerate: float, length: int) -> 
 
 
 @pytest.mark.parametrize(("extractor", "events", "options", "segment"), RECIPES)
+@pytest.mark.slow
 def test_streaming_gives_the_instances_of_whole_array_extraction(
     extractor: str, events: str | None, options: dict, segment: float | None
 ) -> None:

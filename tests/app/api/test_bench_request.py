@@ -77,6 +77,7 @@ REFUSALS: list[tuple[dict[str, Any], str, str]] = [
 ]
 
 
+@pytest.mark.slow
 def test_every_refusal_names_its_field_and_leaves_no_run(
     capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path
 ) -> None:

@@ -130,6 +130,7 @@ def dask_cluster(tmp_path: Path) -> Iterator[str]:
         log.close()
 
 
+@pytest.mark.slow
 def test_the_compose_stack_as_processes(
     postgres_database: str, dask_cluster: str, tmp_path: Path
 ) -> None:

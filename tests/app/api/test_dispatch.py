@@ -28,6 +28,7 @@ from touchbench.app.store.database import Store
 from touchbench.app.store.runs import get_run
 
 
+@pytest.mark.slow
 def test_two_service_processes_run_one_job_at_a_time_each_once(
     make_sqlite_server: Callable[..., Server], tmp_path: Path
 ) -> None:

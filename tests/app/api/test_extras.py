@@ -98,6 +98,7 @@ def test_the_hider_hides(tmp_path: Path) -> None:
         ("minirocket", "sequences"),
     ],
 )
+@pytest.mark.slow
 def test_bench_names_the_missing_extra(stored: Path, classifier: str, extra: str) -> None:
     result = _touchbench(
         stored, "bench", "touches", "-c", f"rf,{classifier}", hidden=EXTRA_MODULES[extra]

@@ -19,6 +19,7 @@ def _import(capsys: pytest.CaptureFixture[str], url: str, path: Path, name: str)
     assert result.code == 0, result.err
 
 
+@pytest.mark.slow
 def test_run_leaderboard_model_and_predictions_over_http(
     capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path
 ) -> None:
@@ -111,6 +112,7 @@ def test_run_leaderboard_model_and_predictions_over_http(
     assert gone.status_code == 404 and gone.json()["error"]["type"] == "NotFoundError"
 
 
+@pytest.mark.slow
 def test_a_multi_target_run_and_model(
     capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path
 ) -> None:

@@ -39,6 +39,7 @@ def _training(
 
 
 @pytest.mark.parametrize("classifier", ["gate", "gate-stubborn"])
+@pytest.mark.slow
 def test_a_running_job_is_cancelled_over_http(
     capsys: pytest.CaptureFixture[str], server: Server, tmp_path: Path, classifier: str
 ) -> None:

@@ -39,6 +39,7 @@ def forest(store_url: str, tmp_path: Path) -> str:
     return store_url
 
 
+@pytest.mark.slow
 def test_requests_at_once_make_one_twin_by_one_job_and_a_get_writes_nothing(
     forest: str, make_server: Callable[..., Server]
 ) -> None:

@@ -33,6 +33,7 @@ def _scores(board: dict[str, Any]) -> list[tuple[Any, ...]]:
     ]
 
 
+@pytest.mark.slow
 def test_kill_9_restart_and_resume_give_the_uninterrupted_leaderboard(
     capsys: pytest.CaptureFixture[str], make_server: Callable[..., Server], tmp_path: Path
 ) -> None:
@@ -72,6 +73,7 @@ def test_kill_9_restart_and_resume_give_the_uninterrupted_leaderboard(
     assert _scores(interrupted) == _scores(uninterrupted)
 
 
+@pytest.mark.slow
 def test_twenty_clients_at_once_lose_and_duplicate_nothing(
     capsys: pytest.CaptureFixture[str],
     make_sqlite_server: Callable[..., Server],

@@ -81,6 +81,7 @@ def test_openapi_describes_every_route_with_models(sqlite_server: Server) -> Non
                 assert {"404", "422"} <= set(answers), (method, path)
 
 
+@pytest.mark.slow
 def test_schemathesis_finds_no_server_error(
     capsys: pytest.CaptureFixture[str], sqlite_server: Server, tmp_path: Path
 ) -> None:

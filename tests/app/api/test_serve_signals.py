@@ -82,6 +82,7 @@ def _stopped(server: Server) -> tuple[int, str]:
     ],
     ids=["ctrl-c", "sigterm", "ctrl-c-twice", "sigterm-2-workers"],
 )
+@pytest.mark.slow
 def test_a_busy_service_stops_on_a_signal(
     make_sqlite_server: Callable[..., Server],
     tmp_path: Path,

@@ -197,6 +197,7 @@ def test_one_class_target_and_unknown_run_exit_2(
     assert resume.code == 2 and "no run '999'" in resume.err
 
 
+@pytest.mark.slow
 def test_a_killed_run_resumes_without_repeating_or_duplicating(
     capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
 ) -> None:

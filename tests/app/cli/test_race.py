@@ -155,6 +155,7 @@ def test_a_budget_that_fits_cuts_nothing_and_a_resume_gets_what_is_left(
     assert "3 done, 3 dropped / 6" in run_cli(capsys, sqlite_store_url, "runs").out
 
 
+@pytest.mark.slow
 def test_a_race_interrupted_by_ctrl_c_resumes_to_the_uninterrupted_leaderboard(
     capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path
 ) -> None:

@@ -48,6 +48,7 @@ GATED = ["--target", "gesture", "--classifiers", "gate", "--folds", "10"]
     ids=["sqlite-ctrl-c", "sqlite-ctrl-c-in-background", "sqlite-sigterm", "postgresql-sigterm"],
     indirect=["store_url"],
 )
+@pytest.mark.slow
 def test_an_interrupt_keeps_the_folds_and_resume_finishes(
     capsys: pytest.CaptureFixture[str],
     store_url: str,

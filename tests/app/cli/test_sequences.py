@@ -34,6 +34,7 @@ def _extract(
     return result.json()
 
 
+@pytest.mark.slow
 def test_a_sequence_data_set_exports_imports_trains_and_predicts(
     capsys: pytest.CaptureFixture[str], store_url: str, link: Path, tmp_path: Path
 ) -> None:

@@ -181,6 +181,7 @@ def test_an_ensemble_keeps_the_folds_of_a_member_the_race_dropped(
     assert all(stored[key].same_as(again[key]) for key in selection)
 
 
+@pytest.mark.slow
 def test_a_run_killed_and_resumed_gives_the_same_ensembles(
     capsys: pytest.CaptureFixture[str], store_url: str, store: Store, tmp_path: Path
 ) -> None:

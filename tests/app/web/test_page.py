@@ -39,6 +39,7 @@ def _upload(tab: Tab, path: Path, name: str) -> None:
     expect(tab.page.locator("#datasets-list")).to_contain_text(name)
 
 
+@pytest.mark.slow
 def test_a_researcher_benchmarks_compares_and_predicts_in_the_browser(
     capsys: pytest.CaptureFixture[str],
     make_sqlite_server: Callable[..., Server],
