@@ -13,8 +13,16 @@ through the ASGI application in-process (no socket: the server's work alone).  T
 is under 300 ms for the page's leaderboard.  Prints median and best times and the ratios;
 nothing is asserted.
 
+``--first-rankings K`` times instead, in CPU seconds (``time.process_time``: the machine may
+be busy), what a service process spends on the first ranking of a new version of a run's
+results (:func:`~app.services.runs.ranked_run` with nothing kept), K times, and the progress
+a page polls every second; ``--results-file N`` makes the run by importing a results file
+of N classifiers x 10 folds instead (an imported paper's run, as ``perf/hostile.py --only
+pages`` does with 3,000).  To compare two versions of the code, run this file from a copy
+of each tree in turn against the same store (``--db URL --run ID``), alternately.
+
     .venv/bin/python perf/leaderboard_page.py [--classifiers 88] [--folds 10]
-        [--requests 30] [--db URL]
+        [--requests 30] [--db URL] [--results-file N] [--first-rankings K] [--run ID]
 """
 
 from __future__ import annotations
@@ -35,10 +43,15 @@ sys.path.insert(0, str(ROOT))
 
 from fastapi.testclient import TestClient  # noqa: E402
 
+from tests.support.hostile_inputs import results_arff  # noqa: E402
 from tests.support.synthetic import touch_arff  # noqa: E402
 from touchbench.app.main import create_app  # noqa: E402
 from touchbench.app.schemas.datasets import ImportRequest  # noqa: E402
+from touchbench.app.schemas.imported import ImportResultsRequest  # noqa: E402
 from touchbench.app.services.datasets import import_file  # noqa: E402
+from touchbench.app.services.imported import import_results  # noqa: E402
+from touchbench.app.services.lifecycle import run_progress  # noqa: E402
+from touchbench.app.services.runs import leaderboard, ranked_run  # noqa: E402
 from touchbench.app.settings import Settings  # noqa: E402
 from touchbench.app.store.database import Store  # noqa: E402
 from touchbench.app.store.runs import create_run, finish_run, record_result  # noqa: E402
@@ -115,6 +128,38 @@ def build_run(store: Store, folder: Path, n_classifiers: int, n_folds: int) -> i
     return run.id
 
 
+def imported_run(store: Store, folder: Path, n_classifiers: int) -> int:
+    """A run imported from a results file of ``n_classifiers`` x 10 folds."""
+    data = touch_arff(folder / "paper.arff", n=90, with_place=False)
+    import_file(store, ImportRequest(file=data, name="paper"))
+    results = results_arff(folder / "results.arff", n_classifiers=n_classifiers)
+    return import_results(store, ImportResultsRequest(file=results, dataset="paper")).id
+
+
+def first_rankings(store: Store, run_id: int, times: int) -> None:
+    """CPU seconds of the first ranking of the run, ``times`` times, and of its progress."""
+    ranked_run(store, run_id)  # warm up: imports, statements compiled
+    seconds = []
+    for _ in range(times):
+        leaderboard._KEPT._kept.clear()  # nothing kept: each is a first ranking
+        start = time.process_time()
+        ranked_run(store, run_id)
+        seconds.append(time.process_time() - start)
+    polls = []
+    for _ in range(20 * times):
+        start = time.process_time()
+        run_progress(store, run_id)
+        polls.append(time.process_time() - start)
+    print(
+        f"first ranking (CPU s): median {statistics.median(seconds):.3f}, "
+        f"best {min(seconds):.3f}, each {' '.join(f'{s:.3f}' for s in seconds)}"
+    )
+    print(
+        f"progress poll (CPU ms): median {1000 * statistics.median(polls):.2f}, "
+        f"best {1000 * min(polls):.2f}"
+    )
+
+
 def timed(get: Callable[[], int], requests: int) -> list[float]:
     """Milliseconds of ``requests`` calls (each must answer 200)."""
     times = []
@@ -133,6 +178,9 @@ def main() -> None:
     parser.add_argument("--folds", type=int, default=10)
     parser.add_argument("--requests", type=int, default=30)
     parser.add_argument("--db", help="store URL (default: a new SQLite file)")
+    parser.add_argument("--results-file", type=int, metavar="N", help="import N classifiers")
+    parser.add_argument("--first-rankings", type=int, metavar="K", help="time K first rankings")
+    parser.add_argument("--run", type=int, help="a run already in the store --db names")
     options = parser.parse_args()
 
     with tempfile.TemporaryDirectory() as name:
@@ -140,11 +188,16 @@ def main() -> None:
         url = options.db or f"sqlite:///{folder / 'perf.db'}"
         store = Store(url)
         started = time.perf_counter()
-        run_id = build_run(store, folder, options.classifiers, options.folds)
-        print(
-            f"run {run_id}: {options.classifiers} configurations x {options.folds} folds "
-            f"written in {time.perf_counter() - started:.1f} s ({url.split(':', 1)[0]})"
-        )
+        if options.run is not None:
+            run_id = options.run
+        elif options.results_file:
+            run_id = imported_run(store, folder, options.results_file)
+        else:
+            run_id = build_run(store, folder, options.classifiers, options.folds)
+        print(f"run {run_id} ready in {time.perf_counter() - started:.1f} s ({url.split(':')[0]})")
+        if options.first_rankings:
+            first_rankings(store, run_id, options.first_rankings)
+            return
         store.dispose()
         settings = Settings(database_url=url, work_dir=folder / "work")
         with TestClient(create_app(settings), base_url="http://localhost") as client:

@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any, Protocol
 
 #: The newest migration; a test checks it against Alembic's own idea of the head.
-HEAD_REVISION = "0013"
+HEAD_REVISION = "0014"
 
 #: What a plain SQLite URL starts with (``sqlite:///relative.db``, ``sqlite:////abs.db``).
 _SQLITE_PREFIX = "sqlite:///"

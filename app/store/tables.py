@@ -126,7 +126,11 @@ class FoldResultRow(Base):
     """The outcome of one classifier on one fold of one repetition of a run."""
 
     __tablename__ = "fold_results"
-    __table_args__ = (UniqueConstraint("run_id", "classifier", "repeat", "fold"),)
+    __table_args__ = (
+        UniqueConstraint("run_id", "classifier", "repeat", "fold"),
+        # the progress a page polls counts a run's results and failures from this index
+        Index("ix_fold_results_run_status", "run_id", "status"),
+    )
 
     id: Mapped[int] = mapped_column(Integer, primary_key=True)
     run_id: Mapped[int] = mapped_column(ForeignKey("runs.id", ondelete="CASCADE"), index=True)

@@ -228,6 +228,7 @@ def run_leaderboard(
     baseline: str | None = None,
     beside: Sequence[int | str] = (),
     aggregate: str | None = None,
+    confusion: bool = True,
 ) -> RunLeaderboard:
     """A run's leaderboard from its stored results.
 
@@ -245,6 +246,10 @@ def run_leaderboard(
         as each run scored.  The run and each run beside it that scored otherwise are
         scored again from their stored test-fold predictions, without fitting
         (:mod:`.rescore`).
+    confusion : bool
+        Read the results' confusion matrices; ``False``: without them (``None``), for a
+        ranking that keeps its board and report only (:func:`ranked_run`): the ranking
+        never reads them, and a run of thousands of classifiers reads less.
 
     Raises
     ------
@@ -261,7 +266,7 @@ def run_leaderboard(
 
     asked = None if aggregate is None else check_aggregate(aggregate)
     run = get_run(store, run_id)
-    results = load_results(store, run.id)
+    results = load_results(store, run.id, confusion=confusion)
     if not results:
         raise NoResultsError(run)
     if metric is not None:
@@ -273,7 +278,7 @@ def run_leaderboard(
         results = rescored_results(store, run, results, rescored)
     theirs = []
     for other in others:
-        stored = load_results(store, other.run.id)
+        stored = load_results(store, other.run.id, confusion=confusion)
         if asked is not None and asked != other.run.config.aggregate:
             stored = rescored_results(store, other.run, stored, asked)
         theirs.append((other, stored))
@@ -426,7 +431,9 @@ def ranked_run(
     others = list(dict.fromkeys(beside))
 
     def compute() -> RankedRun:
-        ranked = run_leaderboard(store, run_id, metric=metric, baseline=baseline, beside=others)
+        ranked = run_leaderboard(
+            store, run_id, metric=metric, baseline=baseline, beside=others, confusion=False
+        )
         return RankedRun(ranked.run, ranked.board, ranked.besides, ranked.drops, ranked.report())
 
     return kept(store, [run_id, *others], ("ranking", metric, baseline), compute)

@@ -7,11 +7,12 @@ from __future__ import annotations
 
 import gc
 import weakref
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import pytest
-from sqlalchemy import Result, event
+from sqlalchemy import Result, event, select
 from sqlalchemy.orm import ORMExecuteState, Session
 
 from tests.support.hostile_inputs import results_arff
@@ -26,7 +27,8 @@ from touchbench.app.services.report import page_view
 from touchbench.app.services.runs import kept, ranked_run, run_leaderboard
 from touchbench.app.store.database import Store
 from touchbench.app.store.run_progress import RunProgress
-from touchbench.app.store.runs import record_result
+from touchbench.app.store.runs import load_results, record_result
+from touchbench.app.store.tables import FoldResultRow
 from touchbench.benchmark.results import TaskKey, TaskResult
 
 
@@ -174,3 +176,65 @@ def test_a_run_s_progress_reads_the_same_whatever_its_size(store: Store, tmp_pat
         )
     with pytest.raises(NotFoundError, match="no run '999'"):
         run_progress(store, 999)
+
+
+def test_a_ranking_reads_what_the_full_read_reads_but_the_confusion_matrices(
+    store: Store, imported: int
+) -> None:
+    """The ranking's read (JSON cells decoded as one document, without the confusion
+    matrices, sorted in Python) gives the results and the report of the full read, and the
+    results the column's own decoding gives: on a run with failed folds, undefined scores,
+    per-target scores, chosen parameters, regression scores and names SQL may sort apart."""
+    nan = float("nan")
+    for fold in range(3):
+        for name, status in (("Zeta+tuned", "ok"), ("Zeta", "ok"), ("bcc:rf", "error")):
+            metrics = {"accuracy": 0.5 + fold / 10, "f1_weighted": 0.4 + fold / 7, "kappa": nan}
+            metrics["mae"] = 1e-05 * (fold + 1)
+            record_result(
+                store,
+                imported,
+                TaskResult(
+                    TaskKey(name, 0, fold),
+                    status,  # type: ignore[arg-type]
+                    None if status == "ok" else f"failed on fold {fold}",
+                    metrics if status == "ok" else {},
+                    [[3, 1], [0, 5]] if status == "ok" else None,
+                    81,
+                    9,
+                    per_target={"x": {"accuracy": 0.25 * fold, "roc_auc": nan}, "b": {"mae": 2.0}},
+                    params={"max_depth": None, "C": 10 ** (fold - 1)} if "+tuned" in name else None,
+                ),
+            )
+    with store.session() as session:  # the column's own decoding, row by row
+        stored = {
+            (r.classifier, r.repeat, r.fold): (r.status, r.metrics, r.confusion)
+            for r in session.scalars(select(FoldResultRow).where(FoldResultRow.run_id == imported))
+        }
+    full = load_results(store, imported)
+    assert [(r.key.classifier, r.key.repeat, r.key.fold) for r in full] == sorted(stored)
+    for result in full:
+        key = result.key
+        status, metrics, confusion = stored[(key.classifier, key.repeat, key.fold)]
+        assert result.status == status and result.confusion == confusion
+        assert result.params == metrics.pop("params", None)
+        per_target = metrics.pop("per_target", None)
+        assert repr(result.per_target) == repr(per_target and _nan(per_target))
+        assert repr(result.metrics) == repr(_nan(metrics))
+    narrow = load_results(store, imported, confusion=False)
+    assert repr([replace(r, confusion=None) for r in full]) == repr(narrow)
+
+    for metric in (None, "kappa", "accuracy"):
+        ranked = ranked_run(store, imported, metric=metric)
+        fresh = run_leaderboard(store, imported, metric=metric)
+        # byte for byte (the models hold NaN, which equals nothing)
+        assert ranked.report.model_dump_json() == fresh.report().model_dump_json()
+        assert ranked.report.tuning and ranked.report.choices
+    row = ranked.board.row("bcc:rf")
+    assert (row.n_ok, row.n_failed) == (0, 3)
+
+
+def _nan(scores: Any) -> Any:
+    """Stored scores as a read gives them: null (undefined) as NaN."""
+    if isinstance(scores, dict):
+        return {name: _nan(value) for name, value in scores.items()}
+    return float("nan") if scores is None else scores
