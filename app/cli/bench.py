@@ -18,6 +18,7 @@ from touchbench.app.cli.output import (
     EXIT_INTERRUPTED,
     ExitWith,
     JsonOption,
+    RescoreOption,
     info,
     print_json,
     run_table,
@@ -820,21 +821,7 @@ def leaderboard_command(
             ),
         ),
     ] = None,
-    aggregate: Annotated[
-        str | None,
-        typer.Option(
-            "--aggregate",
-            metavar="window|recording",
-            help=(
-                "Score each recording's windows as one prediction (recording) or each "
-                "window (window), from the run's stored test-fold predictions: nothing is "
-                "fitted again. Default: as the run was scored. recording needs a data set "
-                "extracted from recordings, one label per recording, and a run that stored "
-                "its predictions (not an imported one)."
-            ),
-            show_default=False,
-        ),
-    ] = None,
+    aggregate: RescoreOption = None,
     as_json: JsonOption = False,
 ) -> None:
     """Show a run's leaderboard with WEKA's significance marks (v better, * worse)."""

@@ -116,3 +116,22 @@ EngineOption = Annotated[
         show_default="auto",
     ),
 ]
+
+
+#: ``--aggregate`` of a finished run's views (``leaderboard``, ``report``): its stored
+#: test-fold predictions scored again, nothing fitted.
+RescoreOption = Annotated[
+    str | None,
+    typer.Option(
+        "--aggregate",
+        metavar="window|recording",
+        help=(
+            "Score each recording's windows as one prediction (recording) or each "
+            "window (window), from the run's stored test-fold predictions: nothing is "
+            "fitted again. Default: as the run was scored. recording needs a data set "
+            "extracted from recordings, one label per recording, and a run that stored "
+            "its predictions (not an imported one)."
+        ),
+        show_default=False,
+    ),
+]

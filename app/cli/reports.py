@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from touchbench.app.cli.output import JsonOption, info, print_json, table
+from touchbench.app.cli.output import JsonOption, RescoreOption, info, print_json, table
 from touchbench.app.cli.state import get_state
 
 if TYPE_CHECKING:
@@ -175,6 +175,7 @@ def report_command(
             "--confusions", min=0, help="Confusion matrices for this many of each run's best."
         ),
     ] = 5,
+    aggregate: RescoreOption = None,
 ) -> None:
     """Write one self-contained HTML file (inline SVG, no network) with each run's
     leaderboard and marks, plots, configuration and library versions, and the comparison
@@ -206,6 +207,7 @@ def report_command(
             alpha=alpha,
             missing=missing_policy(missing),
             confusions=confusions,
+            aggregate=aggregate,
             on_run=lambda run: progress.advance(gathering),
         )
         drawing = progress.add_task("drawing plots", total=None)

@@ -36,7 +36,7 @@ from touchbench.app.schemas.datasets import DatasetDescription, ImportResult
 from touchbench.app.schemas.folds import FoldScoresSchema
 from touchbench.app.schemas.jobs import JobSchema
 from touchbench.app.schemas.models import ModelSchema, PredictionReport
-from touchbench.app.schemas.runs import LeaderboardSchema, RunSchema
+from touchbench.app.schemas.runs import Aggregate, LeaderboardSchema, RunSchema
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -281,11 +281,29 @@ class Client:
         return [Run(self, RunSchema.model_validate(item)) for item in listed]
 
     def leaderboard(
-        self, run: Run | int, *, metric: str | None = None, baseline: str | None = None
+        self,
+        run: Run | int,
+        *,
+        metric: str | None = None,
+        baseline: str | None = None,
+        aggregate: Aggregate | None = None,
     ) -> Leaderboard:
         """A run's leaderboard (``touchbench leaderboard --json``'s rows), its plots drawn
-        from the service's per-fold scores and confusion matrices."""
-        params = {k: v for k, v in (("metric", metric), ("baseline", baseline)) if v is not None}
+        from the service's per-fold scores and confusion matrices.
+
+        Parameters
+        ----------
+        run : Run or int
+        metric, baseline : str, optional
+            Rank by this metric, mark against this classifier; default the run's.
+        aggregate : {"window", "recording"}, optional
+            Score each window, or each recording's windows as one prediction, from the
+            run's stored test-fold predictions, nothing fitted again (``leaderboard
+            --aggregate``); default as the run scored.  The service refuses a run it cannot
+            re-score (an imported one, data without recordings) naming ``aggregate``.
+        """
+        asked = (("metric", metric), ("baseline", baseline), ("aggregate", aggregate))
+        params = {k: v for k, v in asked if v is not None}
         data = self._get(f"/api/runs/{_run_id(run)}/leaderboard", params=params)
         return Leaderboard(LeaderboardSchema.model_validate(data), _HttpSource(self))
 

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any, Generic, Protocol, Self, TypeVar
 from touchbench.app.python.errors import ServiceError, WaitTimeoutError
 from touchbench.app.schemas.jobs import JobSchema
 from touchbench.app.schemas.models import ModelSchema
-from touchbench.app.schemas.runs import RunSchema
+from touchbench.app.schemas.runs import Aggregate, RunSchema
 from touchbench.app.schemas.status import FINAL, Status
 
 if TYPE_CHECKING:
@@ -39,7 +39,13 @@ class Service(Protocol):
     def model(self, model: str | int, /) -> ModelSchema: ...
 
     def leaderboard(
-        self, run: int, /, *, metric: str | None = None, baseline: str | None = None
+        self,
+        run: int,
+        /,
+        *,
+        metric: str | None = None,
+        baseline: str | None = None,
+        aggregate: Aggregate | None = None,
     ) -> Leaderboard: ...
 
 
@@ -115,9 +121,18 @@ class Work(Generic[S]):
 class Run(Work[RunSchema]):
     """A run on the service: its :class:`~app.schemas.runs.RunSchema` (``schema``)."""
 
-    def leaderboard(self, *, metric: str | None = None, baseline: str | None = None) -> Leaderboard:
-        """The run's leaderboard (:meth:`Client.leaderboard`)."""
-        return self._client.leaderboard(self.id, metric=metric, baseline=baseline)
+    def leaderboard(
+        self,
+        *,
+        metric: str | None = None,
+        baseline: str | None = None,
+        aggregate: Aggregate | None = None,
+    ) -> Leaderboard:
+        """The run's leaderboard (:meth:`Client.leaderboard`), re-scored per ``aggregate``
+        when given."""
+        return self._client.leaderboard(
+            self.id, metric=metric, baseline=baseline, aggregate=aggregate
+        )
 
     def cancel(self) -> Run:
         """Cancel the run (finished folds stay)."""

@@ -29,9 +29,11 @@ from touchbench.app.schemas.compare import (
     NemenyiOut,
     PairOut,
 )
+from touchbench.app.schemas.runs import Aggregate
 from touchbench.app.schemas.status import Status
 from touchbench.app.services.beside import besides, merged_results
 from touchbench.app.services.imported import is_imported
+from touchbench.app.services.runs.rescore import as_asked
 from touchbench.app.store.database import Store
 from touchbench.app.store.runs import RunInfo, get_run, load_results
 from touchbench.benchmark.errors import ConfigurationError
@@ -180,6 +182,7 @@ def compare_runs(
     missing: MissingPolicy = "drop-classifier",
     pair: tuple[str, str] | None = None,
     rope: float = DEFAULT_ROPE,
+    aggregate: Aggregate | None = None,
 ) -> Comparison:
     """Rank the classifiers that all the runs share, and test their differences.
 
@@ -199,6 +202,10 @@ def compare_runs(
         Two classifiers for the Bayesian view.
     rope : float
         Region of practical equivalence of the Bayesian tests, in the metric's units.
+    aggregate : {"window", "recording"}, optional
+        Score each run per window or per recording, from its stored test-fold predictions
+        where it scored otherwise (:func:`~app.services.runs.rescore.as_asked`); default as
+        each run scored.
 
     Raises
     ------
@@ -207,6 +214,8 @@ def compare_runs(
     ConfigurationError
         No runs, a run given twice, two runs of the same data set and targets, a metric
         some run lacks, fewer than 2 shared classifiers, an unknown pair.
+    FieldError
+        For ``aggregate``: a run it cannot re-score.
     """
     if not run_refs:
         raise ConfigurationError("give at least one run to compare")
@@ -219,7 +228,8 @@ def compare_runs(
     for run in runs:
         others = besides(run, besides_of.get(run.id, []))
         results, _ = merged_results(
-            load_results(store, run.id), [(b, load_results(store, b.run.id)) for b in others]
+            as_asked(store, run, load_results(store, run.id), aggregate),
+            [(b, as_asked(store, b.run, load_results(store, b.run.id), aggregate)) for b in others],
         )
         names = [name for b in others for name in b.names.values()]
         scores.append(

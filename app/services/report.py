@@ -22,6 +22,7 @@ from touchbench.app.services.runs import (
     per_target_summary,
     run_leaderboard,
 )
+from touchbench.app.services.runs.rescore import check_aggregate
 from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import load_schema
 from touchbench.app.store.runs import RunInfo, get_run, load_results
@@ -185,18 +186,27 @@ def run_view(
     metric: str | None = None,
     baseline: str | None = None,
     beside: Sequence[int | str] = (),
+    aggregate: str | None = None,
 ) -> RunView:
     """A run with its leaderboard (marks against ``baseline``, default the best; with the
-    classifiers of the runs ``beside`` it), results and class labels."""
-    ranked = run_leaderboard(store, run_ref, metric=metric, baseline=baseline, beside=beside)
+    classifiers of the runs ``beside`` it; scored per ``aggregate`` as
+    :func:`~app.services.runs.run_leaderboard` says), results and class labels."""
+    ranked = run_leaderboard(
+        store, run_ref, metric=metric, baseline=baseline, beside=beside, aggregate=aggregate
+    )
     return _view(store, ranked, ranked.results)
 
 
 def page_view(store: Store, ranked: RankedRun, classifiers: Sequence[str]) -> RunView:
     """A ranked run (:func:`~app.services.runs.ranked_run`) with the fold results of
     ``classifiers`` only: what a page that draws a few of a run's classifiers needs, read
-    without the thousands of others (an imported results file)."""
+    without the thousands of others (an imported results file); scored again as the
+    ranking was (:attr:`~app.services.runs.RankedRun.rescored`)."""
     results = load_results(store, ranked.run.id, classifiers=classifiers)
+    if ranked.rescored is not None:
+        from touchbench.app.services.runs.rescore import rescored_results
+
+        results = rescored_results(store, ranked.run, results, ranked.rescored)
     return _view(store, ranked, results)
 
 
@@ -215,7 +225,16 @@ def _view(store: Store, ranked: RunLeaderboard | RankedRun, results: list[TaskRe
         per_target = {
             r.classifier: summary[r.classifier] for r in board.rows if r.classifier in summary
         }
-    return RunView(run, board, results, ranked.besides, ranked.drops, labels, per_target)
+    return RunView(
+        run,
+        board,
+        results,
+        ranked.besides,
+        ranked.drops,
+        labels,
+        per_target,
+        rescored=ranked.rescored,
+    )
 
 
 def build_report(
@@ -226,6 +245,7 @@ def build_report(
     alpha: float = 0.05,
     missing: MissingPolicy = "drop-classifier",
     confusions: int = 5,
+    aggregate: str | None = None,
     on_run: Callable[[RunInfo], None] = lambda run: None,
 ) -> Report:
     """Gather what a report of ``run_refs`` shows.
@@ -245,6 +265,10 @@ def build_report(
         Missing-cell policy of the comparison across runs.
     confusions : int
         Confusion matrices for this many of each run's best classifiers (>= 0).
+    aggregate : {"window", "recording"}, optional
+        Score every run per window or per recording (each recording's windows as one
+        prediction), from the stored test-fold predictions of a run that scored otherwise;
+        default as each run scored.
     on_run : callable
         Called with each run as it is gathered (progress).
     """
@@ -254,15 +278,21 @@ def build_report(
         raise ConfigurationError(
             f"the number of confusion matrices must be at least 0, got {confusions}"
         )
+    asked = None if aggregate is None else check_aggregate(aggregate)
     views = []
     fold_ranks: dict[int, Comparison | str] = {}
     hosts, joined = with_besides([get_run(store, ref) for ref in run_refs])
     for host in hosts:
         beside = [run.id for run in joined.get(host.id, [])]
-        view = run_view(store, host.id, metric=metric, beside=beside)
+        view = run_view(store, host.id, metric=metric, beside=beside, aggregate=asked)
         try:
             fold_ranks[view.run.id] = compare_runs(
-                store, [view.run.id, *beside], metric=view.metric, alpha=alpha, missing=missing
+                store,
+                [view.run.id, *beside],
+                metric=view.metric,
+                alpha=alpha,
+                missing=missing,
+                aggregate=asked,
             )
         except BenchmarkError as error:
             fold_ranks[view.run.id] = str(error)
@@ -271,7 +301,9 @@ def build_report(
     comparison, note = None, None
     if len(views) >= 2:
         try:
-            comparison = compare_runs(store, run_refs, metric=metric, alpha=alpha, missing=missing)
+            comparison = compare_runs(
+                store, run_refs, metric=metric, alpha=alpha, missing=missing, aggregate=asked
+            )
         except BenchmarkError as error:  # the report stands without it; it says why
             note = str(error)
     return Report(

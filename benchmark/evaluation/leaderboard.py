@@ -34,7 +34,9 @@ class LeaderboardRow:
     Parameters
     ----------
     rank : int
-        1 for the best; ties share a rank; classifiers without a score come last.
+        1 for the best; ties share a rank; classifiers that stopped early (dropped by a
+        race, cut by a budget) come after those that ran every fold, whatever the mean of
+        their fewer folds; classifiers without a score come last.
     classifier : str
     metrics : dict of str to (float, float)
         Mean and sample standard deviation over the successful folds (NaN where no fold
@@ -214,16 +216,14 @@ def build_leaderboard(
     # a classifier the budget cut, or a stopped run left, before its first fold is listed
     # too, without scores
     rows += [_summarise(c, [], available) for c in drops or {} if c not in by_classifier]
-    rows.sort(key=lambda row: _sort_key(row, metric, lower))
-    _assign_ranks(rows, metric)
     for row in rows:
         row.dropped = (drops or {}).get(row.classifier)
         row.origin = (origins or {}).get(row.classifier)
-    ranked = [row for row in rows if not math.isnan(row.metrics[metric][0])]
-    finished = [row for row in ranked if row.dropped is None]
-    if baseline is None and finished:
-        ranked = finished
+    rows.sort(key=lambda row: _sort_key(row, metric, lower))
+    _assign_ranks(rows, metric)
     if baseline is None:
+        # the first row with a score: one that ran every fold, when there is one
+        ranked = [row for row in rows if not math.isnan(row.metrics[metric][0])]
         if not ranked:
             raise ConfigurationError(f"no classifier has a {metric} score: every task failed")
         baseline = ranked[0].classifier
@@ -313,22 +313,31 @@ def _summarise(classifier: str, results: list[TaskResult], names: list[str]) -> 
 
 
 def _sort_key(row: LeaderboardRow, metric: str, lower: bool) -> tuple[int, float, str]:
+    """Where ``row`` ranks: by tier, then by its mean in the metric's direction, then by name.
+
+    Tiers: 0 a score over every fold it was to run; 1 a score over the folds it ran before
+    it stopped (a race dropped it, a budget cut it): a mean over fewer folds, not comparable
+    with the others', so after them however high; 2 no score but a successful fold (another
+    metric); 3 nothing.
+    """
     mean = row.metrics[metric][0]
     if math.isnan(mean):
-        return (1 if row.n_ok else 2, 0.0, row.classifier)
-    return (0, mean if lower else -mean, row.classifier)
+        return (2 if row.n_ok else 3, 0.0, row.classifier)
+    return (0 if row.dropped is None else 1, mean if lower else -mean, row.classifier)
 
 
 def _assign_ranks(rows: list[LeaderboardRow], metric: str) -> None:
-    """Competition ranking (1, 2, 2, 4): equal means share a rank."""
-    previous: float | None = None
+    """Competition ranking (1, 2, 2, 4): equal means share a rank, among the rows that ran
+    every fold and among those that stopped early, never across the two."""
+    previous: tuple[bool, float] | None = None
     for position, row in enumerate(rows, start=1):
-        mean = row.metrics[metric][0]
-        if previous is not None and mean == previous:
+        now = (row.dropped is None, row.metrics[metric][0])
+        # NaN == NaN is false: rows without a score never share a rank
+        if previous is not None and now[0] == previous[0] and now[1] == previous[1]:
             row.rank = rows[position - 2].rank
         else:
             row.rank = position
-        previous = mean
+        previous = now
 
 
 def scores_by_fold(results: Sequence[TaskResult], metric: str) -> dict[tuple[int, int], float]:

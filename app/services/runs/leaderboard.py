@@ -261,7 +261,7 @@ def run_leaderboard(
         For ``aggregate``: another value, or a run it cannot re-score
         (:func:`~.rescore.rescored_results`).
     """
-    from touchbench.app.services.runs.rescore import check_aggregate, rescored_results
+    from touchbench.app.services.runs.rescore import as_asked, check_aggregate
     from touchbench.benchmark.evaluation.leaderboard import build_leaderboard
 
     asked = None if aggregate is None else check_aggregate(aggregate)
@@ -274,14 +274,16 @@ def run_leaderboard(
     metric = metric or run_metric(run)
     others = besides(run, [get_run(store, ref) for ref in dict.fromkeys(beside)])
     rescored = asked if asked is not None and asked != run.config.aggregate else None
-    if rescored is not None:
-        results = rescored_results(store, run, results, rescored)
-    theirs = []
-    for other in others:
-        stored = load_results(store, other.run.id, confusion=confusion)
-        if asked is not None and asked != other.run.config.aggregate:
-            stored = rescored_results(store, other.run, stored, asked)
-        theirs.append((other, stored))
+    results = as_asked(store, run, results, asked)
+    theirs = [
+        (
+            other,
+            as_asked(
+                store, other.run, load_results(store, other.run.id, confusion=confusion), asked
+            ),
+        )
+        for other in others
+    ]
     ranked, groups = merged_results(results, theirs)
     drops = {**never_started(run, results), **load_drops(store, run.id)}
     board = build_leaderboard(
@@ -317,6 +319,11 @@ class RankedRun:
     drops : dict of str to Drop
     report : LeaderboardSchema
         :meth:`RunLeaderboard.report` of the ranking.
+    rescored : {"window", "recording"} or None
+        As :attr:`RunLeaderboard.rescored`.
+    aggregates : tuple of str
+        What the run's leaderboard may be scored per (``("window", "recording")``), or
+        ``()`` when only as the run scored it (:func:`~.rescore.rescorable`).
     """
 
     run: RunInfo
@@ -324,6 +331,8 @@ class RankedRun:
     besides: tuple[Beside, ...]
     drops: dict[str, Drop]
     report: LeaderboardSchema
+    rescored: Aggregate | None = None
+    aggregates: tuple[str, ...] = ()
 
     def notes(self) -> list[str]:
         """What the leaderboard's notes say (:meth:`RunLeaderboard.notes`)."""
@@ -418,6 +427,7 @@ def ranked_run(
     metric: str | None = None,
     baseline: str | None = None,
     beside: Sequence[int | str] = (),
+    aggregate: str | None = None,
 ) -> RankedRun:
     """A run's leaderboard as :func:`run_leaderboard` makes it, computed once per version
     of the run's results and of the runs ``beside`` it (:func:`kept`): a page asking
@@ -425,18 +435,34 @@ def ranked_run(
 
     Raises
     ------
-    NoResultsError, ConfigurationError
+    NoResultsError, ConfigurationError, FieldError
         As :func:`run_leaderboard`; nothing is kept then.
     """
+    from touchbench.app.services.runs.rescore import AGGREGATES, rescorable
+
     others = list(dict.fromkeys(beside))
 
     def compute() -> RankedRun:
         ranked = run_leaderboard(
-            store, run_id, metric=metric, baseline=baseline, beside=others, confusion=False
+            store,
+            run_id,
+            metric=metric,
+            baseline=baseline,
+            beside=others,
+            aggregate=aggregate,
+            confusion=False,
         )
-        return RankedRun(ranked.run, ranked.board, ranked.besides, ranked.drops, ranked.report())
+        return RankedRun(
+            ranked.run,
+            ranked.board,
+            ranked.besides,
+            ranked.drops,
+            ranked.report(),
+            rescored=ranked.rescored,
+            aggregates=AGGREGATES if rescorable(store, ranked.run) else (),
+        )
 
-    return kept(store, [run_id, *others], ("ranking", metric, baseline), compute)
+    return kept(store, [run_id, *others], ("ranking", metric, baseline, aggregate), compute)
 
 
 PerTargetSummary = dict[str, dict[str, dict[str, tuple[float, float]]]]

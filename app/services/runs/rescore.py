@@ -19,7 +19,7 @@ from touchbench.app.errors import FieldError
 from touchbench.app.schemas.runs import Aggregate
 from touchbench.app.services.runs.problem import prepare_problem
 from touchbench.app.store.database import Store
-from touchbench.app.store.datasets import load_dataset
+from touchbench.app.store.datasets import count_groups, load_dataset
 from touchbench.app.store.predictions import load_predictions
 from touchbench.app.store.runs import RunInfo
 from touchbench.benchmark.errors import ConfigurationError
@@ -45,6 +45,27 @@ def check_aggregate(aggregate: str) -> Aggregate:
     if aggregate not in AGGREGATES:
         raise FieldError("aggregate", f"Input should be {' or '.join(repr(a) for a in AGGREGATES)}")
     return cast(Aggregate, aggregate)
+
+
+def as_asked(
+    store: Store, run: RunInfo, results: Sequence[TaskResult], aggregate: Aggregate | None
+) -> list[TaskResult]:
+    """``results`` of ``run`` scored per ``aggregate``: as stored where the run scored so
+    (or nothing was asked), else :func:`rescored_results`."""
+    if aggregate is None or aggregate == run.config.aggregate:
+        return list(results)
+    return rescored_results(store, run, results, aggregate)
+
+
+def rescorable(store: Store, run: RunInfo) -> bool:
+    """Whether ``run``'s leaderboard may be asked per recording as well as per window: a run
+    touchbench carried out (an imported one holds no predictions) on a data set whose
+    instances fall into recordings (groups).  What only scoring finds out (a recording of
+    several labels, a run stored before predictions were kept) :func:`rescored_results`
+    refuses."""
+    if run.config.imported or run.dataset_id is None:
+        return False
+    return count_groups(store, run.dataset_id) > 0
 
 
 def rescored_results(

@@ -22,16 +22,17 @@ from typing import TYPE_CHECKING, Annotated, Any
 from fastapi import APIRouter, Query
 from fastapi.responses import HTMLResponse
 
-from touchbench.app.errors import NotFoundError
+from touchbench.app.errors import FieldError, NotFoundError
 from touchbench.app.reports import bounds
 from touchbench.app.reports.answer_tables import run_answer_tables
 from touchbench.app.reports.run_tables import RunTable, run_tables
-from touchbench.app.schemas.runs import BenchRequest
+from touchbench.app.schemas.runs import Aggregate, BenchRequest
 from touchbench.app.schemas.status import FINAL, RESUMABLE, Status
 from touchbench.app.services.answers import run_answers
 from touchbench.app.services.lifecycle import count_runs, get_run, list_runs, run_progress
 from touchbench.app.services.listing import count_datasets, list_datasets
 from touchbench.app.services.runs import NoResultsError, kept, ranked_run
+from touchbench.app.store.database import Store
 from touchbench.app.web.deps import StoreDep
 from touchbench.app.web.listing import newest
 from touchbench.app.web.rendering import Plot, draw, render
@@ -66,6 +67,8 @@ RUN_GROUPS = (
 
 Metric = Annotated[str | None, Query(max_length=100)]
 Baseline = Annotated[str | None, Query(max_length=200)]
+#: Score the leaderboard per window or per recording (``leaderboard --aggregate``).
+AggregateQuery = Annotated[Aggregate | None, Query()]
 
 
 @router.get("", response_class=HTMLResponse)
@@ -120,17 +123,20 @@ def leaderboard(
     metric: Metric = None,
     baseline: Baseline = None,
     beside: Annotated[list[int] | None, Query(max_length=20)] = None,
+    aggregate: AggregateQuery = None,
 ) -> HTMLResponse:
     """The run's classifiers ranked by ``metric`` with WEKA's marks against ``baseline``;
     ``beside``: other runs' classifiers too (a paper's imported results), t-tested where
-    the folds pair and by their means where they do not."""
+    the folds pair and by their means where they do not; ``aggregate``: scored per window
+    or per recording from the run's stored test-fold predictions."""
     try:
-        ranked = ranked_run(
+        ranked, refused = _ranked(
             store,
             run_id,
             metric=metric or None,
             baseline=baseline or None,
             beside=beside or (),
+            aggregate=aggregate,
         )
     except NoResultsError as missing:
         return render("fragments/leaderboard.html.j2", run=missing.run, board=None)
@@ -138,21 +144,42 @@ def leaderboard(
         "fragments/leaderboard.html.j2",
         run=ranked.run,
         board=ranked.board,
-        table=_table(ranked, chosen_baseline=baseline or None),
+        table=_table(
+            ranked,
+            chosen_baseline=baseline or None,
+            chosen_aggregate=None if refused else aggregate,
+        ),
         tables=[_first_rows(table) for table in run_tables(ranked.report)],
         answers=run_answer_tables(run_answers(store, run_id)),
         notes=ranked.notes(),
+        refused=refused,
     )
 
 
+def _ranked(
+    store: Store, run_id: int, *, aggregate: Aggregate | None, **asked: Any
+) -> tuple[RankedRun, str | None]:
+    """The run ranked as asked (:func:`~app.services.runs.ranked_run`) and ``None``; or,
+    when it cannot be scored per ``aggregate`` (a recording of several labels, a run that
+    kept no predictions), ranked as the run scored and why not."""
+    try:
+        return ranked_run(store, run_id, aggregate=aggregate, **asked), None
+    except FieldError as error:
+        if aggregate is None:
+            raise
+        return ranked_run(store, run_id, **asked), f"not scored per {aggregate}: {error.message}"
+
+
 @router.get("/{run_id}/plots", response_class=HTMLResponse)
-def plots(run_id: int, store: StoreDep, metric: Metric = None) -> HTMLResponse:
-    """Every fold's score, per-target scores and class counts."""
+def plots(
+    run_id: int, store: StoreDep, metric: Metric = None, aggregate: AggregateQuery = None
+) -> HTMLResponse:
+    """Every fold's score, per-target scores and class counts, scored as the leaderboard."""
     from touchbench.app.reports import figures
     from touchbench.app.services.report import page_view
 
     def drawn() -> list[Plot]:
-        ranked = ranked_run(store, run_id, metric=metric or None)
+        ranked, _ = _ranked(store, run_id, metric=metric or None, aggregate=aggregate)
         own = set(ranked.run.classifiers)
         best = [row.classifier for row in ranked.board.rows if row.classifier in own]
         view = page_view(store, ranked, best[: bounds.DRAWN])
@@ -164,7 +191,7 @@ def plots(run_id: int, store: StoreDep, metric: Metric = None) -> HTMLResponse:
 
     # drawn once per version of the run's results, as its ranking is
     try:
-        plots = kept(store, [run_id], ("plots", metric or None), drawn)
+        plots = kept(store, [run_id], ("plots", metric or None, aggregate), drawn)
     except NoResultsError:
         plots = []
     return render("fragments/plots.html.j2", plots=plots)
@@ -239,14 +266,22 @@ def answers(run_id: int, store: StoreDep) -> HTMLResponse:
 
 @router.get("/{run_id}/classifiers/{classifier}", response_class=HTMLResponse)
 def classifier(
-    run_id: int, classifier: Ref, store: StoreDep, metric: Metric = None, baseline: Baseline = None
+    run_id: int,
+    classifier: Ref,
+    store: StoreDep,
+    metric: Metric = None,
+    baseline: Baseline = None,
+    aggregate: AggregateQuery = None,
 ) -> HTMLResponse:
-    """A classifier's confusion matrix, its scores and its folds beside the baseline's."""
+    """A classifier's confusion matrix, its scores and its folds beside the baseline's,
+    scored as the leaderboard."""
     from touchbench.app.reports import figures
     from touchbench.app.reports.leaderboard import mean_std
     from touchbench.app.services.report import page_view
 
-    ranked = ranked_run(store, run_id, metric=metric or None, baseline=baseline or None)
+    ranked, _ = _ranked(
+        store, run_id, metric=metric or None, baseline=baseline or None, aggregate=aggregate
+    )
     if classifier not in ranked.run.classifiers:
         raise NotFoundError(
             f"run {ranked.run.id} has no classifier '{classifier}' "
@@ -318,7 +353,9 @@ def _folds(view: RunView, shown: list[str]) -> dict[str, Any]:
     }
 
 
-def _table(ranked: RankedRun, *, chosen_baseline: str | None) -> dict[str, Any]:
+def _table(
+    ranked: RankedRun, *, chosen_baseline: str | None, chosen_aggregate: str | None
+) -> dict[str, Any]:
     """The leaderboard's header (metric columns sortable), rows, and the pickers' options;
     with runs beside it, where each row comes from and how it is compared."""
     from touchbench.app.reports.leaderboard import (
@@ -349,6 +386,10 @@ def _table(ranked: RankedRun, *, chosen_baseline: str | None) -> dict[str, Any]:
         "baselines": _first_and_baseline(baselines, chosen_baseline, at=None).items,
         "dropped": [row.classifier for row in board.rows if row.dropped is not None],
         "chosen_baseline": chosen_baseline,
+        # per window or per recording: offered where the run can be scored either way
+        "aggregates": ranked.aggregates,
+        "aggregate": ranked.report.aggregate,
+        "chosen_aggregate": chosen_aggregate,
         "direction": "lower is better" if board.metric in LOWER_IS_BETTER else "higher is better",
     }
 

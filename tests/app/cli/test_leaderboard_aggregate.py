@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import csv
 import io
+from html import unescape
 from pathlib import Path
 from typing import Any
 
@@ -232,3 +233,44 @@ def test_leaderboard_help_tells_aggregate(capsys: pytest.CaptureFixture[str], db
     words = " ".join(shown.out.replace("│", " ").split())
     assert "--aggregate" in words and "stored test-fold predictions" in words
     assert "nothing is fitted again" in words
+
+
+def test_report_scores_per_recording_when_asked(
+    capsys: pytest.CaptureFixture[str],
+    db: str,
+    tmp_path: Path,
+    two_runs: tuple[int, int],
+    refused_runs: dict[str, int],
+    no_fitting: list[str],
+) -> None:
+    """`report RUN --aggregate recording` shows the leaderboard the run would have had per
+    recording (that of the run scored so from the start), saying so; refused in one line
+    for data without recordings."""
+    windows, recordings = two_runs
+    board = run_cli(capsys, db, "leaderboard", str(recordings), "--json").json()
+    report = tmp_path / "report.html"
+    made = run_cli(
+        capsys, db, "report", str(windows), "-o", str(report), "--aggregate", "recording"
+    )
+    assert made.code == 0, made.err
+    page = " ".join(unescape(report.read_text(encoding="utf-8")).split())
+    assert PER_RECORDING in page and RESCORED in page
+    for row in board["leaderboard"]:
+        mean = row["metrics"]["f1_weighted"]["mean"]
+        assert f"<td>{row['classifier']}</td>" in page and f"{mean:.4f}" in page
+    as_scored = tmp_path / "plain.html"
+    assert run_cli(capsys, db, "report", str(windows), "-o", str(as_scored)).code == 0
+    assert RESCORED not in " ".join(unescape(as_scored.read_text(encoding="utf-8")).split())
+
+    for name, words in (
+        ("ungrouped", "--aggregate: needs windows grouped by recording"),
+        ("mixed", "--aggregate: 1 recording(s) hold windows of several values of 'gesture'"),
+    ):
+        refused = run_cli(
+            capsys, db, "report", str(refused_runs[name]), "-o", str(report), "--aggregate",
+            "recording",
+        )  # fmt: skip
+        one_error_line(refused, words)
+    bad = run_cli(capsys, db, "report", str(windows), "-o", str(report), "--aggregate", "take")
+    one_error_line(bad, "--aggregate: Input should be 'window' or 'recording'")
+    assert no_fitting == []

@@ -17,6 +17,7 @@ from matplotlib.figure import Figure
 
 import touchbench
 from tests.support.cli_runner import run_cli
+from tests.support.recordings import PER_RECORDING, recorded_windows, store_dataset
 from tests.support.service import Server, servers
 from tests.support.synthetic import touch_arff
 from touchbench.app.python import errors
@@ -142,6 +143,38 @@ def test_a_refused_request_raises_with_the_services_field(
     with pytest.raises(errors.BadRequestError) as metric:  # the plots' numbers, refused
         _HttpSource(service).fold_scores(done_run.id, metric="no-such-metric")
     assert metric.value.status == 400 and "no-such-metric" in metric.value.message
+
+
+def test_leaderboard_rescored_per_recording_is_the_clis(
+    server: Server, service: Client, done_run: Run, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``aggregate=`` re-scores the run's stored fold predictions as ``leaderboard
+    --aggregate`` does; a run on data without recordings is refused naming the field."""
+    store_dataset(server.database_url, recorded_windows(), "takes")
+    run = service.bench("takes", classifiers=["nb", "ridge"], folds=4, seed=3, wait=True)
+    assert run.status == "done"
+    board = service.leaderboard(run, aggregate="recording")
+    asked = ("leaderboard", str(run.id), "--aggregate", "recording", "--json")
+    cli = run_cli(capsys, server.database_url, *asked)
+    assert cli.code == 0, cli.err
+    assert board.schema.to_json() == cli.json()
+    assert board.schema.aggregate == "recording"
+    assert board.schema.notes[0].startswith(PER_RECORDING)
+    assert run.leaderboard(aggregate="recording").schema == board.schema
+    plain = service.leaderboard(run, aggregate="window")
+    assert plain.schema == service.leaderboard(run).schema and plain.schema.aggregate == "window"
+    assert (
+        plain.to_pandas()["f1_weighted_mean"].tolist()
+        != board.to_pandas()["f1_weighted_mean"].tolist()
+    )
+
+    with pytest.raises(errors.InvalidRequestError) as ungrouped:
+        service.leaderboard(done_run, aggregate="recording")
+    assert (ungrouped.value.status, ungrouped.value.field) == (422, "aggregate")
+    assert "grouped by recording" in ungrouped.value.message
+    with pytest.raises(errors.InvalidRequestError) as bad:
+        service.leaderboard(run, aggregate="take")  # type: ignore[arg-type]
+    assert bad.value.field == "aggregate"
 
 
 def test_keys_read_only_refused_on_write_and_never_shown(

@@ -16,6 +16,7 @@ import pytest
 from playwright.sync_api import Response, expect
 
 from tests.support.browser import Tab, figure_texts, screen, static_site
+from tests.support.recordings import PER_RECORDING, recorded_windows, store_dataset
 from tests.support.service import Server, finished, servers
 from tests.support.synthetic import touch_arff
 from touchbench.app.schemas.runs import BenchRequest
@@ -23,6 +24,7 @@ from touchbench.app.web.routes.runs import RUN_GROUPS
 
 #: A run or a job takes seconds; the first one also pays for the worker's imports.
 TIMEOUT = 180_000
+RESCORED = "re-scored per recording from the run's stored test-fold predictions"
 
 
 def channels_arff(path: Path, *, n: int = 60, seed: int = 0) -> Path:
@@ -222,3 +224,63 @@ def test_a_page_on_another_origin_can_start_nothing(
     assert outcome == dict.fromkeys(paths, "sent")
     assert statuses == dict.fromkeys(paths, 403)
     assert (api.get("/api/runs").json(), api.get("/api/jobs").json()) == before
+
+
+def _finished_run(service: Server, dataset: str, folds: int) -> int:
+    created = service.client.post(
+        "/api/runs",
+        json={"dataset": dataset, "classifiers": ["nb", "ridge"], "folds": folds, "seed": 3},
+    )
+    assert created.status_code == 202, created.text
+    run_id = int(created.json()["id"])
+    assert service.wait_for(f"/api/runs/{run_id}", finished)["status"] == "done"
+    return run_id
+
+
+def test_the_run_page_scores_per_recording_where_the_run_has_recordings(
+    projector_tab: Tab, service: Server
+) -> None:
+    tab, page, api = projector_tab, projector_tab.page, service.client
+    store_dataset(service.database_url, recorded_windows(), "takes")
+    store_dataset(service.database_url, recorded_windows(mixed=True), "mixed")
+    takes, mixed = _finished_run(service, "takes", 4), _finished_run(service, "mixed", 4)
+    plain = _finished_run(service, "channels", 3)
+
+    # a run on data without recordings: no choice offered
+    page.goto(f"{service.url}/runs/{plain}")
+    expect(page.locator("#leaderboard-table")).to_be_visible()
+    expect(page.locator("select[name=aggregate]")).to_have_count(0)
+
+    # a run on recorded windows: per window as it scored, per recording when asked
+    page.goto(f"{service.url}/runs/{takes}")
+    picker = page.locator("select[name=aggregate]")
+    expect(picker).to_have_value("window")
+    expect(page.locator("#leaderboard")).not_to_contain_text(PER_RECORDING)
+    picker.select_option("recording")
+    page.wait_for_url(re.compile(r"aggregate=recording"))
+    expect(page.locator("#leaderboard")).to_contain_text(RESCORED)
+    expect(page.locator("#leaderboard")).to_contain_text(PER_RECORDING)
+    expect(page.locator("select[name=aggregate]")).to_have_value("recording")
+    board = api.get(f"/api/runs/{takes}/leaderboard", params={"aggregate": "recording"}).json()
+    for row in board["leaderboard"]:
+        mean = row["metrics"]["f1_weighted"]["mean"]
+        cells = page.locator(f"#leaderboard-table tr[data-classifier='{row['classifier']}'] td")
+        expect(cells.nth(3)).to_contain_text(f"{mean:.4f}")
+    screen(tab, "run-per-recording")
+    # ranking by another metric keeps the aggregation, and so does a classifier's page
+    page.locator("#leaderboard-table th a", has_text="accuracy").click()
+    page.wait_for_url(re.compile(r"metric=accuracy.*aggregate=recording"))
+    expect(page.locator("#leaderboard")).to_contain_text(RESCORED)
+    page.locator("#leaderboard-table td a", has_text="nb").click()
+    page.wait_for_url(re.compile(r"/classifiers/nb\?.*aggregate=recording"))
+    nb = next(row for row in board["leaderboard"] if row["classifier"] == "nb")
+    scores = page.locator("#classifier")
+    expect(scores).to_contain_text(f"{nb['metrics']['accuracy']['mean']:.4f}")
+
+    # a run whose recordings hold several labels: as it scored, and why not per recording
+    page.goto(f"{service.url}/runs/{mixed}?aggregate=recording")
+    expect(page.locator("#leaderboard .refused")).to_contain_text(
+        "not scored per recording: 1 recording(s) hold windows of several values of 'gesture'"
+    )
+    expect(page.locator("select[name=aggregate]")).to_have_value("window")
+    expect(page.locator("#leaderboard")).not_to_contain_text(RESCORED)
