@@ -29,7 +29,7 @@ import copy
 import csv
 import itertools
 from array import array
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -131,28 +131,26 @@ def read_csv_series(
         Naming the file, and the line where there is one.
     """
     limits = limits or ReadLimits()
-    header, values, lines = _read_table(path, limits)
-    names = header if header is not None else [f"column {i + 1}" for i in range(values.shape[1])]
-    time = _time_column(path, header, time_column)
-    signal = [i for i in range(len(names)) if i != time]
-    if not signal:
-        raise DriverError(f"{path}: has a time column but no signal column")
-    picked = signal if not channels else _pick(path, names, signal, channels, header is not None)
-    kept_names = tuple(names[i] for i in picked) if header is not None else None
-    samples = values[:, picked]
-    if time is None:
-        return CsvSeries(np.ascontiguousarray(samples.T), samplerate, kept_names, ())
-    repeats = _repeated_rows(values)
-    repeated = None
-    if repeats.any():
+    table = _read_table(
+        path, limits, lambda header, width: _layout(path, header, width, time_column, channels)
+    )
+    layout, samples, lines = table.layout, table.samples, table.lines
+    names, time = layout.names, layout.time
+    kept_names = tuple(names[i] for i in layout.picked) if table.header is not None else None
+    if time is None or table.times is None:
+        return CsvSeries(samples, samplerate, kept_names, ())
+    times, repeated = table.times, None
+    if table.repeats:
         repeated = (
-            f"{int(repeats.sum())} row(s) repeat the row before, stamp and values (from line "
-            f"{lines[int(np.flatnonzero(repeats)[0])]}): left out as logged twice"
+            f"{len(table.repeats)} row(s) repeat the row before, stamp and values (from line "
+            f"{lines[table.repeats[0]]}): left out as logged twice"
         )
-        values, samples, lines = values[~repeats], samples[~repeats], lines.without(repeats)
-    _check_stamps(path, names[time], values[:, time], lines)
-    times, unit = stamps_in_seconds(values[:, time], time_unit)
-    rate, samples, notes = _on_even_grid(
+        dropped = np.zeros(len(lines), dtype=bool)
+        dropped[np.frombuffer(table.repeats, dtype=np.int64)] = True
+        lines = lines.without(dropped)
+    _check_stamps(path, names[time], times, lines)
+    unit = _to_seconds(times, time_unit)
+    rate, samples, notes, step = _on_even_grid(
         path, names[time], times, lines, samples, samplerate, limits
     )
     resampled = samplerate is None and bool(notes)  # the grid's notes only
@@ -160,14 +158,13 @@ def read_csv_series(
         notes.insert(0, repeated)
     if time_unit == "auto" and unit != "s":
         notes.insert(0, f"column '{names[time]}' holds nanoseconds")
-    step = float(np.median(np.diff(times))) if times.size > 1 else 0.0
     if time_unit == "auto" and unit == "s" and step > SLOW_STEP:
         notes.insert(
             0,
             f"column '{names[time]}' read as seconds: {step:g} s between samples "
             f"({1 / step:.3g} Hz); if its stamps are milliseconds, give the time unit (ms)",
         )
-    return CsvSeries(np.ascontiguousarray(samples.T), rate, kept_names, tuple(notes), resampled)
+    return CsvSeries(samples, rate, kept_names, tuple(notes), resampled)
 
 
 def stamps_in_seconds(stamps: np.ndarray, unit: str = "auto") -> tuple[np.ndarray, str]:
@@ -178,18 +175,33 @@ def stamps_in_seconds(stamps: np.ndarray, unit: str = "auto") -> tuple[np.ndarra
     :data:`NS_STEP` (ROS stamps since 1970 in nanoseconds are about 1.7e18; in seconds
     about 1.7e9).
     """
-    stamps = np.asarray(stamps, dtype=np.float64)
-    relative = stamps - stamps[0]
-    if unit != "auto":
-        return relative * TIME_UNITS[unit], unit
-    step = float(np.median(np.diff(stamps))) if stamps.size > 1 else 0.0
-    if np.abs(stamps).max() > NS_MAGNITUDE or step > NS_STEP:
-        return relative * 1e-9, "ns"
-    return relative, "s"
+    seconds = np.array(stamps, dtype=np.float64)  # a copy: the stamps given stay
+    return seconds, _to_seconds(seconds, unit)
+
+
+def _to_seconds(stamps: np.ndarray, unit: str) -> str:
+    """Turn ``stamps`` (float64, shape (n,)) in place into seconds from the first one, as
+    :func:`stamps_in_seconds` says; their unit.  In place, and no temporary array but one
+    of the steps: the time column of a long recording is read once, not copied."""
+    first = stamps[0]
+    if unit == "auto":
+        # The largest |stamp| without an array of them; NaN compares false either way.
+        largest = max(float(stamps.max()), -float(stamps.min()))
+        step = float(np.median(np.diff(stamps), overwrite_input=True)) if stamps.size > 1 else 0.0
+        unit = "ns" if largest > NS_MAGNITUDE or step > NS_STEP else "s"
+        factor = 1e-9 if unit == "ns" else None
+    else:
+        factor = TIME_UNITS[unit]
+    np.subtract(stamps, first, out=stamps)
+    if factor is not None:
+        np.multiply(stamps, factor, out=stamps)
+    return unit
 
 
 #: Rows parsed into one block of floats at a time (text is never held for the whole file).
 ROWS_PER_BLOCK = 4096
+#: Values moved at a time when the columns are closed up (:meth:`_Columns.samples`).
+MOVE_VALUES = 1 << 16
 
 
 class LineNumbers:
@@ -231,15 +243,139 @@ class LineNumbers:
         return kept
 
 
-def _read_table(path: Path, limits: ReadLimits) -> tuple[list[str] | None, np.ndarray, LineNumbers]:
-    """The header (None if the first row is numbers), every cell as a float of shape
-    (n_rows, n_columns), and each row's line number.
+@dataclass(frozen=True)
+class _Layout:
+    """Where a file's columns go: ``names`` of every column, the ``time`` column's index
+    (None without one), the ``picked`` columns' indices, in the channels' order."""
+
+    names: list[str]
+    time: int | None
+    picked: list[int]
+
+
+def _layout(
+    path: Path,
+    header: list[str] | None,
+    width: int,
+    time_column: str | None,
+    channels: Sequence[str] | None,
+) -> _Layout:
+    """The :class:`_Layout` of a file of ``width`` columns under ``header``."""
+    names = header if header is not None else [f"column {i + 1}" for i in range(width)]
+    time = _time_column(path, header, time_column)
+    signal = [i for i in range(len(names)) if i != time]
+    if not signal:
+        raise DriverError(f"{path}: has a time column but no signal column")
+    picked = signal if not channels else _pick(path, names, signal, channels, header is not None)
+    return _Layout(names, time, picked)
+
+
+class _Columns:
+    """The picked columns of the rows read, put straight into their final layout: the
+    samples of shape (n_channels, capacity) and the time column of shape (capacity,), filled
+    block by block.  ``capacity`` is what the file's lines allow (:func:`_count_lines`), so
+    that the arrays are allocated once and only what is read is ever touched (an ``empty``
+    array's pages cost no memory until written); a file that outgrows it (a pipe, a file
+    still being written) has its arrays grown to twice the size, copied.
+
+    With a time column, a row equal to the row before in every column (all of the file's,
+    not only the picked ones) is not kept, and its index among the rows read is in
+    :attr:`repeats`.
+    """
+
+    def __init__(self, layout: _Layout, capacity: int) -> None:
+        self.picked, self.time = layout.picked, layout.time
+        self.capacity = capacity
+        self.count = 0  # rows kept
+        self.read = 0  # rows read
+        self.repeats = array("q")
+        self._flat = np.empty(len(self.picked) * capacity)
+        self._times = np.empty(capacity) if self.time is not None else None
+        self._last: np.ndarray | None = None  # the last row read, every column
+
+    def add(self, block: list[list[float]]) -> None:
+        """Keep the rows of ``block`` (each row's every column, as floats)."""
+        values = np.array(block)
+        first, self.read = self.read, self.read + len(block)
+        if self.time is not None:
+            repeats = np.empty(values.shape[0], dtype=bool)
+            repeats[0] = self._last is not None and bool((values[0] == self._last).all())
+            repeats[1:] = (values[1:] == values[:-1]).all(axis=1)
+            self._last = values[-1].copy()
+            if repeats.any():
+                self.repeats.extend((np.flatnonzero(repeats) + first).tolist())
+                values = values[~repeats]
+        start, stop = self.count, self.count + values.shape[0]
+        if stop > self.capacity:
+            self._grow(max(stop, 2 * self.capacity))
+        samples = self._flat.reshape(len(self.picked), self.capacity)
+        samples[:, start:stop] = values[:, self.picked].T
+        if self._times is not None:
+            self._times[start:stop] = values[:, self.time]
+        self.count = stop
+
+    def _grow(self, capacity: int) -> None:
+        flat = np.empty(len(self.picked) * capacity)
+        kept = self._flat.reshape(len(self.picked), self.capacity)[:, : self.count]
+        flat.reshape(len(self.picked), capacity)[:, : self.count] = kept
+        self._flat = flat
+        if self._times is not None:
+            times = np.empty(capacity)
+            times[: self.count] = self._times[: self.count]
+            self._times = times
+        self.capacity = capacity
+
+    def samples(self) -> np.ndarray:
+        """The samples kept, shape (n_channels, n_rows), C order: the channels are moved
+        down to close the capacity left unused, a bounded piece at a time, and the array
+        shrunk in place to their size."""
+        flat, n, capacity = self._flat, self.count, self.capacity
+        if n < capacity:
+            for channel in range(1, len(self.picked)):
+                to, at = channel * n, channel * capacity
+                for start in range(0, n, MOVE_VALUES):
+                    stop = min(n, start + MOVE_VALUES)
+                    flat[to + start : to + stop] = flat[at + start : at + stop]
+            flat.resize(len(self.picked) * n, refcheck=False)  # nothing else refers to it
+        return flat.reshape(len(self.picked), n)
+
+    def times(self) -> np.ndarray | None:
+        """The time column of the rows kept, shape (n_rows,), or None without one."""
+        if self._times is not None and self.count < self.capacity:
+            self._times.resize(self.count, refcheck=False)
+        return self._times
+
+
+@dataclass(frozen=True)
+class _Table:
+    """What :func:`_read_table` read."""
+
+    header: list[str] | None
+    layout: _Layout
+    samples: np.ndarray  # (n_channels, n_rows), float64, C order
+    times: np.ndarray | None  # (n_rows,), the time column, or None without one
+    lines: LineNumbers  # of every row read, repeats included
+    repeats: array[int]  # the rows read left out as repeats (time column only)
+
+
+def _read_table(
+    path: Path, limits: ReadLimits, layout_of: Callable[[list[str] | None, int], _Layout]
+) -> _Table:
+    """Read the header (None if the first row is numbers) and every row, keeping the columns
+    ``layout_of(header, width)`` says in their final layout (:class:`_Columns`), and each
+    row's line number.
 
     A trailing empty field (a delimiter at the end of the row) is removed.  Rows are
-    converted as they are read, so memory holds the numbers, not the text; a line longer
-    than ``limits.line_chars``, or more values than ``limits.cells``, is refused there.
+    converted as they are read, a block at a time, so memory holds the numbers once, not
+    the text; a line longer than ``limits.line_chars``, or more values than
+    ``limits.cells``, is refused there.  A file whose columns ``layout_of`` refuses is still
+    read through first, so that a bad row is said before a bad column name, as ever.
     """
     numbers = LineNumbers()
+    lines_in_file = _count_lines(path)
+    columns: _Columns | None = None
+    refused: DriverError | None = None
+    block: list[list[float]] = []
     try:
         with path.open(newline="", encoding="utf-8-sig") as handle:
             dialect = csv.excel_tab if path.suffix.lower() == ".tsv" else csv.excel
@@ -259,25 +395,55 @@ def _read_table(path: Path, limits: ReadLimits) -> tuple[list[str] | None, np.nd
                 header = header[:-1]
             width = len(header) if header is not None else len(_trimmed(first[1]))
             names = header or [f"column {i + 1}" for i in range(width)]
-            blocks, block = [], []
+            try:
+                layout = layout_of(header, width)
+            except DriverError as error:
+                refused = error
+            else:
+                rows_in_file = ROWS_PER_BLOCK  # a pipe: no counting first
+                if lines_in_file is not None:  # the header's line holds no row
+                    rows_in_file = lines_in_file - (header is not None)
+                columns = _Columns(layout, max(0, min(rows_in_file, limits.cells // width)))
             for number, row in itertools.chain(pending, rows):
                 block.append(_row_values(path, names, number, _trimmed(row, width)))
                 numbers.append(number)
                 if len(numbers) * width > limits.cells:
                     limits.check_cells(len(numbers), width, what=f"{path}:{number}")
                 if len(block) == ROWS_PER_BLOCK:
-                    blocks.append(np.array(block))
+                    if columns is not None:
+                        columns.add(block)
                     block = []
     except (OSError, UnicodeDecodeError) as error:
         raise DriverError(f"{path}: cannot read as text: {error}") from None
     except csv.Error as error:  # a field over csv.field_size_limit(), a stray quote
         line = numbers.last + 1
         raise DriverError(f"{path}:{line}: cannot read as CSV ({error})") from None
-    if block:
-        blocks.append(np.array(block))
-    if not blocks:
+    if block and columns is not None:
+        columns.add(block)
+    if not len(numbers):
         raise DriverError(f"{path}: the recording has no samples")
-    return header, np.concatenate(blocks), numbers
+    if refused is not None or columns is None:
+        raise refused or AssertionError("no layout and no refusal")
+    return _Table(header, layout, columns.samples(), columns.times(), numbers, columns.repeats)
+
+
+def _count_lines(path: Path) -> int | None:
+    """The lines of the file at ``path`` (ended by ``\\n``, ``\\r\\n`` or ``\\r``, as
+    ``open(newline="")`` reads them, and a last one without), at least its rows: a count of
+    line breaks in the raw bytes, a megabyte at a time, much quicker than the parse.  None
+    for what cannot be read twice (a pipe) or at all (then the parse says why)."""
+    if not path.is_file():
+        return None
+    count, carriage, last = 0, False, b""
+    try:
+        with path.open("rb") as handle:
+            while chunk := handle.read(1 << 20):
+                count += chunk.count(b"\n") + chunk.count(b"\r") - chunk.count(b"\r\n")
+                count -= carriage and chunk[:1] == b"\n"  # a \r\n across two chunks
+                carriage, last = chunk[-1:] == b"\r", chunk[-1:]
+    except OSError:
+        return None
+    return count + (last not in (b"", b"\n", b"\r"))
 
 
 def _trimmed(row: list[str], width: int | None = None) -> list[str]:
@@ -343,15 +509,6 @@ def _pick(
     return picked
 
 
-def _repeated_rows(values: np.ndarray) -> np.ndarray:
-    """Rows of ``values`` (n_rows, n_columns) equal to the row before in every column,
-    time included, shape (n_rows,) bool: a sample logged twice (a recorder that writes its
-    last sample again on closing), not a second sample at the same time."""
-    repeats = np.zeros(values.shape[0], dtype=bool)
-    repeats[1:] = (values[1:] == values[:-1]).all(axis=1)
-    return repeats
-
-
 def _check_stamps(path: Path, name: str, stamps: np.ndarray, lines: LineNumbers) -> None:
     """Refuse a stamp of shape (n,) that is NaN or infinite, naming its line."""
     bad = ~np.isfinite(stamps)
@@ -371,8 +528,9 @@ def _on_even_grid(
     samples: np.ndarray,
     samplerate: float | None,
     limits: ReadLimits,
-) -> tuple[float, np.ndarray, list[str]]:
-    """The rate and the samples of shape (n, n_channels) on an even grid, and notes."""
+) -> tuple[float, np.ndarray, list[str], float]:
+    """The rate and the samples of shape (n_channels, n) on an even grid, notes, and the
+    median step of ``times``."""
     if times.size < 2:
         raise DriverError(f"{path}: column '{name}' needs at least two times to give a rate")
     steps = np.diff(times)
@@ -381,28 +539,31 @@ def _on_even_grid(
         raise DriverError(
             f"{path}:{lines[index]}: column '{name}': the time does not rise over the line before"
         )
-    median = float(np.median(steps))
-    even = float(np.abs(steps - median).max()) <= EVEN * median
+    low, high = float(steps.min()), float(steps.max())
+    median = float(np.median(steps, overwrite_input=True))  # the steps are not needed after
+    del steps
+    # The largest |step - median|, as rounding is monotonic and symmetric.
+    even = max(high - median, median - low) <= EVEN * median
     if even and samplerate is None:
-        return 1.0 / median, samples, []
+        return 1.0 / median, samples, [], median
     if even and samplerate is not None and abs(1.0 / median - samplerate) <= EVEN * samplerate:
-        return samplerate, samples, []
+        return samplerate, samples, [], median
     jitter = jitter_of(times)
     rate = samplerate if samplerate is not None else jitter.rate
     check_grid(
         times,
         rate,
-        samples.shape[1],
+        samples.shape[0],
         limits,
         at=lambda index: f"{path}:{lines[index]}: column '{name}' jumps",
         before="the line before",
     )
-    resampled = resample_even(times, samples.T, rate).T
+    resampled = resample_even(times, samples, rate)
     note = (
         f"column '{name}': {jitter.describe()}; {times.size} samples resampled to "
-        f"{resampled.shape[0]} at {rate:.6g} Hz (linear interpolation)"
+        f"{resampled.shape[1]} at {rate:.6g} Hz (linear interpolation)"
     )
-    return rate, resampled, [note]
+    return rate, resampled, [note], median
 
 
 def _few(names: Sequence[str], shown: int = 8) -> str:

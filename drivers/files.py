@@ -124,13 +124,14 @@ def check_rate(rate: float, path: Path, what: str) -> float:
 def _finish(samples: np.ndarray, rate: float, path: Path) -> Recording:
     if samples.shape[-1] == 0 or samples.size == 0:
         raise DriverError(f"{path}: the recording has no samples")
-    bad = ~np.isfinite(samples)
-    if bad.any():
-        channel, index = np.argwhere(bad)[0]
-        raise DriverError(
-            f"{path}: channel {channel + 1} has a NaN or infinite sample at index {index} "
-            f"({index / rate:.6g} s)"
-        )
+    for channel, row in enumerate(samples):  # a channel's flags at a time, not the whole's
+        finite = np.isfinite(row)
+        if not finite.all():
+            index = int(np.argmin(finite))
+            raise DriverError(
+                f"{path}: channel {channel + 1} has a NaN or infinite sample at index {index} "
+                f"({index / rate:.6g} s)"
+            )
     return Recording(samples=np.ascontiguousarray(samples), samplerate=rate, path=str(path))
 
 
