@@ -22,7 +22,7 @@ from touchbench.app.services.runs import (
     per_target_summary,
     run_leaderboard,
 )
-from touchbench.app.services.runs.rescore import check_aggregate
+from touchbench.app.services.runs.rescore import check_aggregate, rescored_results
 from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import load_schema
 from touchbench.app.store.runs import RunInfo, get_run, load_results
@@ -204,8 +204,6 @@ def page_view(store: Store, ranked: RankedRun, classifiers: Sequence[str]) -> Ru
     ranking was (:attr:`~app.services.runs.RankedRun.rescored`)."""
     results = load_results(store, ranked.run.id, classifiers=classifiers)
     if ranked.rescored is not None:
-        from touchbench.app.services.runs.rescore import rescored_results
-
         results = rescored_results(store, ranked.run, results, ranked.rescored)
     return _view(store, ranked, results)
 
