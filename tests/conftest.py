@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import asyncio
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -14,6 +16,19 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     tests out in this order, and a slow test left to the end keeps the whole run waiting for
     one worker."""
     items.sort(key=lambda item: item.get_closest_marker("slow") is None)
+
+
+@pytest.fixture(autouse=True)
+def _no_event_loop_left_running() -> Iterator[None]:
+    """A test leaves no event loop running in the test process's main thread: a later
+    test's ``asyncio.run`` would refuse to start ("cannot be called from a running event
+    loop") and fail far from the cause."""
+    yield
+    try:
+        left = asyncio.get_running_loop()
+    except RuntimeError:  # none running: as it should be
+        return
+    pytest.fail(f"the test left an event loop running in the main thread: {left!r}")
 
 
 SHARED_DATASETS = Path(__file__).resolve().parents[1].parent / "shared" / "datasets"
