@@ -2,7 +2,9 @@
 # Sets touchbench up (scripts/install.sh), starts PostgreSQL for the store tests, then runs
 # every check: ruff (lint and format), mypy, the import-linter layering contract, and pytest
 # (every store test on both SQLite and PostgreSQL) in three worker processes (pytest-xdist;
-# each has its own PostgreSQL database and temporary folders). Extra arguments go to pytest.
+# each has its own PostgreSQL database and temporary folders; a worker that runs out of tests
+# takes half of the busiest one's, as the tests last from milliseconds to minutes). Extra
+# arguments go to pytest.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -17,4 +19,4 @@ fi
 echo "== ruff" && .venv/bin/ruff check . && .venv/bin/ruff format --check .
 echo "== mypy" && .venv/bin/mypy
 echo "== import-linter" && .venv/bin/lint-imports
-echo "== pytest" && .venv/bin/pytest -n "${TOUCHBENCH_TEST_WORKERS:-3}" "$@"
+echo "== pytest" && .venv/bin/pytest -n "${TOUCHBENCH_TEST_WORKERS:-3}" --dist worksteal "$@"

@@ -18,17 +18,24 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     items.sort(key=lambda item: item.get_closest_marker("slow") is None)
 
 
+def _running_loop() -> asyncio.AbstractEventLoop | None:
+    try:
+        return asyncio.get_running_loop()
+    except RuntimeError:  # none running in this thread
+        return None
+
+
 @pytest.fixture(autouse=True)
 def _no_event_loop_left_running() -> Iterator[None]:
-    """A test leaves no event loop running in the test process's main thread: a later
-    test's ``asyncio.run`` would refuse to start ("cannot be called from a running event
-    loop") and fail far from the cause."""
+    """A test leaves no event loop running in the test process's main thread (one that a
+    wider fixture keeps running, a browser's, may run on): a later test's ``asyncio.run``
+    would refuse to start ("cannot be called from a running event loop") and fail far from
+    the cause."""
+    before = _running_loop()
     yield
-    try:
-        left = asyncio.get_running_loop()
-    except RuntimeError:  # none running: as it should be
-        return
-    pytest.fail(f"the test left an event loop running in the main thread: {left!r}")
+    left = _running_loop()
+    if left is not None and left is not before:
+        pytest.fail(f"the test left an event loop running in the main thread: {left!r}")
 
 
 SHARED_DATASETS = Path(__file__).resolve().parents[1].parent / "shared" / "datasets"

@@ -16,8 +16,11 @@ from playwright.sync_api import Browser, sync_playwright
 from tests.support.browser import ARTIFACTS, CHROMIUM, Tab
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="module")
 def browser() -> Iterator[Browser]:
+    """Chromium for the module's tests. Not for the session: Playwright's sync API keeps an
+    event loop running in the main thread while it is open, and a later module's test that
+    calls ``asyncio.run`` would be refused."""
     assert CHROMIUM.is_file(), f"no Chromium at {CHROMIUM}: run scripts/install.sh"
     with sync_playwright() as playwright:
         launched = playwright.chromium.launch(executable_path=str(CHROMIUM), headless=True)
