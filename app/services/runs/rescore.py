@@ -47,6 +47,24 @@ def check_aggregate(aggregate: str) -> Aggregate:
     return cast(Aggregate, aggregate)
 
 
+def check_rescorable(run: RunInfo, aggregate: Aggregate) -> None:
+    """Refuse what ``run``'s record alone says cannot be scored per ``aggregate``: an
+    imported run (it holds scores, not predictions).  Cheap: callers check it before they
+    read the run's results, which for an imported run may be tens of thousands.
+
+    Raises
+    ------
+    FieldError
+        For ``aggregate``.
+    """
+    if run.config.imported:
+        raise FieldError(
+            "aggregate",
+            f"run {run.id} was imported: it holds its scores, not the fold predictions "
+            f"they were computed from, so it cannot be scored per {aggregate}",
+        )
+
+
 def as_asked(
     store: Store, run: RunInfo, results: Sequence[TaskResult], aggregate: Aggregate | None
 ) -> list[TaskResult]:
@@ -98,12 +116,7 @@ def rescored_results(
         several labels (:func:`~benchmark.evaluation.recordings.check_one_label`); a task
         of the run whose predictions were not stored (a run of an older version).
     """
-    if run.config.imported:
-        raise FieldError(
-            "aggregate",
-            f"run {run.id} was imported: it holds its scores, not the fold predictions "
-            f"they were computed from, so it cannot be scored per {aggregate}",
-        )
+    check_rescorable(run, aggregate)
     prepared = prepare_problem(
         load_dataset(store, run.dataset_id), run.config.targets_given, run.config.position or ()
     )
