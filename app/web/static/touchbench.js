@@ -38,8 +38,10 @@ async function call(url, options = {}) {
   const sent = sessionStorage.getItem(KEY);
   const response = await fetch(url, { ...options, headers: apiHeaders(options.headers) });
   if (response.status === 401 && keyStill(sent)) showKeyState(401);
-  if (response.status === 403 && keyStill(sent)) {
-    if ((await errorOf(response)).message === WRONG_KEY) showKeyState(403);
+  if (response.status === 403) {
+    // Reading the body yields: a new key may have been entered meanwhile, so ask after it.
+    const wrong = (await errorOf(response)).message === WRONG_KEY;
+    if (wrong && keyStill(sent)) showKeyState(403);
   }
   return response;
 }

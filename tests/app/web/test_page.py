@@ -228,3 +228,37 @@ def test_the_page_with_an_api_key(
     page.locator("#api-key-forget").click()
     expect(page.locator("#datasets-list")).to_contain_text("needs an API key")
     assert page.evaluate("sessionStorage.getItem('touchbench.apiKey')") is None
+
+
+#: Holds back the body of every 403 answer for a while, as a slow network would.
+SLOW_REFUSALS = """
+const json = Response.prototype.json;
+Response.prototype.json = function () {
+  const body = json.call(this);
+  if (this.status !== 403) return body;
+  return new Promise((resolve) => setTimeout(() => resolve(body), 1500));
+};
+"""
+
+
+def test_a_refusal_of_the_old_key_read_late_does_not_hide_the_new_one(
+    make_sqlite_server: Callable[..., Server], tab: Tab
+) -> None:
+    key = "s3cret-page-key-of-the-lab"
+    server = make_sqlite_server(api_key=key)
+    page = tab.page
+    page.add_init_script(SLOW_REFUSALS)
+    page.goto(server.url + "/")
+    expect(page.locator("#api-key-state")).to_have_text("this service needs a key")
+
+    # a wrong key, then the right one before the refusals of the wrong one are read
+    key_box = page.locator("#api-key-input")
+    key_box.fill("not-the-key")
+    key_box.press("Enter")
+    key_box.fill(key)
+    key_box.press("Enter")
+    expect(page.locator("#datasets-list")).to_contain_text("No data set")
+    expect(page.locator("#api-key-state")).to_have_text("key in use (this tab)")
+    page.wait_for_timeout(2500)  # every held-back refusal of the wrong key has been read
+    expect(page.locator("#api-key-state")).to_have_text("key in use (this tab)")
+    expect(page.locator("#datasets-list")).not_to_contain_text("wrong")
