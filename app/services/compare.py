@@ -33,9 +33,9 @@ from touchbench.app.schemas.runs import Aggregate
 from touchbench.app.schemas.status import Status
 from touchbench.app.services.beside import besides, merged_results
 from touchbench.app.services.imported import is_imported
-from touchbench.app.services.runs.rescore import as_asked
+from touchbench.app.services.runs.rescore import results_as_asked
 from touchbench.app.store.database import Store
-from touchbench.app.store.runs import RunInfo, get_run, load_results
+from touchbench.app.store.runs import RunInfo, get_run
 from touchbench.benchmark.errors import ConfigurationError
 from touchbench.benchmark.evaluation.bayesian import (
     DEFAULT_ROPE,
@@ -204,8 +204,8 @@ def compare_runs(
         Region of practical equivalence of the Bayesian tests, in the metric's units.
     aggregate : {"window", "recording"}, optional
         Score each run per window or per recording, from its stored test-fold predictions
-        where it scored otherwise (:func:`~app.services.runs.rescore.as_asked`); default as
-        each run scored.
+        where it scored otherwise (:func:`~app.services.runs.rescore.results_as_asked`);
+        default as each run scored.
 
     Raises
     ------
@@ -222,14 +222,13 @@ def compare_runs(
     runs, besides_of = with_besides([get_run(store, ref) for ref in run_refs])
     _check_distinct(runs)
     metric = metric or default_metric([run.kind for run in runs])
-    lower = metric in LOWER_IS_BETTER
     scores = []
     beside_notes: list[str] = []
     for run in runs:
         others = besides(run, besides_of.get(run.id, []))
         results, _ = merged_results(
-            as_asked(store, run, load_results(store, run.id), aggregate),
-            [(b, as_asked(store, b.run, load_results(store, b.run.id), aggregate)) for b in others],
+            results_as_asked(store, run, aggregate),
+            [(b, results_as_asked(store, b.run, aggregate)) for b in others],
         )
         names = [name for b in others for name in b.names.values()]
         scores.append(
@@ -240,6 +239,45 @@ def compare_runs(
             f"run {run.id} (same data set and target); as for their folds: {b.note}"
             for b in others
         ]
+    return _compared(
+        scores, metric, alpha=alpha, missing=missing, pair=pair, rope=rope, notes=beside_notes
+    )
+
+
+def compare_folds(
+    run: RunInfo,
+    results: Sequence[TaskResult],
+    *,
+    metric: str,
+    alpha: float = 0.05,
+    missing: MissingPolicy = "drop-classifier",
+) -> Comparison:
+    """One run's classifiers ranked over its folds, as :func:`compare_runs` ranks a run
+    given alone, from ``results`` already read (and scored as asked: a leaderboard's).
+
+    Raises
+    ------
+    ConfigurationError
+        As :func:`compare_runs`.
+    """
+    return _compared(
+        [run_scores(run, metric, results)], metric, alpha=alpha, missing=missing, notes=[]
+    )
+
+
+def _compared(
+    scores: list[RunScores],
+    metric: str,
+    *,
+    alpha: float,
+    missing: MissingPolicy,
+    notes: list[str],
+    pair: tuple[str, str] | None = None,
+    rope: float = DEFAULT_ROPE,
+) -> Comparison:
+    """The classifiers every run of ``scores`` has, ranked and tested over the runs (one
+    run: over its folds); ``notes`` are said first."""
+    lower = metric in LOWER_IS_BETTER
     runs = [s.run for s in scores]
     shared = [c for c in runs[0].classifiers if all(c in run.classifiers for run in runs[1:])]
     not_shared = sorted({c for run in runs for c in run.classifiers} - set(shared))
@@ -248,7 +286,7 @@ def compare_runs(
             f"the runs share {len(shared)} classifier(s) ({', '.join(shared) or 'none'}): "
             "a comparison needs at least 2"
         )
-    notes = beside_notes + [
+    notes = notes + [
         f"run {run.id} is {run.status}: {run.n_results} of {run.n_tasks} tasks have results"
         for run in runs
         if run.status != Status.DONE

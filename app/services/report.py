@@ -276,7 +276,7 @@ def build_report(
         raise ConfigurationError(
             f"the number of confusion matrices must be at least 0, got {confusions}"
         )
-    asked = None if aggregate is None else check_aggregate(aggregate)
+    asked = check_aggregate(aggregate)
     views = []
     fold_ranks: dict[int, Comparison | str] = {}
     hosts, joined = with_besides([get_run(store, ref) for ref in run_refs])

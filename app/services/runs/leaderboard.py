@@ -261,10 +261,15 @@ def run_leaderboard(
         For ``aggregate``: another value, or a run it cannot re-score
         (:func:`~.rescore.rescored_results`).
     """
-    from touchbench.app.services.runs.rescore import as_asked, check_aggregate, check_rescorable
+    from touchbench.app.services.runs.rescore import (
+        as_asked,
+        check_aggregate,
+        check_rescorable,
+        results_as_asked,
+    )
     from touchbench.benchmark.evaluation.leaderboard import build_leaderboard
 
-    asked = None if aggregate is None else check_aggregate(aggregate)
+    asked = check_aggregate(aggregate)
     run = get_run(store, run_id)
     if asked is not None and asked != run.config.aggregate:
         check_rescorable(run, asked)  # before reading results it could not use
@@ -277,12 +282,7 @@ def run_leaderboard(
     others = besides(run, [get_run(store, ref) for ref in dict.fromkeys(beside)])
     rescored = asked if asked is not None and asked != run.config.aggregate else None
     results = as_asked(store, run, results, asked)
-    theirs = []
-    for other in others:
-        if asked is not None and asked != other.run.config.aggregate:
-            check_rescorable(other.run, asked)
-        stored = load_results(store, other.run.id, confusion=confusion)
-        theirs.append((other, as_asked(store, other.run, stored, asked)))
+    theirs = [(b, results_as_asked(store, b.run, asked, confusion=confusion)) for b in others]
     ranked, groups = merged_results(results, theirs)
     drops = {**never_started(run, results), **load_drops(store, run.id)}
     board = build_leaderboard(

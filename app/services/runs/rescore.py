@@ -21,7 +21,7 @@ from touchbench.app.services.runs.problem import prepare_problem
 from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import count_groups, load_dataset
 from touchbench.app.store.predictions import load_predictions
-from touchbench.app.store.runs import RunInfo
+from touchbench.app.store.runs import RunInfo, load_results
 from touchbench.benchmark.errors import ConfigurationError
 from touchbench.benchmark.evaluation.fold_scores import score_fold
 from touchbench.benchmark.evaluation.metrics import COST_METRICS
@@ -34,17 +34,18 @@ AGGREGATES: tuple[str, ...] = get_args(Aggregate)
 _INNER_COSTS = ("inner_time", "inner_cpu_time")
 
 
-def check_aggregate(aggregate: str) -> Aggregate:
-    """``aggregate`` if it is one of :data:`AGGREGATES`.
+def check_aggregate(aggregate: str | None) -> Aggregate | None:
+    """``aggregate`` if it is one of :data:`AGGREGATES`; ``None`` (as the run scored) if
+    ``None``.
 
     Raises
     ------
     FieldError
         For ``aggregate``: another value.
     """
-    if aggregate not in AGGREGATES:
+    if aggregate is not None and aggregate not in AGGREGATES:
         raise FieldError("aggregate", f"Input should be {' or '.join(repr(a) for a in AGGREGATES)}")
-    return cast(Aggregate, aggregate)
+    return cast(Aggregate | None, aggregate)
 
 
 def check_rescorable(run: RunInfo, aggregate: Aggregate) -> None:
@@ -73,6 +74,27 @@ def as_asked(
     if aggregate is None or aggregate == run.config.aggregate:
         return list(results)
     return rescored_results(store, run, results, aggregate)
+
+
+def results_as_asked(
+    store: Store, run: RunInfo, aggregate: Aggregate | None, *, confusion: bool = True
+) -> list[TaskResult]:
+    """``run``'s stored results scored per ``aggregate`` (:func:`as_asked`); a run that
+    cannot be scored so refused before they are read (:func:`check_rescorable`).
+
+    Parameters
+    ----------
+    confusion : bool
+        Read the results' confusion matrices (:func:`~app.store.runs.load_results`).
+
+    Raises
+    ------
+    FieldError
+        For ``aggregate``: as :func:`rescored_results`.
+    """
+    if aggregate is not None and aggregate != run.config.aggregate:
+        check_rescorable(run, aggregate)
+    return as_asked(store, run, load_results(store, run.id, confusion=confusion), aggregate)
 
 
 def rescorable(store: Store, run: RunInfo) -> bool:
