@@ -7,6 +7,7 @@ from __future__ import annotations
 from pydantic import Field
 
 from touchbench.app.schemas.base import Schema
+from touchbench.app.schemas.runs import Aggregate
 
 
 class ClassScores(Schema):
@@ -74,3 +75,9 @@ class RunCertainty(Schema):
     targets: list[str]
     metric: str = Field(description="The leaderboard metric that orders the classifiers.")
     classifiers: list[ClassifierCertainty]
+    aggregate: Aggregate = Field(
+        default="window",
+        description="What the confusion matrices and the calibration count: windows, or "
+        "recordings (each one's windows pooled into one prediction), as the run scored or "
+        "as asked.",
+    )

@@ -8,6 +8,7 @@ from pydantic import Field
 
 from touchbench.app.schemas.base import Schema
 from touchbench.app.schemas.compare import ComparisonOut
+from touchbench.app.schemas.runs import Aggregate
 
 
 class FoldScoresSchema(Schema):
@@ -28,3 +29,8 @@ class FoldScoresSchema(Schema):
         "ranked (see `ranks_note`)."
     )
     ranks_note: str | None = Field(default=None, description="Why there are no ranks.")
+    aggregate: Aggregate = Field(
+        default="window",
+        description="What one prediction of the scores is: a window, or a recording's "
+        "windows pooled (`recording`), as the run scored or as asked.",
+    )

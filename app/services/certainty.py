@@ -30,7 +30,11 @@ from touchbench.benchmark.results import TaskResult
 
 
 def run_certainty(
-    store: Store, run_ref: int | str, *, classifiers: Sequence[str] | None = None
+    store: Store,
+    run_ref: int | str,
+    *,
+    classifiers: Sequence[str] | None = None,
+    aggregate: str | None = None,
 ) -> RunCertainty:
     """Per-class scores, confusion matrices and calibration of a run's classifiers.
 
@@ -39,6 +43,10 @@ def run_certainty(
     classifiers : sequence of str, optional
         These classifiers, in this order; default every classifier of the run with a
         successful fold, best first.
+    aggregate : {"window", "recording"}, optional
+        Count each window, or each recording's windows pooled into one prediction, as the
+        run's leaderboard scores (:func:`~app.services.runs.run_leaderboard`); default as
+        the run scored.
 
     Raises
     ------
@@ -47,8 +55,10 @@ def run_certainty(
         successful fold.
     NotFoundError
         No such run.
+    FieldError
+        For ``aggregate``: another value, or a run it cannot re-score.
     """
-    return certainty_of(run_view(store, run_ref), classifiers)
+    return certainty_of(run_view(store, run_ref, aggregate=aggregate), classifiers)
 
 
 def certainty_of(view: RunView, classifiers: Sequence[str] | None = None) -> RunCertainty:
@@ -78,6 +88,7 @@ def certainty_of(view: RunView, classifiers: Sequence[str] | None = None) -> Run
         targets=run.targets,
         metric=view.metric,
         classifiers=[_classifier(view, name) for name in chosen],
+        aggregate=view.aggregate,
     )
 
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from touchbench.app.schemas.base import finite
 from touchbench.app.schemas.folds import FoldScoresSchema
-from touchbench.app.services.compare import compare_runs, comparison_schema
+from touchbench.app.services.compare import compare_folds, comparison_schema
 from touchbench.app.services.report import run_view
 from touchbench.app.store.database import Store
 from touchbench.benchmark.errors import BenchmarkError
@@ -14,10 +14,16 @@ from touchbench.benchmark.evaluation.metrics import LOWER_IS_BETTER
 
 
 def run_fold_scores(
-    store: Store, run_ref: int | str, *, metric: str | None = None, alpha: float = 0.05
+    store: Store,
+    run_ref: int | str,
+    *,
+    metric: str | None = None,
+    alpha: float = 0.05,
+    aggregate: str | None = None,
 ) -> FoldScoresSchema:
     """Per-fold scores of a run's classifiers on ``metric`` (default: its leaderboard's),
-    and their ranks over the folds at ``alpha`` where they can be ranked.
+    and their ranks over the folds at ``alpha`` where they can be ranked; scored per
+    ``aggregate`` as the run's leaderboard (:func:`~app.services.runs.run_leaderboard`).
 
     Raises
     ------
@@ -25,13 +31,16 @@ def run_fold_scores(
         No such run.
     ConfigurationError
         An unknown metric, or a run without results.
+    FieldError
+        For ``aggregate``: another value, or a run it cannot re-score.
     """
-    view = run_view(store, run_ref, metric=metric)
+    view = run_view(store, run_ref, metric=metric, aggregate=aggregate)
     table = view.fold_scores()
     ranks, note = None, None
     try:
+        # the view's results: scored as asked once, not read and re-scored again
         ranks = comparison_schema(
-            compare_runs(store, [view.run.id], metric=view.metric, alpha=alpha)
+            compare_folds(view.run, view.results, metric=view.metric, alpha=alpha)
         )
     except BenchmarkError as error:  # the scores stand without ranks; the answer says why
         note = str(error)
@@ -45,4 +54,5 @@ def run_fold_scores(
         scores={name: [finite(float(v)) for v in table.column(name)] for name in table.classifiers},
         ranks=ranks,
         ranks_note=note,
+        aggregate=view.aggregate,
     )

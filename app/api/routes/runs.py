@@ -7,6 +7,8 @@ import io
 # Imports inside functions: start-up time: the leaderboard's text formats, the plots and the results
 # ARFF writer load when a format other than JSON is first asked for.
 import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated, Literal
 
@@ -100,6 +102,29 @@ def resume(run_id: int, service: ServiceDep) -> RunSchema:
     return run.schema()
 
 
+#: ``aggregate`` of a finished run's views (its leaderboard, folds and classes).
+AggregateQuery = Annotated[
+    Aggregate | None,
+    Query(
+        description="`recording`: each recording's windows scored as one prediction; "
+        "`window`: each window; from the run's stored test-fold predictions, nothing "
+        "fitted again (default: as the run was scored)."
+    ),
+]
+
+
+@contextmanager
+def _query_fields() -> Iterator[None]:
+    """A :class:`~app.errors.FieldError` located in the query, where these routes' fields
+    are (the service's handler locates one in the body)."""
+    try:
+        yield
+    except FieldError as error:
+        raise RequestValidationError(
+            [{"type": "value_error", "loc": ("query", error.field), "msg": error.message}]
+        ) from None
+
+
 LEADERBOARD_FORMATS = {
     "csv": "text/csv; charset=utf-8",
     "markdown": "text/markdown; charset=utf-8",
@@ -119,21 +144,14 @@ def leaderboard(
     baseline: Annotated[str | None, Query(max_length=200)] = None,
     format: Annotated[Literal["json", "csv", "markdown", "arff"], Query()] = "json",
     beside: Annotated[list[int] | None, Query(max_length=20)] = None,
-    aggregate: Annotated[
-        Aggregate | None,
-        Query(
-            description="`recording`: each recording's windows scored as one prediction; "
-            "`window`: each window; from the run's stored test-fold predictions, nothing "
-            "fitted again (default: as the run was scored)."
-        ),
-    ] = None,
+    aggregate: AggregateQuery = None,
 ) -> LeaderboardSchema | PlainTextResponse:
     """The run's classifiers ranked by ``metric`` with WEKA's marks against ``baseline``
     (JSON: the same rows as ``touchbench leaderboard --json``); ``beside`` adds other runs'
     classifiers (same data set and target: a paper's imported results), t-tested where the
     folds pair and by their means where they do not; ``aggregate`` scores the run's stored
     predictions per recording or per window."""
-    try:
+    with _query_fields():
         ranked = run_leaderboard(
             store,
             run_id,
@@ -142,10 +160,6 @@ def leaderboard(
             beside=beside or (),
             aggregate=aggregate,
         )
-    except FieldError as error:  # the fields of this route are query parameters
-        raise RequestValidationError(
-            [{"type": "value_error", "loc": ("query", error.field), "msg": error.message}]
-        ) from None
     run, board = ranked.run, ranked.board
     if format == "json":
         return ranked.report()
@@ -183,10 +197,19 @@ def _classifiers(text: str | None) -> list[str] | None:
 
 
 @router.get("/{run_id}/classes", response_model=RunCertainty)
-def classes(run_id: int, store: StoreDep, classifier: ClassifiersQuery = None) -> RunCertainty:
+def classes(
+    run_id: int,
+    store: StoreDep,
+    classifier: ClassifiersQuery = None,
+    aggregate: AggregateQuery = None,
+) -> RunCertainty:
     """Per-class precision, recall and F1, confusion matrices (summed over folds) per
-    target, and out-of-fold calibration of each classifier (``touchbench classes --json``)."""
-    return run_certainty(store, run_id, classifiers=_classifiers(classifier))
+    target, and out-of-fold calibration of each classifier (``touchbench classes --json``);
+    ``aggregate`` counts each recording (or window) as the leaderboard scores them."""
+    with _query_fields():
+        return run_certainty(
+            store, run_id, classifiers=_classifiers(classifier), aggregate=aggregate
+        )
 
 
 @router.get("/{run_id}/folds", response_model=FoldScoresSchema)
@@ -195,10 +218,13 @@ def folds(
     store: StoreDep,
     metric: Annotated[str | None, Query(max_length=100)] = None,
     alpha: Annotated[float, Query(gt=0, lt=1)] = 0.05,
+    aggregate: AggregateQuery = None,
 ) -> FoldScoresSchema:
     """Every fold's score of every classifier, and their ranks over the folds (Friedman,
-    Nemenyi's critical difference): what ``plot --kind folds`` and ``--kind cd`` draw."""
-    return run_fold_scores(store, run_id, metric=metric, alpha=alpha)
+    Nemenyi's critical difference): what ``plot --kind folds`` and ``--kind cd`` draw;
+    ``aggregate`` scores them per recording or per window as the leaderboard does."""
+    with _query_fields():
+        return run_fold_scores(store, run_id, metric=metric, alpha=alpha, aggregate=aggregate)
 
 
 @router.get("/{run_id}/ablation", response_model=AblationResult)
@@ -219,11 +245,16 @@ def calibration_svg(
     store: StoreDep,
     classifier: ClassifiersQuery = None,
     top: Annotated[int, Query(ge=1, le=50)] = 5,
+    aggregate: AggregateQuery = None,
 ) -> Response:
-    """The reliability diagram of the run's best ``top`` classifiers with probabilities."""
+    """The reliability diagram of the run's best ``top`` classifiers with probabilities,
+    per recording or per window as ``aggregate`` says."""
     from touchbench.app.reports.figures import reliability_figure
     from touchbench.app.reports.plots import svg_text
 
-    certainty = run_certainty(store, run_id, classifiers=_classifiers(classifier))
+    with _query_fields():
+        certainty = run_certainty(
+            store, run_id, classifiers=_classifiers(classifier), aggregate=aggregate
+        )
     svg = svg_text(reliability_figure(certainty, top))
     return Response(svg, media_type="image/svg+xml")
