@@ -489,12 +489,14 @@ class _HttpSource:
     def __init__(self, client: Client) -> None:
         self._client = client
 
-    def fold_scores(self, run_id: int, *, metric: str) -> FoldScoresSchema:
-        data = self._client._get(f"/api/runs/{run_id}/folds", params={"metric": metric})
+    def fold_scores(self, run_id: int, *, metric: str, aggregate: Aggregate) -> FoldScoresSchema:
+        params = {"metric": metric, "aggregate": aggregate}
+        data = self._client._get(f"/api/runs/{run_id}/folds", params=params)
         return FoldScoresSchema.model_validate(data)
 
-    def classes(self, run_id: int, *, classifier: str) -> RunCertainty:
-        data = self._client._get(f"/api/runs/{run_id}/classes", params={"classifier": classifier})
+    def classes(self, run_id: int, *, classifier: str, aggregate: Aggregate) -> RunCertainty:
+        params = {"classifier": classifier, "aggregate": aggregate}
+        data = self._client._get(f"/api/runs/{run_id}/classes", params=params)
         return RunCertainty.model_validate(data)
 
 

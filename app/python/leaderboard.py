@@ -22,7 +22,12 @@ from typing import TYPE_CHECKING, Any, Literal, Protocol, get_args
 from touchbench.app.errors import AppError
 from touchbench.app.schemas.certainty import RunCertainty
 from touchbench.app.schemas.folds import FoldScoresSchema
-from touchbench.app.schemas.runs import LeaderboardRowSchema, LeaderboardSchema, MetricValue
+from touchbench.app.schemas.runs import (
+    Aggregate,
+    LeaderboardRowSchema,
+    LeaderboardSchema,
+    MetricValue,
+)
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -34,13 +39,14 @@ PLOT_KINDS: tuple[str, ...] = get_args(PlotKind)
 
 
 class ResultSource(Protocol):
-    """Where a leaderboard reads what its plots draw beyond its rows."""
+    """Where a leaderboard reads what its plots draw beyond its rows, scored per
+    ``aggregate`` as the leaderboard was (a window, or a recording's windows pooled)."""
 
-    def fold_scores(self, run_id: int, *, metric: str) -> FoldScoresSchema:
+    def fold_scores(self, run_id: int, *, metric: str, aggregate: Aggregate) -> FoldScoresSchema:
         """Every fold's score of the run's classifiers on ``metric``, and their ranks."""
         ...
 
-    def classes(self, run_id: int, *, classifier: str) -> RunCertainty:
+    def classes(self, run_id: int, *, classifier: str, aggregate: Aggregate) -> RunCertainty:
         """``classifier``'s confusion matrices (summed over folds) and per-class scores."""
         ...
 
@@ -291,10 +297,13 @@ class Leaderboard:
 
     @cached_property
     def _fold_scores(self) -> FoldScoresSchema:
-        return self._needs_source().fold_scores(self.run_id, metric=self.metric)
+        return self._needs_source().fold_scores(
+            self.run_id, metric=self.metric, aggregate=self.schema.aggregate
+        )
 
     def fold_scores(self) -> pd.DataFrame:
-        """Every fold's score on the ranking metric.
+        """Every fold's score on the ranking metric, scored as the rows (per window or per
+        recording: ``schema.aggregate``).
 
         Returns
         -------
@@ -311,7 +320,8 @@ class Leaderboard:
         )
 
     def plot(self, kind: PlotKind = "cd", *, classifier: str | None = None) -> Figure:
-        """One plot of the run, as ``touchbench plot --kind KIND`` draws it.
+        """One plot of the run, as ``touchbench plot --kind KIND`` draws it, scored as the
+        rows (per window or per recording: ``schema.aggregate``).
 
         Parameters
         ----------
@@ -366,7 +376,9 @@ class Leaderboard:
             if classifier is None:
                 raise AppError(f"run {self.run_id} has no classifier with a successful fold")
         row = self.row(classifier)
-        found = self._needs_source().classes(self.run_id, classifier=classifier)
+        found = self._needs_source().classes(
+            self.run_id, classifier=classifier, aggregate=self.schema.aggregate
+        )
         entry = next(c for c in found.classifiers if c.classifier == classifier)
         failed = f", {row.n_failed} failed" if row.n_failed else ""
         return plots.confusion_figure(

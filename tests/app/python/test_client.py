@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 import httpx
+import numpy as np
 import pandas as pd
 import pytest
 from matplotlib.figure import Figure
@@ -20,6 +21,7 @@ from tests.support.cli_runner import run_cli
 from tests.support.recordings import PER_RECORDING, recorded_windows, store_dataset
 from tests.support.service import Server, servers
 from tests.support.synthetic import touch_arff
+from touchbench.app.errors import FieldError
 from touchbench.app.python import errors
 from touchbench.app.python.client import Client, _HttpSource
 from touchbench.app.python.sources import stored_leaderboard
@@ -141,15 +143,21 @@ def test_a_refused_request_raises_with_the_services_field(
         service.cancel(done_run)
 
     with pytest.raises(errors.BadRequestError) as metric:  # the plots' numbers, refused
-        _HttpSource(service).fold_scores(done_run.id, metric="no-such-metric")
+        _HttpSource(service).fold_scores(done_run.id, metric="no-such-metric", aggregate="window")
     assert metric.value.status == 400 and "no-such-metric" in metric.value.message
 
 
 def test_leaderboard_rescored_per_recording_is_the_clis(
-    server: Server, service: Client, done_run: Run, capsys: pytest.CaptureFixture[str]
+    server: Server,
+    service: Client,
+    done_run: Run,
+    capsys: pytest.CaptureFixture[str],
+    tmp_path: Path,
 ) -> None:
     """``aggregate=`` re-scores the run's stored fold predictions as ``leaderboard
-    --aggregate`` does; a run on data without recordings is refused naming the field."""
+    --aggregate`` does, and the leaderboard's plots and fold scores follow it (over HTTP and
+    from the store); a run on data without recordings, or an imported one, is refused
+    naming the field."""
     store_dataset(server.database_url, recorded_windows(), "takes")
     run = service.bench("takes", classifiers=["nb", "ridge"], folds=4, seed=3, wait=True)
     assert run.status == "done"
@@ -167,6 +175,60 @@ def test_leaderboard_rescored_per_recording_is_the_clis(
         plain.to_pandas()["f1_weighted_mean"].tolist()
         != board.to_pandas()["f1_weighted_mean"].tolist()
     )
+
+    # its plots draw the folds and classes scored per recording, over HTTP and from the store
+    folds = board.fold_scores()
+    means = board.to_pandas()["f1_weighted_mean"]
+    assert folds.mean().to_dict() == pytest.approx(means.to_dict(), abs=1e-12)
+    assert not folds.equals(plain.fold_scores())
+    store = Store(server.database_url)
+    stored = stored_leaderboard(store, run.id, aggregate="recording")
+    assert stored.schema == board.schema
+    pd.testing.assert_frame_equal(folds, stored.fold_scores())
+    pd.testing.assert_frame_equal(
+        plain.fold_scores(), stored_leaderboard(store, run.id).fold_scores()
+    )
+    for kind in ("cd", "folds"):
+        assert board.plot(kind).axes and stored.plot(kind).axes
+    for made in (board, stored):
+        confusion = made.plot("confusion", classifier="nb")
+        assert "nb, summed over 4 folds" in " ".join(confusion.get_suptitle().split())
+        # 16 recordings of 16 windows: per recording, each cell counts recordings
+        counts = [text.get_text() for text in confusion.axes[0].texts]
+        assert sum(int(c.rsplit("\n", 1)[-1]) for c in counts) == 16, counts
+    window_counts = plain.plot("confusion", classifier="nb").axes[0].texts
+    assert sum(int(t.get_text().rsplit("\n", 1)[-1]) for t in window_counts) == 256
+
+    # an imported run (scores, not predictions): its plots as it scored; per recording refused
+    exported = tmp_path / "results.arff"
+    exported.write_text(
+        run_cli(capsys, server.database_url, "leaderboard", str(run.id), "-f", "arff").out
+    )
+    imported = run_cli(
+        capsys, server.database_url, "import-results", str(exported), "--dataset", "takes", "--json"
+    )
+    assert imported.code == 0, imported.err
+    paper = int(imported.json()["id"])
+    as_scored = service.leaderboard(paper)
+    assert as_scored.schema.aggregate == "window" and as_scored.plot("folds").axes
+    # the same folds as the run's per window (exported under WEKA's names)
+    np.testing.assert_allclose(
+        sorted(as_scored.fold_scores().T.to_numpy().tolist()),
+        sorted(plain.fold_scores().T.to_numpy().tolist()),
+    )
+    for refused in (
+        lambda: service.leaderboard(paper, aggregate="recording"),
+        lambda: _HttpSource(service).fold_scores(
+            paper, metric="f1_weighted", aggregate="recording"
+        ),
+        lambda: _HttpSource(service).classes(paper, classifier="nb", aggregate="recording"),
+        lambda: stored_leaderboard(store, paper, aggregate="recording"),
+    ):
+        with pytest.raises((errors.InvalidRequestError, FieldError)) as imported_refused:
+            refused()
+        assert imported_refused.value.field == "aggregate"
+        assert f"run {paper} was imported" in str(imported_refused.value)
+    store.dispose()
 
     with pytest.raises(errors.InvalidRequestError) as ungrouped:
         service.leaderboard(done_run, aggregate="recording")
