@@ -118,7 +118,7 @@ EngineOption = Annotated[
 ]
 
 
-#: ``--aggregate`` of a finished run's views (``leaderboard``, ``report``): its stored
+#: ``--aggregate`` of a finished run's views (``leaderboard``, ``plot``, ``report``): its stored
 #: test-fold predictions scored again, nothing fitted.
 RescoreOption = Annotated[
     str | None,

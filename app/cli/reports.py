@@ -144,6 +144,7 @@ def plot_command(
     metric: MetricOption = None,
     alpha: AlphaOption = 0.05,
     missing: MissingOption = "drop-classifier",
+    aggregate: RescoreOption = None,
 ) -> None:
     """Draw one plot of a run as SVG (text kept as text) or PNG."""
     from touchbench.app.reports.plots import figure_format, save_figure
@@ -155,7 +156,7 @@ def plot_command(
             "--classifier goes with --kind confusion", param_hint="--classifier"
         )
     figure_format(output)
-    figure = _run_figure(ctx, run, kind, classifier, metric, alpha, missing)
+    figure = _run_figure(ctx, run, kind, classifier, metric, alpha, missing, aggregate)
     save_figure(figure, output)
     info(f"wrote {output}")
 
@@ -228,19 +229,26 @@ def _run_figure(
     metric: str | None,
     alpha: float,
     missing: str,
+    aggregate: str | None,
 ) -> Figure:
     from touchbench.app.reports import figures
     from touchbench.app.services.compare import compare_runs
     from touchbench.app.services.report import run_view
+    from touchbench.app.services.runs.rescore import check_aggregate
     from touchbench.benchmark.evaluation.score_table import missing_policy
 
     store = get_state(ctx).store
     if kind == "cd":
         comparison = compare_runs(
-            store, [run_id], metric=metric, alpha=alpha, missing=missing_policy(missing)
+            store,
+            [run_id],
+            metric=metric,
+            alpha=alpha,
+            missing=missing_policy(missing),
+            aggregate=check_aggregate(aggregate),
         )
         return figures.cd_figure(comparison)
-    view = run_view(store, run_id, metric=metric)
+    view = run_view(store, run_id, metric=metric, aggregate=aggregate)
     if kind == "folds":
         return figures.folds_figure(view)
     if kind == "confusion":

@@ -9,6 +9,7 @@ from __future__ import annotations
 import csv
 import io
 from html import unescape
+from itertools import pairwise
 from pathlib import Path
 from typing import Any
 
@@ -16,6 +17,7 @@ import pytest
 from sqlalchemy import create_engine, text
 
 from tests.support.cli_runner import one_error_line, run_cli
+from tests.support.figures import svg_texts
 from tests.support.recordings import PER_RECORDING, recorded_windows, store_dataset
 from tests.support.synthetic import touch_arff
 from touchbench.app.services.runs import run_leaderboard
@@ -233,6 +235,51 @@ def test_leaderboard_help_tells_aggregate(capsys: pytest.CaptureFixture[str], db
     words = " ".join(shown.out.replace("│", " ").split())
     assert "--aggregate" in words and "stored test-fold predictions" in words
     assert "nothing is fitted again" in words
+
+
+def test_plot_scores_per_recording_when_asked(
+    capsys: pytest.CaptureFixture[str],
+    db: str,
+    tmp_path: Path,
+    two_runs: tuple[int, int],
+    refused_runs: dict[str, int],
+    no_fitting: list[str],
+) -> None:
+    """`plot RUN --aggregate recording` draws the folds, the CD diagram and a confusion
+    matrix of the run scored per recording: those of the run scored so from the start (but
+    for the run named in the title), not the run's own; refused in one line for an
+    imported run."""
+    windows, recordings = two_runs
+
+    def texts(run: int, kind: str, *options: str) -> list[str]:
+        out = tmp_path / f"{run}-{kind}-{len(options)}.svg"
+        made = run_cli(capsys, db, "plot", str(run), "--kind", kind, "-o", str(out), *options)
+        assert made.code == 0, made.err
+        return [t.replace(f"run {run}", "run N") for t in svg_texts(out.read_text())]
+
+    for kind in ("folds", "cd", "confusion"):
+        rescored = texts(windows, kind, "--aggregate", "recording")
+        assert rescored == texts(recordings, kind), kind
+        assert rescored != texts(windows, kind), kind
+        assert texts(recordings, kind, "--aggregate", "window") == texts(windows, kind), kind
+    # the confusion matrix counts the 16 recordings, not their 256 windows
+    cells = texts(windows, "confusion", "--aggregate", "recording", "-c", "nb")
+    counts = [int(count) for share, count in pairwise(cells) if "." in share and count.isdigit()]
+    assert sum(counts) == 16, cells
+
+    imported = refused_runs["imported"]
+    for kind in ("folds", "cd", "confusion"):
+        refused = run_cli(
+            capsys, db, "plot", str(imported), "--kind", kind, "-o", str(tmp_path / "x.svg"),
+            "--aggregate", "recording",
+        )  # fmt: skip
+        one_error_line(refused, f"--aggregate: run {imported} was imported: it holds its scores")
+    bad = run_cli(
+        capsys, db, "plot", str(windows), "-o", str(tmp_path / "x.svg"), "--aggregate", "take"
+    )
+    one_error_line(bad, "--aggregate: Input should be 'window' or 'recording'")
+    assert not (tmp_path / "x.svg").exists()
+    assert no_fitting == []
 
 
 def test_report_scores_per_recording_when_asked(
