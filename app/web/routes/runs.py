@@ -104,8 +104,9 @@ def run_form(
 
 
 @router.get("/{run_id}/progress", response_class=HTMLResponse)
-def progress(run_id: int, store: StoreDep) -> HTMLResponse:
-    """Status and tasks done; polled every second until the run is over."""
+def progress(run_id: int, store: StoreDep, aggregate: AggregateQuery = None) -> HTMLResponse:
+    """Status and tasks done; polled every second until the run is over.  ``aggregate``:
+    the leaderboard's CSV scored so, as the page's leaderboard is."""
     run = run_progress(store, run_id)
     return render(
         "fragments/progress.html.j2",
@@ -113,6 +114,7 @@ def progress(run_id: int, store: StoreDep) -> HTMLResponse:
         final=run.status in FINAL,
         resumable=run.status in RESUMABLE,
         done=run.status == Status.DONE,
+        aggregate=aggregate,
     )
 
 
@@ -176,13 +178,9 @@ def plots(
 ) -> HTMLResponse:
     """Every fold's score, per-target scores and class counts, scored as the leaderboard."""
     from touchbench.app.reports import figures
-    from touchbench.app.services.report import page_view
 
     def drawn() -> list[Plot]:
-        ranked, _ = _ranked(store, run_id, metric=metric or None, aggregate=aggregate)
-        own = set(ranked.run.classifiers)
-        best = [row.classifier for row in ranked.board.rows if row.classifier in own]
-        view = page_view(store, ranked, best[: bounds.DRAWN])
+        view = _drawn_view(store, run_id, metric=metric or None, aggregate=aggregate)
         plots = [draw(f"{view.metric} of every fold", partial(figures.folds_figure, view))]
         if view.per_target is not None:
             plots.append(draw("Accuracy per target", partial(figures.targets_figure, view)))
@@ -198,23 +196,33 @@ def plots(
 
 
 @router.get("/{run_id}/calibration", response_class=HTMLResponse)
-def calibration(run_id: int, store: StoreDep) -> HTMLResponse:
+def calibration(run_id: int, store: StoreDep, aggregate: AggregateQuery = None) -> HTMLResponse:
     """The calibration of the classifiers the plots draw (a table) and their reliability
-    diagram; why there is none for a regression or an imported run (no predictions kept)."""
-    from touchbench.app.services.report import page_view
+    diagram, per window or per recording as the leaderboard; why there is none for a
+    regression or an imported run (no predictions kept)."""
 
     def made() -> dict[str, Any]:
-        ranked = ranked_run(store, run_id)
-        own = set(ranked.run.classifiers)
-        best = [row.classifier for row in ranked.board.rows if row.classifier in own]
-        return _calibration(page_view(store, ranked, best[: bounds.DRAWN]))
+        return _calibration(_drawn_view(store, run_id, metric=None, aggregate=aggregate))
 
     # computed once per version of the run's results, as its ranking is
     try:
-        sure = kept(store, [run_id], ("calibration",), made)
+        sure = kept(store, [run_id], ("calibration", aggregate), made)
     except NoResultsError:
         sure = None
     return render("fragments/calibration.html.j2", sure=sure)
+
+
+def _drawn_view(
+    store: Store, run_id: int, *, metric: str | None, aggregate: Aggregate | None
+) -> RunView:
+    """The run ranked as the leaderboard (:func:`_ranked`) with the fold results of the
+    best classifiers a figure draws (:data:`~app.reports.bounds.DRAWN`), scored as ranked."""
+    from touchbench.app.services.report import page_view
+
+    ranked, _ = _ranked(store, run_id, metric=metric, aggregate=aggregate)
+    own = set(ranked.run.classifiers)
+    best = [row.classifier for row in ranked.board.rows if row.classifier in own]
+    return page_view(store, ranked, best[: bounds.DRAWN])
 
 
 def _calibration(view: RunView) -> dict[str, Any]:

@@ -2,11 +2,14 @@
 every field of the run request in its group with the request's defaults, bad values refused
 by the page and then by the service under the request's field names, a raced run on a
 total budget started from the form with the dropped classifier marked, calibration on the
-run's page, and an ablation started from the run's page with its plot; a page on another
-origin can start none of these on the same (keyless) service."""
+run's page, the leaderboard with its CSV and calibration scored per recording when asked,
+and an ablation started from the run's page with its plot; a page on another origin can
+start none of these on the same (keyless) service."""
 
 from __future__ import annotations
 
+import csv
+import io
 import re
 from collections.abc import Iterator
 from pathlib import Path
@@ -256,6 +259,13 @@ def test_the_run_page_scores_per_recording_where_the_run_has_recordings(
     picker = page.locator("select[name=aggregate]")
     expect(picker).to_have_value("window")
     expect(page.locator("#leaderboard")).not_to_contain_text(PER_RECORDING)
+    csv_link = page.locator("#progress a[data-download]")
+    expect(csv_link).to_have_attribute("href", f"/api/runs/{takes}/leaderboard?format=csv")
+    # nb's calibration (the cells: classifier, ECE, instances, folds, note) counts windows
+    nb_calibration = page.locator("#calibration table[data-table='calibration'] tbody tr").filter(
+        has=page.locator("td:first-child", has_text=re.compile(r"^nb$"))
+    )
+    expect(nb_calibration.locator("td").nth(2)).to_have_text("256")
     picker.select_option("recording")
     page.wait_for_url(re.compile(r"aggregate=recording"))
     expect(page.locator("#leaderboard")).to_contain_text(RESCORED)
@@ -266,6 +276,25 @@ def test_the_run_page_scores_per_recording_where_the_run_has_recordings(
         mean = row["metrics"]["f1_weighted"]["mean"]
         cells = page.locator(f"#leaderboard-table tr[data-classifier='{row['classifier']}'] td")
         expect(cells.nth(3)).to_contain_text(f"{mean:.4f}")
+    # the CSV and the calibration follow the choice: 16 recordings, the ECE the API says
+    classes = api.get(f"/api/runs/{takes}/classes", params={"aggregate": "recording"}).json()
+    nb = next(c for c in classes["classifiers"] if c["classifier"] == "nb")["calibration"]
+    expect(nb_calibration.locator("td").nth(2)).to_have_text("16")
+    expect(nb_calibration.locator("td").nth(1)).to_have_text(f"{nb['ece']:.4f}")
+    expect(csv_link).to_have_attribute(
+        "href", f"/api/runs/{takes}/leaderboard?format=csv&aggregate=recording"
+    )
+    with page.expect_download() as downloading:
+        csv_link.click()
+    rows = list(csv.DictReader(io.StringIO(downloading.value.path().read_text(encoding="utf-8"))))
+    assert [row["classifier"] for row in rows] == [
+        row["classifier"] for row in board["leaderboard"]
+    ]
+    assert {row["aggregate"] for row in rows} == {"recording"}
+    for row, ranked in zip(rows, board["leaderboard"], strict=True):
+        assert float(row["f1_weighted_mean"]) == pytest.approx(
+            ranked["metrics"]["f1_weighted"]["mean"]
+        )
     screen(tab, "run-per-recording")
     # ranking by another metric keeps the aggregation, and so does a classifier's page
     page.locator("#leaderboard-table th a", has_text="accuracy").click()
