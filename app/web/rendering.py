@@ -26,6 +26,7 @@ from touchbench.benchmark.errors import BenchmarkError
 
 if TYPE_CHECKING:  # Jinja, matplotlib and the statistics load with the first page, not at start
     from jinja2 import Environment
+    from markupsafe import Markup
     from matplotlib.figure import Figure
 
 TEMPLATES = Path(__file__).with_name("templates")
@@ -70,8 +71,14 @@ def environment() -> Environment:
 
 def render(template: str, /, **context: Any) -> HTMLResponse:
     """A template as an HTML answer with the security headers."""
-    html = environment().get_template(template).render(**context)
-    return HTMLResponse(html, headers=SECURITY_HEADERS)
+    return HTMLResponse(rendered(template, **context), headers=SECURITY_HEADERS)
+
+
+def rendered(template: str, /, **context: Any) -> Markup:
+    """A template rendered (autoescaped) as markup another template shows as it is."""
+    from markupsafe import Markup
+
+    return Markup(environment().get_template(template).render(**context))
 
 
 @dataclass(frozen=True)

@@ -35,13 +35,15 @@ from touchbench.app.services.runs import NoResultsError, kept, ranked_run
 from touchbench.app.store.database import Store
 from touchbench.app.web.deps import StoreDep
 from touchbench.app.web.listing import newest
-from touchbench.app.web.rendering import Plot, draw, render
+from touchbench.app.web.rendering import Plot, draw, render, rendered
 from touchbench.app.web.request_form import form_fields, grouped
 from touchbench.app.web.routes.pages import Ref
 
 # The plots and the statistics (matplotlib, scipy) load with the first fragment that needs
 # them, so that the service starts at once.
 if TYPE_CHECKING:
+    from markupsafe import Markup
+
     from touchbench.app.services.report import RunView
     from touchbench.app.services.runs import RankedRun
 
@@ -131,31 +133,36 @@ def leaderboard(
     ``beside``: other runs' classifiers too (a paper's imported results), t-tested where
     the folds pair and by their means where they do not; ``aggregate``: scored per window
     or per recording from the run's stored test-fold predictions."""
-    try:
+    asked = (metric or None, baseline or None, tuple(beside or ()), aggregate)
+
+    def made() -> tuple[Markup, bool]:
         ranked, refused = _ranked(
-            store,
-            run_id,
-            metric=metric or None,
-            baseline=baseline or None,
-            beside=beside or (),
-            aggregate=aggregate,
+            store, run_id, metric=asked[0], baseline=asked[1], beside=asked[2], aggregate=aggregate
         )
+        table = _table(
+            ranked, chosen_baseline=asked[1], chosen_aggregate=None if refused else aggregate
+        )
+        ranking = rendered(
+            "fragments/ranking.html.j2",
+            run=ranked.run,
+            board=ranked.board,
+            table=table,
+            tables=[_first_rows(part) for part in run_tables(ranked.report)],
+            notes=ranked.notes(),
+            refused=refused,
+        )
+        return ranking, ranked.board.baseline is not None
+
+    # rendered once per version of the results, as the ranking is: a client asking for the
+    # page back to back costs a light query a run, not the table again
+    try:
+        ranking, ranked = kept(store, [run_id, *asked[2]], ("leaderboard", *asked), made)
     except NoResultsError as missing:
-        return render("fragments/leaderboard.html.j2", run=missing.run, board=None)
-    return render(
-        "fragments/leaderboard.html.j2",
-        run=ranked.run,
-        board=ranked.board,
-        table=_table(
-            ranked,
-            chosen_baseline=baseline or None,
-            chosen_aggregate=None if refused else aggregate,
-        ),
-        tables=[_first_rows(table) for table in run_tables(ranked.report)],
-        answers=run_answer_tables(run_answers(store, run_id)),
-        notes=ranked.notes(),
-        refused=refused,
-    )
+        ranking = rendered("fragments/ranking.html.j2", run=missing.run, board=None)
+        ranked = False
+    # the answers (ablation, importance) change apart from the results
+    answers = run_answer_tables(run_answers(store, run_id)) if ranked else []
+    return render("fragments/leaderboard.html.j2", ranking=ranking, answers=answers)
 
 
 def _ranked(
