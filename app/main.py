@@ -28,7 +28,6 @@ from touchbench.app.store.jobs import mark_lost_jobs
 from touchbench.app.store.runs import finish_run, get_run, mark_lost_runs
 from touchbench.app.web.site import install as install_web_page
 
-
 #: Seconds a thread holds the GIL while another waits for it (Python's default: 0.005).  A
 #: page's rendering runs in a worker thread; a prediction on the event loop waits this long
 #: for the GIL at each of its steps (reading the request, predicting, answering) while a

@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # Sets touchbench up (scripts/install.sh), starts PostgreSQL for the store tests, then runs
-# every check: ruff (lint and format), mypy, the import-linter layering contract, and pytest
+# every check: ruff (lint and format), the import-linter layering contract, mypy, and pytest
 # (every store test on both SQLite and PostgreSQL) in three worker processes (pytest-xdist;
 # each has its own PostgreSQL database and temporary folders; a worker that runs out of tests
 # takes half of the busiest one's, as the tests last from milliseconds to minutes). Extra
-# arguments go to pytest.
+# arguments go to pytest. Any check that fails fails the command, after pytest has run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -16,7 +16,22 @@ else
   export TOUCHBENCH_TEST_POSTGRES_URL=""
 fi
 
-echo "== ruff" && .venv/bin/ruff check . && .venv/bin/ruff format --check .
-echo "== mypy" && .venv/bin/mypy
-echo "== import-linter" && .venv/bin/lint-imports
-echo "== pytest" && .venv/bin/pytest -n "${TOUCHBENCH_TEST_WORKERS:-3}" --dist worksteal "$@"
+# Each check on its own line: under `set -e`, a failure inside an `a && b` list is not fatal.
+echo "== ruff"
+.venv/bin/ruff check .
+.venv/bin/ruff format --check .
+echo "== import-linter"
+.venv/bin/lint-imports
+# mypy takes one core for most of a minute: it runs beside pytest, whose workers leave part
+# of the cores idle while they wait on the services and processes they start.
+typed=$(mktemp)
+trap 'rm -f "$typed"' EXIT
+.venv/bin/mypy >"$typed" 2>&1 &
+mypy=$!
+echo "== pytest"
+status=0
+.venv/bin/pytest -n "${TOUCHBENCH_TEST_WORKERS:-3}" --dist worksteal "$@" || status=$?
+echo "== mypy"
+cat "$typed"
+wait "$mypy" || status=$((status ? status : 1))
+exit "$status"
