@@ -1,6 +1,7 @@
 """Hostile clients (issue 36): each case of the issue replayed against a real service, with
-the service's peak memory and another client's one-instance prediction latency during it,
-beside the same latency on the idle service just before (the two windows alternate).
+the service's peak memory and another client's one-instance prediction latency during it
+(that client in a process of its own), beside the same latency on the idle service just
+before (the two windows alternate).
 
     .venv/bin/python perf/hostile.py [--quick] [--seconds 8] [--db URL] [--only pages]
 
@@ -18,6 +19,8 @@ from __future__ import annotations
 
 import argparse
 import concurrent.futures
+import contextlib
+import multiprocessing
 import os
 import secrets
 import subprocess
@@ -27,6 +30,7 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from multiprocessing.connection import Connection
 from pathlib import Path
 
 import httpx
@@ -87,31 +91,64 @@ class Window:
     verdict: str = ""
 
 
+class Prober:
+    """Another client's one-instance predictions, from a process of its own: in a thread of
+    this one, it would wait for this process's GIL while a case's client builds or reads a
+    large body, and time this process, not the service."""
+
+    def __init__(self, url: str, model: int) -> None:
+        context = multiprocessing.get_context("spawn")
+        self._connection, child = context.Pipe()
+        self._process = context.Process(target=_probe, args=(url, model, child), daemon=True)
+        self._process.start()
+
+    def start(self) -> None:
+        self._connection.send("start")
+
+    def stop(self) -> list[float]:
+        """The latencies (s) since :meth:`start`."""
+        self._connection.send("stop")
+        said, value = self._connection.recv()
+        if said != "ok":
+            raise RuntimeError(f"a prediction failed: {value}")
+        return list(value)
+
+    def close(self) -> None:
+        self._connection.send("quit")
+        self._process.join(timeout=30)
+
+
+def _probe(url: str, model: int, connection: Connection) -> None:
+    with httpx.Client(base_url=url, timeout=120) as client:
+        while connection.recv() == "start":
+            latencies: list[float] = []
+            failed = None
+            while not connection.poll():
+                start = time.perf_counter()
+                answer = client.post(f"/api/models/{model}/predict", json={"instances": [RECORD]})
+                latencies.append(time.perf_counter() - start)
+                if answer.status_code != 200 and failed is None:
+                    failed = answer.text[:300]
+            connection.recv()  # "stop"
+            connection.send(("ok", latencies) if failed is None else ("error", failed))
+
+
 def window(
-    url: str, pid: int, model: int, seconds: float, work: Callable[[], object] | None = None
+    prober: Prober, pid: int, seconds: float, work: Callable[[], object] | None = None
 ) -> Window:
     """Another client's predictions for ``seconds`` (at least while ``work`` runs once),
     with ``work`` replayed meanwhile when given."""
     stop = threading.Event()
-    latencies: list[float] = []
     peak = [rss_mb(pid)]
-
-    def predict() -> None:
-        with httpx.Client(base_url=url, timeout=120) as client:
-            while not stop.is_set():
-                start = time.perf_counter()
-                answer = client.post(f"/api/models/{model}/predict", json={"instances": [RECORD]})
-                latencies.append(time.perf_counter() - start)
-                assert answer.status_code == 200, answer.text
 
     def sample() -> None:
         while not stop.is_set():
             peak[0] = max(peak[0], rss_mb(pid))
             time.sleep(0.01)
 
-    threads = [threading.Thread(target=f, daemon=True) for f in (predict, sample)]
-    for thread in threads:
-        thread.start()
+    sampler = threading.Thread(target=sample, daemon=True)
+    sampler.start()
+    prober.start()
     statuses: list[int] = []
     verdicts: list[str] = []
     deadline = time.monotonic() + seconds
@@ -127,9 +164,9 @@ def window(
             if time.monotonic() >= deadline:
                 break
     finally:
+        latencies = prober.stop()
         stop.set()
-        for thread in threads:
-            thread.join()
+        sampler.join()
     return Window(latencies, statuses, peak[0], verdicts[-1] if verdicts else "")
 
 
@@ -155,10 +192,14 @@ def post_file(client: httpx.Client, path: str, file: Path, **data: str) -> int:
 
 
 def session_upload(client: httpx.Client, recordings: list[Path], labels: Path, **form: str) -> int:
-    files = [("recordings", (p.name, p.read_bytes())) for p in recordings]
-    with labels.open("rb") as handle:
-        files.append(("labels", (labels.name, handle.read())))
-    return client.post("/api/datasets/recordings", files=files, data=form).status_code
+    """The files streamed from disk: read whole into this process, their copies would hold
+    its GIL, and the measuring client's thread would wait on this one, not on the service."""
+    with contextlib.ExitStack() as stack:
+        files = [
+            (field, (path.name, stack.enter_context(path.open("rb"))))
+            for field, path in [*(("recordings", p) for p in recordings), ("labels", labels)]
+        ]
+        return client.post("/api/datasets/recordings", files=files, data=form).status_code
 
 
 def wait_job(client: httpx.Client, job: int) -> dict[str, object]:
@@ -397,13 +438,15 @@ def main() -> None:
                     for case in build()
                 ]
                 cases *= args.repeat
-                window(url, process.pid, model, 1.0)  # warm: the model loaded
+                prober = Prober(url, model)
+                window(prober, process.pid, 1.0)  # warm: the model loaded
                 idle_hwm = peak_rss_mb(process.pid)  # after every case's set-up
                 for name, replay in cases:
                     # the sides alternate, so that a change of the machine's load meets both
-                    idle = window(url, process.pid, model, seconds)
-                    busy = window(url, process.pid, model, seconds, replay)
+                    idle = window(prober, process.pid, seconds)
+                    busy = window(prober, process.pid, seconds, replay)
                     rows.append((name, idle, busy, peak_rss_mb(process.pid)))
+                prober.close()
         finally:
             process.terminate()
             process.wait(timeout=60)
