@@ -133,14 +133,14 @@ def leaderboard(
     ``beside``: other runs' classifiers too (a paper's imported results), t-tested where
     the folds pair and by their means where they do not; ``aggregate``: scored per window
     or per recording from the run's stored test-fold predictions."""
-    asked = (metric or None, baseline or None, tuple(beside or ()), aggregate)
+    metric, baseline, besides = metric or None, baseline or None, tuple(beside or ())
 
     def made() -> tuple[Markup, bool]:
         ranked, refused = _ranked(
-            store, run_id, metric=asked[0], baseline=asked[1], beside=asked[2], aggregate=aggregate
+            store, run_id, metric=metric, baseline=baseline, beside=besides, aggregate=aggregate
         )
         table = _table(
-            ranked, chosen_baseline=asked[1], chosen_aggregate=None if refused else aggregate
+            ranked, chosen_baseline=baseline, chosen_aggregate=None if refused else aggregate
         )
         ranking = rendered(
             "fragments/ranking.html.j2",
@@ -155,13 +155,14 @@ def leaderboard(
 
     # rendered once per version of the results, as the ranking is: a client asking for the
     # page back to back costs a light query a run, not the table again
+    asked = ("leaderboard", metric, baseline, besides, aggregate)
     try:
-        ranking, ranked = kept(store, [run_id, *asked[2]], ("leaderboard", *asked), made)
+        ranking, succeeded = kept(store, [run_id, *besides], asked, made)
     except NoResultsError as missing:
         ranking = rendered("fragments/ranking.html.j2", run=missing.run, board=None)
-        ranked = False
+        succeeded = False
     # the answers (ablation, importance) change apart from the results
-    answers = run_answer_tables(run_answers(store, run_id)) if ranked else []
+    answers = run_answer_tables(run_answers(store, run_id)) if succeeded else []
     return render("fragments/leaderboard.html.j2", ranking=ranking, answers=answers)
 
 
