@@ -3,6 +3,8 @@ meaning (``touchbench extractors``, ``GET /api/extractors``)."""
 
 from __future__ import annotations
 
+# Imports inside functions: start-up time: the extractors and detectors import scipy.signal
+# and scikit-learn, which the service loads with the first listing, not before it answers.
 from typing import Any
 
 from touchbench.app.schemas.extraction import (
@@ -12,14 +14,15 @@ from touchbench.app.schemas.extraction import (
     ExtractorsRequest,
     OptionInfo,
 )
-from touchbench.features.events import EVENT_KINDS
-from touchbench.features.extractors import EXTRACTORS
 from touchbench.features.options import Option
 
 
 def list_extractors(request: ExtractorsRequest) -> ExtractorList:
     """Every extractor and event detector with its options; the defaults that depend on
     the sample rate computed at ``request.samplerate`` when it is given."""
+    from touchbench.features.events import EVENT_KINDS
+    from touchbench.features.extractors import EXTRACTORS
+
     rate = request.samplerate
     return ExtractorList(
         samplerate=rate,

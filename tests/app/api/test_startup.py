@@ -1,5 +1,6 @@
-"""The service's start-up: building the application imports no library that only some
-requests need (the statistics, the signal processing, the classifiers)."""
+"""The service's start-up: building the application (its API and its web pages) imports no
+library that only some requests need (the statistics, the signal processing, the
+classifiers)."""
 
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ ON_DEMAND = ("scipy.stats", "scipy.signal", "sklearn", "xgboost", "pandas", "mat
 def test_the_application_imports_no_library_a_request_may_not_need(tmp_path: Path) -> None:
     script = (
         "import sys\n"
-        "import touchbench.app.api.main\n"
+        "import touchbench.app.main\n"
         f"print(' '.join(m for m in {ON_DEMAND!r} if m in sys.modules))\n"
     )
     done = run_script(script, tmp_path)
