@@ -56,6 +56,13 @@ def create_app(settings: Settings | None = None) -> FastAPI:
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
+        # scikit-learn (and with it scipy.stats and pandas) loads here, in one thread, before
+        # the first request: its modules import one another in cycles, and two request
+        # threads importing it at once from different modules (a run's plan through the
+        # catalogue, a prediction through a model) meet importlib's deadlock detection, which
+        # hands one of them a half-initialised module (ImportError, answered 500).
+        import sklearn  # noqa: F401
+
         switch_interval = sys.getswitchinterval()
         sys.setswitchinterval(SWITCH_INTERVAL)
         store = Store(settings.database_url)
