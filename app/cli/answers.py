@@ -13,7 +13,14 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from touchbench.app.cli.output import JsonOption, info, print_json, run_table, table
+from touchbench.app.cli.output import (
+    JsonOption,
+    RescoreOption,
+    info,
+    print_json,
+    run_table,
+    table,
+)
 from touchbench.app.cli.state import get_state
 from touchbench.app.schemas.runs import DEFAULT_TIMEOUT
 
@@ -47,13 +54,14 @@ def classes_command(
     ctx: typer.Context,
     run: RunArgument,
     classifier: ClassifiersOption = None,
+    aggregate: RescoreOption = None,
     as_json: JsonOption = False,
 ) -> None:
     """Show per-class precision, recall and F1, the confusion matrix (summed over folds)
     and the expected calibration error of a run's classifiers, per target."""
     from touchbench.app.reports.certainty_tables import calibrations, class_tables, score
 
-    certainty = _certainty(ctx, run, classifier)
+    certainty = _certainty(ctx, run, classifier, aggregate)
     if as_json:
         print_json(certainty.to_json())
         return
@@ -84,6 +92,7 @@ def calibration_command(
     top: Annotated[
         int, typer.Option("--top", min=1, help="Classifiers in the diagram (the best first).")
     ] = 5,
+    aggregate: RescoreOption = None,
     as_json: JsonOption = False,
 ) -> None:
     """Show the expected calibration error of a run's classifiers from their out-of-fold
@@ -92,7 +101,7 @@ def calibration_command(
 
     if output is not None:
         figure_format(output)
-    certainty = _certainty(ctx, run, classifier)
+    certainty = _certainty(ctx, run, classifier, aggregate)
     if output is not None:
         from touchbench.app.reports.figures import reliability_figure
 
@@ -107,11 +116,13 @@ def calibration_command(
         info(f"wrote {output}")
 
 
-def _certainty(ctx: typer.Context, run: int, classifiers: str | None) -> RunCertainty:
+def _certainty(
+    ctx: typer.Context, run: int, classifiers: str | None, aggregate: str | None
+) -> RunCertainty:
     from touchbench.app.services.certainty import run_certainty
 
     names = [c.strip() for c in classifiers.split(",") if c.strip()] if classifiers else None
-    return run_certainty(get_state(ctx).store, run, classifiers=names)
+    return run_certainty(get_state(ctx).store, run, classifiers=names, aggregate=aggregate)
 
 
 def import_results_command(

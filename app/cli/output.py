@@ -118,8 +118,8 @@ EngineOption = Annotated[
 ]
 
 
-#: ``--aggregate`` of a finished run's views (``leaderboard``, ``plot``, ``report``): its stored
-#: test-fold predictions scored again, nothing fitted.
+#: ``--aggregate`` of a finished run's views (``leaderboard``, ``plot``, ``report``,
+#: ``classes``, ``calibration``): its stored test-fold predictions scored again, nothing fitted.
 RescoreOption = Annotated[
     str | None,
     typer.Option(

@@ -72,11 +72,11 @@ def certainty_of(view: RunView, classifiers: Sequence[str] | None = None) -> Run
             "matrices or probabilities"
         )
     if classifiers:
-        unknown = [c for c in classifiers if c not in run.classifiers]
+        unknown = [c for c in classifiers if c not in view.entries]
         if unknown:
             raise ConfigurationError(
                 f"run {run.id} has no classifier '{unknown[0]}' "
-                f"(classifiers: {', '.join(run.classifiers)})"
+                f"(classifiers: {', '.join(view.entries)})"
             )
         chosen = list(dict.fromkeys(classifiers))
     else:

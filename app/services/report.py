@@ -103,10 +103,10 @@ class RunView(RunLeaderboard):
 
     def confusion(self, classifier: str) -> Confusion:
         """``classifier``'s confusion matrices summed over its successful folds."""
-        if classifier not in self.run.classifiers:
+        if classifier not in self.entries:
             raise ConfigurationError(
                 f"run {self.run.id} has no classifier '{classifier}' "
-                f"(classifiers: {', '.join(self.run.classifiers)})"
+                f"(classifiers: {', '.join(self.entries)})"
             )
         mine = [r for r in self.results if r.key.classifier == classifier]
         ok = [r for r in mine if r.ok and r.confusion is not None]

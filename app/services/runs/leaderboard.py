@@ -101,6 +101,12 @@ class RunLeaderboard:
     rescored: Aggregate | None = field(default=None, kw_only=True)
 
     @property
+    def entries(self) -> list[str]:
+        """The run's classifiers, then the helpers fitted only as members of its ensembles:
+        every entry with rows and folds of its own."""
+        return [*self.run.classifiers, *self.run.config.helpers]
+
+    @property
     def aggregate(self) -> Aggregate:
         """What one prediction of the leaderboard's scores is: a window or a recording."""
         return self.rescored or self.run.config.aggregate

@@ -321,3 +321,62 @@ def test_report_scores_per_recording_when_asked(
     bad = run_cli(capsys, db, "report", str(windows), "-o", str(report), "--aggregate", "take")
     one_error_line(bad, "--aggregate: Input should be 'window' or 'recording'")
     assert no_fitting == []
+
+
+def test_classes_and_calibration_score_per_recording_when_asked(
+    capsys: pytest.CaptureFixture[str],
+    db: str,
+    tmp_path: Path,
+    two_runs: tuple[int, int],
+    refused_runs: dict[str, int],
+    no_fitting: list[str],
+) -> None:
+    """`classes` and `calibration RUN --aggregate recording` of a run scored per window are
+    those of the same run scored per recording from the start (one pooled prediction per
+    recording); refused in one line where the leaderboard is.  The members `voting-hard`
+    fitted for itself (helpers: rows of their own) are shown beside the run's classifiers."""
+    windows, recordings = two_runs
+    listed = run_cli(capsys, db, "classes", str(windows), "--json")
+    assert listed.code == 0, listed.err
+    names = {entry["classifier"] for entry in listed.json()["classifiers"]}
+    assert names == {*CLASSIFIERS.split(","), "logistic", "rf-200", "svm-rbf"}
+
+    def shown(command: str, run: int, *options: str) -> dict[str, Any]:
+        made = run_cli(capsys, db, command, str(run), "--json", *options)
+        assert made.code == 0, made.err
+        body: dict[str, Any] = made.json()
+        return body
+
+    for command in ("classes", "calibration"):
+        rescored = shown(command, windows, "--aggregate", "recording")
+        assert rescored["aggregate"] == "recording"
+        assert rescored["classifiers"] == shown(command, recordings)["classifiers"]
+        as_scored = shown(command, windows)
+        assert as_scored["aggregate"] == "window"
+        assert shown(command, recordings, "--aggregate", "window") == as_scored | {
+            "run_id": recordings
+        }
+    pooled = {
+        c["classifier"]: c
+        for c in shown("classes", windows, "--aggregate", "recording")["classifiers"]
+    }
+    for entry in shown("classes", windows)["classifiers"]:
+        [per_window] = entry["targets"]
+        [per_recording] = pooled[entry["classifier"]]["targets"]
+        assert sum(map(sum, per_window["confusion"])) == 16 * sum(
+            map(sum, per_recording["confusion"])
+        )
+    diagram = tmp_path / "reliability.svg"
+    drawn = run_cli(
+        capsys, db, "calibration", str(windows), "-o", str(diagram), "--aggregate", "recording"
+    )
+    assert drawn.code == 0 and diagram.read_text().lstrip().startswith("<?xml"), drawn.err
+
+    for command in ("classes", "calibration"):
+        refused = run_cli(
+            capsys, db, command, str(refused_runs["ungrouped"]), "--aggregate", "recording"
+        )
+        one_error_line(refused, "--aggregate: needs windows grouped by recording")
+        bad = run_cli(capsys, db, command, str(windows), "--aggregate", "take")
+        one_error_line(bad, "--aggregate: Input should be 'window' or 'recording'")
+    assert no_fitting == []
