@@ -106,9 +106,16 @@ def run_form(
 
 
 @router.get("/{run_id}/progress", response_class=HTMLResponse)
-def progress(run_id: int, store: StoreDep, aggregate: AggregateQuery = None) -> HTMLResponse:
-    """Status and tasks done; polled every second until the run is over.  ``aggregate``:
-    the leaderboard's CSV scored so, as the page's leaderboard is."""
+def progress(
+    run_id: int,
+    store: StoreDep,
+    metric: Metric = None,
+    baseline: Baseline = None,
+    aggregate: AggregateQuery = None,
+) -> HTMLResponse:
+    """Status and tasks done; polled every second until the run is over.  ``metric``,
+    ``baseline`` and ``aggregate``: the leaderboard's CSV ranked and scored so, as the
+    page's leaderboard is."""
     run = run_progress(store, run_id)
     return render(
         "fragments/progress.html.j2",
@@ -116,7 +123,7 @@ def progress(run_id: int, store: StoreDep, aggregate: AggregateQuery = None) -> 
         final=run.status in FINAL,
         resumable=run.status in RESUMABLE,
         done=run.status == Status.DONE,
-        aggregate=aggregate,
+        download={"format": "csv", "metric": metric, "baseline": baseline, "aggregate": aggregate},
     )
 
 

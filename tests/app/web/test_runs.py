@@ -281,8 +281,8 @@ def test_the_run_page_scores_per_recording_where_the_run_has_recordings(
     nb = next(c for c in classes["classifiers"] if c["classifier"] == "nb")["calibration"]
     expect(nb_calibration.locator("td").nth(2)).to_have_text("16")
     expect(nb_calibration.locator("td").nth(1)).to_have_text(f"{nb['ece']:.4f}")
-    expect(csv_link).to_have_attribute(
-        "href", f"/api/runs/{takes}/leaderboard?format=csv&aggregate=recording"
+    expect(csv_link).to_have_attribute(  # the picker sent the page's metric with its choice
+        "href", f"/api/runs/{takes}/leaderboard?format=csv&metric=f1_weighted&aggregate=recording"
     )
     with page.expect_download() as downloading:
         csv_link.click()
@@ -300,6 +300,27 @@ def test_the_run_page_scores_per_recording_where_the_run_has_recordings(
     page.locator("#leaderboard-table th a", has_text="accuracy").click()
     page.wait_for_url(re.compile(r"metric=accuracy.*aggregate=recording"))
     expect(page.locator("#leaderboard")).to_contain_text(RESCORED)
+    # and so does the CSV: ranked by accuracy, scored per recording
+    expect(csv_link).to_have_attribute(
+        "href", f"/api/runs/{takes}/leaderboard?format=csv&metric=accuracy&aggregate=recording"
+    )
+    with page.expect_download() as downloading:
+        csv_link.click()
+    by_accuracy = api.get(
+        f"/api/runs/{takes}/leaderboard", params={"aggregate": "recording", "metric": "accuracy"}
+    ).json()
+    rows = list(csv.DictReader(io.StringIO(downloading.value.path().read_text(encoding="utf-8"))))
+    assert [row["classifier"] for row in rows] == [
+        row["classifier"] for row in by_accuracy["leaderboard"]
+    ]
+    assert list(rows[0])[3] == "accuracy_mean"  # the ranking metric's column first
+    # and the baseline the marks are against
+    page.goto(f"{service.url}/runs/{takes}?baseline=ridge")
+    expect(page.locator("#leaderboard-table")).to_have_attribute("data-baseline", "ridge")
+    expect(csv_link).to_have_attribute(
+        "href", f"/api/runs/{takes}/leaderboard?format=csv&baseline=ridge"
+    )
+    page.goto(f"{service.url}/runs/{takes}?metric=accuracy&aggregate=recording")
     page.locator("#leaderboard-table td a", has_text="nb").click()
     page.wait_for_url(re.compile(r"/classifiers/nb\?.*aggregate=recording"))
     nb = next(row for row in board["leaderboard"] if row["classifier"] == "nb")
