@@ -235,10 +235,14 @@ def test_a_flood_of_alias_moves_drops_no_stream_and_no_request(
 ) -> None:
     """Promote, rollback and alias in a loop while a session on ``mic@champion`` streams
     (following checked at every block): every touch is answered, by a version the alias
-    named; no request fails with a 5xx; the session switches at most once per block."""
+    named; no request fails with a 5xx; the session switches at most once per block.
+
+    The flood starts once the session has answered its first touch: a session that opens
+    while the flood has the alias on ``mic@3`` (no recipe) is refused, rightly, and the
+    session's start (the feature stack imported in a worker thread) may take a while."""
     import threading
 
-    _copy_of(prepared, tmp_path)
+    touches = _copy_of(prepared, tmp_path)
     server = make_sqlite_server(
         api_keys=f"lab:write:{WRITE},robot:predict:{PREDICT}", live_follow_seconds="0"
     )
@@ -259,13 +263,16 @@ def test_a_flood_of_alias_moves_drops_no_stream_and_no_request(
                 statuses.append(lab.post(path, json=body).status_code)
 
     samples, rate = as_int16(tmp_path / "unseen.wav")
-    blocks = [samples[i : i + 2048].tobytes() for i in range(0, len(samples), 2048)]
+    frames, cut = 2048, int(touches[1][0] * rate)  # the first touch whole, then the flood
+    parts = [samples[:cut], samples[cut:]]
+    first, rest = ([p[i : i + frames].tobytes() for i in range(0, len(p), frames)] for p in parts)
+    blocks = [*first, *rest]
     seen: list[dict[str, Any]] = []
     flooding = threading.Thread(target=flood)
-    with _champion_session(server, samples, rate, blocks[:1], seen, until="") as socket:
+    with _champion_session(server, samples, rate, first, seen) as socket:
         flooding.start()
         try:
-            _finish(socket, blocks[1:], seen)
+            _finish(socket, rest, seen)
         finally:
             stop.set()
             flooding.join()
