@@ -41,8 +41,20 @@ stamp=".venv/.installed-$(cat pyproject.toml scripts/constraints.txt | sha256sum
 if [ ! -f "$stamp" ]; then
   echo "installing touchbench with every extra and its test tools into .venv/" >&2
   .venv/bin/python -m pip install -q --upgrade pip
-  # the exact versions tested on this machine (scripts/constraints.txt), every extra
+  # the exact versions tested on this machine (scripts/constraints.txt), every extra: first
+  # the packages with numba kernels, whose kernels are then compiled into numba's cache
+  # (scripts/compile_kernels.py, reading touchbench from this folder) on one core while
+  # pip installs the rest on the other
+  .venv/bin/python -m pip install -q -c scripts/constraints.txt aeon librosa
+  PYTHONPATH="$PWD" .venv/bin/python scripts/compile_kernels.py 2>.venv/compile-kernels.log &
+  kernels=$!
+  trap 'kill "$kernels" 2>/dev/null || true' EXIT
   .venv/bin/python -m pip install -q -c scripts/constraints.txt -e '.[all,test]'
+  if ! wait "$kernels"; then
+    echo "warning: numba kernels not compiled ahead (see .venv/compile-kernels.log);" \
+      "they compile on first use" >&2
+  fi
+  trap - EXIT
   rm -f .venv/.installed-*
   touch "$stamp"
 fi

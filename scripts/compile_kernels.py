@@ -1,0 +1,60 @@
+"""Compiles the numba kernels of aeon's MiniRocket and MultiRocket (the ``minirocket`` and
+``multirocket`` classifiers) and of librosa (the test suite's reference features) once, so
+that numba's on-disk cache (``cache=True``, beside each module) holds them.
+
+Without it, every process that first meets a kernel compiles it: a run of ``multirocket``
+on two engine workers compiles the same kernels in both, and the test suite's workers do the
+same. ``scripts/install.sh`` runs this beside pip's install of the rest; it is safe to run
+again (it then loads the cached kernels). The calls go through touchbench's own classifier
+so that the kernels compiled are those of the types touchbench passes (float32, one or
+several channels); librosa's are compiled when its modules load.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+
+
+def compile_rockets() -> None:
+    """Fit and predict each rocket on one and on two channels."""
+    from touchbench.benchmark.catalogue.time_series import ROCKETS, RocketClassifier
+
+    rng = np.random.default_rng(0)
+    length = 32
+    for n_channels in (1, 2):
+        X = rng.normal(size=(8, n_channels * length))
+        y = np.arange(8) % 2
+        for variant in ROCKETS:
+            model = RocketClassifier(
+                variant, n_kernels=84, sequence=(0, n_channels, length), random_state=0
+            )
+            model.fit(X, y).predict(X)
+
+
+def compile_librosa() -> None:
+    """Load librosa's modules with kernels (their ``guvectorize`` kernels compile on load)."""
+    import librosa
+
+    y = np.random.default_rng(0).normal(size=4096)
+    librosa.feature.zero_crossing_rate(y)
+    librosa.feature.spectral_centroid(y=y, sr=22050)
+    librosa.feature.mfcc(y=y, sr=22050, n_mfcc=13)
+
+
+def main() -> int:
+    for name, step in (("aeon", compile_rockets), ("librosa", compile_librosa)):
+        start = time.monotonic()
+        try:
+            step()
+        except ImportError as error:  # an environment without that extra: nothing to compile
+            print(f"{name}: not installed ({error}); nothing compiled", file=sys.stderr)
+            continue
+        print(f"{name}: kernels compiled in {time.monotonic() - start:.0f} s", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
