@@ -12,6 +12,8 @@ several channels); librosa's are compiled when its modules load.
 
 from __future__ import annotations
 
+import argparse
+import subprocess
 import sys
 import time
 
@@ -44,17 +46,26 @@ def compile_librosa() -> None:
     librosa.feature.mfcc(y=y, sr=22050, n_mfcc=13)
 
 
-def main() -> int:
-    for name, step in (("aeon", compile_rockets), ("librosa", compile_librosa)):
-        start = time.monotonic()
-        try:
-            step()
-        except ImportError as error:  # an environment without that extra: nothing to compile
-            print(f"{name}: not installed ({error}); nothing compiled", file=sys.stderr)
-            continue
-        print(f"{name}: kernels compiled in {time.monotonic() - start:.0f} s", file=sys.stderr)
+STEPS = {"aeon": compile_rockets, "librosa": compile_librosa}
+
+
+def main(arguments: list[str]) -> int:
+    """Each step in a process of its own, at once (one step when named)."""
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("step", nargs="?", choices=sorted(STEPS), help="only this step")
+    name = parser.parse_args(arguments).step
+    if name is None:
+        steps = [subprocess.Popen([sys.executable, __file__, step]) for step in STEPS]
+        return max(step.wait() for step in steps)
+    start = time.monotonic()
+    try:
+        STEPS[name]()
+    except ImportError as error:  # an environment without that extra: nothing to compile
+        print(f"{name}: not installed ({error}); nothing compiled", file=sys.stderr)
+        return 0
+    print(f"{name}: kernels compiled in {time.monotonic() - start:.0f} s", file=sys.stderr)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(main(sys.argv[1:]))

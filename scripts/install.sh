@@ -43,8 +43,8 @@ if [ ! -f "$stamp" ]; then
   .venv/bin/python -m pip install -q --upgrade pip
   # the exact versions tested on this machine (scripts/constraints.txt), every extra: first
   # the packages with numba kernels, whose kernels are then compiled into numba's cache
-  # (scripts/compile_kernels.py, reading touchbench from this folder) on one core while
-  # pip installs the rest on the other
+  # (scripts/compile_kernels.py, reading touchbench from this folder) while pip, which
+  # keeps one core busy, installs the rest
   .venv/bin/python -m pip install -q -c scripts/constraints.txt aeon librosa
   PYTHONPATH="$PWD" .venv/bin/python scripts/compile_kernels.py 2>.venv/compile-kernels.log &
   kernels=$!
