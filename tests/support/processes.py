@@ -52,10 +52,18 @@ def scalar(url: str, query: str) -> Any:
 
 def wait_for_results(url: str, child: subprocess.Popen[bytes], at_least: int) -> None:
     deadline = time.monotonic() + 120
-    while (scalar(url, "SELECT count(*) FROM fold_results") or 0) < at_least:
-        assert child.poll() is None, child.stderr.read().decode() if child.stderr else ""
-        assert time.monotonic() < deadline, "the run recorded nothing in two minutes"
-        time.sleep(0.05)
+    engine = store_engine(url)  # one connection for every poll, not one (a backend) each
+    try:
+        while True:
+            with engine.connect() as connection:
+                found = connection.execute(text("SELECT count(*) FROM fold_results")).scalar()
+            if (found or 0) >= at_least:
+                return
+            assert child.poll() is None, child.stderr.read().decode() if child.stderr else ""
+            assert time.monotonic() < deadline, "the run recorded nothing in two minutes"
+            time.sleep(0.05)
+    finally:
+        engine.dispose()
 
 
 def run_script(script: str, cwd: Path) -> subprocess.CompletedProcess[str]:

@@ -6,14 +6,14 @@ import subprocess
 import time
 
 import pytest
-from sqlalchemy import create_engine, text
+from sqlalchemy import Engine, create_engine, text
 
 from tests.support.cli_runner import run_cli
 
 
 def count_rows(url: str, table: str) -> int:
     """Rows of ``table`` in the store at ``url`` (SQLite or PostgreSQL)."""
-    engine = create_engine(url.replace("postgresql://", "postgresql+psycopg://", 1))
+    engine = _engine(url)
     try:
         with engine.connect() as connection:
             return int(connection.execute(text(f"SELECT count(*) FROM {table}")).scalar_one())
@@ -29,12 +29,9 @@ def stored_names(capsys: pytest.CaptureFixture[str], store_url: str) -> list[str
 def count_of(url: str, sql: str) -> int:
     """The count a ``SELECT count(*) ...`` finds in the store at ``url``; 0 while its
     tables do not exist yet (a run's process still creating them)."""
-    engine = create_engine(url.replace("postgresql://", "postgresql+psycopg://", 1))
+    engine = _engine(url)
     try:
-        with engine.connect() as connection:
-            return int(connection.execute(text(sql)).scalar() or 0)
-    except Exception:
-        return 0
+        return _count(engine, sql)
     finally:
         engine.dispose()
 
@@ -44,7 +41,23 @@ def wait_for_count(
 ) -> None:
     """Wait until :func:`count_of` ``sql`` reaches ``at_least`` while ``child`` (the process
     writing the rows) lives, until ``deadline`` (``time.monotonic()``) at most."""
-    while count_of(url, sql) < at_least:
-        assert child.poll() is None, child.stderr.read().decode() if child.stderr else ""
-        assert time.monotonic() < deadline, f"fewer than {at_least} rows by the deadline: {sql}"
-        time.sleep(0.05)
+    engine = _engine(url)  # one connection for every poll, not one (a PostgreSQL backend) each
+    try:
+        while _count(engine, sql) < at_least:
+            assert child.poll() is None, child.stderr.read().decode() if child.stderr else ""
+            assert time.monotonic() < deadline, f"fewer than {at_least} rows by the deadline: {sql}"
+            time.sleep(0.05)
+    finally:
+        engine.dispose()
+
+
+def _engine(url: str) -> Engine:
+    return create_engine(url.replace("postgresql://", "postgresql+psycopg://", 1))
+
+
+def _count(engine: Engine, sql: str) -> int:
+    try:
+        with engine.connect() as connection:
+            return int(connection.execute(text(sql)).scalar() or 0)
+    except Exception:
+        return 0
