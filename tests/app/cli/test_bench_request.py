@@ -4,6 +4,9 @@ cannot honour is refused naming its option, in one line, exit 2, before a run ro
 
 from __future__ import annotations
 
+import io
+import sqlite3
+from contextlib import closing, redirect_stderr, redirect_stdout
 from pathlib import Path
 
 import pytest
@@ -12,6 +15,7 @@ from tests.support.cli_runner import CliResult, run_cli
 from tests.support.rows import count_rows
 from tests.support.synthetic import position_arff, touch_arff
 from touchbench.app.cli.bench import BENCH_OPTIONS
+from touchbench.app.cli.main import main
 from touchbench.app.schemas.runs import BenchHereRequest, BenchRequest
 from touchbench.app.services.runs import NoResultsError, create_run, run_leaderboard
 from touchbench.app.store.database import Store
@@ -33,10 +37,30 @@ def db(capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path) -> st
     return _imported(capsys, store_url, tmp_path)
 
 
+@pytest.fixture(scope="module")
+def sqlite_template(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A SQLite store holding the two data sets, imported once for the module."""
+    folder = tmp_path_factory.mktemp("bench-request")
+    url = f"sqlite:///{folder / 'touchbench.db'}"
+    for path, name in (
+        (touch_arff(folder / "touch.arff", n=60), "touch"),
+        (position_arff(folder / "contact.arff"), "contact"),
+    ):
+        with redirect_stdout(io.StringIO()), redirect_stderr(io.StringIO()) as err:
+            code = main(["--db", url, "import", str(path), "--name", name])
+        assert code == 0, err.getvalue()
+    return folder / "touchbench.db"
+
+
 @pytest.fixture
-def sqlite_db(capsys: pytest.CaptureFixture[str], sqlite_store_url: str, tmp_path: Path) -> str:
-    """The two data sets on SQLite only: for what is refused before a run exists."""
-    return _imported(capsys, sqlite_store_url, tmp_path)
+def sqlite_db(sqlite_store_url: str, sqlite_template: Path) -> str:
+    """The two data sets on SQLite only: for what is refused before a run exists (a copy
+    of the module's template, the test's own)."""
+    copy = sqlite_store_url.removeprefix("sqlite:///")
+    source, target = sqlite3.connect(sqlite_template), sqlite3.connect(copy)
+    with closing(source), closing(target):
+        source.backup(target)
+    return sqlite_store_url
 
 
 def _refused(result: CliResult, line: str) -> None:

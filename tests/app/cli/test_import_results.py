@@ -33,9 +33,11 @@ def touch(capsys: pytest.CaptureFixture[str], store_url: str, tmp_path: Path) ->
     return store_url
 
 
-def test_our_results_file_imports_back_and_ranks_beside_us(
+def test_our_results_file_imports_back_ranks_beside_us_and_reports_and_compares(
     capsys: pytest.CaptureFixture[str], touch: str, tmp_path: Path
 ) -> None:
+    """Our run's results file imports back as a run that ranks beside ours; `report` and
+    `compare` put the imported classifiers beside ours (one run and import for both)."""
     ours = _bench(capsys, touch, "--folds", "5")
     results = _exported(capsys, touch, ours, tmp_path / "results.arff")
     imported = run_cli(
@@ -75,6 +77,21 @@ def test_our_results_file_imports_back_and_ranks_beside_us(
     assert rows[twin.get(both["baseline"], both["baseline"])]["mark"] == ""
     table = run_cli(capsys, touch, "leaderboard", str(ours), "--beside", str(run["id"]))
     assert table.code == 0 and "folds paired by number" in table.err
+
+    # report and compare put the imported classifiers beside ours
+    compared = run_cli(capsys, touch, "compare", str(ours), str(run["id"]), "--json")
+    assert compared.code == 0, compared.err
+    ranked = {row["classifier"] for row in compared.json()["classifiers"]}
+    assert ranked == {"j48", "nb", "J48", "NaiveBayes"}
+    assert any(
+        f"run {run['id']}" in note and "paired by number" in note
+        for note in compared.json()["notes"]
+    )
+    page = tmp_path / "report.html"
+    made = run_cli(capsys, touch, "report", str(ours), str(run["id"]), "-o", str(page))
+    assert made.code == 0, made.err
+    html = page.read_text(encoding="utf-8")
+    assert "folds paired by number" in html and ">NaiveBayes<" in html
 
 
 def test_runs_whose_folds_do_not_pair_compare_by_their_means(
@@ -182,26 +199,3 @@ def test_the_damaged_results_file_is_refused_at_line_207(
     assert "weka_results_place.arff:207: unterminated quote" in result.err
     assert len(result.err.strip().splitlines()) == 1
     assert run_cli(capsys, store_url, "runs", "--json").json() == {"runs": []}
-
-
-def test_report_and_compare_put_the_imported_classifiers_beside_ours(
-    capsys: pytest.CaptureFixture[str], touch: str, tmp_path: Path
-) -> None:
-    ours = _bench(capsys, touch, "--folds", "5")
-    results = _exported(capsys, touch, ours, tmp_path / "results.arff")
-    imported = run_cli(
-        capsys, touch, "import-results", str(results), "--dataset", "touch", "--json"
-    ).json()["id"]
-    compared = run_cli(capsys, touch, "compare", str(ours), str(imported), "--json")
-    assert compared.code == 0, compared.err
-    ranked = {row["classifier"] for row in compared.json()["classifiers"]}
-    assert ranked == {"j48", "nb", "J48", "NaiveBayes"}
-    assert any(
-        f"run {imported}" in note and "paired by number" in note
-        for note in compared.json()["notes"]
-    )
-    page = tmp_path / "report.html"
-    made = run_cli(capsys, touch, "report", str(ours), str(imported), "-o", str(page))
-    assert made.code == 0, made.err
-    html = page.read_text(encoding="utf-8")
-    assert "folds paired by number" in html and ">NaiveBayes<" in html

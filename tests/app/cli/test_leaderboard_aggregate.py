@@ -8,6 +8,9 @@ from __future__ import annotations
 
 import csv
 import io
+import sqlite3
+from contextlib import closing, redirect_stderr, redirect_stdout
+from dataclasses import dataclass
 from html import unescape
 from itertools import pairwise
 from pathlib import Path
@@ -16,10 +19,11 @@ from typing import Any
 import pytest
 from sqlalchemy import create_engine, text
 
-from tests.support.cli_runner import one_error_line, run_cli
+from tests.support.cli_runner import CliResult, one_error_line, run_cli
 from tests.support.figures import svg_texts
 from tests.support.recordings import PER_RECORDING, recorded_windows, store_dataset
 from tests.support.synthetic import touch_arff
+from touchbench.app.cli.main import main
 from touchbench.app.services.runs import run_leaderboard
 from touchbench.app.store.database import Store
 from touchbench.app.store.runs import load_results
@@ -33,11 +37,43 @@ COSTS = {*COST_METRICS, "inner_time", "inner_cpu_time"}
 RESCORED = "re-scored per recording from the run's stored test-fold predictions"
 
 
-@pytest.fixture
-def db(tmp_path: Path) -> str:
-    url = f"sqlite:///{tmp_path / 'touchbench.db'}"
+@dataclass(frozen=True)
+class _Built:
+    """The runs every test reads, made once for the module in a template store; each test
+    gets a copy of its own (:func:`db`), so that nothing one test does reaches another."""
+
+    path: Path
+    two_runs: tuple[int, int]
+    refused_runs: dict[str, int]
+
+
+def _cli(db: str, *args: str) -> CliResult:
+    """``touchbench --db DB ARGS...`` in this process, for a module's fixture (no capsys)."""
+    out, err = io.StringIO(), io.StringIO()
+    with redirect_stdout(out), redirect_stderr(err):
+        code = main(["--db", db, *args])
+    return CliResult(code, out.getvalue(), err.getvalue())
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory: pytest.TempPathFactory) -> _Built:
+    """Data set `takes` and, in this order, the runs of :func:`two_runs` and of
+    :func:`refused_runs`."""
+    folder = tmp_path_factory.mktemp("aggregate")
+    path = folder / "touchbench.db"
+    url = f"sqlite:///{path}"
     store_dataset(url, recorded_windows(), "takes")
-    return url
+    two = _bench(url), _bench(url, "--aggregate", "recording")
+    return _Built(path, two, _refused_runs(url, folder))
+
+
+@pytest.fixture
+def db(tmp_path: Path, built: _Built) -> str:
+    """A store of the test's own: a copy of the module's template (:func:`built`)."""
+    path = tmp_path / "touchbench.db"
+    with closing(sqlite3.connect(built.path)) as source, closing(sqlite3.connect(path)) as copy:
+        source.backup(copy)
+    return f"sqlite:///{path}"
 
 
 @pytest.fixture
@@ -58,11 +94,10 @@ def no_fitting(monkeypatch: pytest.MonkeyPatch) -> list[str]:
     return asked
 
 
-def _bench(capsys: pytest.CaptureFixture[str], db: str, *options: str) -> int:
-    result = run_cli(
-        capsys, db, "bench", "takes", "-c", CLASSIFIERS, "-k", "4", "--seed", "3", "--json",
-        *options,
-    )  # fmt: skip
+def _bench(db: str, *options: str) -> int:
+    result = _cli(
+        db, "bench", "takes", "-c", CLASSIFIERS, "-k", "4", "--seed", "3", "--json", *options
+    )
     assert result.code == 0, result.err
     return int(result.json()["run_id"])
 
@@ -99,9 +134,9 @@ def _ranked(board: dict[str, Any]) -> list[tuple[Any, ...]]:
 
 
 @pytest.fixture
-def two_runs(capsys: pytest.CaptureFixture[str], db: str) -> tuple[int, int]:
+def two_runs(built: _Built) -> tuple[int, int]:
     """Run 1 scored per window, run 2 per recording: the same tasks on the same folds."""
-    return _bench(capsys, db), _bench(capsys, db, "--aggregate", "recording")
+    return built.two_runs
 
 
 def test_rescored_runs_equal_runs_scored_so_from_the_start(
@@ -171,21 +206,26 @@ def test_rescored_runs_equal_runs_scored_so_from_the_start(
 
 
 @pytest.fixture
-def refused_runs(capsys: pytest.CaptureFixture[str], db: str, tmp_path: Path) -> dict[str, int]:
+def refused_runs(built: _Built) -> dict[str, int]:
+    """Runs that cannot be scored per recording (see :func:`_refused_runs`)."""
+    return dict(built.refused_runs)
+
+
+def _refused_runs(db: str, folder: Path) -> dict[str, int]:
     """Runs that cannot be scored per recording: on a data set without recordings, on one
     with a recording of two labels, a run imported from a results file, and a run stored
     before runs kept their fold predictions (its predictions deleted)."""
     store_dataset(db, recorded_windows(mixed=True), "mixed")
-    path = touch_arff(tmp_path / "touch.arff", n=60, with_place=False)
-    assert run_cli(capsys, db, "import", str(path), "--name", "touch").code == 0
+    path = touch_arff(folder / "touch.arff", n=60, with_place=False)
+    assert _cli(db, "import", str(path), "--name", "touch").code == 0
     runs = {}
     for name, dataset in (("ungrouped", "touch"), ("mixed", "mixed"), ("old", "takes")):
-        made = run_cli(capsys, db, "bench", dataset, "-c", "nb,zeror", "-k", "4", "--json")
+        made = _cli(db, "bench", dataset, "-c", "nb,zeror", "-k", "4", "--json")
         assert made.code == 0, made.err
         runs[name] = int(made.json()["run_id"])
-    exported = tmp_path / "results.arff"
-    exported.write_text(run_cli(capsys, db, "leaderboard", str(runs["old"]), "-f", "arff").out)
-    imported = run_cli(capsys, db, "import-results", str(exported), "--dataset", "takes", "--json")
+    exported = folder / "results.arff"
+    exported.write_text(_cli(db, "leaderboard", str(runs["old"]), "-f", "arff").out)
+    imported = _cli(db, "import-results", str(exported), "--dataset", "takes", "--json")
     assert imported.code == 0, imported.err
     runs["imported"] = int(imported.json()["id"])
     engine = create_engine(db)

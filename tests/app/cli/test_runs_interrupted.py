@@ -108,22 +108,22 @@ def test_a_run_whose_every_task_fails_is_failed_and_says_why(
         "-c",
         "rf,nb",
         "--folds",
-        "3",
+        "2",
         "--timeout",
         "0.001",
     )
     assert result.code == 1
-    assert "run 1 failed: all 6 tasks failed" in result.err and "timed out" in result.err
+    assert "run 1 failed: all 4 tasks failed" in result.err and "timed out" in result.err
     run = run_cli(capsys, store_url, "runs", "--json").json()["runs"][0]
-    assert (run["status"], run["tasks_done"], run["tasks_failed"]) == ("failed", 6, 6)
-    assert run["error"].startswith("all 6 tasks failed")
+    assert (run["status"], run["tasks_done"], run["tasks_failed"]) == ("failed", 4, 4)
+    assert run["error"].startswith("all 4 tasks failed")
     board = run_cli(capsys, store_url, "leaderboard", "1", "--json")
     assert board.code == 0, board.err
     report = board.json()
     assert report["status"] == "failed" and report["baseline"] is None
     assert {row["classifier"] for row in report["leaderboard"]} == {"rf", "nb"}
     assert all(
-        row["n_failed"] == 3 and "timed out" in row["errors"][0] for row in report["leaderboard"]
+        row["n_failed"] == 2 and "timed out" in row["errors"][0] for row in report["leaderboard"]
     )
     table = run_cli(capsys, store_url, "leaderboard", "1")
     assert table.code == 0 and "timed out" in table.out

@@ -3,34 +3,52 @@ calibration of a run's classifiers from what each fold stored, on SQLite."""
 
 from __future__ import annotations
 
+import io
+import sqlite3
+from contextlib import closing, redirect_stderr, redirect_stdout
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from tests.support.cli_runner import run_cli
+from tests.support.cli_runner import CliResult, run_cli
 from tests.support.synthetic import position_arff, touch_arff
+from touchbench.app.cli.main import main
+
+
+def _cli(db: str, *args: str) -> CliResult:
+    """``touchbench --db DB ARGS...`` in this process, for a module's fixture (no capsys)."""
+    out, err = io.StringIO(), io.StringIO()
+    with redirect_stdout(out), redirect_stderr(err):
+        code = main(["--db", db, *args])
+    return CliResult(code, out.getvalue(), err.getvalue())
+
+
+@pytest.fixture(scope="module")
+def benched(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, int]:
+    """A template store holding the run every test reads, made once for the module: its
+    file and the run's id."""
+    folder = tmp_path_factory.mktemp("certainty")
+    url = f"sqlite:///{folder / 'touchbench.db'}"
+    path = touch_arff(folder / "touch.arff", n=90)
+    assert _cli(url, "import", str(path)).code == 0
+    result = _cli(
+        url, "bench", "touch", "--target", "gesture", "-c", "j48,nb,svm-rbf", "--folds", "5",
+        "--json",
+    )  # fmt: skip
+    assert result.code == 0, result.err
+    return folder / "touchbench.db", int(result.json()["run_id"])
 
 
 @pytest.fixture
-def run(capsys: pytest.CaptureFixture[str], sqlite_store_url: str, tmp_path: Path) -> int:
-    path = touch_arff(tmp_path / "touch.arff", n=90)
-    assert run_cli(capsys, sqlite_store_url, "import", str(path)).code == 0
-    result = run_cli(
-        capsys,
-        sqlite_store_url,
-        "bench",
-        "touch",
-        "--target",
-        "gesture",
-        "-c",
-        "j48,nb,svm-rbf",
-        "--folds",
-        "5",
-        "--json",
-    )
-    assert result.code == 0, result.err
-    return int(result.json()["run_id"])
+def run(sqlite_store_url: str, benched: tuple[Path, int]) -> int:
+    """The run, in the test's own store (a copy of the module's template: nothing one test
+    does reaches another)."""
+    template, run_id = benched
+    copy = sqlite_store_url.removeprefix("sqlite:///")
+    with closing(sqlite3.connect(template)) as source, closing(sqlite3.connect(copy)) as target:
+        source.backup(target)
+    return run_id
 
 
 def test_classes_sum_the_folds_and_score_each_class(

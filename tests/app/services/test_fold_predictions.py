@@ -36,6 +36,17 @@ from touchbench.benchmark.run.folds import Fold
 
 COSTS = {"fit_time", "predict_time", "fit_cpu_time", "predict_cpu_time", "model_size"}
 COSTS |= {"inner_time", "inner_cpu_time"}  # seconds of the inner predictions
+#: Runs each (command line, output file) of the JSON list in argv[1] with touchbench's main,
+#: in order, each command's stdout to its file; exits with the first failing status.
+BENCH_EACH = (
+    "import contextlib, json, sys\n"
+    "from touchbench.app.cli.main import main\n"
+    "for command, output in json.loads(sys.argv[1]):\n"
+    "    with open(output, 'w') as out, contextlib.redirect_stdout(out):\n"
+    "        code = main(command)\n"
+    "    if code:\n"
+    "        sys.exit(code)\n"
+)
 
 
 def _imported(capsys: pytest.CaptureFixture[str], url: str, path: Path) -> None:
@@ -76,7 +87,7 @@ def test_a_finished_run_s_fold_predictions_rescore_and_vote_as_refitted(
     a VotingClassifier of the same fitted members predicts, to the last bit."""
     _imported(capsys, store_url, touch_arff(tmp_path / "touch.arff", n=150))
     board = _bench(
-        capsys, store_url, "-c", "nb,logistic,voting-hard,voting", "--folds", "3", "--ensemble", "3"
+        capsys, store_url, "-c", "nb,logistic,voting-hard,voting", "--folds", "2", "--ensemble", "3"
     )
     origins = {row["classifier"]: row.get("origin") for row in board["leaderboard"]}
     for entry in ("voting", "voting-hard", "ensemble-3"):
@@ -134,21 +145,21 @@ def test_a_member_shared_by_two_ensembles_is_fitted_once_per_fold(
 ) -> None:
     _imported(capsys, store_url, touch_arff(tmp_path / "touch.arff", n=120))
     request = BenchRequest(
-        dataset="touch", target="gesture", classifiers=["voting-hard", "stacking"], folds=3
+        dataset="touch", target="gesture", classifiers=["voting-hard", "stacking"], folds=2
     )
     run = create_run(store, request)
     # voting-hard: logistic, rf-200, svm-rbf; stacking: rf-200, extra-trees-200,
     # svm-rbf, logistic
     assert run.config.helpers == ["logistic", "rf-200", "svm-rbf", "extra-trees-200"]
-    assert run.n_tasks == 6 * 3
+    assert run.n_tasks == 6 * 2
     started: list[TaskKey] = []
     execute_run(store, run.id, callbacks=Callbacks(on_start=started.append))
     starts = Counter(started)
     assert set(starts.values()) == {1}  # no task ran twice
     assert {k.classifier for k in starts} == set(run.config.helpers)  # ensembles fit none
-    assert Counter(k.classifier for k in starts) == dict.fromkeys(run.config.helpers, 3)
+    assert Counter(k.classifier for k in starts) == dict.fromkeys(run.config.helpers, 2)
     results = load_results(store, run.id)
-    assert len(results) == 18 and all(r.ok for r in results)
+    assert len(results) == 12 and all(r.ok for r in results)
     assert get_run(store, run.id).config.origins["rf-200"].entries == [
         "voting-hard",
         "stacking",
@@ -161,18 +172,18 @@ def test_an_ensemble_keeps_the_folds_of_a_member_the_race_dropped(
     """zeror is dropped by the race; the selection over it stays live, and each of its
     folds is the unraced run's (zeror still a candidate on the later folds)."""
     _imported(capsys, store_url, touch_arff(tmp_path / "touch.arff", n=180))
-    common = ["-c", "logistic,zeror", "--folds", "6", "--ensemble", "2"]
+    common = ["-c", "logistic,zeror", "--folds", "5", "--ensemble", "2"]
     raced = _bench(capsys, store_url, *common, "--race")
     full = _bench(capsys, store_url, *common)
     rows = {row["classifier"]: row for row in raced["leaderboard"]}
     assert rows["zeror"]["dropped"]["reason"] == "race"
-    assert rows["ensemble-2"]["dropped"] is None and rows["ensemble-2"]["n_ok"] == 6
+    assert rows["ensemble-2"]["dropped"] is None and rows["ensemble-2"]["n_ok"] == 5
     ours = _by_key(load_results(store, raced["run_id"]))
     theirs = _by_key(load_results(store, full["run_id"]))
     after = rows["zeror"]["dropped"]["after_fold"]
     assert {k.fold for k in ours if k.classifier == "zeror"} == set(range(after))
     selection = [key for key in ours if key.classifier == "ensemble-2"]
-    assert len(selection) == 6
+    assert len(selection) == 5
     for key in selection:
         assert ours[key].params == theirs[key].params  # the same weights
         assert _scores(ours[key]) == _scores(theirs[key])
@@ -189,7 +200,7 @@ def test_a_run_killed_and_resumed_gives_the_same_ensembles(
     gate = Gate(tmp_path / "gate")  # its fits wait for the test: killed while one waits
     environment = {**os.environ, **gate.environment()}
     bench = [sys.executable, "-m", "touchbench.app.cli.main", "--db", store_url, "bench"]
-    args = ["touch", "--target", "gesture", "-c", "nb,gate,voting-hard", "--folds", "4"]
+    args = ["touch", "--target", "gesture", "-c", "nb,gate,voting-hard", "--folds", "3"]
     args += ["--ensemble", "2"]
     child = subprocess.Popen(
         [*bench, *args], env=environment, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE
@@ -204,7 +215,7 @@ def test_a_run_killed_and_resumed_gives_the_same_ensembles(
     child.wait()
     before = count_of(store_url, "SELECT count(*) FROM fold_results")
     kept = count_of(store_url, selections)
-    assert 1 <= kept < 4 and before < 7 * 4
+    assert 1 <= kept < 3 and before < 7 * 3
     assert (
         count_of(store_url, "SELECT count(*) FROM fold_predictions WHERE part = 'test'") == before
     )
@@ -220,18 +231,23 @@ def test_a_run_killed_and_resumed_gives_the_same_ensembles(
         assert not set(predictions.indices) & set(fold.test)
 
     gate.open()
-    resumed = subprocess.run(
-        [*bench, "--resume", "1", "--json"], env=environment, capture_output=True, timeout=600
+    # the resumed run, then an uninterrupted one, in one process (the gate is a plugin, read
+    # when the catalogue is imported: not in this one)
+    outputs = [tmp_path / "resumed.json", tmp_path / "again.json"]
+    commands = [["--db", store_url, "bench", *c, "--json"] for c in (["--resume", "1"], args)]
+    each = [[command, str(output)] for command, output in zip(commands, outputs, strict=True)]
+    done = subprocess.run(
+        [sys.executable, "-c", BENCH_EACH, json.dumps(each)],
+        env=environment,
+        capture_output=True,
+        timeout=600,
     )
-    assert resumed.returncode == 0, resumed.stderr.decode()
-    again = subprocess.run(
-        [*bench, *args, "--json"], env=environment, capture_output=True, timeout=600
-    )
-    assert again.returncode == 0, again.stderr.decode()
-    assert json.loads(again.stdout)["run_id"] == 2
+    assert done.returncode == 0, done.stderr.decode()
+    assert json.loads(outputs[0].read_text())["run_id"] == 1
+    assert json.loads(outputs[1].read_text())["run_id"] == 2
     first, second = _by_key(load_results(store, 1)), _by_key(load_results(store, 2))
     assert set(first) == {TaskKey(k.classifier, k.repeat, k.fold) for k in second}
-    assert len(first) == 7 * 4  # nb, gate, the votes, logistic, rf-200, svm-rbf
+    assert len(first) == 7 * 3  # nb, gate, the votes, logistic, rf-200, svm-rbf
     for key in first:
         if key.classifier in ("ensemble-2", "voting-hard"):
             assert first[key].params == second[key].params
