@@ -8,8 +8,11 @@ them, as if ``pip install touchbench`` had installed the core alone.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
+import shutil
+import sqlite3
 import subprocess
 import sys
 from collections.abc import Callable
@@ -18,6 +21,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.support.cli_runner import run_cli
 from tests.support.service import Server
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -71,11 +75,30 @@ def _one_line_naming(result: subprocess.CompletedProcess[str], extra: str) -> No
     assert "Traceback" not in result.stderr
 
 
-@pytest.fixture
-def stored(tmp_path: Path) -> Path:
-    """A store with the data set ``touches``."""
-    imported = _touchbench(tmp_path, "import", str(_arff(tmp_path / "touches.arff")))
+def _url(folder: Path) -> str:
+    """The store ``_touchbench`` uses in ``folder``."""
+    return f"sqlite:///{folder / 'touchbench.db'}"
+
+
+@pytest.fixture(scope="module")
+def imported_once(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A folder with ``touches.arff`` and a store it was imported into (by the CLI, as a
+    process), made once for the module: each test gets a copy (:func:`stored`)."""
+    folder = tmp_path_factory.mktemp("extras")
+    imported = _touchbench(folder, "import", str(_arff(folder / "touches.arff")))
     assert imported.returncode == 0, imported.stderr
+    return folder
+
+
+@pytest.fixture
+def stored(imported_once: Path, tmp_path: Path) -> Path:
+    """A store with the data set ``touches`` (a copy of the module's: the tests add to it)."""
+    shutil.copy(imported_once / "touches.arff", tmp_path / "touches.arff")
+    with (
+        contextlib.closing(sqlite3.connect(imported_once / "touchbench.db")) as source,
+        contextlib.closing(sqlite3.connect(tmp_path / "touchbench.db")) as target,
+    ):
+        source.backup(target)  # with what a write-ahead log holds
     return tmp_path
 
 
@@ -99,14 +122,16 @@ def test_the_hider_hides(tmp_path: Path) -> None:
     ],
 )
 @pytest.mark.slow
-def test_bench_names_the_missing_extra(stored: Path, classifier: str, extra: str) -> None:
+def test_bench_names_the_missing_extra(
+    capsys: pytest.CaptureFixture[str], stored: Path, classifier: str, extra: str
+) -> None:
     result = _touchbench(
         stored, "bench", "touches", "-c", f"rf,{classifier}", hidden=EXTRA_MODULES[extra]
     )
     _one_line_naming(result, extra)
     assert f"'{classifier}'" in result.stderr and "--classifiers" in result.stderr
-    runs = _touchbench(stored, "runs", "--json")
-    assert json.loads(runs.stdout)["runs"] == []  # nothing was stored
+    runs = run_cli(capsys, _url(stored), "runs", "--json")  # in this process: hides nothing
+    assert runs.json()["runs"] == []  # nothing was stored
 
 
 def test_classifiers_marks_what_is_not_installed(tmp_path: Path) -> None:
@@ -128,23 +153,29 @@ def test_classifiers_marks_what_is_not_installed(tmp_path: Path) -> None:
     assert "lgbm" not in ids and "catboost" in ids
 
 
-def test_a_stored_model_of_a_missing_library_names_the_extra(stored: Path) -> None:
-    trained = _touchbench(stored, "train", "touches", "-c", "catboost", "--name", "cat")
-    assert trained.returncode == 0, trained.stderr
+def test_a_stored_model_of_a_missing_library_names_the_extra(
+    capsys: pytest.CaptureFixture[str], stored: Path
+) -> None:
+    # trained in this process, where nothing is hidden; predicted by a process without it
+    trained = run_cli(capsys, _url(stored), "train", "touches", "-c", "catboost", "--name", "cat")
+    assert trained.code == 0, trained.err
     data = str(stored / "touches.arff")
     result = _touchbench(stored, "predict", "cat", data, hidden=EXTRA_MODULES["boosting"])
     _one_line_naming(result, "boosting")
 
 
-def test_onnx_export_and_engine_name_the_missing_extra(stored: Path) -> None:
-    trained = _touchbench(stored, "train", "touches", "-c", "logistic", "--name", "lin")
-    assert trained.returncode == 0, trained.stderr
+def test_onnx_export_and_engine_name_the_missing_extra(
+    capsys: pytest.CaptureFixture[str], stored: Path
+) -> None:
+    # what hides nothing runs in this process; what hides the extra, in a process of its own
+    trained = run_cli(capsys, _url(stored), "train", "touches", "-c", "logistic", "--name", "lin")
+    assert trained.code == 0, trained.err
     onnx = EXTRA_MODULES["onnx"]
     _one_line_naming(
         _touchbench(stored, "export-model", "lin", "-o", "lin.onnx", hidden=onnx), "onnx"
     )
-    exported = _touchbench(stored, "export-model", "lin", "-o", "lin.onnx")
-    assert exported.returncode == 0, exported.stderr
+    exported = run_cli(capsys, _url(stored), "export-model", "lin", "-o", str(stored / "lin.onnx"))
+    assert exported.code == 0, exported.err
     data = str(stored / "touches.arff")
     engine = _touchbench(stored, "predict", "lin", data, "--engine", "onnx", hidden=onnx)
     _one_line_naming(engine, "onnx")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -22,27 +23,29 @@ from touchbench.app.store.database import Store
 from touchbench.drivers.replay import FileReplaySource
 
 
-@pytest.fixture
-def trained(tmp_path: Path, sqlite_store: Store) -> tuple[str, Path]:
-    """A model trained on extracted sessions, and a session it never saw."""
+@pytest.fixture(scope="module")
+def trained(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Store, str, Path]]:
+    """A store (SQLite) with a model trained on extracted sessions, the model's name, and a
+    session it never saw; made once for the module's tests, which only read them."""
+    folder = tmp_path_factory.mktemp("live")
+    store = Store(f"sqlite:///{folder / 'touchbench.db'}")
     recordings, rows = [], []
     for seed in range(3):
-        wav, touches = write_session(tmp_path, f"s{seed}", n_touches=10, seed=seed)
+        wav, touches = write_session(folder, f"s{seed}", n_touches=10, seed=seed)
         recordings.append(wav)
         rows += [(wav.name, *touch) for touch in touches]
-    labels = write_labels(tmp_path / "labels.csv", rows)
-    extract_and_store(
-        sqlite_store, ExtractRequest(recordings=recordings, labels=labels, name="touch")
-    )
-    model = train(sqlite_store, TrainRequest(dataset="touch", classifier="cc:rf"))
-    unseen, _ = write_session(tmp_path, "unseen", n_touches=6, seed=99)
-    return model.name, unseen
+    labels = write_labels(folder / "labels.csv", rows)
+    extract_and_store(store, ExtractRequest(recordings=recordings, labels=labels, name="touch"))
+    model = train(store, TrainRequest(dataset="touch", classifier="cc:rf"))
+    unseen, _ = write_session(folder, "unseen", n_touches=6, seed=99)
+    yield store, model.name, unseen
+    store.dispose()
 
 
 def test_live_predicts_what_predict_says_of_the_extracted_instances(
-    sqlite_store: Store, trained: tuple[str, Path]
+    trained: tuple[Store, str, Path],
 ) -> None:
-    name, unseen = trained
+    sqlite_store, name, unseen = trained
     offline = extract_dataset([unseen], labels=None, extractor="uc3m-audio").dataset
     _, model = load_model(sqlite_store, name)
     expected = predict(model, offline)
@@ -64,9 +67,9 @@ def test_live_predicts_what_predict_says_of_the_extracted_instances(
 
 
 def test_the_recipe_travels_with_the_data_set_to_the_model(
-    sqlite_store: Store, trained: tuple[str, Path]
+    trained: tuple[Store, str, Path],
 ) -> None:
-    name, _ = trained
+    sqlite_store, name, _ = trained
     info, _ = load_model(sqlite_store, name)
     recipe = info.extraction
     assert recipe is not None
@@ -75,9 +78,9 @@ def test_the_recipe_travels_with_the_data_set_to_the_model(
 
 
 def test_a_stream_unlike_the_training_recordings_is_refused(
-    sqlite_store: Store, trained: tuple[str, Path]
+    trained: tuple[Store, str, Path],
 ) -> None:
-    name, _ = trained
+    sqlite_store, name, _ = trained
     with pytest.raises(AppError, match=r"trained on 3-channel recordings .* source has 2"):
         open_live(sqlite_store, name, samplerate=44100.0, n_channels=2)
     with pytest.raises(AppError, match=r"recordings at 44100 Hz, but the source runs at 48000"):
@@ -101,19 +104,28 @@ def test_a_model_of_an_imported_arff_refuses_live(
     assert "imported from a file, not extracted from recordings" in result.err
 
 
-def test_live_bad_input_is_one_line(
-    capsys: pytest.CaptureFixture[str], sqlite_store_url: str, tmp_path: Path
-) -> None:
-    sqlite_store = Store(sqlite_store_url)
+@pytest.fixture(scope="module")
+def j48_of_one_session(tmp_path_factory: pytest.TempPathFactory) -> tuple[str, Path]:
+    """The URL of a store (SQLite) with ``touch-j48`` (gesture) trained on one extracted
+    session of six touches, and that session's recording; made once for the module's
+    tests, which only read them."""
+    folder = tmp_path_factory.mktemp("j48")
+    url = f"sqlite:///{folder / 'touchbench.db'}"
+    store = Store(url)
     try:
-        wav, touches = write_session(tmp_path, "s", n_touches=6, seed=4)
-        labels = write_labels(tmp_path / "l.csv", [(wav.name, *t) for t in touches])
-        extract_and_store(
-            sqlite_store, ExtractRequest(recordings=[wav], labels=labels, name="touch")
-        )
-        train(sqlite_store, TrainRequest(dataset="touch", classifier="j48", target="gesture"))
+        wav, touches = write_session(folder, "s", n_touches=6, seed=4)
+        labels = write_labels(folder / "l.csv", [(wav.name, *t) for t in touches])
+        extract_and_store(store, ExtractRequest(recordings=[wav], labels=labels, name="touch"))
+        train(store, TrainRequest(dataset="touch", classifier="j48", target="gesture"))
     finally:
-        sqlite_store.dispose()
+        store.dispose()
+    return url, wav
+
+
+def test_live_bad_input_is_one_line(
+    capsys: pytest.CaptureFixture[str], j48_of_one_session: tuple[str, Path], tmp_path: Path
+) -> None:
+    sqlite_store_url, wav = j48_of_one_session
     mono = tmp_path / "mono.wav"
     soundfile.write(mono, np.zeros(44100), 44100)
     odd = tmp_path / "take.xyz"
@@ -133,12 +145,9 @@ def test_live_bad_input_is_one_line(
 
 
 def test_the_block_length_changes_when_touches_are_told_not_what_they_are(
-    capsys: pytest.CaptureFixture[str], sqlite_store: Store, sqlite_store_url: str, tmp_path: Path
+    capsys: pytest.CaptureFixture[str], j48_of_one_session: tuple[str, Path]
 ) -> None:
-    wav, touches = write_session(tmp_path, "s", n_touches=6, seed=4)
-    labels = write_labels(tmp_path / "l.csv", [(wav.name, *t) for t in touches])
-    extract_and_store(sqlite_store, ExtractRequest(recordings=[wav], labels=labels, name="touch"))
-    train(sqlite_store, TrainRequest(dataset="touch", classifier="j48", target="gesture"))
+    sqlite_store_url, wav = j48_of_one_session
     seen = []
     for block in ("256", "512", "4096"):
         result = run_cli(
@@ -152,9 +161,9 @@ def test_the_block_length_changes_when_touches_are_told_not_what_they_are(
 
 
 def test_live_session_takes_a_recipe_given_explicitly(
-    sqlite_store: Store, trained: tuple[str, Path]
+    trained: tuple[Store, str, Path],
 ) -> None:
-    name, unseen = trained
+    sqlite_store, name, unseen = trained
     info, model = load_model(sqlite_store, name)
     session = LiveSession(info, model, samplerate=44100.0, n_channels=3, extraction=info.extraction)
     samples, _ = soundfile.read(unseen, always_2d=True)

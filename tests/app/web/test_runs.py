@@ -208,11 +208,18 @@ def foreign_site(tmp_path: Path) -> Iterator[str]:
         yield url
 
 
+@pytest.fixture(scope="module")
+def channels_run(service: Server) -> int:
+    """A finished run on ``channels`` (data without recordings), made once for the tests
+    that only read it: one needs a run to attack, another a run without recordings."""
+    return _finished_run(service, "channels", 3)
+
+
 def test_a_page_on_another_origin_can_start_nothing(
-    tab: Tab, service: Server, foreign_site: str
+    tab: Tab, service: Server, foreign_site: str, channels_run: int
 ) -> None:
     api = service.client
-    run_id = _finished_run(service, "channels", 2)  # its own: the module's tests may run apart
+    run_id = channels_run
     before = (api.get("/api/runs").json(), api.get("/api/jobs").json())
     statuses: dict[str, int] = {}
 
@@ -241,13 +248,13 @@ def _finished_run(service: Server, dataset: str, folds: int) -> int:
 
 
 def test_the_run_page_scores_per_recording_where_the_run_has_recordings(
-    projector_tab: Tab, service: Server
+    projector_tab: Tab, service: Server, channels_run: int
 ) -> None:
     tab, page, api = projector_tab, projector_tab.page, service.client
     store_dataset(service.database_url, recorded_windows(), "takes")
     store_dataset(service.database_url, recorded_windows(mixed=True), "mixed")
     takes, mixed = _finished_run(service, "takes", 4), _finished_run(service, "mixed", 4)
-    plain = _finished_run(service, "channels", 3)
+    plain = channels_run
 
     # a run on data without recordings: no choice offered
     page.goto(f"{service.url}/runs/{plain}")
