@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import io
 import json
 import re
+from contextlib import redirect_stderr, redirect_stdout
 from dataclasses import dataclass
 from typing import Any
 
@@ -28,6 +30,15 @@ def run_cli(capsys: pytest.CaptureFixture[str], db: str, *args: str) -> CliResul
     code = main(["--db", db, *args])
     out, err = capsys.readouterr()
     return CliResult(code, out, err)
+
+
+def run_cli_captured(db: str, *args: str) -> CliResult:
+    """``touchbench --db DB ARGS...`` in this process, its output caught here: for a fixture
+    wider than a test, which has no ``capsys``."""
+    out, err = io.StringIO(), io.StringIO()
+    with redirect_stdout(out), redirect_stderr(err):
+        code = main(["--db", db, *args])
+    return CliResult(code, out.getvalue(), err.getvalue())
 
 
 #: A command-line word: an option (``--budget``) or a command (``touchbench bench``).

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import sqlite3
+from contextlib import closing
+from pathlib import Path
 from typing import Any
 
 from sqlalchemy import create_engine, text
@@ -35,3 +38,11 @@ def alembic(connection: Any, action: str, revision: str) -> None:
     config.set_main_option("script_location", str(MIGRATIONS))
     config.attributes["connection"] = connection
     getattr(command, action)(config, revision)
+
+
+def copy_sqlite(source: Path, target: Path) -> str:
+    """A copy at ``target`` of the SQLite store ``source`` (with what its write-ahead log
+    holds): a test's own store, made from a module's template; its URL."""
+    with closing(sqlite3.connect(source)) as original, closing(sqlite3.connect(target)) as copy:
+        original.backup(copy)
+    return f"sqlite:///{target}"

@@ -8,11 +8,9 @@ them, as if ``pip install touchbench`` had installed the core alone.
 
 from __future__ import annotations
 
-import contextlib
 import json
 import os
 import shutil
-import sqlite3
 import subprocess
 import sys
 from collections.abc import Callable
@@ -23,6 +21,7 @@ import pytest
 
 from tests.support.cli_runner import run_cli
 from tests.support.service import Server
+from tests.support.stores import copy_sqlite
 
 ROOT = Path(__file__).resolve().parents[3]
 HIDER = ROOT / "tests" / "without_extras"
@@ -94,11 +93,7 @@ def imported_once(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def stored(imported_once: Path, tmp_path: Path) -> Path:
     """A store with the data set ``touches`` (a copy of the module's: the tests add to it)."""
     shutil.copy(imported_once / "touches.arff", tmp_path / "touches.arff")
-    with (
-        contextlib.closing(sqlite3.connect(imported_once / "touchbench.db")) as source,
-        contextlib.closing(sqlite3.connect(tmp_path / "touchbench.db")) as target,
-    ):
-        source.backup(target)  # with what a write-ahead log holds
+    copy_sqlite(imported_once / "touchbench.db", tmp_path / "touchbench.db")
     return tmp_path
 
 

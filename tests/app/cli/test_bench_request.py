@@ -4,18 +4,15 @@ cannot honour is refused naming its option, in one line, exit 2, before a run ro
 
 from __future__ import annotations
 
-import io
-import sqlite3
-from contextlib import closing, redirect_stderr, redirect_stdout
 from pathlib import Path
 
 import pytest
 
-from tests.support.cli_runner import CliResult, run_cli
+from tests.support.cli_runner import CliResult, run_cli, run_cli_captured
 from tests.support.rows import count_rows
+from tests.support.stores import copy_sqlite
 from tests.support.synthetic import position_arff, touch_arff
 from touchbench.app.cli.bench import BENCH_OPTIONS
-from touchbench.app.cli.main import main
 from touchbench.app.schemas.runs import BenchHereRequest, BenchRequest
 from touchbench.app.services.runs import NoResultsError, create_run, run_leaderboard
 from touchbench.app.store.database import Store
@@ -46,9 +43,8 @@ def sqlite_template(tmp_path_factory: pytest.TempPathFactory) -> Path:
         (touch_arff(folder / "touch.arff", n=60), "touch"),
         (position_arff(folder / "contact.arff"), "contact"),
     ):
-        with redirect_stdout(io.StringIO()), redirect_stderr(io.StringIO()) as err:
-            code = main(["--db", url, "import", str(path), "--name", name])
-        assert code == 0, err.getvalue()
+        imported = run_cli_captured(url, "import", str(path), "--name", name)
+        assert imported.code == 0, imported.err
     return folder / "touchbench.db"
 
 
@@ -56,10 +52,7 @@ def sqlite_template(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def sqlite_db(sqlite_store_url: str, sqlite_template: Path) -> str:
     """The two data sets on SQLite only: for what is refused before a run exists (a copy
     of the module's template, the test's own)."""
-    copy = sqlite_store_url.removeprefix("sqlite:///")
-    source, target = sqlite3.connect(sqlite_template), sqlite3.connect(copy)
-    with closing(source), closing(target):
-        source.backup(target)
+    copy_sqlite(sqlite_template, Path(sqlite_store_url.removeprefix("sqlite:///")))
     return sqlite_store_url
 
 

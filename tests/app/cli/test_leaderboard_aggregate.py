@@ -8,8 +8,6 @@ from __future__ import annotations
 
 import csv
 import io
-import sqlite3
-from contextlib import closing, redirect_stderr, redirect_stdout
 from dataclasses import dataclass
 from html import unescape
 from itertools import pairwise
@@ -19,11 +17,11 @@ from typing import Any
 import pytest
 from sqlalchemy import create_engine, text
 
-from tests.support.cli_runner import CliResult, one_error_line, run_cli
+from tests.support.cli_runner import one_error_line, run_cli, run_cli_captured
 from tests.support.figures import svg_texts
 from tests.support.recordings import PER_RECORDING, recorded_windows, store_dataset
+from tests.support.stores import copy_sqlite
 from tests.support.synthetic import touch_arff
-from touchbench.app.cli.main import main
 from touchbench.app.services.runs import run_leaderboard
 from touchbench.app.store.database import Store
 from touchbench.app.store.runs import load_results
@@ -47,14 +45,6 @@ class _Built:
     refused_runs: dict[str, int]
 
 
-def _cli(db: str, *args: str) -> CliResult:
-    """``touchbench --db DB ARGS...`` in this process, for a module's fixture (no capsys)."""
-    out, err = io.StringIO(), io.StringIO()
-    with redirect_stdout(out), redirect_stderr(err):
-        code = main(["--db", db, *args])
-    return CliResult(code, out.getvalue(), err.getvalue())
-
-
 @pytest.fixture(scope="module")
 def built(tmp_path_factory: pytest.TempPathFactory) -> _Built:
     """Data set `takes` and, in this order, the runs of :func:`two_runs` and of
@@ -70,10 +60,7 @@ def built(tmp_path_factory: pytest.TempPathFactory) -> _Built:
 @pytest.fixture
 def db(tmp_path: Path, built: _Built) -> str:
     """A store of the test's own: a copy of the module's template (:func:`built`)."""
-    path = tmp_path / "touchbench.db"
-    with closing(sqlite3.connect(built.path)) as source, closing(sqlite3.connect(path)) as copy:
-        source.backup(copy)
-    return f"sqlite:///{path}"
+    return copy_sqlite(built.path, tmp_path / "touchbench.db")
 
 
 @pytest.fixture
@@ -95,7 +82,7 @@ def no_fitting(monkeypatch: pytest.MonkeyPatch) -> list[str]:
 
 
 def _bench(db: str, *options: str) -> int:
-    result = _cli(
+    result = run_cli_captured(
         db, "bench", "takes", "-c", CLASSIFIERS, "-k", "4", "--seed", "3", "--json", *options
     )
     assert result.code == 0, result.err
@@ -217,15 +204,15 @@ def _refused_runs(db: str, folder: Path) -> dict[str, int]:
     before runs kept their fold predictions (its predictions deleted)."""
     store_dataset(db, recorded_windows(mixed=True), "mixed")
     path = touch_arff(folder / "touch.arff", n=60, with_place=False)
-    assert _cli(db, "import", str(path), "--name", "touch").code == 0
+    assert run_cli_captured(db, "import", str(path), "--name", "touch").code == 0
     runs = {}
     for name, dataset in (("ungrouped", "touch"), ("mixed", "mixed"), ("old", "takes")):
-        made = _cli(db, "bench", dataset, "-c", "nb,zeror", "-k", "4", "--json")
+        made = run_cli_captured(db, "bench", dataset, "-c", "nb,zeror", "-k", "4", "--json")
         assert made.code == 0, made.err
         runs[name] = int(made.json()["run_id"])
     exported = folder / "results.arff"
-    exported.write_text(_cli(db, "leaderboard", str(runs["old"]), "-f", "arff").out)
-    imported = _cli(db, "import-results", str(exported), "--dataset", "takes", "--json")
+    exported.write_text(run_cli_captured(db, "leaderboard", str(runs["old"]), "-f", "arff").out)
+    imported = run_cli_captured(db, "import-results", str(exported), "--dataset", "takes", "--json")
     assert imported.code == 0, imported.err
     runs["imported"] = int(imported.json()["id"])
     engine = create_engine(db)

@@ -3,25 +3,14 @@ calibration of a run's classifiers from what each fold stored, on SQLite."""
 
 from __future__ import annotations
 
-import io
-import sqlite3
-from contextlib import closing, redirect_stderr, redirect_stdout
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from tests.support.cli_runner import CliResult, run_cli
+from tests.support.cli_runner import run_cli, run_cli_captured
+from tests.support.stores import copy_sqlite
 from tests.support.synthetic import position_arff, touch_arff
-from touchbench.app.cli.main import main
-
-
-def _cli(db: str, *args: str) -> CliResult:
-    """``touchbench --db DB ARGS...`` in this process, for a module's fixture (no capsys)."""
-    out, err = io.StringIO(), io.StringIO()
-    with redirect_stdout(out), redirect_stderr(err):
-        code = main(["--db", db, *args])
-    return CliResult(code, out.getvalue(), err.getvalue())
 
 
 @pytest.fixture(scope="module")
@@ -31,8 +20,8 @@ def benched(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, int]:
     folder = tmp_path_factory.mktemp("certainty")
     url = f"sqlite:///{folder / 'touchbench.db'}"
     path = touch_arff(folder / "touch.arff", n=90)
-    assert _cli(url, "import", str(path)).code == 0
-    result = _cli(
+    assert run_cli_captured(url, "import", str(path)).code == 0
+    result = run_cli_captured(
         url, "bench", "touch", "--target", "gesture", "-c", "j48,nb,svm-rbf", "--folds", "5",
         "--json",
     )  # fmt: skip
@@ -45,9 +34,7 @@ def run(sqlite_store_url: str, benched: tuple[Path, int]) -> int:
     """The run, in the test's own store (a copy of the module's template: nothing one test
     does reaches another)."""
     template, run_id = benched
-    copy = sqlite_store_url.removeprefix("sqlite:///")
-    with closing(sqlite3.connect(template)) as source, closing(sqlite3.connect(copy)) as target:
-        source.backup(target)
+    copy_sqlite(template, Path(sqlite_store_url.removeprefix("sqlite:///")))
     return run_id
 
 
