@@ -8,7 +8,7 @@ from collections.abc import Iterator
 import numpy as np
 import pytest
 from sklearn.base import clone
-from sklearn.ensemble import RandomForestClassifier
+from sklearn.ensemble import HistGradientBoostingClassifier, RandomForestClassifier
 from sklearn.linear_model import LogisticRegression
 from sklearn.svm import SVC
 from sklearn.tree import DecisionTreeClassifier
@@ -269,6 +269,24 @@ def test_every_entry_fits_and_predicts_nominal_and_missing_inputs(classifier_id:
         )
     if "classifier__n_kernels" in model.get_params():  # rockets: 84 kernels, not thousands
         model.set_params(classifier__n_kernels=84)
+    # ensembles of trees (forests, boosting, bagging, also inside a vote): ten trees, not
+    # hundreds; the fit, the predictions and the artifact round trip do the same per tree
+    params = model.get_params(deep=True)
+    model.set_params(
+        **{
+            name: 10
+            for name, value in params.items()
+            if isinstance(value, int)
+            and value > 10
+            and (
+                name.endswith("n_estimators")
+                or (
+                    name.endswith("__max_iter")
+                    and isinstance(params[name.rpartition("__")[0]], HistGradientBoostingClassifier)
+                )
+            )
+        }
+    )
     model.fit(X[::2], y[::2])
     predicted = model.predict(X[1::2])
     assert predicted.shape == (90,)

@@ -165,8 +165,9 @@ def test_an_interrupted_run_resumes_without_repeating_tasks(problem, folds) -> N
         )
     assert len(stored) == 2
     done = {r.key for r in stored}
+    # the interrupted run had a task in flight in its second worker; the rest needs only one
     rest = run_tasks(
-        problem, ["nb", "j48"], folds, jobs=2, timeout=TIMEOUT, skip=done, on_result=stored.append
+        problem, ["nb", "j48"], folds, jobs=1, timeout=TIMEOUT, skip=done, on_result=stored.append
     )
     assert {r.key for r in rest}.isdisjoint(done)
     assert sorted(r.key for r in stored) == sorted(

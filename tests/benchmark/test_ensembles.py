@@ -220,8 +220,8 @@ def test_a_live_ensemble_keeps_the_folds_of_a_member_the_race_dropped() -> None:
     keys = {r.key for r in raced}
     assert {k.fold for k in keys if k.classifier == "zeror"} == {0, 1, 2}
     assert {k.fold for k in keys if k.classifier == "vote"} == set(range(6))
-    # its later folds are those of the same vote with zeror a helper, unraced
-    full = by_key(run_tasks(problem, ["vote"], folds, timeout=TIMEOUT, jobs=2, extra_specs=extra))
+    # its later folds are those of the same vote with zeror a helper, unraced (in one worker)
+    full = by_key(run_tasks(problem, ["vote"], folds, timeout=TIMEOUT, jobs=1, extra_specs=extra))
     for result in raced:
         if result.key.classifier == "vote":
             twin = full[result.key]
@@ -392,26 +392,47 @@ def _stored(folder: Path, with_predictions: bool) -> list[TaskResult]:
     return results
 
 
+@pytest.fixture(scope="module")
+def killed_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, int]:
+    """The folder a run killed midway (SIGKILL of its own process) stored its results in,
+    and that process's return code: one killed run, read (never written) by both legs of
+    the resume test."""
+    folder = tmp_path_factory.mktemp("killed")
+    root = Path(__file__).resolve().parents[2]
+    command = [sys.executable, "-c", RUNNER, str(folder), str(KILLED_AFTER)]
+    runner = subprocess.run(command, cwd=root, timeout=300, check=False)
+    return folder, runner.returncode
+
+
+@pytest.fixture(scope="module")
+def uninterrupted_run() -> dict[TaskKey, TaskResult]:
+    """The results of the killed run's classifiers run without interruption (only read)."""
+    problem = small_problem()
+    folds = make_folds(problem.Y, n_folds=3)[0]
+    classifiers, extra = resumable(0.0)
+    return by_key(
+        run_tasks(problem, classifiers, folds, timeout=TIMEOUT, extra_specs=extra, ensemble=2)
+    )
+
+
 @pytest.mark.parametrize("with_predictions", [True, False], ids=["stored", "not stored"])
 @pytest.mark.slow
 def test_a_run_killed_and_resumed_gives_the_same_ensembles(
-    tmp_path: Path, with_predictions: bool
+    killed_run: tuple[Path, int],
+    uninterrupted_run: dict[TaskKey, TaskResult],
+    with_predictions: bool,
 ) -> None:
     """The run's process kills itself (SIGKILL) midway, right after storing a result;
     resumed from what it stored (with its fold predictions, or without them as a store
     that does not keep them): every ensemble fold is the uninterrupted run's."""
     problem = small_problem()
     folds = make_folds(problem.Y, n_folds=3)[0]
-    root = Path(__file__).resolve().parents[2]
-    command = [sys.executable, "-c", RUNNER, str(tmp_path), str(KILLED_AFTER)]
-    runner = subprocess.run(command, cwd=root, timeout=300, check=False)
-    assert runner.returncode == -signal.SIGKILL
-    stored = _stored(tmp_path, with_predictions)
+    folder, returncode = killed_run
+    assert returncode == -signal.SIGKILL
+    stored = _stored(folder, with_predictions)
     assert len(stored) == KILLED_AFTER
     classifiers, extra = resumable(0.0)
-    expected = by_key(
-        run_tasks(problem, classifiers, folds, timeout=TIMEOUT, extra_specs=extra, ensemble=2)
-    )
+    expected = uninterrupted_run
     assert len(stored) < len(expected), "the run was not killed midway"
     plan = plan_run(problem, classifiers, extra_specs=extra, ensemble=2)
     again = plan.reruns([(0, f.fold) for f in folds], {r.key for r in stored}, by_key(stored))

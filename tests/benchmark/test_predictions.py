@@ -96,7 +96,7 @@ def test_a_finished_run_re_scores_from_its_fold_predictions_exactly(
         regression=problem.kind == "regression",
     )
     results = run_tasks(
-        problem, classifiers, folds, timeout=TIMEOUT, jobs=2, by_recording=recordings
+        problem, classifiers, folds, timeout=TIMEOUT, jobs=1, by_recording=recordings
     )
     assert results and all(r.ok for r in results), [r.error for r in results]
     assert {r.key.classifier for r in results} >= set(classifiers)

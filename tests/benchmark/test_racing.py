@@ -46,13 +46,13 @@ def folds(problem: Problem) -> list:
     return make_folds(problem.Y, n_folds=6)[0]
 
 
-def race(problem: Problem, folds: list, classifiers: list[str], **options: Any):
+def race(problem: Problem, folds: list, classifiers: list[str], jobs: int = 2, **options: Any):
     drops: list[Drop] = []
     results = run_tasks(
         problem,
         classifiers,
         folds,
-        jobs=2,
+        jobs=jobs,
         timeout=TIMEOUT,
         on_drop=drops.append,
         **options,
@@ -88,7 +88,7 @@ def test_the_race_drops_zero_rule_after_the_third_fold_and_keeps_the_leader(race
 
 def test_the_baseline_is_never_dropped(problem, folds) -> None:
     rule = RaceRule("f1_weighted", protected=frozenset({"zeror"}))
-    results, drops = race(problem, folds, ["zeror", "nb", "j48"], race=rule)
+    results, drops = race(problem, folds, ["zeror", "nb", "j48"], jobs=1, race=rule)
     assert drops == []
     assert Counter(r.key.classifier for r in results) == {"zeror": 6, "nb": 6, "j48": 6}
 
@@ -97,7 +97,7 @@ def test_marks_and_p_values_equal_a_full_run_restricted_to_the_same_folds(
     problem, folds, raced
 ) -> None:
     results, drops = raced
-    full, _ = race(problem, folds, IDS)
+    full, _ = race(problem, folds, IDS, jobs=1)  # no race: the reference, in one worker
     assert len(full) == len(IDS) * len(folds) > len(results)
     ran = {r.key for r in results}
     restricted = [r for r in full if r.key in ran]
@@ -122,7 +122,7 @@ def test_regression_races_by_mae_where_lower_is_better() -> None:
     y = 5.0 * X[:, 0] + rng.normal(scale=0.1, size=120)
     problem = Problem(X=X, Y=y[:, None], n_classes=(), target_names=("force",), task="regression")
     folds = make_folds(problem.Y, n_folds=5, regression=True)[0]
-    results, drops = race(problem, folds, ["zeror", "linear"], race=RaceRule("mae"))
+    results, drops = race(problem, folds, ["zeror", "linear"], jobs=1, race=RaceRule("mae"))
     assert [(d.classifier, d.leader) for d in drops] == [("zeror", "linear")]
     counts = Counter(r.key.classifier for r in results)
     assert counts["zeror"] == drops[0].after_fold < 5 and counts["linear"] == 5
@@ -135,7 +135,9 @@ def test_multi_target_races_by_the_hamming_score() -> None:
     X = rng.normal(size=(n, 4)) + np.concatenate([4.0 * Y, 4.0 * Y], axis=1)
     problem = Problem(X=X, Y=Y, n_classes=(3, 2), target_names=("gesture", "place"))
     folds = make_folds(problem.Y, n_folds=5, target_names=problem.target_names)[0]
-    results, drops = race(problem, folds, ["cr:zeror", "cr:nb"], race=RaceRule("hamming_score"))
+    results, drops = race(
+        problem, folds, ["cr:zeror", "cr:nb"], jobs=1, race=RaceRule("hamming_score")
+    )
     assert [(d.classifier, d.leader) for d in drops] == [("cr:zeror", "cr:nb")]
     counts = Counter(r.key.classifier for r in results)
     assert counts["cr:zeror"] == drops[0].after_fold < 5 and counts["cr:nb"] == 5
