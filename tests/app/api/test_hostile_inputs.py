@@ -13,9 +13,9 @@ its versions of results) is tried on both stores.
 
 from __future__ import annotations
 
+import contextlib
+import io
 import re
-import subprocess
-import sys
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -35,9 +35,10 @@ from tests.support.hostile_inputs import (
     timed_takes,
 )
 from tests.support.memory import DATA_URI, peak_rss_mb
-from tests.support.service import ROOT, Server, finished, servers
+from tests.support.service import Server, finished, servers
 from tests.support.stores import emptied
 from tests.support.synthetic import touch_arff
+from touchbench.app.cli.main import main
 from touchbench.app.reports import bounds
 
 #: The most the service's peak memory may grow over its start while hostile requests are
@@ -58,34 +59,30 @@ def served(
     else:
         url = emptied(request.getfixturevalue("postgres_database"))
     recordings, labels = timed_takes(folder / "takes")
-    extracted = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "touchbench.app.cli.main",
-            "--db",
-            url,
-            "extract",
-            *map(str, recordings),
-            "--labels",
-            str(labels),
-            "-e",
-            "sequence",
-            "--events",
-            "none",
-            "--segment",
-            "0.05",
-            "-O",
-            "length=50",
-            "--name",
-            "takes",
-        ],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    assert extracted.returncode == 0, extracted.stderr
+    # the CLI in this process: a subprocess would cost an interpreter and its imports
+    said = io.StringIO()
+    with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
+        code = main(
+            [
+                "--db",
+                url,
+                "extract",
+                *map(str, recordings),
+                "--labels",
+                str(labels),
+                "-e",
+                "sequence",
+                "--events",
+                "none",
+                "--segment",
+                "0.05",
+                "-O",
+                "length=50",
+                "--name",
+                "takes",
+            ]
+        )
+    assert code == 0, said.getvalue()
     builder = servers(url, folder)
     server = next(builder)()
     trained = server.client.post(

@@ -4,7 +4,7 @@ origins with or without a key, and keeps CORS closed unless origins are listed."
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -13,7 +13,7 @@ import pytest
 from websockets.exceptions import InvalidStatus
 from websockets.sync.client import connect
 
-from tests.support.service import Server, cancelled_run
+from tests.support.service import Server, cancelled_run, servers
 from tests.support.synthetic import touch_arff
 
 FOREIGN = "http://127.0.0.1:9"  # another port of the same machine is another origin
@@ -36,6 +36,18 @@ def _names(api: httpx.Client) -> set[str]:
     return {row["name"] for row in answer.json()["datasets"]}
 
 
+@pytest.fixture(scope="module")
+def plain(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
+    """A service on SQLite with the default settings (no key, no hosts or origins listed),
+    started once for the tests that send it only what it must refuse or what writes nothing
+    (each test that changes its state or its settings starts a service of its own)."""
+    folder = tmp_path_factory.mktemp("trust-plain")
+    builder = servers(f"sqlite:///{folder / 'touchbench.db'}", folder)
+    yield next(builder)()
+    for _ in builder:  # stops the service
+        pass
+
+
 def _refused(answer: httpx.Response, status: int, kind: str, where: str) -> dict[str, Any]:
     assert answer.status_code == status, answer.text
     assert answer.headers["content-type"] == "application/json"
@@ -45,9 +57,9 @@ def _refused(answer: httpx.Response, status: int, kind: str, where: str) -> dict
 
 
 def test_other_host_names_are_refused_as_dns_rebinding_would_send_them(
-    make_sqlite_server: Callable[..., Server], tmp_path: Path
+    plain: Server, tmp_path: Path
 ) -> None:
-    server = make_sqlite_server()
+    server = plain
     port = server.url.rsplit(":", 1)[1]
     api = server.client
     data = touch_arff(tmp_path / "touch.arff", n=30)
@@ -122,10 +134,8 @@ def test_a_key_does_not_let_a_foreign_origin_in(
     assert api.post("/api/runs/1/resume").status_code == 404
 
 
-def test_websocket_handshakes_from_a_foreign_origin_are_refused(
-    make_sqlite_server: Callable[..., Server],
-) -> None:
-    server = make_sqlite_server()
+def test_websocket_handshakes_from_a_foreign_origin_are_refused(plain: Server) -> None:
+    server = plain
     url = server.url.replace("http://", "ws://") + "/api/models/nope/live"
     for foreign in (FOREIGN, "http://evil.example", "null"):
         with pytest.raises(InvalidStatus) as refused:
@@ -141,10 +151,10 @@ def test_websocket_handshakes_from_a_foreign_origin_are_refused(
 
 
 def test_cors_stays_closed_unless_origins_are_listed(
-    make_sqlite_server: Callable[..., Server], tmp_path: Path
+    plain: Server, make_sqlite_server: Callable[..., Server], tmp_path: Path
 ) -> None:
     preflight = {"Origin": FOREIGN, "Access-Control-Request-Method": "POST"}
-    closed = make_sqlite_server()
+    closed = plain
     answer = closed.client.options("/api/datasets", headers=preflight)
     assert answer.status_code >= 400 and "access-control-allow-origin" not in answer.headers
 
