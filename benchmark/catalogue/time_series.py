@@ -67,7 +67,7 @@ class _SequenceClassifier(ClassifierMixin, BaseEstimator):
         X, y = validate_data(self, X, y)
         sequences, others = self._split(X)
         self.classes_ = np.unique(y)
-        self.transform_ = self._make_transform().fit(sequences, y)
+        self.transform_ = self._make_transform().fit(self._prepared(sequences), y)
         features = np.hstack([self._transformed(sequences), others])
         self.head_ = self._make_head().fit(features, y)
         return self
@@ -82,8 +82,13 @@ class _SequenceClassifier(ClassifierMixin, BaseEstimator):
         sequences, others = self._split(X)
         return np.hstack([self._transformed(sequences), others])
 
+    def _prepared(self, sequences: np.ndarray) -> np.ndarray:
+        """The sequences as the transform takes them, in fitting as in transforming."""
+        return sequences
+
     def _transformed(self, sequences: np.ndarray) -> np.ndarray:
-        return np.asarray(self.transform_.transform(sequences), dtype=np.float64)
+        features = self.transform_.transform(self._prepared(sequences))
+        return np.asarray(features, dtype=np.float64)
 
     def _split(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         if self.sequence is None:
@@ -150,9 +155,10 @@ class RocketClassifier(_SequenceClassifier):
             StandardScaler(with_mean=False), RidgeClassifierCV(alphas=list(RIDGE_ALPHAS))
         )
 
-    def _transformed(self, sequences: np.ndarray) -> np.ndarray:
-        # aeon's rockets compute in float32; their input must be C-contiguous
-        return super()._transformed(np.ascontiguousarray(sequences, dtype=np.float32))
+    def _prepared(self, sequences: np.ndarray) -> np.ndarray:
+        # aeon's rockets compute in float32 and compile a kernel per memory layout: always
+        # C-contiguous, so that fitting and transforming use the same compiled kernels
+        return np.ascontiguousarray(sequences, dtype=np.float32)
 
 
 class IntervalForestClassifier(_SequenceClassifier):

@@ -159,6 +159,32 @@ def test_flat_classifiers_and_multi_target_bases_work_on_sequence_data_sets() ->
     assert np.mean(predicted[:, 0] == y) == 1.0  # its training data
 
 
+@pytest.mark.parametrize("variant", ["minirocket", "multirocket"])
+def test_rockets_fit_and_transform_through_kernels_of_one_memory_layout(variant: str) -> None:
+    """A rocket's numba kernels compile once per argument type and memory layout (minutes for
+    MultiRocket, cached by scripts/compile_kernels.py for C-contiguous float32): a sequence
+    block read out of a data set's columns (column-major) is a strided view, and must not
+    compile another."""
+    from aeon.transformations.collection.convolution_based import _minirocket, _multirocket
+
+    from touchbench.benchmark.catalogue.time_series import RocketClassifier
+
+    sequences, y = shapes(n=20)
+    columns = sequence_dataset(sequences, y).X  # the gain, then the sequences
+    assert not columns.flags.c_contiguous
+    model = RocketClassifier(variant, n_kernels=84, sequence=(1, len(CHANNELS), LENGTH))
+    model.fit(columns, y).predict(columns)
+    kernels = {
+        "minirocket": [_minirocket._fit_biases, _minirocket._static_transform_multi],
+        "multirocket": [_multirocket._fit_biases_multivariate, _multirocket._transform_multi],
+    }[variant]
+    layouts = {
+        kernel.__name__: {signature[0].layout for signature in kernel.signatures}
+        for kernel in kernels
+    }
+    assert layouts == {kernel.__name__: {"C"} for kernel in kernels}
+
+
 def test_a_trained_minirocket_round_trips_naming_only_its_own_aeon_class() -> None:
     sequences, y = shapes(n=40)
     data = sequence_dataset(sequences, y)
