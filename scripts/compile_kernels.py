@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import functools
+import signal
 import subprocess
 import sys
 import time
@@ -61,8 +62,7 @@ def main(arguments: list[str]) -> int:
     parser.add_argument("step", nargs="?", choices=sorted(STEPS), help="only this step")
     name = parser.parse_args(arguments).step
     if name is None:
-        steps = [subprocess.Popen([sys.executable, __file__, step]) for step in STEPS]
-        return max(step.wait() for step in steps)
+        return _run_steps()
     start = time.monotonic()
     try:
         STEPS[name]()
@@ -71,6 +71,19 @@ def main(arguments: list[str]) -> int:
         return 0
     print(f"{name}: kernels compiled in {time.monotonic() - start:.0f} s", file=sys.stderr)
     return 0
+
+
+def _run_steps() -> int:
+    """Every step at once; a SIGTERM (install.sh's, when pip fails or is interrupted) ends
+    them too, rather than leaving them compiling on their own."""
+    signal.signal(signal.SIGTERM, lambda number, frame: sys.exit(128 + number))
+    steps = [subprocess.Popen([sys.executable, __file__, step]) for step in STEPS]
+    try:
+        return max(step.wait() for step in steps)
+    finally:
+        for step in steps:
+            step.terminate()
+            step.wait()
 
 
 if __name__ == "__main__":

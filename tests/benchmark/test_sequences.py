@@ -161,8 +161,8 @@ def test_flat_classifiers_and_multi_target_bases_work_on_sequence_data_sets() ->
 
 @pytest.mark.parametrize("variant", ["minirocket", "multirocket"])
 def test_rockets_fit_and_transform_through_kernels_of_one_memory_layout(variant: str) -> None:
-    """A rocket's numba kernels compile once per argument type and memory layout (minutes for
-    MultiRocket, cached by scripts/compile_kernels.py for C-contiguous float32): a sequence
+    """A rocket's numba kernels compile once per argument type and memory layout (cached
+    ahead by scripts/compile_kernels.py for C-contiguous float32): a sequence
     block read out of a data set's columns (column-major) is a strided view, and must not
     compile another."""
     from aeon.transformations.collection.convolution_based import _minirocket, _multirocket
