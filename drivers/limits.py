@@ -97,7 +97,11 @@ class LineTooLongError(DriverError):
 
 def bounded_lines(handle: TextIO, *, limit: int, source: str) -> Iterator[str]:
     """The lines of ``handle``, each read up to ``limit`` characters and refused past them,
-    so that no more than ``limit + 1`` characters of one line are ever held.
+    so that no more than ``limit + 2`` characters of one line are ever held.
+
+    A line is read with its line break (two characters for ``\\r\\n``), so that a line of
+    exactly ``limit`` characters comes whole and the lines keep the numbers of the file's
+    own lines (the service's early refusal of an upload names the same line).
 
     Raises
     ------
@@ -106,10 +110,10 @@ def bounded_lines(handle: TextIO, *, limit: int, source: str) -> Iterator[str]:
     """
     number = 0
     while True:
-        line = handle.readline(limit + 1)
+        line = handle.readline(limit + 2)
         if not line:
             return
         number += 1
-        if len(line) > limit and line[-1] not in "\r\n":
+        if len(line) > limit and len(line.rstrip("\r\n")) > limit:
             raise LineTooLongError(source, number, limit)
         yield line

@@ -1,4 +1,4 @@
-"""The JSON API's part of the service: its routers, error answers and upload limit.
+"""The JSON API's part of the service: its routers, error answers and upload limits.
 
 The application is made by :func:`app.main.create_app`, which wires this and the web page.
 """
@@ -20,6 +20,7 @@ from touchbench.app.api.routes import (
     recordings,
     runs,
 )
+from touchbench.app.api.upload_rules import line_rules
 from touchbench.app.api.uploads import BodyLimit
 from touchbench.app.settings import Settings
 
@@ -29,7 +30,10 @@ def install(app: FastAPI, settings: Settings) -> None:
     checks it itself), its error handlers and the upload limit to ``app``."""
     errors.install(app)
     app.add_middleware(
-        BodyLimit, limit=settings.max_upload_bytes, json_limit=settings.max_json_bytes
+        BodyLimit,
+        limit=settings.max_upload_bytes,
+        json_limit=settings.max_json_bytes,
+        line_rules=line_rules,
     )
     protected = [Depends(require_api_key)]
     app.include_router(health.router)

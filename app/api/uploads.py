@@ -1,13 +1,13 @@
 """Uploads: a body-size limit enforced while the body streams in (a lower one, and a depth
-limit, for JSON bodies), uploaded files saved under safe names, and requests built from a
-form's fields."""
+limit, for JSON bodies; a line limit for the text files of a form), uploaded files saved
+under safe names, and requests built from a form's fields."""
 
 from __future__ import annotations
 
 import json
 import re
 import shutil
-from collections.abc import Iterator
+from collections.abc import Awaitable, Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, TypeVar
@@ -18,7 +18,8 @@ from pydantic import ValidationError
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from touchbench.app.api.counting import DepthScan
-from touchbench.app.api.errors import UploadTooLarge, error_body
+from touchbench.app.api.errors import UploadTooLarge, error_body, status_of, where_of
+from touchbench.app.api.multipart_lines import Chooser, MultipartLines, boundary_of
 from touchbench.app.errors import USER_ERRORS, AppError, client_words
 from touchbench.app.schemas.base import Request
 
@@ -27,6 +28,9 @@ RequestType = TypeVar("RequestType", bound=Request)
 #: Bytes copied at a time from an upload to its file.
 CHUNK = 1 << 20
 _UNSAFE = re.compile(r"[^\w.+-]+")
+#: ``rules(scope, declared)``: the line rules of the files of an upload whose body says it
+#: is ``declared`` bytes long (None when not said), None when its lines are not checked.
+LineRules = Callable[[Scope, int | None], Awaitable[Chooser | None]]
 
 
 class JsonTooLarge(UploadTooLarge):
@@ -42,20 +46,32 @@ class JsonTooLarge(UploadTooLarge):
 
 class BodyLimit:
     """ASGI middleware: a request body over ``limit`` bytes (``json_limit`` for a JSON
-    body) is refused with 413, and a JSON body nested too deep with 422
-    (:class:`app.api.counting.DepthScan`), at the chunk where it passes the limit.
+    body) is refused with 413, a JSON body nested too deep with 422
+    (:class:`app.api.counting.DepthScan`), and a form's text file with a line longer than
+    its reader allows as that reader would refuse it (``line_rules``,
+    :class:`app.api.multipart_lines.MultipartLines`), at the chunk where it passes the
+    limit.
 
     A declared ``Content-Length`` over the limit is refused before any byte is read; a
     body without one is counted as it arrives and refused as soon as it passes the limit,
     so that nothing larger is ever spooled to memory or disk.  A JSON body is gathered
     here (the route reads it whole anyway), and answered here when refused: a route's
-    body parser would turn any error met reading the body into a 400.
+    body parser would turn any error met reading the body into a 400.  A form is handed
+    on chunk by chunk as it comes; a line too long is answered here, and the form parser
+    then told that the client went away, so that the route never runs.
     """
 
-    def __init__(self, app: ASGIApp, limit: int, json_limit: int | None = None) -> None:
+    def __init__(
+        self,
+        app: ASGIApp,
+        limit: int,
+        json_limit: int | None = None,
+        line_rules: LineRules | None = None,
+    ) -> None:
         self.app = app
         self.limit = limit
         self.json_limit = limit if json_limit is None else min(limit, json_limit)
+        self.line_rules = line_rules
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] != "http":
@@ -72,17 +88,48 @@ class BodyLimit:
             await self._json(scope, receive, send)
             return
         seen = 0
+        lines = await self._lines(scope, declared)
+        answered = False
 
         async def counted() -> Message:
-            nonlocal seen
+            nonlocal seen, answered
+            if answered:
+                return {"type": "http.disconnect"}
             message = await receive()
             if message["type"] == "http.request":
-                seen += len(message.get("body", b""))
+                body = message.get("body", b"")
+                seen += len(body)
                 if seen > limit:
                     raise too_large(limit)
+                found = lines.feed(body) if lines is not None else None
+                if found is not None:
+                    error = found.error
+                    kind, where = type(error).__name__, where_of(error)
+                    await _answer(send, status_of(error), kind, str(error), where)
+                    # the form parser stops as for a client gone; the route never runs
+                    answered = True
+                    return {"type": "http.disconnect"}
             return message
 
-        await self.app(scope, counted, send)
+        async def unless_answered(message: Message) -> None:
+            if not answered:  # the app's answer to the "disconnect" goes nowhere
+                await send(message)
+
+        await self.app(scope, counted, unless_answered)
+
+    async def _lines(self, scope: Scope, declared: int | None) -> MultipartLines | None:
+        """The scanner of the lines of a form's text files, None for any other body."""
+        if self.line_rules is None:
+            return None
+        boundary = None
+        for key, value in scope.get("headers", ()):
+            if key == b"content-type":
+                boundary = boundary_of(value)
+                break
+        if boundary is None:
+            return None
+        choose = await self.line_rules(scope, declared)
+        return MultipartLines(boundary, choose) if choose is not None else None
 
     async def _json(self, scope: Scope, receive: Receive, send: Send) -> None:
         """Gather a JSON body, refuse it when too large or too deep, else hand it on."""
@@ -208,10 +255,12 @@ def _content_length(scope: Scope) -> int | None:
     return None
 
 
-async def _answer(send: Send, status: int, kind: str, message: str) -> None:
+async def _answer(
+    send: Send, status: int, kind: str, message: str, where: str | None = "body"
+) -> None:
     """Answer the request here, in the service's error body, and close the connection
     (the rest of a refused body is not read)."""
-    body: Any = json.dumps(error_body(kind, message, "body"))
+    body: Any = json.dumps(error_body(kind, message, where))
     await send(
         {
             "type": "http.response.start",

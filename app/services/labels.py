@@ -63,6 +63,12 @@ class LabelTable:
     rows: dict[str, list[LabelRow]]
 
 
+def long_line_error(source: str, line: int, limit: int = LINE_CHARS) -> DataFormatError:
+    """The refusal of a labels file's line longer than ``limit`` characters (as
+    :func:`read_labels` says it; the service's early refusal of an upload says the same)."""
+    return DataFormatError(f"a line longer than {limit:,} characters", source=source, line=line)
+
+
 def count_label_targets(path: Path) -> int:
     """How many target columns the header of a labels CSV names (the file is read up to
     its first non-empty row only; a file that cannot be read counts 0, and
@@ -121,9 +127,7 @@ def read_labels(path: Path, *, max_rows: int | None = None) -> LabelTable:
     except csv.Error as error:
         raise DataFormatError(csv_problem(error), source=source, line=line + 1) from None
     except LineTooLongError as error:
-        raise DataFormatError(
-            f"a line longer than {error.limit:,} characters", source=source, line=error.line
-        ) from None
+        raise long_line_error(source, error.line, error.limit) from None
     if not by_file:
         raise DataFormatError("the labels file has a header but no rows", source=source)
     for file_name, entries in by_file.items():

@@ -376,6 +376,17 @@ def predict_path(
     return predict(model, data, source=path.name).report(info)
 
 
+def predicts_recordings(store: Store, ref: str | int) -> bool:
+    """Whether a file posted to the model ``ref`` may be a raw recording
+    (:func:`predict_path`): the model was trained on extracted features.
+
+    Raises
+    ------
+    NotFoundError
+    """
+    return get_model(store, ref).extraction is not None
+
+
 def is_recording(path: Path, schema: Schema) -> bool:
     """Whether ``path`` is a raw recording rather than a file of instances: anything but
     ARFF and CSV, or a CSV whose header names none of the model's features (a time

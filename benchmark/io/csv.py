@@ -97,6 +97,17 @@ def _records(text: str, delimiter: str, source: str) -> list[Record]:
     return records
 
 
+def long_line_error(source: str, line: int) -> DataFormatError:
+    """The refusal of a line longer than :data:`MAX_LINE` characters, ``\\n`` alone ending
+    a line (as :func:`read_csv` finds it; the service's early refusal of an upload says the
+    same)."""
+    return DataFormatError(
+        f"a line longer than {MAX_LINE:,} characters (a file of one line?)",
+        source=source,
+        line=line,
+    )
+
+
 def csv_problem(error: csv.Error) -> str:
     """What ``csv``'s ``error`` means, in the words of a file's author.
 
@@ -218,11 +229,7 @@ def read_csv(
     source = source or named
     long_line = _LONG_LINE.search(text)  # one pass in C before any cell is made
     if long_line is not None:
-        raise DataFormatError(
-            f"a line longer than {MAX_LINE:,} characters (a file of one line?)",
-            source=source,
-            line=text.count("\n", 0, long_line.start()) + 1,
-        )
+        raise long_line_error(source, text.count("\n", 0, long_line.start()) + 1)
     records = _records(text, sniff_delimiter(text), source)
     if not records:
         raise DataFormatError("empty file", source=source)

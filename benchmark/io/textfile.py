@@ -35,6 +35,11 @@ BLOCK_BYTES = 4 << 20
 #: would otherwise be held, and then split, whole.  Rows of sequence data sets are long
 #: (44 channels x 800 steps are about 700 KB of text), hence the room.
 MAX_LINE_BYTES = 8 << 20
+#: A line longer than this many bytes is refused by :class:`LineBlocks` wherever it falls:
+#: the reader checks a line when a read of :data:`BLOCK_BYTES` brings no line break, so a
+#: line a little over :data:`MAX_LINE_BYTES` whose end comes in the same read as its
+#: first bytes past the limit is read whole.
+REFUSED_LINE_BYTES = MAX_LINE_BYTES + BLOCK_BYTES
 _UTF16_BOMS = (b"\xff\xfe", b"\xfe\xff")
 _UTF8_BOM = b"\xef\xbb\xbf"
 _CONTROL = re.compile(r"[\x00-\x08\x0e-\x1f\x7f]")
@@ -286,6 +291,16 @@ def count_line_ends(data: bytes) -> int:
     return newlines + data.count(b"\r") - data.count(b"\r\n")
 
 
+def long_line_error(source: str | None, line: int) -> DataFormatError:
+    """The refusal of a line longer than :data:`MAX_LINE_BYTES` (as :class:`LineBlocks`
+    finds it; the service's early refusal of an upload says the same)."""
+    return DataFormatError(
+        f"a line longer than {MAX_LINE_BYTES:,} bytes (a file of one line?)",
+        source=source,
+        line=line,
+    )
+
+
 class LineBlocks:
     """A binary stream read as lines, then as blocks of whole lines.
 
@@ -405,11 +420,7 @@ class LineBlocks:
         """Refuse the line from ``start`` when it is longer than :data:`MAX_LINE_BYTES`
         and has no line break yet."""
         if len(data) - start > MAX_LINE_BYTES:
-            raise DataFormatError(
-                f"a line longer than {MAX_LINE_BYTES:,} bytes (a file of one line?)",
-                source=self._source,
-                line=self.lines_read + 1,
-            )
+            raise long_line_error(self._source, self.lines_read + 1)
 
     def _cut(self, data: bytes) -> int:
         """Length of the longest prefix of whole lines (0 if there is none yet)."""

@@ -21,14 +21,18 @@ def test_bounded_lines_refuse_a_long_line_without_reading_it_whole() -> None:
     assert next(lines) == "a,b\n" and next(lines) == "x" * 50 + "\n"
     with pytest.raises(LineTooLongError, match=r"^f\.csv:3: a line longer than 60 characters"):
         next(lines)
-    assert handle.tell() == 4 + 51 + 61  # read up to the limit and one more, no further
+    assert handle.tell() == 4 + 51 + 62  # up to the limit and a line break, no further
 
 
-def test_a_line_of_exactly_the_limit_is_read() -> None:
-    assert list(bounded_lines(io.StringIO("x" * 8 + "\r\n"), limit=8, source="f")) == [
-        "x" * 8 + "\r",
-        "\n",
-    ]
+def test_a_line_of_exactly_the_limit_is_read_whole_with_its_line_break() -> None:
+    text = "x" * 8 + "\r\n" + "y" * 8 + "\n" + "z" * 9 + "\r\n"
+    lines = bounded_lines(io.StringIO(text), limit=8, source="f")
+    assert [next(lines), next(lines)] == ["x" * 8 + "\r\n", "y" * 8 + "\n"]
+    with pytest.raises(LineTooLongError, match=r"^f:3: ") as refused:
+        next(lines)
+    assert refused.value.line == 3  # the file's own third line, not one more
+    handle = io.TextIOWrapper(io.BytesIO(text.encode()), newline="", encoding="utf-8")
+    assert [len(line) for line in bounded_lines(handle, limit=9, source="f")] == [10, 9, 11]
 
 
 def test_a_gap_is_refused_before_the_grid_is_made() -> None:

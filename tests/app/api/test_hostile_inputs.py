@@ -179,6 +179,135 @@ def test_a_20_mb_csv_of_one_line_is_refused_as_it_streams_in(
     _within_bound(served)
 
 
+class _OneLine(io.RawIOBase):
+    """A file of ``head`` then one line of ``0.5,`` to ``size`` bytes, made as the client
+    reads it; :attr:`sent` counts the bytes it has read."""
+
+    def __init__(self, size: int, head: bytes = b"") -> None:
+        super().__init__()
+        self.size, self.head, self.sent = size, head, 0
+        self._block = b"0.5," * (1 << 15)
+
+    def readable(self) -> bool:
+        return True
+
+    def read(self, size: int | None = -1) -> bytes:
+        size = min(self.size - self.sent, 1 << 16 if size is None or size < 0 else size)
+        if size <= 0:
+            return b""
+        at = self.sent
+        data = self.head[at : at + size]
+        if len(data) < size:
+            offset = (at + len(data) - len(self.head)) % 4
+            data += self._block[offset : offset + size - len(data)]
+        self.sent += len(data)
+        return data
+
+
+def _written_mb(server: Server) -> float:
+    """The bytes the service process has written (``wchar``: to files, its spool
+    included), in MB."""
+    assert server.process is not None
+    io_counts = Path(f"/proc/{server.process.pid}/io").read_text()
+    match = re.search(r"^wchar:\s+(\d+)", io_counts, re.MULTILINE)
+    assert match, io_counts
+    return int(match.group(1)) / 2**20
+
+
+def _stored(server: Server) -> tuple[object, ...]:
+    """What the service keeps: its work folder's files, data sets, jobs, runs, replays."""
+    client = server.client
+    return (
+        sorted(str(path) for path in server.work_dir.rglob("*")),
+        client.get("/api/datasets").json(),
+        client.get("/api/jobs").json(),
+        client.get("/api/runs").json(),
+        client.get("/api/live/recordings").json(),
+    )
+
+
+_ARFF_HEAD = b"@relation r\n@attribute a numeric\n@attribute c {x,y}\n@data\n"
+
+
+@on_sqlite
+@pytest.mark.parametrize(
+    ("path", "field", "name", "head", "said"),
+    [
+        (
+            "/api/models/takes-nb/predict/file",
+            "file",
+            "one-line.csv",
+            b"",
+            "LineTooLongError: one-line.csv:1: a line longer than 1,048,576 characters",
+        ),
+        (
+            "/api/datasets",
+            "file",
+            "one-line.csv",
+            b"",
+            "DataFormatError: one-line.csv:1: a line longer than 8,388,608 characters",
+        ),
+        (
+            "/api/datasets",
+            "file",
+            "one-line.arff",
+            _ARFF_HEAD,
+            "DataFormatError: one-line.arff:5: a line longer than 8,388,608 bytes",
+        ),
+        (
+            "/api/datasets/recordings",
+            "labels",
+            "one-line-labels.csv",
+            b"file,state\n",
+            "DataFormatError: one-line-labels.csv:2: a line longer than 1,048,576 characters",
+        ),
+        (
+            "/api/datasets/recordings",
+            "recordings",
+            "take-long.csv",
+            b"time,ch1\n",
+            "LineTooLongError: take-long.csv:2: a line longer than 1,048,576 characters",
+        ),
+        (
+            "/api/live/recordings",
+            "recording",
+            "one-line.csv",
+            b"",
+            "AppError: one-line.csv:1: a line longer than 1,048,576 characters",
+        ),
+        (
+            "/api/runs/import-results",
+            "file",
+            "results.arff",
+            _ARFF_HEAD,
+            "DataFormatError: results.arff:5: a line longer than 8,388,608 bytes",
+        ),
+    ],
+)
+def test_a_line_too_long_is_refused_before_the_upload_is_read(
+    served: Server, tmp_path: Path, path: str, field: str, name: str, head: bytes, said: str
+) -> None:
+    """A 64 MB file of one long line, sent as the client reads it: the answer is the
+    reader's refusal, said before the client has sent half of it; the service neither
+    spools it nor keeps anything of the request."""
+    take = timed_takes(tmp_path / "takes", n_takes=1)[0][0]
+    before, written = _stored(served), _written_mb(served)
+    upload = _OneLine(64 << 20, head)
+    files: list[tuple[str, tuple[str, Any]]] = [(field, (name, upload))]
+    if field == "labels":
+        files.insert(0, ("recordings", (take.name, take.read_bytes())))
+    data = {"extractor": "window"} if path.endswith("/recordings") and field != "recording" else {}
+    answer = served.client.post(path, files=files, data=data)
+    kind, _, words = said.partition(": ")
+    error = _refusal(answer, 400, words)
+    assert error["type"] == kind
+    spooled = _written_mb(served) - written
+    assert spooled < 16, f"the service wrote {spooled:.0f} MB: the upload was spooled"
+    assert upload.sent < upload.size // 2, f"the client sent {upload.sent:,} bytes"
+    assert _stored(served) == before, "the refused request left something behind"
+    _within_bound(served)
+
+
 # -- 4. labels files streamed and bounded ------------------------------------------------------
 
 
