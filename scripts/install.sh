@@ -58,3 +58,9 @@ if [ ! -f "$stamp" ]; then
   rm -f .venv/.installed-*
   touch "$stamp"
 fi
+
+# The project's own modules compiled to bytecode, as pip compiles what it installs (an
+# editable install's sources are this folder's): every touchbench process (a service, a
+# job, each engine worker) then reads them rather than compiling them again, also where
+# PYTHONDONTWRITEBYTECODE is set.  Only what changed since the last run is compiled.
+.venv/bin/python -m compileall -q -j 0 touchbench app benchmark features drivers >/dev/null

@@ -9,6 +9,11 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 bash scripts/install.sh
+# The suite starts hundreds of Python processes (services, jobs, engine workers, the CLI)
+# and three pytest workers that each rewrite every test module's assertions: all of them
+# keep their bytecode in __pycache__ (git ignores it) rather than compiling it again, even
+# where the environment says PYTHONDONTWRITEBYTECODE.
+unset PYTHONDONTWRITEBYTECODE
 if bash scripts/postgres.sh; then
   export TOUCHBENCH_TEST_POSTGRES_URL=${TOUCHBENCH_TEST_POSTGRES_URL:-postgresql://postgres:postgres@127.0.0.1:5432/test}
 else
