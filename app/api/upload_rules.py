@@ -33,6 +33,7 @@ from touchbench.app.api.multipart_lines import Chooser, FilePart, LineRule
 from touchbench.app.api.uploads import safe_name
 from touchbench.app.errors import AppError
 from touchbench.app.services.datasets import guess_format
+from touchbench.app.services.labels import long_line_error as labels_line_error
 from touchbench.app.services.limits import read_limits
 from touchbench.benchmark.io.csv import MAX_LINE
 from touchbench.benchmark.io.csv import long_line_error as csv_line_error
@@ -105,8 +106,6 @@ def _session_file(part: FilePart) -> LineRule | None:
     if part.field == "recordings":
         return _recording(safe_name(part.filename, f"recording-{part.index}"))
     if part.field == "labels":
-        from touchbench.app.services.labels import long_line_error as labels_line_error
-
         name = safe_name(part.filename, "labels.csv")
         return LineRule(LINE_CHARS, lambda line: labels_line_error(name, line), utf8=True)
     return None
