@@ -3,7 +3,7 @@ the service's peak memory and another client's one-instance prediction latency d
 (that client in a process of its own), beside the same latency on the idle service just
 before (the two windows alternate).
 
-    .venv/bin/python perf/hostile.py [--quick] [--seconds 8] [--db URL] [--only pages]
+    .venv/bin/python perf/hostile.py [--quick] [--seconds 8] [--db URL] [--only pages] [--pace 0.5]
 
 Goal: every case under 300 MB over idle and its p99 within 2x of the idle p99.  Memory is
 the service process's resident set sampled every 10 ms during the case (its growth over
@@ -184,6 +184,20 @@ def once(replay: Callable[[], object]) -> Callable[[], object]:
         return done[0]
 
     return first
+
+
+def paced(replay: Callable[[], object], seconds: float) -> Callable[[], object]:
+    """``replay`` taking at least ``seconds`` (it sleeps the rest): a case then asks at one
+    rate whatever a version of the service answers in, and the measuring client's p99
+    compares the service's cost, not how fast the hostile client can ask."""
+
+    def at_pace() -> object:
+        start = time.monotonic()
+        said = replay()
+        time.sleep(max(0.0, seconds - (time.monotonic() - start)))
+        return said
+
+    return at_pace
 
 
 def post_file(client: httpx.Client, path: str, file: Path, **data: str) -> int:
@@ -428,6 +442,12 @@ def main() -> None:
     parser.add_argument(
         "--repeat", type=int, default=1, help="replay the cases this many times, in turn"
     )
+    parser.add_argument(
+        "--pace",
+        type=float,
+        help="replay each case at most once per this many seconds (default: back to back); "
+        "two versions of the service then meet the same request rate",
+    )
     args = parser.parse_args()
     seconds = args.seconds or (3.0 if args.quick else 8.0)
     rows = []
@@ -458,6 +478,7 @@ def main() -> None:
                 window(prober, process.pid, 1.0)  # warm: the model loaded
                 idle_hwm = peak_rss_mb(process.pid)  # after every case's set-up
                 for name, replay in cases:
+                    replay = paced(replay, args.pace) if args.pace else replay
                     # the sides alternate, so that a change of the machine's load meets both
                     idle = window(prober, process.pid, seconds)
                     busy = window(prober, process.pid, seconds, replay)
