@@ -29,8 +29,14 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Literal
 
-import numpy as np
 from python_multipart.multipart import parse_options_header
+
+from touchbench.benchmark.io.textfile import (
+    UTF8_BOM,
+    UTF16_BOMS,
+    count_line_ends,
+    count_newlines,
+)
 
 #: Bytes a text reader decodes past the point where it finds a line too long (what
 #: ``io.TextIOWrapper`` reads at a time): a strict UTF-8 reader meets an undecodable byte
@@ -42,8 +48,6 @@ READ_AHEAD = 8192
 MAX_HEADERS = 16 << 10
 #: The most bytes of a form field's value kept for :attr:`FilePart.fields`.
 FIELD_BYTES = 1024
-_UTF8_BOM = b"\xef\xbb\xbf"
-_UTF16_BOMS = (b"\xff\xfe", b"\xfe\xff")
 #: The bytes that continue a UTF-8 character (not counted as characters).
 _CONTINUATION = bytes(range(0x80, 0xC0))
 
@@ -149,14 +153,14 @@ class _Lines:
             return None
         if not self._started:
             data = self._held + data
-            if len(data) < len(_UTF8_BOM) and _mark_begins(data):
+            if len(data) < len(UTF8_BOM) and _mark_begins(data):
                 self._held = data
                 return None
             self._started, self._held = True, b""
-            if data.startswith(_UTF16_BOMS):  # transcoded by some readers: left to them
+            if data.startswith(UTF16_BOMS):  # transcoded by some readers: left to them
                 self.on = False
                 return None
-            data = data.removeprefix(_UTF8_BOM)
+            data = data.removeprefix(UTF8_BOM)
         return self._follow(data)
 
     def finish(self) -> int | None:
@@ -240,7 +244,7 @@ class _Lines:
 
 def _mark_begins(data: bytes) -> bool:
     """Whether ``data`` may be the start of a byte-order mark."""
-    return any(mark.startswith(data) for mark in (_UTF8_BOM, *_UTF16_BOMS))
+    return any(mark.startswith(data) for mark in (UTF8_BOM, *UTF16_BOMS))
 
 
 def _first_break(data: bytes, any_break: bool) -> int:
@@ -257,19 +261,8 @@ def _last_break(data: bytes, any_break: bool) -> int:
 
 
 def _count_breaks(data: bytes, any_break: bool) -> int:
-    """Line breaks in ``data`` (``\\r\\n`` counts once).
-
-    Counted by NumPy: ``bytes.count`` goes a byte at a time, several times slower, and an
-    upload of many short lines has them counted in every chunk.
-    """
-    codes = np.frombuffer(data, dtype=np.uint8)
-    newlines = codes == 10
-    count = int(np.count_nonzero(newlines))
-    if not any_break or b"\r" not in data:
-        return count
-    carriages = codes == 13
-    pairs = int(np.count_nonzero(carriages[:-1] & newlines[1:]))
-    return count + int(np.count_nonzero(carriages)) - pairs
+    """Line breaks in ``data`` (``\\r\\n`` counts once), as the rule says lines end."""
+    return count_line_ends(data) if any_break else count_newlines(data)
 
 
 def _measure(data: bytes, unit: str) -> int:

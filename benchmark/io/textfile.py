@@ -40,8 +40,10 @@ MAX_LINE_BYTES = 8 << 20
 #: line a little over :data:`MAX_LINE_BYTES` whose end comes in the same read as its
 #: first bytes past the limit is read whole.
 REFUSED_LINE_BYTES = MAX_LINE_BYTES + BLOCK_BYTES
-_UTF16_BOMS = (b"\xff\xfe", b"\xfe\xff")
-_UTF8_BOM = b"\xef\xbb\xbf"
+#: The byte-order marks of UTF-16 (a file that starts with one is transcoded, not read as
+#: bytes) and of UTF-8 (dropped).
+UTF16_BOMS = (b"\xff\xfe", b"\xfe\xff")
+UTF8_BOM = b"\xef\xbb\xbf"
 _CONTROL = re.compile(r"[\x00-\x08\x0e-\x1f\x7f]")
 _LINE_END = re.compile(rb"\r\n|\r|\n")
 
@@ -117,7 +119,7 @@ def sniff_text(head: bytes, *, source: str) -> None:
     DataFormatError
         If the bytes hold a NUL (outside UTF-16) or more than 1 % control characters.
     """
-    if head.startswith(_UTF16_BOMS):
+    if head.startswith(UTF16_BOMS):
         text = head.decode("utf-16", errors="replace")
     else:
         if b"\x00" in head:
@@ -173,10 +175,10 @@ def scan_file(
         digest.update(chunk)
         body = chunk
         if total == 0:
-            if chunk.startswith(_UTF16_BOMS):
+            if chunk.startswith(UTF16_BOMS):
                 utf16 = codecs.getincrementaldecoder("utf-16")()
                 utf8 = None
-            body = chunk.removeprefix(_UTF8_BOM)
+            body = chunk.removeprefix(UTF8_BOM)
         total += len(chunk)
         if utf16 is not None:
             try:
@@ -232,7 +234,7 @@ def decode_text(data: str | bytes, *, source: str) -> str:
         If the file is empty (or only whitespace) or is not a text file.
     """
     if isinstance(data, bytes):
-        if data.startswith(_UTF16_BOMS):
+        if data.startswith(UTF16_BOMS):
             try:
                 text = data.decode("utf-16")
             except UnicodeDecodeError:
@@ -283,12 +285,21 @@ def split_lines(text: str) -> list[str]:
     return text.split("\n")
 
 
+def count_newlines(data: bytes) -> int:
+    """How many ``\\n`` ``data`` holds (counted by NumPy: ``bytes.count`` is several times
+    slower where they are dense, as in a block of short lines)."""
+    return int(np.count_nonzero(np.frombuffer(data, dtype=np.uint8) == 10))
+
+
 def count_line_ends(data: bytes) -> int:
-    """How many lines ``data`` ends (``\\r\\n`` counts once)."""
-    newlines = int(np.count_nonzero(np.frombuffer(data, dtype=np.uint8) == 10))
+    """How many lines ``data`` ends, ``\\r\\n``, ``\\r`` and ``\\n`` each ending one
+    (``\\r\\n`` counts once)."""
     if b"\r" not in data:
-        return newlines
-    return newlines + data.count(b"\r") - data.count(b"\r\n")
+        return count_newlines(data)
+    codes = np.frombuffer(data, dtype=np.uint8)
+    newlines, carriages = codes == 10, codes == 13
+    pairs = int(np.count_nonzero(carriages[:-1] & newlines[1:]))
+    return int(np.count_nonzero(newlines)) + int(np.count_nonzero(carriages)) - pairs
 
 
 def long_line_error(source: str | None, line: int) -> DataFormatError:
@@ -362,7 +373,7 @@ class LineBlocks:
                 "utf-8", "surrogatepass"
             )
         else:
-            data = chunk if self._started else chunk.removeprefix(_UTF8_BOM)
+            data = chunk if self._started else chunk.removeprefix(UTF8_BOM)
         self._started = True
         self._eof = not chunk
         self._buffer = self._buffer[self._position :] + data
