@@ -1,12 +1,17 @@
 """Worker processes that hold one run's data and execute its tasks on request.
 
-A worker is a fresh Python interpreter (``subprocess``, not ``multiprocessing``): it can be
+A worker is forked from this process's zygote (:mod:`benchmark.run.zygote`), a fresh
+interpreter that has imported what every worker needs, or, where no zygote answers, is a
+fresh interpreter itself (``subprocess``, not ``multiprocessing``).  Either way it can be
 started from anywhere (a multi-threaded service, a daemonic Dask worker), its BLAS and
-OpenMP thread counts are set through its environment before any library loads, and it can
-be killed outright (its whole process group) when a task overruns its time limit, native
-code included.  The run's :class:`~benchmark.run.task.TaskContext` is pickled once by the
-parent and sent to each worker once; afterwards each task costs one small message each
-way.
+OpenMP thread counts are set through the environment before those libraries load, and it
+can be killed outright (its whole process group) when a task overruns its time limit,
+native code included.  BLAS and OpenMP get one thread each: parallelism comes from running
+several workers, the matrices of a fold are small, and threads that spin-wait for cores
+other processes hold slow fits down many times.
+
+The run's :class:`~benchmark.run.task.TaskContext` is pickled once by the parent and sent
+to each worker once; afterwards each task costs one small message each way.
 
 Messages from a worker: ``("ready", pid)`` once the context is loaded, ``("result",
 TaskResult)`` per task, ``("broken", text)`` if the context cannot be loaded.
@@ -23,16 +28,41 @@ import sys
 import tempfile
 import threading
 import time
+from collections.abc import Callable
 from multiprocessing.connection import Connection
-from typing import Any
+from typing import Any, TypeAlias
 
 from touchbench.benchmark.results import TaskKey, TaskResult
+from touchbench.benchmark.run import zygote
 from touchbench.benchmark.run.task import describe_exception, execute_task
+from touchbench.benchmark.run.zygote import ForkedProcess
 
 #: Characters of a dead worker's stderr quoted in the error.
 STDERR_TAIL = 300
 #: Seconds between a worker's checks that its parent is still alive.
 PARENT_CHECK_INTERVAL = 1.0
+#: How a fresh interpreter becomes a worker (its arguments: the pipes and the memory limit).
+FRESH_WORKER = "from touchbench.benchmark.run.worker import serve; serve()"
+#: What a worker imports, once for all a process's workers (by the zygote).
+PRELOAD = (
+    __name__,
+    "sklearn.calibration",
+    "sklearn.discriminant_analysis",
+    "sklearn.ensemble",
+    "sklearn.linear_model",
+    "sklearn.metrics",
+    "sklearn.model_selection",
+    "sklearn.naive_bayes",
+    "sklearn.neighbors",
+    "sklearn.neural_network",
+    "sklearn.preprocessing",
+    "sklearn.svm",
+    "sklearn.tree",
+    "xgboost",
+)
+
+
+Process: TypeAlias = "ForkedProcess | subprocess.Popen[bytes]"
 
 
 class WorkerDiedError(Exception):
@@ -46,42 +76,43 @@ class Worker:
     ----------
     context : bytes
         The pickled :class:`~benchmark.run.task.TaskContext`.
-    threads : int
-        OpenMP threads the worker may use; BLAS always gets one.  Parallelism comes from
-        running several workers: the matrices of a fold are small, and BLAS or OpenMP
-        threads that spin-wait for cores other processes hold slow fits down many times
-        (a logistic regression 100x, histogram boosting 5x on a busy 2-core machine).
     max_memory : int, optional
         Bytes of data memory each task may allocate on top of what the worker holds once
         the run's data is loaded (``RLIMIT_DATA``); a task that needs more fails with an
         out-of-memory error instead of taking the machine down.
     """
 
-    def __init__(self, context: bytes, *, threads: int = 1, max_memory: int | None = None) -> None:
-        parent_in, child_out = os.pipe()
-        child_in, parent_out = os.pipe()
+    def __init__(self, context: bytes, *, max_memory: int | None = None) -> None:
         self._stderr = tempfile.TemporaryFile()  # noqa: SIM115 (open for the worker's life)
-        command = [
-            sys.executable,
-            "-c",
-            "from touchbench.benchmark.run.worker import serve; serve()",
-            str(child_in),
-            str(child_out),
-            str(max_memory or 0),
-        ]
-        try:
-            self.process = subprocess.Popen(
-                command,
+        environment = _worker_environment()
+        limit = max_memory or 0
+
+        def fork(child_in: int, child_out: int) -> ForkedProcess | None:
+            return zygote.spawn(
+                f"{__name__}:serve_pipes",
+                (child_in, child_out),
+                (limit,),
+                stderr=self._stderr,
+                environment=environment,
+                preload=PRELOAD,
+            )
+
+        def interpret(child_in: int, child_out: int) -> subprocess.Popen[bytes]:
+            command = [sys.executable, "-c", FRESH_WORKER, str(child_in), str(child_out)]
+            return subprocess.Popen(
+                [*command, str(limit)],
                 pass_fds=(child_in, child_out),
                 stdin=subprocess.DEVNULL,
                 stdout=subprocess.DEVNULL,
                 stderr=self._stderr,
-                env=_worker_environment(threads),
+                env=environment,
                 start_new_session=True,
             )
-        finally:
-            os.close(child_in)
-            os.close(child_out)
+
+        # a fresh interpreter where no zygote answers, with pipes of its own
+        started = _with_pipes(fork) or _with_pipes(interpret)
+        assert started is not None  # Popen answers or raises
+        parent_in, parent_out, self.process = started
         self.connection = Connection(parent_in, writable=False)
         self._outbox = Connection(parent_out, readable=False)
         self.ready = False
@@ -173,6 +204,29 @@ class Worker:
         return lines[-1][-STDERR_TAIL:] if lines else ""
 
 
+def _with_pipes(
+    start: Callable[[int, int], Process | None],
+) -> tuple[int, int, Process] | None:
+    """Start a worker on two new pipes: the parent's ends and the process, or ``None``.
+
+    ``start`` is given the worker's ends (read, write), which are closed here afterwards.
+    """
+    parent_in, child_out = os.pipe()
+    child_in, parent_out = os.pipe()
+    try:
+        process = start(child_in, child_out)
+    except BaseException:
+        process = None
+        raise
+    finally:
+        os.close(child_in)
+        os.close(child_out)
+        if process is None:
+            os.close(parent_in)
+            os.close(parent_out)
+    return None if process is None else (parent_in, parent_out, process)
+
+
 def _exit_with_parent(parent: int) -> None:
     """End this worker, even in the middle of a fit, once its parent has died (kill -9)."""
     while os.getppid() == parent:
@@ -180,7 +234,7 @@ def _exit_with_parent(parent: int) -> None:
     os._exit(1)
 
 
-def _worker_environment(threads: int) -> dict[str, str]:
+def _worker_environment() -> dict[str, str]:
     environment = dict(os.environ)
     paths = [p for p in sys.path if p]
     if environment.get("PYTHONPATH"):
@@ -188,7 +242,7 @@ def _worker_environment(threads: int) -> dict[str, str]:
     environment["PYTHONPATH"] = os.pathsep.join(dict.fromkeys(paths))
     for name in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS"):
         environment[name] = "1"
-    environment["OMP_NUM_THREADS"] = str(max(1, threads))
+    environment["OMP_NUM_THREADS"] = "1"
     return environment
 
 
@@ -205,10 +259,23 @@ def _limit_data_memory(extra: int) -> None:
 
 
 def serve() -> None:
-    """The worker's main loop: load the context, then run tasks until told to stop."""
+    """A fresh interpreter's worker: its pipes and memory limit are its arguments."""
+    serve_pipes(int(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3]) if len(sys.argv) > 3 else 0)
+
+
+def serve_pipes(inbox_fd: int, outbox_fd: int, limit: int) -> None:
+    """The worker's main loop: load the context, then run tasks until told to stop.
+
+    Parameters
+    ----------
+    inbox_fd, outbox_fd : int
+        The read end of the pipe from the parent and the write end of the pipe to it.
+    limit : int
+        Bytes of data memory a task may allocate beyond the loaded context; 0 for no limit.
+    """
     threading.Thread(target=_exit_with_parent, args=(os.getppid(),), daemon=True).start()
-    inbox = Connection(int(sys.argv[1]), writable=False)
-    outbox = Connection(int(sys.argv[2]), readable=False)
+    inbox = Connection(inbox_fd, writable=False)
+    outbox = Connection(outbox_fd, readable=False)
     try:
         context = pickle.loads(inbox.recv_bytes())
     except EOFError:
@@ -216,7 +283,6 @@ def serve() -> None:
     except Exception as exc:
         outbox.send(("broken", f"cannot load the run's data: {describe_exception(exc)}"))
         return
-    limit = int(sys.argv[3]) if len(sys.argv) > 3 else 0
     if limit > 0:
         _limit_data_memory(limit)
     outbox.send(("ready", os.getpid()))
