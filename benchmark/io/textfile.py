@@ -386,18 +386,22 @@ class LineBlocks:
             match = _LINE_END.search(self._buffer, self._position)
             # A "\r" ending the buffer may be the first half of a "\r\n" not read yet.
             if match is not None and (self._eof or match.end() < len(self._buffer)):
+                # its end may have come in the same chunk that took it past the limit
+                if match.start() - self._position > MAX_LINE_BYTES:
+                    raise long_line_error(self._source, self.lines_read + 1)
                 line = self._buffer[self._position : match.start()]
                 self._position = match.end()
                 self.lines_read += 1
                 return line
             self._check_line(self._buffer, self._position)
-            if not self._read():
-                if self._position >= len(self._buffer):
-                    return None
-                line = self._buffer[self._position :]
-                self._position = len(self._buffer)
-                self.lines_read += 1
-                return line
+            if self._read() or match is not None:
+                continue  # read on; or the stream has ended, and that line end is whole
+            if self._position >= len(self._buffer):
+                return None
+            line = self._buffer[self._position :]
+            self._position = len(self._buffer)
+            self.lines_read += 1
+            return line
 
     def blocks(self) -> Iterator[tuple[bytes, int]]:
         """The rest of the stream as blocks of whole lines.
@@ -422,6 +426,7 @@ class LineBlocks:
             if not rest:
                 return
             block = rest[:cut]
+            self._check_lines(block)
             self._buffer, self._position = rest[cut:], 0
             first_line = self.lines_read + 1
             self.lines_read += count_line_ends(block)
@@ -429,9 +434,24 @@ class LineBlocks:
 
     def _check_line(self, data: bytes, start: int) -> None:
         """Refuse the line from ``start`` when it is longer than :data:`MAX_LINE_BYTES`
-        and has no line break yet."""
-        if len(data) - start > MAX_LINE_BYTES:
+        and has no line break yet (but perhaps the first byte of one, at the very end)."""
+        if len(data) - start - data.endswith((b"\n", b"\r")) > MAX_LINE_BYTES:
             raise long_line_error(self._source, self.lines_read + 1)
+
+    def _check_lines(self, block: bytes) -> None:
+        """Refuse the first line of ``block`` longer than :data:`MAX_LINE_BYTES`: a line
+        whose end came in the chunk that took it past the limit, or any line of a block
+        larger than the limit."""
+        if len(block) <= MAX_LINE_BYTES:
+            return
+        codes = np.frombuffer(block, dtype=np.uint8)
+        breaks = np.flatnonzero((codes == 10) | (codes == 13))  # "\r\n": a line of 0
+        starts = np.concatenate(([0], breaks + 1))
+        lengths = np.concatenate((breaks, [len(block)])) - starts
+        long = np.flatnonzero(lengths > MAX_LINE_BYTES)
+        if long.size:
+            before = block[: int(starts[long[0]])]
+            raise long_line_error(self._source, self.lines_read + 1 + count_line_ends(before))
 
     def _cut(self, data: bytes) -> int:
         """Length of the longest prefix of whole lines (0 if there is none yet)."""
