@@ -37,7 +37,7 @@ from touchbench.app.services.labels import long_line_error as labels_line_error
 from touchbench.app.services.limits import read_limits
 from touchbench.benchmark.io.csv import MAX_LINE
 from touchbench.benchmark.io.csv import long_line_error as csv_line_error
-from touchbench.benchmark.io.textfile import REFUSED_LINE_BYTES
+from touchbench.benchmark.io.textfile import MAX_LINE_BYTES
 from touchbench.benchmark.io.textfile import long_line_error as arff_line_error
 from touchbench.drivers.limits import LINE_CHARS, LineTooLongError, ReadLimits
 from touchbench.drivers.replay import CSV_SUFFIXES
@@ -153,7 +153,7 @@ def _data_file(name: str, file_format: str) -> LineRule:
     ARFF (read in blocks of bytes)."""
     if file_format == "csv":
         return LineRule(MAX_LINE, lambda line: csv_line_error(name, line), breaks="lf")
-    return LineRule(REFUSED_LINE_BYTES, lambda line: arff_line_error(name, line), unit="bytes")
+    return LineRule(MAX_LINE_BYTES, lambda line: arff_line_error(name, line), unit="bytes")
 
 
 def _recording(

@@ -35,11 +35,6 @@ BLOCK_BYTES = 4 << 20
 #: would otherwise be held, and then split, whole.  Rows of sequence data sets are long
 #: (44 channels x 800 steps are about 700 KB of text), hence the room.
 MAX_LINE_BYTES = 8 << 20
-#: A line longer than this many bytes is refused by :class:`LineBlocks` wherever it falls:
-#: the reader checks a line when a read of :data:`BLOCK_BYTES` brings no line break, so a
-#: line a little over :data:`MAX_LINE_BYTES` whose end comes in the same read as its
-#: first bytes past the limit is read whole.
-REFUSED_LINE_BYTES = MAX_LINE_BYTES + BLOCK_BYTES
 #: The byte-order marks of UTF-16 (a file that starts with one is transcoded, not read as
 #: bytes) and of UTF-8 (dropped).
 UTF16_BOMS = (b"\xff\xfe", b"\xfe\xff")

@@ -176,6 +176,12 @@ def test_a_20_mb_csv_of_one_line_is_refused_as_it_streams_in(
     with arff.open("rb") as handle:
         imported = served.client.post("/api/datasets", files={"file": (arff.name, handle)})
     _refusal(imported, 400, "one-line.arff:5: a line longer than 8,388,608 bytes")
+    # a line just over the limit, ended, and a row after it: refused at the limit too (the
+    # reader once read lines up to a chunk over it whole, and the early scan let them by)
+    arff.write_bytes(_ARFF_HEAD + b"1," * (9 << 19) + b"x\n1,y\n")
+    with arff.open("rb") as handle:
+        imported = served.client.post("/api/datasets", files={"file": (arff.name, handle)})
+    _refusal(imported, 400, "one-line.arff:5: a line longer than 8,388,608 bytes")
     _within_bound(served)
 
 
