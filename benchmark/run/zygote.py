@@ -35,6 +35,7 @@ import struct
 import subprocess
 import sys
 import threading
+import time
 from collections.abc import Mapping, Sequence
 from typing import IO, Any
 
@@ -46,6 +47,9 @@ ANSWER_TIMEOUT = 120.0
 LARGEST_REQUEST = 1 << 20
 #: Seconds between the zygote's checks that its caller is alive, when nothing arrives.
 PARENT_CHECK_INTERVAL = 1.0
+#: Seconds a zygote with no child left waits for a request before it ends (and frees its
+#: memory: a notebook's kernel lives long); the next request starts another.
+IDLE_SECONDS = 120.0
 #: Most descriptors a request passes (the child's, its stderr and its status pipe).
 MOST_DESCRIPTORS = 16
 _PID = struct.Struct("!i")
@@ -111,9 +115,10 @@ class _Zygote:
 
     def __init__(self, environment: Mapping[str, str], preload: Sequence[str]) -> None:
         self.socket, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
+        arguments = [str(theirs.fileno()), str(IDLE_SECONDS), *preload]
         try:
             self.process = subprocess.Popen(
-                [sys.executable, "-c", _ZYGOTE_MAIN, str(theirs.fileno()), *preload],
+                [sys.executable, "-c", _ZYGOTE_MAIN, *arguments],
                 pass_fds=(theirs.fileno(),),
                 stdin=subprocess.DEVNULL,
                 stdout=subprocess.DEVNULL,
@@ -156,6 +161,10 @@ class _Zygote:
             os.close(status_read)
             raise ConnectionError("the zygote ended")
         return ForkedProcess(_PID.unpack(answer)[0], status_read)
+
+    def ended(self) -> bool:
+        """Whether the zygote has ended (idle, or killed)."""
+        return self.process.poll() is not None
 
     def close(self) -> None:
         """Let the zygote end (it does once the socket closes)."""
@@ -218,6 +227,9 @@ def spawn(
     global _ZYGOTE
     with _LOCK:
         try:
+            if _ZYGOTE is not None and _ZYGOTE.owner == os.getpid() and _ZYGOTE.ended():
+                _ZYGOTE.close()  # idle for too long: reaped here
+                _ZYGOTE = None
             if _ZYGOTE is None or _ZYGOTE.owner != os.getpid():
                 _ZYGOTE = _Zygote(environment, preload)
             return _ZYGOTE.spawn(function, fds, arguments, stderr.fileno(), environment)
@@ -241,10 +253,12 @@ def _close_zygote() -> None:
 def serve() -> None:
     """The zygote's main loop: import, then fork a child per request until the caller goes.
 
-    Its arguments are the socket's descriptor and the modules to preload."""
+    Its arguments are the socket's descriptor, the seconds it may stay idle and the modules
+    to preload."""
     caller = socket.socket(fileno=int(sys.argv[1]))
+    idle = float(sys.argv[2])
     parent = os.getppid()
-    for name in sys.argv[2:]:
+    for name in sys.argv[3:]:
         with contextlib.suppress(ImportError):  # a child that needs it says why, itself
             importlib.import_module(name)
     # SIGCHLD wakes the loop through this pipe, so that ended children are reaped at once.
@@ -253,12 +267,16 @@ def serve() -> None:
     signal.set_wakeup_fd(wake_write)
     signal.signal(signal.SIGCHLD, lambda *_: None)
     statuses: dict[int, int] = {}
+    last_activity = time.monotonic()
     while os.getppid() == parent:
         ready, _, _ = select.select([caller.fileno(), wake_read], [], [], PARENT_CHECK_INTERVAL)
         if wake_read in ready:
             with contextlib.suppress(BlockingIOError):
                 os.read(wake_read, 4096)
-        _reap(statuses)
+        if _reap(statuses):
+            last_activity = time.monotonic()
+        if not ready and not statuses and time.monotonic() - last_activity > idle:
+            break
         if caller.fileno() not in ready:
             continue
         try:
@@ -267,6 +285,7 @@ def serve() -> None:
             continue
         if not request:
             break  # the caller closed the socket or died
+        last_activity = time.monotonic()
         *given, stderr, status = fds
         pid = os.fork()
         if pid == 0:
@@ -280,20 +299,23 @@ def serve() -> None:
             break
 
 
-def _reap(statuses: dict[int, int]) -> None:
-    """Write the exit status of every ended child into its status pipe."""
+def _reap(statuses: dict[int, int]) -> int:
+    """Write the exit status of every ended child into its status pipe; how many ended."""
+    ended = 0
     while statuses:
         try:
             pid, status = os.waitpid(-1, os.WNOHANG)
         except ChildProcessError:
-            return
+            break
         if pid == 0:
-            return
+            break
         write = statuses.pop(pid, None)
         if write is not None:
+            ended += 1
             with contextlib.suppress(OSError):
                 os.write(write, _PID.pack(os.waitstatus_to_exitcode(status)))
             os.close(write)
+    return ended
 
 
 def _become_child(request: dict[str, Any], given: list[int], stderr: int) -> None:

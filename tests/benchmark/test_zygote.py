@@ -235,3 +235,30 @@ def _running(pid: int) -> bool:
     except FileNotFoundError:
         return False
     return state != "Z"
+
+
+def test_an_idle_zygote_ends_and_the_next_worker_starts_another(
+    tmp_path: Path, workers: list[Worker], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A zygote with no child left and no request for its idle time ends (a notebook's
+    kernel lives long; the zygote's memory need not); it waits while a child lives."""
+    monkeypatch.setattr(zygote, "_ZYGOTE", None)
+    monkeypatch.setattr(zygote, "IDLE_SECONDS", 1.0)
+    context = _context(tmp_path)
+    first = Worker(context)
+    _run(first, TaskKey("nb", 0, 0))
+    started = zygote._ZYGOTE
+    assert started is not None
+    time.sleep(3.0)  # idle time thrice over, but its child lives
+    assert not started.ended()
+    first.close()
+    deadline = time.monotonic() + 15
+    while not started.ended() and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert started.ended(), "the zygote outlived its idle time"
+    second = Worker(context)
+    workers.append(second)
+    assert isinstance(second.process, ForkedProcess)
+    assert zygote._ZYGOTE is not started
+    assert _run(second, TaskKey("nb", 0, 1)).status == "ok"
+    zygote._close_zygote()
