@@ -13,6 +13,8 @@ file's lines are left to it.  A data set's ``format`` field counts when it comes
 file (as our client and a browser's form send it); one sent after it is not seen yet, and
 the file's name decides, as when no format is given.
 
+A file posted to a model that is not there is answered 404 before its body is read.
+
 Only a client whose key may call the route has its upload scanned (the others are answered
 401 or 403 by the route, as ever), and only a body that may hold a line over the smallest
 limit: an upload smaller than that pays nothing.
@@ -30,8 +32,8 @@ from starlette.types import Scope
 
 from touchbench.app.api.deps import KeyRefused, Service, key_name, needed_role
 from touchbench.app.api.multipart_lines import Chooser, FilePart, LineRule
-from touchbench.app.api.uploads import safe_name
-from touchbench.app.errors import AppError
+from touchbench.app.api.uploads import RefusedBeforeBodyError, safe_name
+from touchbench.app.errors import AppError, NotFoundError
 from touchbench.app.services.datasets import guess_format
 from touchbench.app.services.labels import long_line_error as labels_line_error
 from touchbench.app.services.limits import read_limits
@@ -75,7 +77,9 @@ async def line_rules(scope: Scope, declared: int | None) -> Chooser | None:
     try:
         # the model decides who reads the file: asked of the store off the event loop
         recordings = await run_in_threadpool(predicts_recordings, service.store, predicted["ref"])
-    except Exception:  # no such model, a store away...: the route says it
+    except NotFoundError as missing:  # no body could make it there: said before it is read
+        raise RefusedBeforeBodyError(missing) from None
+    except Exception:  # a store away...: the route says it
         return None
     return lambda part: _predicted_file(part, recordings)
 

@@ -33,6 +33,21 @@ _UNSAFE = re.compile(r"[^\w.+-]+")
 LineRules = Callable[[Scope, int | None], Awaitable[Chooser | None]]
 
 
+class RefusedBeforeBodyError(Exception):
+    """Raised by line rules: the request is answered ``error`` before its body is read
+    (nothing in it could change the answer: a file posted to a model that is not there).
+
+    Parameters
+    ----------
+    error : Exception
+        The route's own error, answered as the route would answer it.
+    """
+
+    def __init__(self, error: Exception) -> None:
+        super().__init__(str(error))
+        self.error = error
+
+
 class JsonTooLarge(UploadTooLarge):
     """A JSON body larger than ``TOUCHBENCH_MAX_JSON_MB`` (answered 413 as any upload)."""
 
@@ -88,7 +103,12 @@ class BodyLimit:
             await self._json(scope, receive, send)
             return
         seen = 0
-        lines = await self._lines(scope, declared)
+        try:
+            lines = await self._lines(scope, declared)
+        except RefusedBeforeBodyError as refused:
+            error = refused.error
+            await _answer(send, status_of(error), type(error).__name__, str(error), None)
+            return
         answered = False
 
         async def counted() -> Message:

@@ -314,6 +314,24 @@ def test_a_line_too_long_is_refused_before_the_upload_is_read(
     _within_bound(served)
 
 
+@on_sqlite
+def test_a_file_posted_to_a_model_that_is_not_there_is_answered_before_it_is_read(
+    served: Server,
+) -> None:
+    """404 as the route says it, before the client has sent a tenth of 64 MB."""
+    upload = _OneLine(64 << 20)
+    answer = served.client.post(
+        "/api/models/no-such-model/predict/file", files={"file": ("take.csv", upload)}
+    )
+    error = _refusal(answer, 404, "no-such-model")
+    assert upload.sent < upload.size // 10, f"the client sent {upload.sent:,} bytes"
+    # the route's own answer to the same request with a small file: the same error
+    small = served.client.post(
+        "/api/models/no-such-model/predict/file", files={"file": ("take.csv", b"t,x\n0,1\n")}
+    )
+    assert small.status_code == 404 and small.json()["error"] == error
+
+
 # -- 4. labels files streamed and bounded ------------------------------------------------------
 
 
