@@ -93,8 +93,10 @@ class ForkedProcess:
         try:
             if self.returncode is not None:
                 return self.returncode
-            ready, _, _ = select.select([self._status], [], [], timeout)
-            if not ready:
+            # poll, not select: a long-lived caller's descriptors may pass select's 1,024
+            waiting = select.poll()
+            waiting.register(self._status, select.POLLIN)
+            if not waiting.poll(None if timeout is None else timeout * 1000):
                 return None
             data = os.read(self._status, _PID.size)
             os.close(self._status)
@@ -267,9 +269,13 @@ def serve() -> None:
     signal.set_wakeup_fd(wake_write)
     signal.signal(signal.SIGCHLD, lambda *_: None)
     statuses: dict[int, int] = {}
+    # poll, not select: the socket keeps the caller's number for it, which may pass 1,024
+    waiting = select.poll()
+    for fd in (caller.fileno(), wake_read):
+        waiting.register(fd, select.POLLIN)
     last_activity = time.monotonic()
     while os.getppid() == parent:
-        ready, _, _ = select.select([caller.fileno(), wake_read], [], [], PARENT_CHECK_INTERVAL)
+        ready = {fd for fd, _ in waiting.poll(PARENT_CHECK_INTERVAL * 1000)}
         if wake_read in ready:
             with contextlib.suppress(BlockingIOError):
                 os.read(wake_read, 4096)

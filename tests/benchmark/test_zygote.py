@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 import os
 import pickle
+import resource
 import signal
 import subprocess
 import sys
@@ -262,3 +263,32 @@ def test_an_idle_zygote_ends_and_the_next_worker_starts_another(
     assert zygote._ZYGOTE is not started
     assert _run(second, TaskKey("nb", 0, 1)).status == "ok"
     zygote._close_zygote()
+
+
+def test_a_caller_with_many_descriptors_reads_its_workers_statuses(
+    tmp_path: Path, workers: list[Worker], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A long-lived service holds more than select's 1,024 descriptors: its zygote's socket
+    and a worker's status pipe then get numbers past it, and still work."""
+    monkeypatch.setattr(zygote, "_ZYGOTE", None)
+    soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+    if hard != resource.RLIM_INFINITY and hard < 1200:
+        pytest.skip(f"this machine allows {hard} open files, fewer than the test needs")
+    resource.setrlimit(resource.RLIMIT_NOFILE, (max(soft, 1200), hard))
+    held = []
+    try:
+        with open(os.devnull) as null:
+            while not held or held[-1] < 1100:
+                held.append(os.dup(null.fileno()))
+        worker = Worker(_context(tmp_path))
+        workers.append(worker)
+        assert isinstance(worker.process, ForkedProcess)
+        assert worker.process._status > 1024
+        _run(worker, TaskKey("nb", 0, 0))
+        worker.close()
+        assert worker.process.poll() == 0
+        zygote._close_zygote()
+    finally:
+        for fd in held:
+            os.close(fd)
+        resource.setrlimit(resource.RLIMIT_NOFILE, (soft, hard))
