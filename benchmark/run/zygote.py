@@ -235,11 +235,15 @@ def spawn(
             if _ZYGOTE is None or _ZYGOTE.owner != os.getpid():
                 _ZYGOTE = _Zygote(environment, preload)
             return _ZYGOTE.spawn(function, fds, arguments, stderr.fileno(), environment)
-        except (OSError, ValueError):
+        except BaseException as error:
+            # Ctrl-C between a request and its answer included: an answer left unread would
+            # be taken as the next request's, so this zygote is not asked again
             if _ZYGOTE is not None and _ZYGOTE.owner == os.getpid():
                 _ZYGOTE.kill()
             _ZYGOTE = None
-            return None
+            if isinstance(error, (OSError, ValueError)):
+                return None
+            raise
 
 
 @atexit.register

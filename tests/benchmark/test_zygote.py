@@ -10,6 +10,7 @@ import os
 import pickle
 import resource
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -275,7 +276,7 @@ def test_a_caller_with_many_descriptors_reads_its_workers_statuses(
     if hard != resource.RLIM_INFINITY and hard < 1200:
         pytest.skip(f"this machine allows {hard} open files, fewer than the test needs")
     resource.setrlimit(resource.RLIMIT_NOFILE, (max(soft, 1200), hard))
-    held = []
+    held: list[int] = []
     try:
         with open(os.devnull) as null:
             while not held or held[-1] < 1100:
@@ -292,3 +293,35 @@ def test_a_caller_with_many_descriptors_reads_its_workers_statuses(
         for fd in held:
             os.close(fd)
         resource.setrlimit(resource.RLIMIT_NOFILE, (soft, hard))
+
+
+def test_a_request_interrupted_before_its_answer_retires_the_zygote(
+    tmp_path: Path, workers: list[Worker], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Ctrl-C after a request was sent and before its answer was read (a notebook goes on
+    afterwards): the answer left in the socket must not be taken as the next request's,
+    so the next worker has its own pid, the one that reports from the fit."""
+    monkeypatch.setattr(zygote, "_ZYGOTE", None)
+    reports = tmp_path / "reports"
+    reports.mkdir()
+    context = _context(reports)
+    workers.append(Worker(context))  # a zygote, running
+    first = zygote._ZYGOTE
+    assert first is not None
+    send = socket.send_fds
+
+    def interrupted(*args: object, **kwargs: object) -> int:
+        send(*args, **kwargs)  # type: ignore[arg-type]
+        raise KeyboardInterrupt
+
+    with monkeypatch.context() as patched:
+        patched.setattr(socket, "send_fds", interrupted)
+        with pytest.raises(KeyboardInterrupt):
+            Worker(context)
+    assert zygote._ZYGOTE is None and first.ended()
+    later = Worker(context)
+    workers.append(later)
+    assert isinstance(later.process, ForkedProcess)
+    _run(later, TaskKey("reporting", 0, 0))
+    assert later.pid in _reports(reports)
+    zygote._close_zygote()
