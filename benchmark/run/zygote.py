@@ -147,8 +147,8 @@ class _Zygote:
                 "function": function,
                 "arguments": list(arguments),
                 "environment": dict(environment),
-                "path": sys.path,
-                "directory": os.getcwd(),
+                "path": [str(entry) for entry in sys.path],
+                "directory": _working_directory(),
             }
         ).encode()
         try:
@@ -182,6 +182,15 @@ class _Zygote:
         with contextlib.suppress(ProcessLookupError):
             self.process.kill()
         self.process.wait()
+
+
+def _working_directory() -> str | None:
+    """This process's folder, None if it has been deleted (the child then works in the
+    zygote's, rather than the zygote being given up for a path it cannot name)."""
+    try:
+        return os.getcwd()
+    except OSError:
+        return None
 
 
 _LOCK = threading.Lock()
@@ -340,8 +349,9 @@ def _become_child(request: dict[str, Any], given: list[int], stderr: int) -> Non
         os.environ.clear()
         os.environ.update(request["environment"])
         sys.path[:] = request["path"]
-        with contextlib.suppress(OSError):
-            os.chdir(request["directory"])
+        if request["directory"] is not None:
+            with contextlib.suppress(OSError):
+                os.chdir(request["directory"])
         _reseed_numpy()
         module, name = request["function"].split(":")
         getattr(importlib.import_module(module), name)(*given, *request["arguments"])

@@ -325,3 +325,17 @@ def test_a_request_interrupted_before_its_answer_retires_the_zygote(
     _run(later, TaskKey("reporting", 0, 0))
     assert later.pid in _reports(reports)
     zygote._close_zygote()
+
+
+def test_a_caller_in_a_deleted_folder_still_gets_a_forked_worker(
+    tmp_path: Path, workers: list[Worker], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    context = _context(tmp_path)
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    monkeypatch.chdir(gone)
+    gone.rmdir()
+    worker = Worker(context)
+    workers.append(worker)
+    assert isinstance(worker.process, ForkedProcess)
+    assert _run(worker, TaskKey("nb", 0, 0)).status == "ok"
