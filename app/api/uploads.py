@@ -106,8 +106,7 @@ class BodyLimit:
         try:
             lines = await self._lines(scope, declared)
         except RefusedBeforeBodyError as refused:
-            error = refused.error
-            await _answer(send, status_of(error), type(error).__name__, str(error), None)
+            await _answer_error(send, refused.error)
             return
         answered = False
 
@@ -123,9 +122,7 @@ class BodyLimit:
                     raise too_large(limit)
                 found = lines.feed(body) if lines is not None else None
                 if found is not None:
-                    error = found.error
-                    kind, where = type(error).__name__, where_of(error)
-                    await _answer(send, status_of(error), kind, str(error), where)
+                    await _answer_error(send, found.error)
                     # the form parser stops as for a client gone; the route never runs
                     answered = True
                     return {"type": "http.disconnect"}
@@ -273,6 +270,11 @@ def _content_length(scope: Scope) -> int | None:
             except ValueError:
                 return None
     return None
+
+
+async def _answer_error(send: Send, error: Exception) -> None:
+    """Answer ``error`` here as the service's handlers answer it from a route."""
+    await _answer(send, status_of(error), type(error).__name__, str(error), where_of(error))
 
 
 async def _answer(

@@ -368,7 +368,7 @@ def _become_child(request: dict[str, Any], given: list[int], stderr: int) -> Non
 
 def _close_all_but(kept: Sequence[int]) -> None:
     """Close every descriptor above stderr but ``kept``, as ``subprocess`` does for a child:
-    the zygote's socket, other children' status pipes, anything a library opened."""
+    the zygote's socket, other children's status pipes, anything a library opened."""
     low = 3
     for fd in sorted(kept):
         os.closerange(low, fd)
