@@ -57,6 +57,7 @@ from touchbench.benchmark.io.arff import read_arff
 from touchbench.benchmark.results import Drop, TaskResult
 from touchbench.benchmark.run.engine import Problem, RaceRule, run_tasks
 from touchbench.benchmark.run.folds import make_folds
+from touchbench.benchmark.run.members import plan_run
 from touchbench.benchmark.run.racing import FIRST_ROUND, decide
 
 #: ``../shared/datasets`` beside the project; ``TOUCHBENCH_DATASETS`` names another place
@@ -260,10 +261,17 @@ def main() -> int:
         )[0]
         ratio = float(np.mean([f.test.size / f.train.size for f in folds]))
         print(f"\n{robot} {task}: {len(ids)} entries ({args.suite}), {len(folds)} folds")
+        plan = plan_run(problem, ids)
+        # an ensemble of entries has no seconds of its own: its results carry its members'
+        derived = {entry: sorted(plan.uses(entry)) for entry in plan.derived}
         full, _, full_wall = timed(problem, ids, folds, args.jobs, random_state=args.seed)
         if args.save:
             with open(args.save, "wb") as file:
-                pickle.dump({"ids": ids, "results": full, "wall": full_wall}, file)
+                pickle.dump(
+                    {"ids": ids, "results": full, "wall": full_wall, "derived": derived,
+                     "helpers": list(plan.helpers)},
+                    file,
+                )  # fmt: skip
         race = RaceRule(metric, args.alpha)
         raced, drops, raced_wall = timed(
             problem, ids, folds, args.jobs, random_state=args.seed, race=race
@@ -285,7 +293,7 @@ def main() -> int:
         # the floor of that ratio: the share of the full run's fit and predict seconds
         # spent on what the race still runs
         seconds = {r.key: r.metrics.get("fit_time", 0.0) + r.metrics.get("predict_time", 0.0)
-                   for r in full if r.ok}  # fmt: skip
+                   for r in full if r.ok and r.key.classifier not in derived}  # fmt: skip
         kept = {r.key for r in raced}
         share = sum(v for k, v in seconds.items() if k in kept) / max(sum(seconds.values()), 1e-9)
         print(f"  share of the full run's fit+predict seconds the race still spends: {share:.3f}")
@@ -294,7 +302,7 @@ def main() -> int:
         busy = sum(
             r.metrics.get("fit_time", 0.0) + r.metrics.get("predict_time", 0.0)
             for r in raced
-            if r.ok
+            if r.ok and r.key.classifier not in derived
         )
         print(
             f"  raced run's worker seconds not in fit+predict: "
@@ -302,6 +310,8 @@ def main() -> int:
         )
         spent: Counter[str] = Counter()
         for r in raced:
+            if r.key.classifier in derived:
+                continue
             spent[r.key.classifier] += r.metrics.get("fit_time", 0.0) + r.metrics.get(
                 "predict_time", 0.0
             )
@@ -322,6 +332,13 @@ def main() -> int:
             f"folds of the rest): {floor:.3f} of the full run's seconds"
         )
         print(f"  full top 5 live at the end of the race: {len(top_live)}/5 ({', '.join(top)})")
+        not_worse = [row.classifier for row in full_board.rows if row.mark != "*"]
+        lost = [entry for entry in not_worse if entry in drops]
+        print(
+            f"  entries the full run does not mark significantly worse than its winner, live "
+            f"at the end: {len(not_worse) - len(lost)}/{len(not_worse)} "
+            f"({', '.join(not_worse)}; dropped: {', '.join(lost) or 'none'})"
+        )
         print(
             f"  winner: full {full_best.classifier} {full_best.metrics[metric][0]:.4f}, "
             f"raced {raced_best.classifier} {raced_best.metrics[metric][0]:.4f}; "

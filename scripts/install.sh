@@ -4,7 +4,7 @@
 # runtime, which the tests run to check the WEKA-named classifiers; Chromium, which the
 # web-page tests drive through Playwright; wrk, the HTTP load generator of perf/serve.py;
 # ROS 1 (rosmaster, rospy, genpy) for `touchbench ros` and its tests, which reach these
-# system packages from the venv through drivers/ros1.py only),
+# system packages from the venv through drivers/ros1.py only; R's limma for one test),
 # a .venv/ at the repository root, and touchbench with every extra and its test tools
 # installed (editable) inside it, at the versions of scripts/constraints.txt.
 # Safe to run again: it only does what is missing.
@@ -14,7 +14,8 @@ cd "$(dirname "$0")/.."
 as_root() { if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi; }
 
 apt_install() {
-  local missing=()
+  local options=() missing=()
+  if [ "${1-}" = --lean ]; then options=(--no-install-recommends); shift; fi
   for package in "$@"; do
     dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" \
       || missing+=("$package")
@@ -22,7 +23,8 @@ apt_install() {
   if [ ${#missing[@]} -gt 0 ]; then
     echo "installing Debian packages: ${missing[*]}" >&2
     as_root apt-get update -qq
-    as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}" >/dev/null
+    as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${options[@]}" "${missing[@]}" \
+      >/dev/null
   fi
 }
 
@@ -34,6 +36,9 @@ fi
 
 apt_install libportaudio2 libsndfile1 weka default-jre-headless chromium wrk \
   ros-core python3-rospy python3-genpy python3-rosgraph
+# R's limma, the reference the race's moderated t-test is checked against (R's
+# recommended packages would add compilers and manuals the check does not need)
+apt_install --lean r-bioc-limma
 "$PYTHON" -c 'import ensurepip, venv' 2>/dev/null || apt_install python3-venv
 
 [ -x .venv/bin/python ] || "$PYTHON" -m venv .venv
