@@ -211,7 +211,9 @@ def main() -> int:
         default=None,
         help="side by side with the code of this worktree (issue 35's measurement)",
     )
-    parser.add_argument("--ensemble", type=int, default=5, help="with --against: N")
+    parser.add_argument(
+        "--ensemble", type=int, default=5, help="with --against: N (0: no selection run)"
+    )
     parser.add_argument("--rounds", type=int, default=1, help="with --against: passes")
     parser.add_argument("--quick", action="store_true", help="with --against: a quick check")
     parser.add_argument("--keep", metavar="FILE", help="with --against: append each run's JSON")
@@ -528,7 +530,7 @@ def side_by_side(args: argparse.Namespace) -> int:
                 ("full", here, "touchbench.benchmark", "full"),
                 ("race", here, "touchbench.benchmark", "race"),
                 ("ensemble", here, "touchbench.benchmark", "ensemble"),
-            ]
+            ][: 4 if args.ensemble else 3]
             for round_ in range(args.rounds):
                 for name, code, pkg, mode in order if round_ % 2 == 0 else order[::-1]:
                     found = _measure(args, code, pkg, f"{robot}:{task}:{mode}")
@@ -556,20 +558,29 @@ def side_by_side(args: argparse.Namespace) -> int:
             not_worse = [c for c, row in means["full"].items() if row["mark"] != "*"]
             lost = [c for c in not_worse if means["race"].get(c, {}).get("dropped", True)]
             selection = f"ensemble-{args.ensemble}"
-            chosen = means["ensemble"].get(selection, {}).get("mean", math.nan)
-            single = max(
-                (r["mean"] for c, r in means["ensemble"].items() if c != selection),
-                default=math.nan,
+            selected = means.get("ensemble", {})
+            chosen = selected.get(selection, {}).get("mean", math.nan)
+            others = [r["mean"] for c, r in selected.items() if c != selection]
+            single = max(others, default=math.nan)
+            ensemble = (
+                f"{wall['ensemble']:.1f} ({wall['ensemble'] / wall['full']:.2f})"
+                if args.ensemble
+                else "not run"
+            )
+            versus = (
+                f"{chosen:.4f} vs {single:.4f} ({'>=' if chosen >= 0.88 else '<'} 0.88)"
+                if args.ensemble
+                else "not run"
             )
             print(
                 f"| {robot} {task} | {wall['older']:.1f} "
-                f"| {wall['full']:.1f} ({wall['full'] / wall['older']:.2f}) "
-                f"| {wall['race']:.1f} ({wall['race'] / wall['older']:.2f}) "
-                f"| {wall['ensemble']:.1f} ({wall['ensemble'] / wall['full']:.2f}) "
+                f"| {wall['full']:.1f} ({wall['full'] / wall['older']:.3f}) "
+                f"| {wall['race']:.1f} ({wall['race'] / wall['older']:.3f}) "
+                f"| {ensemble} "
                 f"| {winners['older']} / {winners['full']} / {winners['race']} "
                 f"| {', '.join(moved) or 'none'} "
                 f"| {'yes' if not lost else 'no: ' + ', '.join(lost)} "
-                f"| {chosen:.4f} vs {single:.4f} ({'>=' if chosen >= 0.88 else '<'} 0.88) |"
+                f"| {versus} |"
             )
     return 0
 

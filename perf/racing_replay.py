@@ -9,7 +9,7 @@ Printed: the replayed wall seconds and their ratio to the full run's (replayed a
 tasks started and handed on (a task started for an entry the race then drops is wasted),
 worker seconds idle, the drops per fold, the full top 5 still live, the winner's
 difference, and the floor of any race that keeps the full top 5 to the end.  ``--against
-COMMIT`` replays that commit's schedule beside it.
+COMMIT`` replays that commit's schedule and race rule beside it.
 
     .venv/bin/python perf/racing.py --robots maggie --tasks gesture --save maggie.pkl
     .venv/bin/python perf/racing_replay.py maggie.pkl [--workers 2,4] [--against 1d4384d]
@@ -102,22 +102,32 @@ def derived_of(saved: dict[str, Any]) -> tuple[dict[str, list[str]], list[str]]:
     return saved.get("derived", {}), saved.get("helpers", [])
 
 
-def schedule_of(commit: str) -> type:
-    """``RoundSchedule`` as ``benchmark/run/schedule.py`` was at ``commit``."""
+def _module_of(commit: str, path: str, name: str) -> Any:
+    """The module at ``path`` as it was at ``commit``, loaded under ``name``."""
     text = subprocess.run(
-        ["git", "show", f"{commit}:benchmark/run/schedule.py"],
+        ["git", "show", f"{commit}:{path}"],
         capture_output=True,
         text=True,
         check=True,
         cwd=Path(__file__).resolve().parents[1],
     ).stdout
-    path = Path(tempfile.mkdtemp()) / "schedule_then.py"
-    path.write_text(text, encoding="utf-8")
-    spec = importlib.util.spec_from_file_location("schedule_then", path)
+    file = Path(tempfile.mkdtemp()) / f"{name}.py"
+    file.write_text(text, encoding="utf-8")
+    spec = importlib.util.spec_from_file_location(name, file)
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module  # its dataclasses look their module up
     spec.loader.exec_module(module)
-    return module.RoundSchedule
+    return module
+
+
+def schedule_of(commit: str) -> type:
+    """``RoundSchedule`` as ``benchmark/run/schedule.py`` was at ``commit``, deciding by
+    ``benchmark/run/racing.py``'s rule of then."""
+    schedule = _module_of(commit, "benchmark/run/schedule.py", "schedule_then")
+    racing = _module_of(commit, "benchmark/run/racing.py", "racing_then")
+    schedule.race_round = racing.race_round
+    return schedule.RoundSchedule
 
 
 def main() -> int:
@@ -137,6 +147,7 @@ def main() -> int:
         metric = args.metric
         full_board = build_leaderboard(saved["results"], metric=metric)
         top = [row.classifier for row in full_board.rows[:5]]
+        not_worse = [row.classifier for row in full_board.rows if row.mark != "*"]
         derived, _ = derived_of(saved)
         cost = {r.key: seconds(r) for r in saved["results"] if r.key.classifier not in derived}
         total = sum(cost.values())
@@ -163,6 +174,16 @@ def main() -> int:
                     f"{out['idle'] / (workers * out['wall']):.3f}, {len(dropped)} dropped "
                     f"(after fold: {when}), top 5 live "
                     f"{sum(e not in dropped for e in top)}/5, winner difference {difference:.4f}"
+                )
+                lost = [e for e in not_worse if e in dropped]
+                print(
+                    f"    not marked worse than the full run's winner: "
+                    f"{len(not_worse) - len(lost)}/{len(not_worse)} live"
+                    + "".join(
+                        f"; {e} dropped after fold {dropped[e].after_fold} "
+                        f"(p {dropped[e].p_value:.4f} against {dropped[e].leader})"
+                        for e in lost
+                    )
                 )
     return 0
 
