@@ -482,10 +482,11 @@ def bench_command(
         typer.Option(
             "--race",
             help=(
-                "Race: every classifier on fold 1, then fold 2, ... (cheap first); after each "
+                "Race: every classifier on fold 1, then fold 2, ... (dear first); after each "
                 "fold from the third, those significantly worse than the leader (corrected "
-                "resampled t-test at --race-alpha) stop, marked `dropped after fold k`. The "
-                "leader and the baseline never stop. Needs 3 folds or more."
+                "resampled t-test, its variances moderated across the fold's entries, at "
+                "--race-alpha) stop, marked `dropped after fold k`. The leader and the "
+                "baseline never stop. Needs 3 folds or more."
             ),
         ),
     ] = False,

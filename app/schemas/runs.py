@@ -456,10 +456,10 @@ class BenchRequest(Request):
     )
     race: bool = Field(
         default=False,
-        description="Race the classifiers: every one on fold 1, then fold 2, ... (cheap "
+        description="Race the classifiers: every one on fold 1, then fold 2, ... (dear "
         "first); after each fold from the third, those significantly worse than the leader "
-        "(corrected resampled t-test at `race_alpha`) stop. The leader and the baseline "
-        "never stop.",
+        "(corrected resampled t-test, its variances moderated across the fold's entries, at "
+        "`race_alpha`) stop. The leader and the baseline never stop.",
     )
     race_alpha: float = Field(
         default=0.01,
