@@ -4,9 +4,11 @@ For each robot (Mini, Maggie) and task (``gesture`` multi-class, ``gesture+place
 multi-target), the suite runs under k-fold cross-validation twice with the same seed: in
 full, and raced (``--race``, alpha 0.01).  Printed per data set:
 
-- wall seconds of each and their ratio raced / full (goal <= 0.5);
-- the full run's top 5: how many are still live at the end of the race (goal 5 of 5), and
-  the raced winner's score beside the full winner's (goal within 0.005);
+- wall seconds of each and their ratio raced / full (issue 35's goals are against an older
+  full run: ``--against`` below);
+- the full run's top 5 and the entries it does not mark significantly worse than its
+  winner: how many are still live at the end of the race, and the raced winner's score
+  beside the full winner's;
 - with ``--budget-fraction F`` a third run with a total budget of F x the full run's wall
   time: what it completed and cut, and its wall time against the budget;
 - on the full run's per-fold scores, the two racing rules the issue weighs, replayed round
@@ -291,7 +293,7 @@ def main() -> int:
             f"  raced: {raced_wall:7.1f} s, {len(raced)} tasks, {len(drops)} dropped "
             f"(after fold: {when})"
         )
-        print(f"  wall ratio raced/full: {raced_wall / full_wall:.3f} (goal <= 0.5)")
+        print(f"  wall ratio raced/full: {raced_wall / full_wall:.3f}")
         # the floor of that ratio: the share of the full run's fit and predict seconds
         # spent on what the race still runs
         seconds = {r.key: r.metrics.get("fit_time", 0.0) + r.metrics.get("predict_time", 0.0)
