@@ -75,8 +75,7 @@ def corrected_resampled_ttest(
     mean = float(d.mean())
     variance = float(d.var(ddof=1))
     if variance > 0:
-        t = mean / math.sqrt((1.0 / k + test_train_ratio) * variance)
-        p = float(2.0 * stdtr(k - 1, -abs(t)))  # Student's t survival function, as a ufunc
+        t, p = _corrected_t(mean, variance, k, test_train_ratio, df=k - 1)
     elif mean == 0:
         t, p = 0.0, 1.0
     else:
@@ -85,6 +84,15 @@ def corrected_resampled_ttest(
     if p <= alpha:
         sign = 1 if a.mean() > b.mean() else -1
     return t, p, sign
+
+
+def _corrected_t(
+    mean: float, variance: float, k: int, test_train_ratio: float, *, df: float
+) -> tuple[float, float]:
+    """Nadeau and Bengio's t of ``k`` paired differences of ``mean`` and ``variance`` (> 0),
+    and its two-sided p-value with ``df`` degrees of freedom (``inf``: the normal's)."""
+    t = mean / math.sqrt((1.0 / k + test_train_ratio) * variance)
+    return t, float(2.0 * stdtr(df, -abs(t)))  # Student's t survival function, as a ufunc
 
 
 @dataclass(frozen=True)
@@ -203,6 +211,5 @@ def moderated_corrected_ttests(
         else:
             variance = (prior.df * prior.variance + df * own) / (prior.df + df)
             df += prior.df
-        t = float(d.mean()) / math.sqrt((1.0 / k + test_train_ratio) * variance)
-        out.append((t, float(2.0 * stdtr(df, -abs(t)))))
+        out.append(_corrected_t(float(d.mean()), variance, k, test_train_ratio, df=df))
     return out
