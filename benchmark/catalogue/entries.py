@@ -441,7 +441,7 @@ _SINGLE: tuple[ClassifierSpec, ...] = (
         RandomForestClassifier,
         {"n_estimators": 200},
         family="forests",
-        description="Random forest, 200 trees (a member of voting-hard and stacking)",
+        description="Random forest, 200 trees (a member of stacking)",
         missing=True,
         suites=ALL_ONLY,
     ),
@@ -1232,7 +1232,7 @@ SPECS: tuple[ClassifierSpec, ...] = (
     # Ensembles of the entries above: a run computes them from their members' fold
     # predictions, fitting each member once per fold
     _ensemble("voting", "soft", ("xgb", "hgb", "calibrated-svm-rbf"), cost="slow"),
-    _ensemble("voting-hard", "hard", ("logistic", "rf-200", "svm-rbf")),
+    _ensemble("voting-hard", "hard", ("logistic", "rf", "svm-rbf")),
     stacked_spec(
         [_BY_ID[member] for member in _STACKED],
         len(_STACKED),

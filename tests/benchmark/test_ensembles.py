@@ -171,11 +171,11 @@ def test_a_member_shared_by_two_ensembles_is_fitted_once_per_fold(
 def test_the_catalogue_s_ensembles_are_defined_by_their_members() -> None:
     voting, hard, stacking = get_spec("voting"), get_spec("voting-hard"), get_spec("stacking")
     assert [m.id for m in voting.members] == ["xgb", "hgb", "calibrated-svm-rbf"]
-    assert [m.id for m in hard.members] == ["logistic", "rf-200", "svm-rbf"]
+    assert [m.id for m in hard.members] == ["logistic", "rf", "svm-rbf"]
     assert [m.id for m in stacking.members] == ["rf-200", "extra-trees-200", "svm-rbf", "logistic"]
     assert (voting.combine, hard.combine, stacking.combine) == ("soft", "hard", "stack")
     assert voting.description == "Soft vote of xgb, hgb and calibrated-svm-rbf"
-    assert hard.description == "Majority vote of logistic, rf-200 and svm-rbf"
+    assert hard.description == "Majority vote of logistic, rf and svm-rbf"
     assert "rf-200, extra-trees-200, svm-rbf and logistic" in stacking.description
     for spec in (voting, hard, stacking):
         assert spec.to_json()["members"] == [m.id for m in spec.members]

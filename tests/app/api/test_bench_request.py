@@ -146,12 +146,12 @@ def test_every_refusal_names_its_field_and_leaves_no_run(
     assert selecting.status_code == 202, selecting.text
     run = server.wait_for(f"/api/runs/{selecting.json()['id']}", finished)
     assert run["status"] == "done" and run["config"]["ensemble"] == 2
-    assert run["config"]["helpers"] == ["logistic", "rf-200", "svm-rbf"]
+    assert run["config"]["helpers"] == ["logistic", "rf", "svm-rbf"]
     assert run["classifiers"] == ["nb", "voting-hard", "ensemble-2"]
     board = api.get(f"/api/runs/{run['id']}/leaderboard").json()
     rows = {row["classifier"]: row for row in board["leaderboard"]}
     assert rows["ensemble-2"]["origin"]["note"] == "from fold predictions of nb, voting-hard"
-    assert rows["rf-200"]["origin"]["note"] == "helper of voting-hard"
+    assert rows["rf"]["origin"]["note"] == "helper of voting-hard"
     assert rows["nb"]["origin"] is None and rows["ensemble-2"]["n_ok"] == 3
     assert {choice["classifier"] for choice in board["choices"]} == {"ensemble-2"}
     page = api.get(f"/fragments/runs/{run['id']}/leaderboard").text

@@ -165,7 +165,7 @@ def test_rescored_runs_equal_runs_scored_so_from_the_start(
     assert board["aggregate"] == theirs.json()["aggregate"] == "recording"
     assert _ranked(board) == _ranked(theirs.json())  # the same ranks, marks and t-tests
     assert board["notes"][0].startswith(PER_RECORDING) and board["notes"][1].startswith(RESCORED)
-    helpers = "fitted only as members of ensembles: logistic, rf-200, svm-rbf ("
+    helpers = "fitted only as members of ensembles: logistic, rf, svm-rbf ("
     assert [note.startswith(helpers) for note in board["notes"][2:]] == [True]
     back_board = run_cli(
         capsys, db, "leaderboard", str(recordings), "--aggregate", "window", "--json"
@@ -366,7 +366,7 @@ def test_classes_and_calibration_score_per_recording_when_asked(
     listed = run_cli(capsys, db, "classes", str(windows), "--json")
     assert listed.code == 0, listed.err
     names = {entry["classifier"] for entry in listed.json()["classifiers"]}
-    assert names == {*CLASSIFIERS.split(","), "logistic", "rf-200", "svm-rbf"}
+    assert names == {*CLASSIFIERS.split(","), "logistic", "rf", "svm-rbf"}
 
     def shown(command: str, run: int, *options: str) -> dict[str, Any]:
         made = run_cli(capsys, db, command, str(run), "--json", *options)

@@ -93,7 +93,7 @@ def test_a_finished_run_s_fold_predictions_rescore_and_vote_as_refitted(
     for entry in ("voting", "voting-hard", "ensemble-3"):
         assert origins[entry]["kind"] == "from fold predictions"
         assert origins[entry]["note"].startswith("from fold predictions of ")
-    assert origins["rf-200"] == {
+    assert origins["rf"] == {
         "kind": "helper",
         "entries": ["voting-hard"],
         "note": "helper of voting-hard",
@@ -109,7 +109,7 @@ def test_a_finished_run_s_fold_predictions_rescore_and_vote_as_refitted(
     run = get_run(store, run_id)
     entries = [*run.classifiers, *run.config.helpers]
     assert set(run.config.helpers) == {
-        "rf-200", "svm-rbf", "xgb", "hgb", "calibrated-svm-rbf",
+        "rf", "svm-rbf", "xgb", "hgb", "calibrated-svm-rbf",
     }  # fmt: skip
     assert run.n_tasks == len(entries) * len(folds) == len(results) == len(stored)
     for key, result in results.items():
@@ -148,10 +148,10 @@ def test_a_member_shared_by_two_ensembles_is_fitted_once_per_fold(
         dataset="touch", target="gesture", classifiers=["voting-hard", "stacking"], folds=2
     )
     run = create_run(store, request)
-    # voting-hard: logistic, rf-200, svm-rbf; stacking: rf-200, extra-trees-200,
-    # svm-rbf, logistic
-    assert run.config.helpers == ["logistic", "rf-200", "svm-rbf", "extra-trees-200"]
-    assert run.n_tasks == 6 * 2
+    # voting-hard: logistic, rf, svm-rbf; stacking: rf-200, extra-trees-200, svm-rbf,
+    # logistic
+    assert run.config.helpers == ["logistic", "rf", "svm-rbf", "rf-200", "extra-trees-200"]
+    assert run.n_tasks == 7 * 2
     started: list[TaskKey] = []
     execute_run(store, run.id, callbacks=Callbacks(on_start=started.append))
     starts = Counter(started)
@@ -159,11 +159,11 @@ def test_a_member_shared_by_two_ensembles_is_fitted_once_per_fold(
     assert {k.classifier for k in starts} == set(run.config.helpers)  # ensembles fit none
     assert Counter(k.classifier for k in starts) == dict.fromkeys(run.config.helpers, 2)
     results = load_results(store, run.id)
-    assert len(results) == 12 and all(r.ok for r in results)
-    assert get_run(store, run.id).config.origins["rf-200"].entries == [
-        "voting-hard",
-        "stacking",
-    ]
+    assert len(results) == 14 and all(r.ok for r in results)
+    origins = get_run(store, run.id).config.origins
+    assert origins["rf-200"].entries == ["stacking"]
+    shared = ["voting-hard", "stacking"]
+    assert origins["svm-rbf"].entries == origins["logistic"].entries == shared
 
 
 def test_an_ensemble_keeps_the_folds_of_a_member_the_race_dropped(
@@ -224,7 +224,7 @@ def test_a_run_killed_and_resumed_gives_the_same_ensembles(
     # the training rows only, each once, never a row of the outer test fold
     _, folds = _problem_and_folds(store, 1)
     inner = load_predictions(store, 1, part="inner")
-    assert {k.classifier for k in inner} == {"nb", "gate", "logistic", "rf-200", "svm-rbf"}
+    assert {k.classifier for k in inner} == {"nb", "gate", "logistic", "rf", "svm-rbf"}
     for key, predictions in inner.items():
         fold = folds[key.fold]
         assert sorted(predictions.indices) == sorted(fold.train), key
@@ -247,7 +247,7 @@ def test_a_run_killed_and_resumed_gives_the_same_ensembles(
     assert json.loads(outputs[1].read_text())["run_id"] == 2
     first, second = _by_key(load_results(store, 1)), _by_key(load_results(store, 2))
     assert set(first) == {TaskKey(k.classifier, k.repeat, k.fold) for k in second}
-    assert len(first) == 7 * 3  # nb, gate, the votes, logistic, rf-200, svm-rbf
+    assert len(first) == 7 * 3  # nb, gate, the votes, logistic, rf, svm-rbf
     for key in first:
         if key.classifier in ("ensemble-2", "voting-hard"):
             assert first[key].params == second[key].params
