@@ -193,10 +193,11 @@ def moderated_corrected_ttests(
     if not test_train_ratio >= 0:
         raise ConfigurationError(f"test_train_ratio must be >= 0, got {test_train_ratio}")
     rows = [np.asarray(d, dtype=np.float64).reshape(-1) for d in differences]
-    tested = [d for d in rows if d.size >= 2]
-    prior = variance_prior([float(d.var(ddof=1)) for d in tested], [d.size - 1 for d in tested])
+    # NaN for fewer than 2 folds, which the prior leaves out (no degrees of freedom)
+    variances = [float(d.var(ddof=1)) if d.size >= 2 else math.nan for d in rows]
+    prior = variance_prior(variances, [max(d.size - 1, 0) for d in rows])
     out = []
-    for d in rows:
+    for d, own in zip(rows, variances, strict=True):
         k = d.size
         if k < 2:
             out.append((math.nan, math.nan))
@@ -205,7 +206,7 @@ def moderated_corrected_ttests(
             t, p, _ = corrected_resampled_ttest(d, np.zeros(k), test_train_ratio=test_train_ratio)
             out.append((t, p))
             continue
-        own, df = float(d.var(ddof=1)), k - 1.0
+        df = k - 1.0
         if math.isinf(prior.df):
             variance, df = prior.variance, math.inf
         else:
