@@ -71,9 +71,10 @@ def corrected_resampled_ttest(
     k = a.size
     if k < 2:
         return math.nan, math.nan, 0
-    d = a - b
-    mean = float(d.mean())
-    variance = float(d.var(ddof=1))
+    with np.errstate(invalid="ignore", over="ignore"):  # an infinite score: see below
+        d = a - b
+        mean = float(d.mean())
+        variance = float(d.var(ddof=1))
     if variance > 0:
         t, p = _corrected_t(mean, variance, k, test_train_ratio, df=k - 1)
     elif mean == 0:
@@ -188,13 +189,17 @@ def moderated_corrected_ttests(
         For each comparison: ``mean / sqrt((1/k + ratio) * v)`` with the moderated variance
         ``v = (d0 s0^2 + (k - 1) s^2) / (d0 + k - 1)`` and the two-sided p-value with
         ``d0 + k - 1`` degrees of freedom.  Without a prior (too few comparisons) each is
-        :func:`corrected_resampled_ttest`'s; NaN for a comparison of fewer than 2 folds.
+        :func:`corrected_resampled_ttest`'s, and so is a comparison with an infinite
+        difference (an infinite deficit is a certain one); NaN for a comparison of fewer
+        than 2 folds.
     """
     if not test_train_ratio >= 0:
         raise ConfigurationError(f"test_train_ratio must be >= 0, got {test_train_ratio}")
     rows = [np.asarray(d, dtype=np.float64).reshape(-1) for d in differences]
-    # NaN for fewer than 2 folds, which the prior leaves out (no degrees of freedom)
-    variances = [float(d.var(ddof=1)) if d.size >= 2 else math.nan for d in rows]
+    # NaN for fewer than 2 folds, which the prior leaves out (no degrees of freedom); an
+    # infinite difference (a regressor's error that overflowed) has no finite variance
+    with np.errstate(invalid="ignore", over="ignore"):
+        variances = [float(d.var(ddof=1)) if d.size >= 2 else math.nan for d in rows]
     prior = variance_prior(variances, [max(d.size - 1, 0) for d in rows])
     out = []
     for d, own in zip(rows, variances, strict=True):
@@ -202,7 +207,8 @@ def moderated_corrected_ttests(
         if k < 2:
             out.append((math.nan, math.nan))
             continue
-        if prior is None:
+        if prior is None or not np.isfinite(d).all():
+            # the plain test: as WEKA's, an infinite deficit is a certain one
             t, p, _ = corrected_resampled_ttest(d, np.zeros(k), test_train_ratio=test_train_ratio)
             out.append((t, p))
             continue

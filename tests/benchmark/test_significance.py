@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 import shutil
 import subprocess
+import warnings
 
 import numpy as np
 import pytest
@@ -175,3 +176,18 @@ def test_the_moderated_variance_and_degrees_of_freedom_by_hand() -> None:
     t_mine, p_mine = moderated_corrected_ttests(rows, test_train_ratio=1 / 9)[-1]
     assert t_mine == pytest.approx(t, rel=1e-12)
     assert p_mine == pytest.approx(2 * student.sf(abs(t), prior.df + 2), rel=1e-9)
+
+
+def test_an_infinite_difference_takes_the_plain_test_and_warns_nothing() -> None:
+    """A regressor whose error overflowed on a fold (an infinite MAE) is certainly worse: the
+    plain test says p = 0, as for a constant deficit; its variance is no variance, so it
+    neither joins the prior nor makes the moderated test's p NaN."""
+    rng = np.random.default_rng(3)
+    differences = [rng.normal(-0.01, 0.02, 3) for _ in range(10)]
+    broken = np.array([-np.inf, -0.1, -0.2])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        out = moderated_corrected_ttests([*differences, broken], test_train_ratio=1 / 9)
+        finite = moderated_corrected_ttests(differences, test_train_ratio=1 / 9)
+    assert out[-1] == (-math.inf, 0.0)
+    assert out[:-1] == finite  # the others' prior as without it
