@@ -20,7 +20,7 @@ if TYPE_CHECKING:
 
 
 #: The race's test, as the leaderboards name it.
-RACE_TEST = "corrected resampled t-test against the leader"
+RACE_TEST = "corrected resampled t-test against the leader, variances moderated"
 
 
 #: Seconds a resumed run whose total budget is spent gets: positive for the engine, too
