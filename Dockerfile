@@ -17,5 +17,5 @@ RUN useradd --create-home touchbench && mkdir -p /var/lib/touchbench \
     && chown touchbench /var/lib/touchbench
 USER touchbench
 WORKDIR /var/lib/touchbench
-EXPOSE 8000 8786
+EXPOSE 8000 8001 8786
 CMD ["touchbench", "--help"]

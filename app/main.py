@@ -1,11 +1,12 @@
 """The touchbench service: wiring only (settings, store, dispatcher, the JSON API, the web
-page).
+page), or, with ``predictions_only``, the prediction routes alone (no dispatcher, no page).
 
 ``uvicorn --factory app.main:create_app`` or ``touchbench serve``.
 """
 
 from __future__ import annotations
 
+import logging
 import sys
 import threading
 from collections.abc import AsyncIterator
@@ -34,12 +35,25 @@ from touchbench.app.web.site import install as install_web_page
 #: client asks for pages back to back.  Shorter, a prediction is barely delayed by them.
 SWITCH_INTERVAL = 0.0005
 
+log = logging.getLogger("touchbench.service")
+
 
 def _warm_up() -> None:
     """Import the machine-learning stack in the background, so that start-up is quick and
     the first prediction does not pay for the imports."""
     import touchbench.app.services.models
     import touchbench.benchmark.model  # noqa: F401
+
+
+def _recover(store: Store, *, resume: bool) -> None:
+    """Mark what a dead process left running (runs, jobs) as lost; with ``resume``, put its
+    interrupted runs back in the queue (not those being cancelled)."""
+    lost = mark_lost_runs(store)
+    mark_lost_jobs(store)
+    if resume:
+        for run_id in lost:
+            if get_run(store, run_id).status == Status.INTERRUPTED:
+                finish_run(store, run_id, Status.QUEUED)
 
 
 def create_app(settings: Settings | None = None) -> FastAPI:
@@ -66,24 +80,25 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         switch_interval = sys.getswitchinterval()
         sys.setswitchinterval(SWITCH_INTERVAL)
         store = Store(settings.database_url)
-        lost = mark_lost_runs(store)
-        mark_lost_jobs(store)
-        if settings.resume_on_start:  # runs their process left; not those being cancelled
-            for run_id in lost:
-                if get_run(store, run_id).status == Status.INTERRUPTED:
-                    finish_run(store, run_id, Status.QUEUED)
+        dispatches = not settings.predictions_only  # a predictions-only process never does
+        if dispatches:
+            _recover(store, resume=settings.resume_on_start)
         settings.work_dir.mkdir(parents=True, exist_ok=True)
         dispatcher = Dispatcher(store, settings)
         models = ModelCache(settings.model_cache)
         placement = PredictionPlacement(models.known)
         app.state.service = Service(settings, store, dispatcher, models, placement)
-        dispatcher.start()
+        if dispatches:
+            dispatcher.start()
+        else:
+            log.info("serving predictions only; a full service on the store answers the rest")
         if settings.warm_up:
             threading.Thread(target=_warm_up, daemon=True, name="warm-up").start()
         try:
             yield
         finally:
-            dispatcher.stop()
+            if dispatches:
+                dispatcher.stop()
             app.state.service.placement.close()
             store.dispose()
             sys.setswitchinterval(switch_interval)
@@ -99,7 +114,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         lifespan=lifespan,
     )
     api.install(app, settings)
-    install_web_page(app, dependencies=[Depends(require_api_key)])
+    if not settings.predictions_only:
+        install_web_page(app, dependencies=[Depends(require_api_key)])
     if settings.origins:  # CORS stays closed unless origins are listed
         app.add_middleware(
             Cors,

@@ -142,6 +142,13 @@ class Settings(BaseSettings):
         default=None,
         description="tcp://host:port of a Dask scheduler: runs' tasks go there instead.",
     )
+    predictions_only: bool = Field(
+        default=False,
+        description="Serve predictions only (models listed and described, predictions over "
+        "REST and the live WebSocket, /healthz), beside a full service on the same store: "
+        "no other route, no web page, no jobs dispatched, so that clients managing the store "
+        "do not share a process with the robots' predictions.",
+    )
     resume_on_start: bool = Field(
         default=False,
         description="Put runs interrupted by a crash back in the queue when the service starts.",

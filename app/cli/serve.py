@@ -42,6 +42,16 @@ def serve_command(
             "can read and change the store).",
         ),
     ] = False,
+    predictions_only: Annotated[
+        bool,
+        typer.Option(
+            "--predictions-only",
+            help="Serve the robots' side only, beside a full service on the same store: "
+            "models listed and described, their ONNX twins, predictions over REST and the live "
+            "WebSocket, /healthz; no other route, no web page, no jobs.  A client flooding the "
+            "full service with changes then does not slow the predictions.",
+        ),
+    ] = False,
     log_level: Annotated[
         str, typer.Option("--log-level", metavar="LEVEL", help="debug, info, warning, error.")
     ] = "info",
@@ -53,8 +63,9 @@ def serve_command(
     (required beyond loopback), TOUCHBENCH_ALLOWED_HOSTS (required beyond loopback),
     TOUCHBENCH_ALLOWED_ORIGINS, TOUCHBENCH_JOB_WORKERS, TOUCHBENCH_RUN_JOBS,
     TOUCHBENCH_DASK_SCHEDULER, TOUCHBENCH_MAX_UPLOAD_MB, TOUCHBENCH_MAX_TARGETS,
-    TOUCHBENCH_MAX_ATTRIBUTES, TOUCHBENCH_RESUME_ON_START.  Ctrl-C or SIGTERM stops it within
-    a few seconds (exit 130 or 143), whatever it is computing.
+    TOUCHBENCH_MAX_ATTRIBUTES, TOUCHBENCH_RESUME_ON_START, TOUCHBENCH_PREDICTIONS_ONLY.
+    Ctrl-C or SIGTERM stops it within a few seconds (exit 130 or 143), whatever it is
+    computing.
     """
     import uvicorn
 
@@ -65,6 +76,8 @@ def serve_command(
     # The service's processes (uvicorn's workers, the job processes) read their settings
     # from the environment: the store the CLI was given goes there.
     put_setting("database_url", state.database_url)
+    if predictions_only:
+        put_setting("predictions_only", "1")
     get_settings.cache_clear()
     settings = get_settings()  # a value a setting refuses: one line, exit 2
     settings.check_trust()  # a bad key, host or origin: one line, exit 2

@@ -1,5 +1,6 @@
-"""Recordings and windows made in the test: tactile takes, and data sets whose
-instances are windows of recordings."""
+"""Recordings and windows made in the test: tactile takes, simulated contact-microphone
+sessions extracted into a data set, and data sets whose instances are windows of
+recordings."""
 
 from __future__ import annotations
 
@@ -8,9 +9,24 @@ from pathlib import Path
 import numpy as np
 
 from tests.support.csvfiles import write_biotac_csv
+from touchbench.app.schemas.extraction import ExtractRequest
+from touchbench.app.services.extraction import extract_and_store
+from touchbench.app.services.simulation import write_labels, write_session
 from touchbench.app.store.database import Store
 from touchbench.app.store.datasets import add_dataset
 from touchbench.benchmark.dataset import Attribute, Dataset, Schema
+
+
+def extract_sessions(store: Store, folder: Path, *, sessions: int, touches: int) -> None:
+    """``sessions`` simulated 3-microphone sessions (``s0.wav``, ...) of ``touches`` labelled
+    touches each, written to ``folder`` and extracted into the data set ``touch``."""
+    recordings, rows = [], []
+    for seed in range(sessions):
+        wav, labelled = write_session(folder, f"s{seed}", n_touches=touches, seed=seed)
+        recordings.append(wav)
+        rows += [(wav.name, *touch) for touch in labelled]
+    labels = write_labels(folder / "labels.csv", rows)
+    extract_and_store(store, ExtractRequest(recordings=recordings, labels=labels, name="touch"))
 
 
 def write_take(path: Path, kind: str, seed: int) -> np.ndarray:

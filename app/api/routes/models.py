@@ -38,7 +38,11 @@ from touchbench.app.schemas.models import (
 from touchbench.app.services.jobs import submit_export, submit_training
 from touchbench.app.services.registry import count_models, delete_model, find_model, list_models
 
+#: What changes the registry (train, twins, delete, aliases): the full service only.
 router = APIRouter(prefix="/api/models", tags=["models"])
+#: What a robot reads and asks (list, describe, the ONNX twin, predict a file): also served by a
+#: predictions-only process (``touchbench serve --predictions-only``).
+serving = APIRouter(prefix="/api/models", tags=["models"])
 #: Predictions of JSON instances: documented by FastAPI, answered by a direct handler (the
 #: request costs FastAPI more than a quick model's prediction; see ``app.api.direct``).
 predictions = APIRouter(prefix="/api/models", tags=["models"], route_class=DirectRoute)
@@ -55,7 +59,7 @@ def train(body: TrainRequest, service: ServiceDep) -> JobCreated:
     return JobCreated(job=job.id, status=job.status, kind=job.kind)
 
 
-@router.get("", response_model=ModelList)
+@serving.get("", response_model=ModelList)
 def models(store: StoreDep, page: PageDep, request: Request, response: Response) -> ModelList:
     """The models, oldest first, a page of at most 1,000 (``X-Total-Count``, ``Link``)."""
     paginate(request, response, page, count_models(store))
@@ -63,14 +67,14 @@ def models(store: StoreDep, page: PageDep, request: Request, response: Response)
     return ModelList(models=[m.to_schema() for m in listed])
 
 
-@router.get("/{model_ref}", response_model=ModelSchema)
+@serving.get("/{model_ref}", response_model=ModelSchema)
 def model(model_ref: str, store: StoreDep) -> ModelSchema:
     """A model; ``onnx.problem`` says why its twin could not be loaded, once this service
     tried (its predictions with engine auto then run the model itself)."""
     return find_model(store, model_ref).to_schema()
 
 
-@router.get(
+@serving.get(
     "/{model_ref}/onnx",
     response_class=Response,
     responses={200: {"content": {"application/octet-stream": {}}}},
@@ -179,7 +183,7 @@ def _predict_records(service: Service, model_ref: str, body: PredictRequest, siz
     return report.model_dump_json().encode()
 
 
-@router.post("/{model_ref}/predict/file", response_model=PredictionReport)
+@serving.post("/{model_ref}/predict/file", response_model=PredictionReport)
 def predict_upload(
     model_ref: str,
     service: ServiceDep,

@@ -35,10 +35,14 @@ def test_the_compose_file_names_what_exists() -> None:
     from touchbench.app.cli.main import app as cli
 
     services = _compose()["services"]
-    assert {"db", "api", "scheduler", "worker"} <= set(services)
-    commands = {c.name for c in typer.main.get_command(cli).commands.values()}  # type: ignore[attr-defined]
-    api_command = services["api"]["command"]
-    assert api_command[0] == "touchbench" and api_command[1] in commands
+    assert {"db", "api", "predictions", "scheduler", "worker"} <= set(services)
+    commands = typer.main.get_command(cli).commands  # type: ignore[attr-defined]
+    for name in ("api", "predictions"):
+        command = services[name]["command"]
+        assert command[0] == "touchbench" and command[1] in commands, name
+        options = {o for p in commands[command[1]].params for o in p.opts}
+        assert {part for part in command if part.startswith("--")} <= options, name
+    assert "--predictions-only" in services["predictions"]["command"]
     assert services["scheduler"]["command"][:2] == ["dask", "scheduler"]
     assert services["worker"]["command"][:2] == ["dask", "worker"]
     for name in ("scheduler", "worker"):
@@ -64,7 +68,7 @@ def test_the_compose_file_names_what_exists() -> None:
             if re.search(r"PASSWORD|API_KEY|SECRET", key):
                 assert str(value).startswith("${") or "${" in str(value), (name, key)
     assert "TOUCHBENCH_API_KEY" in services["api"]["environment"]
-    for name in ("db", "scheduler", "api"):
+    for name in ("db", "scheduler", "api", "predictions"):
         assert services[name].get("healthcheck"), f"{name} has no health check"
     assert "${TOUCHBENCH_DB_PASSWORD" in services["api"]["environment"]["TOUCHBENCH_DATABASE_URL"]
 
@@ -130,22 +134,15 @@ def dask_cluster(tmp_path: Path) -> Iterator[str]:
         log.close()
 
 
-@pytest.mark.slow
-def test_the_compose_stack_as_processes(
-    postgres_database: str, dask_cluster: str, tmp_path: Path
-) -> None:
-    services = _compose()["services"]
-    variables = {
-        "TOUCHBENCH_DB_PASSWORD": "postgres",
-        "TOUCHBENCH_API_KEY": "stack-key-of-the-lab",
-        "TOUCHBENCH_ALLOWED_HOSTS": "localhost",
-    }
-    settings = {
-        key: _expand(str(value), variables) for key, value in services["api"]["environment"].items()
-    }
-    # the compose network's host names, as this machine reaches them
+def _service(name: str, postgres_database: str, tmp_path: Path, **variables: str) -> Server:
+    """The compose file's service ``name`` as a process on loopback: its command's options
+    but the address, its environment with the compose network's host names replaced by
+    those this machine reaches."""
     from sqlalchemy.engine import make_url
 
+    service = _compose()["services"][name]
+    environment = service["environment"].items()
+    settings = {key: _expand(str(value), variables) for key, value in environment}
     database = make_url(postgres_database)
     settings["TOUCHBENCH_DATABASE_URL"] = (
         make_url(settings["TOUCHBENCH_DATABASE_URL"])
@@ -158,8 +155,32 @@ def test_the_compose_stack_as_processes(
         )
         .render_as_string(hide_password=False)
     )
-    settings["TOUCHBENCH_DASK_SCHEDULER"] = dask_cluster
     settings["TOUCHBENCH_WORK_DIR"] = str(tmp_path / "work")
+    command = service["command"]
+    assert command[:2] == ["touchbench", "serve"]
+    options = command[2:]
+    for address in ("--host", "--port"):  # loopback and a free port here
+        at = options.index(address)
+        options = options[:at] + options[at + 2 :]
+    return Server(
+        url=f"http://127.0.0.1:{free_port()}",
+        database_url=settings["TOUCHBENCH_DATABASE_URL"],
+        work_dir=tmp_path / "work",
+        environment={**os.environ, "PYTHONPATH": str(ROOT), **settings},
+        log=tmp_path / f"{name}.log",
+        arguments=tuple(options),
+    )
+
+
+@pytest.mark.slow
+def test_the_compose_stack_as_processes(
+    postgres_database: str, dask_cluster: str, tmp_path: Path
+) -> None:
+    variables = {
+        "TOUCHBENCH_DB_PASSWORD": "postgres",
+        "TOUCHBENCH_API_KEY": "stack-key-of-the-lab",
+        "TOUCHBENCH_ALLOWED_HOSTS": "localhost",
+    }
     from sqlalchemy import create_engine, text
 
     engine = create_engine(postgres_database, isolation_level="AUTOCOMMIT")
@@ -168,17 +189,12 @@ def test_the_compose_stack_as_processes(
         connection.execute(text("CREATE SCHEMA public"))
     engine.dispose()
 
-    command = services["api"]["command"]
-    assert command[:2] == ["touchbench", "serve"]
-    server = Server(
-        url=f"http://127.0.0.1:{free_port()}",
-        database_url=settings["TOUCHBENCH_DATABASE_URL"],
-        work_dir=tmp_path / "work",
-        environment={**os.environ, "PYTHONPATH": str(ROOT), **settings},
-        log=tmp_path / "api.log",
-    )
+    server = _service("api", postgres_database, tmp_path, **variables)
+    server.environment["TOUCHBENCH_DASK_SCHEDULER"] = dask_cluster
+    robots = _service("predictions", postgres_database, tmp_path, **variables)
     server.start()
     try:
+        robots.start()  # after the full service, as the compose file orders them
         api = server.client
         assert httpx.get(f"{server.url}/api/runs").status_code == 401
         path = touch_arff(tmp_path / "touch.arff", n=90)
@@ -202,12 +218,18 @@ def test_the_compose_stack_as_processes(
         job = api.post("/api/models", json={"run": done["id"]}).json()
         model = server.wait_for(f"/api/jobs/{job['job']}", finished, timeout=600)
         assert model["status"] == "done", model
-        predicted = api.post(
-            f"/api/models/{model['result']['model_id']}/predict",
-            json={"instances": [{"f0": 4.0, "f1": 0.0, "f2": 0, "f3": 0, "mic": "both"}]},
-        )
-        assert predicted.status_code == 200 and predicted.json()["predictions"][0]["gesture"]
+        instance = {"instances": [{"f0": 4.0, "f1": 0.0, "f2": 0, "f3": 0, "mic": "both"}]}
+        # robots predict on the predictions-only process, with the key; it starts nothing
+        model_id = model["result"]["model_id"]
+        unkeyed = httpx.post(f"{robots.url}/api/models/{model_id}/predict", json=instance)
+        assert unkeyed.status_code == 401, unkeyed.text
+        refused = robots.client.post("/api/runs", json={"dataset": "touch"})
+        assert refused.status_code == 404, refused.text
+        for service in (robots, server):
+            predicted = service.client.post(f"/api/models/{model_id}/predict", json=instance)
+            assert predicted.status_code == 200 and predicted.json()["predictions"][0]["gesture"]
     finally:
+        robots.stop()
         server.stop()
     from distributed import Client
 

@@ -13,12 +13,11 @@ import soundfile
 
 from tests.support.cli_runner import run_cli
 from tests.support.live import as_int16, pcm_blocks, stream, ws_url
+from tests.support.recordings import extract_sessions
 from tests.support.service import Server
-from touchbench.app.schemas.extraction import ExtractRequest
 from touchbench.app.schemas.models import TrainRequest
-from touchbench.app.services.extraction import extract_and_store
 from touchbench.app.services.models import train
-from touchbench.app.services.simulation import write_labels, write_session
+from touchbench.app.services.simulation import write_session
 from touchbench.app.store.database import Store
 
 
@@ -27,13 +26,7 @@ def live_model(tmp_path: Path, sqlite_store_url: str) -> tuple[str, Path]:
     """A model trained on extracted sessions, and a session it never saw."""
     store = Store(sqlite_store_url)
     try:
-        recordings, rows = [], []
-        for seed in range(3):
-            wav, touches = write_session(tmp_path, f"s{seed}", n_touches=8, seed=seed)
-            recordings.append(wav)
-            rows += [(wav.name, *touch) for touch in touches]
-        labels = write_labels(tmp_path / "labels.csv", rows)
-        extract_and_store(store, ExtractRequest(recordings=recordings, labels=labels, name="touch"))
+        extract_sessions(store, tmp_path, sessions=3, touches=8)
         model = train(store, TrainRequest(dataset="touch", classifier="cc:j48"))
     finally:
         store.dispose()

@@ -18,15 +18,14 @@ import pytest
 from websockets.sync.client import ClientConnection, connect
 
 from tests.support.live import as_int16
+from tests.support.recordings import extract_sessions
 from tests.support.service import Server
 from tests.support.synthetic import touch_arff
 from touchbench.app.schemas.datasets import ImportRequest
-from touchbench.app.schemas.extraction import ExtractRequest
 from touchbench.app.schemas.models import TrainRequest
 from touchbench.app.services.datasets import import_file
-from touchbench.app.services.extraction import extract_and_store
 from touchbench.app.services.models import train
-from touchbench.app.services.simulation import SAMPLERATE, write_labels, write_session
+from touchbench.app.services.simulation import SAMPLERATE, write_session
 from touchbench.app.store.database import Store
 
 WRITE = "lab-write-key-0123456789"
@@ -38,13 +37,7 @@ def _versions(store_url: str, tmp_path: Path) -> list[tuple[float, float, str, s
     the touches of ``unseen.wav``, a session none of them saw."""
     store = Store(store_url)
     try:
-        recordings, rows = [], []
-        for seed in range(2):
-            wav, touches = write_session(tmp_path, f"s{seed}", n_touches=6, seed=seed)
-            recordings.append(wav)
-            rows += [(wav.name, *touch) for touch in touches]
-        labels = write_labels(tmp_path / "labels.csv", rows)
-        extract_and_store(store, ExtractRequest(recordings=recordings, labels=labels, name="touch"))
+        extract_sessions(store, tmp_path, sessions=2, touches=6)
         for classifier in ("cc:j48", "cc:nb"):
             train(store, TrainRequest(dataset="touch", classifier=classifier, name="mic"))
         flat = touch_arff(tmp_path / "flat.arff", n=40)

@@ -11,6 +11,7 @@ import pytest
 import soundfile
 
 from tests.support.cli_runner import run_cli
+from tests.support.recordings import extract_sessions
 from touchbench.app.errors import AppError
 from touchbench.app.schemas.extraction import ExtractRequest
 from touchbench.app.schemas.models import TrainRequest
@@ -29,13 +30,7 @@ def trained(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Store, s
     session it never saw; made once for the module's tests, which only read them."""
     folder = tmp_path_factory.mktemp("live")
     store = Store(f"sqlite:///{folder / 'touchbench.db'}")
-    recordings, rows = [], []
-    for seed in range(3):
-        wav, touches = write_session(folder, f"s{seed}", n_touches=10, seed=seed)
-        recordings.append(wav)
-        rows += [(wav.name, *touch) for touch in touches]
-    labels = write_labels(folder / "labels.csv", rows)
-    extract_and_store(store, ExtractRequest(recordings=recordings, labels=labels, name="touch"))
+    extract_sessions(store, folder, sessions=3, touches=10)
     model = train(store, TrainRequest(dataset="touch", classifier="cc:rf"))
     unseen, _ = write_session(folder, "unseen", n_touches=6, seed=99)
     yield store, model.name, unseen

@@ -19,14 +19,13 @@ from sqlalchemy import create_engine, text
 
 from tests.support.cli_runner import CLI_WORDS, run_cli
 from tests.support.live import pcm_blocks, stream, ws_url
+from tests.support.recordings import extract_sessions
 from tests.support.rows import count_rows
 from tests.support.service import Server, finished, servers
-from touchbench.app.schemas.extraction import ExtractRequest
 from touchbench.app.schemas.models import TrainRequest
 from touchbench.app.services.datasets import read_data_file
-from touchbench.app.services.extraction import extract_and_store
 from touchbench.app.services.models import train
-from touchbench.app.services.simulation import write_labels, write_session
+from touchbench.app.services.simulation import write_session
 from touchbench.app.store.database import Store
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -40,13 +39,7 @@ def trained(tmp_path_factory: pytest.TempPathFactory) -> tuple[str, Path, Path]:
     folder = tmp_path_factory.mktemp("onnx")
     url = f"sqlite:///{folder / 'touchbench.db'}"
     store = Store(url)
-    recordings, rows = [], []
-    for seed in range(2):
-        wav, touches = write_session(folder, f"s{seed}", n_touches=8, seed=seed)
-        recordings.append(wav)
-        rows += [(wav.name, *touch) for touch in touches]
-    labels = write_labels(folder / "labels.csv", rows)
-    extract_and_store(store, ExtractRequest(recordings=recordings, labels=labels, name="touch"))
+    extract_sessions(store, folder, sessions=2, touches=8)
     for classifier in ("rf", "j48"):
         train(store, TrainRequest(dataset="touch", classifier=classifier, target="gesture"))
     store.dispose()
