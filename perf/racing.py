@@ -226,6 +226,9 @@ def main() -> int:
         default=None,
         help="pickle the (last) full run for perf/racing_replay.py",
     )
+    parser.add_argument(
+        "--full-only", action="store_true", help="the full run alone (with --save: for replays)"
+    )
     args = parser.parse_args()
     if not args.regression and not DATASETS.is_dir():
         print(f"skipped: {DATASETS} is absent (the shared reference data sets)")
@@ -276,6 +279,9 @@ def main() -> int:
                      "helpers": list(plan.helpers)},
                     file,
                 )  # fmt: skip
+        if args.full_only:
+            print(f"  full : {full_wall:7.1f} s, {len(full)} tasks")
+            continue
         race = RaceRule(metric, args.alpha)
         raced, drops, raced_wall = timed(
             problem, ids, folds, args.jobs, random_state=args.seed, race=race

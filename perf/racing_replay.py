@@ -13,6 +13,7 @@ COMMIT`` replays that commit's schedule and race rule beside it.
 
     .venv/bin/python perf/racing.py --robots maggie --tasks gesture --save maggie.pkl
     .venv/bin/python perf/racing_replay.py maggie.pkl [--workers 2,4] [--against 1d4384d]
+        [--first-round 2] [--alpha 0.01]
 """
 
 from __future__ import annotations
@@ -48,7 +49,12 @@ def seconds(result: TaskResult) -> float:
 
 
 def replay(
-    saved: dict[str, Any], schedule: type, workers: int, metric: str, alpha: float
+    saved: dict[str, Any],
+    schedule: type,
+    workers: int,
+    metric: str,
+    alpha: float,
+    first_round: int = FIRST_ROUND,
 ) -> dict[str, Any]:
     """The race of ``schedule`` on the saved run's task seconds, ``workers`` at a time."""
     results = {r.key: r for r in saved["results"]}
@@ -67,7 +73,7 @@ def replay(
         rounds,
         delivered.append,
         hints=hints,
-        race=RaceRule(metric, alpha),
+        race=RaceRule(metric, alpha, first_round=first_round),
         test_train_ratio=float(np.mean([r.n_test / max(r.n_train, 1) for r in results.values()])),
         on_drop=drops.append,
         clock=lambda: clock[0],
@@ -138,6 +144,9 @@ def main() -> int:
     parser.add_argument("--workers", default="2")
     parser.add_argument("--alpha", type=float, default=0.01)
     parser.add_argument("--metric", default="f1_weighted")
+    parser.add_argument(
+        "--first-round", type=int, default=FIRST_ROUND, help="folds before the first decision"
+    )
     parser.add_argument("--against", metavar="COMMIT", default=None)
     args = parser.parse_args()
     schedules: list[tuple[str, type]] = [("now", RoundSchedule)]
@@ -155,7 +164,9 @@ def main() -> int:
         total = sum(cost.values())
         # what the top 5 fit: themselves, or the members they are computed from
         fitted = set(top).union(*(derived.get(entry, ()) for entry in top))
-        floor = sum(v for k, v in cost.items() if k.classifier in fitted or k.fold < FIRST_ROUND)
+        floor = sum(
+            v for k, v in cost.items() if k.classifier in fitted or k.fold < args.first_round
+        )
         print(f"\n{name}: {len(saved['ids'])} entries, {len(cost)} tasks, {total:.0f} CPU s")
         print(f"  full top 5: {', '.join(top)}; their share of the seconds "
               f"{sum(v for k, v in cost.items() if k.classifier in fitted) / total:.3f}; floor of "
@@ -163,7 +174,8 @@ def main() -> int:
         for workers in (int(w) for w in args.workers.split(",")):
             full_wall = total / workers
             for label, schedule in schedules:
-                out = replay(saved, schedule, workers, metric, args.alpha)
+                first = args.first_round if label == "now" else FIRST_ROUND
+                out = replay(saved, schedule, workers, metric, args.alpha, first)
                 dropped = {d.classifier: d for d in out["drops"]}
                 board = build_leaderboard(out["delivered"], metric=metric, drops=dropped)
                 best = next(row for row in board.rows if row.dropped is None)
