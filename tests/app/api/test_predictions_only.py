@@ -12,7 +12,9 @@ from pathlib import Path
 from typing import Any
 
 import httpx
+import pytest
 
+import touchbench
 from tests.support.live import pcm_blocks, stream, ws_url
 from tests.support.recordings import extract_sessions
 from tests.support.service import Server
@@ -99,6 +101,13 @@ def test_the_robots_side_answers_as_the_full_service_and_follows_its_aliases(
         return [{k: v for k, v in touch.items() if k != "latency_ms"} for touch in touches]
 
     assert without_latency(messages) == without_latency(expected)
+
+    # touchbench.Client pointed at it: the robots' methods work, the others say why not
+    with touchbench.Client(robots.url, api_key=KEY) as client:
+        assert [model.version for model in client.models()] == [1, 2]
+        assert client.predict("pin@1", instance["instances"]).model == "pin@1"
+        with pytest.raises(touchbench.ServiceError, match="is not served here"):
+            client.datasets()
 
 
 #: Requests only the full service answers: each changes the store, queues work or shows
