@@ -150,6 +150,20 @@ def test_every_other_route_is_refused_and_nothing_changes(
         assert message.startswith(f"{method} {path} is not served here"), message
         assert "--predictions-only" in message, message
 
+    # the full service's guards stand in front of its prediction routes too
+    foreign = robots.client.post(
+        "/api/models/pin@1/predict", json={"instances": []}, headers={"Origin": "http://evil.test"}
+    )
+    assert foreign.status_code == 403 and "evil.test" in foreign.json()["error"]["message"]
+    rebound = robots.client.get("/api/models", headers={"Host": "evil.test"})
+    assert rebound.status_code == 400, rebound.text
+    zeros = robots.client.post(
+        "/api/models/pin@1/predict",
+        content=bytes(17 * 2**20),
+        headers={"Content-Type": "application/json"},
+    )
+    assert zeros.status_code == 413, zeros.text
+
     assert full.client.get("/api/models").json() == before
     assert full.client.get("/api/jobs").headers["x-total-count"] == "0"
     documented = set(robots.client.get("/openapi.json").json()["paths"])
