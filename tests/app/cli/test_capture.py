@@ -232,7 +232,8 @@ def test_ctrl_c_keeps_the_take_so_far_and_a_valid_labels_file(
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
-        env={**os.environ, "HOME": str(home), "PYTHONPATH": str(ROOT)},
+        # faulthandler: a process that does not stop prints every thread's stack at SIGABRT
+        env={**os.environ, "HOME": str(home), "PYTHONPATH": str(ROOT), "PYTHONFAULTHANDLER": "1"},
         # A job started in the background inherits SIGINT ignored; a terminal's is not.
         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
@@ -241,7 +242,12 @@ def test_ctrl_c_keeps_the_take_so_far_and_a_valid_labels_file(
     while not (part.exists() and part.stat().st_size > 100_000) and time.monotonic() < deadline:
         time.sleep(0.05)
     process.send_signal(signal.SIGINT)
-    _, err = process.communicate(timeout=60)
+    try:
+        _, err = process.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        process.send_signal(signal.SIGABRT)
+        _, stacks = process.communicate(timeout=30)
+        pytest.fail(f"record did not stop within 60 s of Ctrl-C; its threads:\n{stacks}")
     assert process.returncode == 2, err
     # Touches heard before the Ctrl-C are shown as they end; the outcome is one line.
     errors = [line for line in err.splitlines() if not line.startswith("touch ")]
