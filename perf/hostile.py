@@ -51,12 +51,10 @@ from tests.support import hostile_inputs as hostile  # noqa: E402
 from tests.support.synthetic import touch_arff  # noqa: E402
 
 GOAL_MB = 300
+GOAL_RATIO = 2.0
 #: A row that measures the load of a case without its harm (what the machine's cores cost).
 CONTROL = "control:"
-GOAL_RATIO = 2.0
 RECORD = {"f0": 0.1, "f1": 0.2, "f2": -0.3, "f3": 1.0, "mic": "left"}
-
-
 #: The paths a predictions-only process answers that the cases ask.
 PREDICTION_PATH = re.compile(r"^/api/models/[^/]+/predict(/file)?$")
 
