@@ -24,6 +24,7 @@ from touchbench.benchmark.errors import ConfigurationError
 from touchbench.benchmark.estimators import build_estimator, check_classifier, group_fit_params
 from touchbench.benchmark.evaluation.metrics import expand_proba
 from touchbench.benchmark.forest_inference import forest_proba
+from touchbench.benchmark.predicting import predicts_most_probable
 from touchbench.benchmark.problem import feature_matrix, problem_from_dataset
 
 #: Libraries whose versions are recorded with a model.
@@ -119,13 +120,10 @@ class TrainedModel:
     def predict_with_proba(self, X: np.ndarray) -> tuple[np.ndarray, list[np.ndarray] | None]:
         """Codes and probabilities at once, in one pass where the classifier allows it.
 
-        Forests, trees, logistic regression, Gaussian naive Bayes, k-nearest neighbours
-        and the neural sequence classifiers predict the class of highest probability
-        (their probabilities are a monotone map of what ``predict`` maximises), so their
-        codes are read off the probabilities instead of running the model twice: live and
-        served predictions pay for each pass.
-        Other classifiers (an SVM's Platt scaling, calibration, voting) predict in their
-        own way.
+        A classifier that predicts its class of highest probability
+        (:func:`benchmark.predicting.predicts_most_probable`) has its codes read off the
+        probabilities instead of running twice: live and served predictions pay for each
+        pass.
 
         Returns
         -------
@@ -143,26 +141,7 @@ class TrainedModel:
         return self.predict(X), probabilities
 
     def _predicts_most_probable(self) -> bool:
-        from sklearn.ensemble._forest import ForestClassifier
-        from sklearn.linear_model import LogisticRegression
-        from sklearn.naive_bayes import GaussianNB
-        from sklearn.neighbors import KNeighborsClassifier
-        from sklearn.tree import BaseDecisionTree
-
-        from touchbench.benchmark.catalogue.neural import NeuralSequenceClassifier
-
-        if len(self.schema.target_indices) != 1:
-            return False
-        final = self.estimator[-1] if hasattr(self.estimator, "steps") else self.estimator
-        most_probable = (
-            ForestClassifier,
-            BaseDecisionTree,
-            LogisticRegression,
-            GaussianNB,
-            KNeighborsClassifier,
-            NeuralSequenceClassifier,  # argmax of the softmax: one pass of the network
-        )
-        return isinstance(final, most_probable)
+        return len(self.schema.target_indices) == 1 and predicts_most_probable(self.estimator)
 
     def _features(self, X: np.ndarray) -> np.ndarray:
         X = np.asarray(X, dtype=np.float64)

@@ -18,6 +18,8 @@ import numpy as np
 from sklearn.base import clone
 from sklearn.model_selection import KFold, StratifiedKFold
 
+from touchbench.benchmark.predicting import labels_and_probabilities
+
 #: Inner folds of every choice made inside a training fold.
 INNER_FOLDS = 3
 
@@ -86,8 +88,8 @@ def out_of_fold(
     for train, test in splits:
         extra = fit_params(train) if fit_params is not None else {}
         model = clone(estimator).fit(X[train], y[train], **extra)
-        labels[test] = np.asarray(model.predict(X[test]), dtype=np.int64)
-        if proba is not None:
+        labels[test], inner = labels_and_probabilities(model, X[test], probabilities=probabilities)
+        if proba is not None and inner is not None:
             columns = np.searchsorted(classes, np.asarray(model.classes_, dtype=np.int64))
-            proba[np.ix_(test, columns)] = model.predict_proba(X[test])
+            proba[np.ix_(test, columns)] = inner
     return labels, proba

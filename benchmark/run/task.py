@@ -23,6 +23,7 @@ from touchbench.benchmark.catalogue.inner import inner_splits, out_of_fold
 from touchbench.benchmark.estimators import build_estimator, group_fit_params
 from touchbench.benchmark.evaluation.fold_scores import score_fold
 from touchbench.benchmark.evaluation.metrics import expand_proba
+from touchbench.benchmark.predicting import labels_and_probabilities
 from touchbench.benchmark.predictions import FoldPredictions
 from touchbench.benchmark.problem import Problem
 from touchbench.benchmark.results import Status, TaskKey, TaskResult
@@ -120,12 +121,12 @@ def _run_multiclass(context: TaskContext, key: TaskKey, fold: Fold) -> TaskResul
     timer = _Timer()
     model.fit(problem.X[fold.train], y[fold.train], **_groups(model, problem, fold.train))
     fit_time, fit_cpu = timer.lap()
-    X_test = problem.X[fold.test]
-    y_pred = np.asarray(model.predict(X_test), dtype=np.int64)
-    proba = None
     probabilities = context.specs[key.classifier].probabilities
-    if probabilities:
-        proba = expand_proba(model.predict_proba(X_test), model.classes_, n_classes=n_classes)
+    y_pred, proba = labels_and_probabilities(
+        model, problem.X[fold.test], probabilities=probabilities
+    )
+    if proba is not None:
+        proba = expand_proba(proba, model.classes_, n_classes=n_classes)
     predict_time, predict_cpu = timer.lap()
     costs = _costs(fit_time, fit_cpu, predict_time, predict_cpu, model)
     result = scored_result(

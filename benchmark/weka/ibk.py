@@ -25,8 +25,9 @@ from touchbench.benchmark.weka._data import NanClassifier, check_test_data, chec
 
 Weighting = Literal["none", "inverse", "similarity"]
 
-#: Bytes of scratch memory per block of prediction rows.
-BLOCK_BYTES = 8 * 2**20
+#: Bytes of each of the two scratch matrices of a block of prediction rows: small enough
+#: for both to stay in a core's cache while every attribute passes over them.
+BLOCK_BYTES = 512 * 2**10
 
 
 class WekaIBk(NanClassifier):
@@ -115,9 +116,11 @@ class WekaIBk(NanClassifier):
         """Squared WEKA distances of shape (n_rows, n_train), ranges ``low..high``.
 
         Accumulated attribute by attribute, in WEKA's order and arithmetic, so that ties
-        between neighbours are the ones WEKA sees.
+        between neighbours are the ones WEKA sees; each attribute's differences go through
+        one scratch block, written in place (a block that stays in the cache).
         """
         out = np.zeros((rows.shape[0], self.X_.shape[0]))
+        scratch = np.empty_like(out)
         for column in range(rows.shape[1]):
             a, b = rows[:, column][:, None], self.X_[:, column][None, :]
             a_missing, b_missing = np.isnan(a), np.isnan(b)
@@ -129,12 +132,12 @@ class WekaIBk(NanClassifier):
                 a, b = (a - low[column]) / width, (b - low[column]) / width
             else:  # no range: WEKA normalises every value to 0
                 a, b = np.where(a_missing, np.nan, 0.0), np.where(b_missing, np.nan, 0.0)
-            diff = a - b
+            diff = np.subtract(a, b, out=scratch)
             if a_missing.any() or b_missing.any():
                 one = np.where(a_missing, b, a)
                 diff = np.where(a_missing ^ b_missing, np.maximum(one, 1.0 - one), diff)
                 diff = np.where(a_missing & b_missing, 1.0, diff)
-            out += diff * diff
+            out += np.multiply(diff, diff, out=scratch)
         return out
 
     def _vote(self, squared: np.ndarray, n_features: int) -> np.ndarray:
@@ -154,5 +157,7 @@ class WekaIBk(NanClassifier):
         weight = np.where(neighbour, weight, 0.0)
         votes = np.full((n_rows, n_classes), 1.0 / max(1, n_train))
         for c in range(n_classes):
-            votes[:, c] += weight[:, self.y_ == c].sum(axis=1)
+            # row by row: numpy adds a row of a many-row matrix in another order than the
+            # row alone, and a row's votes must not depend on the rows predicted with it
+            votes[:, c] += [row.sum() for row in weight[:, self.y_ == c]]
         return np.asarray(votes / votes.sum(axis=1, keepdims=True))

@@ -65,3 +65,19 @@ def test_bad_parameters_are_refused() -> None:
         WekaIBk(n_neighbors=0).fit(np.zeros((2, 1)), [0, 1])
     with pytest.raises(ValueError, match="weighting must be"):
         WekaIBk(weighting="gauss").fit(np.zeros((2, 1)), [0, 1])
+
+
+def test_blocks_of_rows_do_not_change_a_bit(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Rows predicted in blocks of one row, of a few, or all at once: the same votes."""
+    from touchbench.benchmark.weka import ibk
+
+    rng = np.random.default_rng(5)
+    X = np.column_stack([rng.normal(size=300), rng.integers(0, 3, 300), rng.normal(size=300)])
+    X[rng.random(X.shape) < 0.05] = NAN
+    model = WekaIBk(7, "inverse", nominal_features={1: 3}).fit(X[:200], np.arange(200) % 3)
+    test = X[200:].copy()
+    test[:, [0, 2]] *= 1.5  # rows beyond the training ranges widen them as they come
+    whole = model.predict_proba(test)
+    for rows in (1, 3):
+        monkeypatch.setattr(ibk, "BLOCK_BYTES", 8 * 200 * rows)
+        np.testing.assert_array_equal(model.predict_proba(test), whole)
