@@ -33,7 +33,11 @@ score against the best single entry and its cost against this code's full run::
 
     git -C /work/main worktree add /work/wt/beb0232 beb0232
     .venv/bin/python perf/racing.py --against /work/wt/beb0232 --tasks gesture \
-        [--rounds 2] [--ensemble 5] [--quick]
+        [--rounds 2] [--ensemble 5] [--quick] [--race-only]
+
+Each pass's race is also printed against the older run of the same pass (the machine's speed
+drifts less within a pass than across passes). ``--race-only`` runs only those two, for more
+passes of the ratio at the goal's edge.
 
 ``--quick`` (a busy machine: the script works, the figures are not final): the fast suite
 with ``voting`` and ``voting-hard``, 3 folds, 600 instances of each data set.
@@ -217,6 +221,12 @@ def main() -> int:
         "--ensemble", type=int, default=5, help="with --against: N (0: no selection run)"
     )
     parser.add_argument("--rounds", type=int, default=1, help="with --against: passes")
+    parser.add_argument(
+        "--race-only",
+        action="store_true",
+        help="with --against: the older full run and this code's race alone, alternating "
+        "(more passes of the ratio at the goal's edge)",
+    )
     parser.add_argument("--quick", action="store_true", help="with --against: a quick check")
     parser.add_argument("--keep", metavar="FILE", help="with --against: append each run's JSON")
     parser.add_argument("--child", default=None, help=argparse.SUPPRESS)
@@ -539,6 +549,8 @@ def side_by_side(args: argparse.Namespace) -> int:
                 ("race", here, "touchbench.benchmark", "race"),
                 ("ensemble", here, "touchbench.benchmark", "ensemble"),
             ][: 4 if args.ensemble else 3]
+            if args.race_only:
+                order = [order[0], order[2]]
             for round_ in range(args.rounds):
                 for name, code, pkg, mode in order if round_ % 2 == 0 else order[::-1]:
                     found = _measure(args, code, pkg, f"{robot}:{task}:{mode}")
@@ -556,6 +568,23 @@ def side_by_side(args: argparse.Namespace) -> int:
                     if found["failed"] == found["tasks"]:
                         raise SystemExit(f"every task of {name} failed: {found['error']}")
             wall = {name: float(np.median(values)) for name, values in walls.items()}
+            # each pass's race against the older run of the same pass: the machine's speed
+            # drifts from minute to minute, less within a pass than across passes
+            paired = [r / o for r, o in zip(walls["race"], walls["older"], strict=True)]
+            print(
+                f"  {robot} {task}: race / older full, pass by pass: "
+                + ", ".join(f"{ratio:.3f}" for ratio in paired)
+                + f" (median {np.median(paired):.3f})",
+                file=sys.stderr,
+            )
+            if args.race_only:
+                print(
+                    f"| {robot} {task} | {wall['older']:.1f} | not run "
+                    f"| {wall['race']:.1f} ({wall['race'] / wall['older']:.3f}) | not run "
+                    f"| {last['older']['rows'][0]['classifier']} / - / "
+                    f"{last['race']['rows'][0]['classifier']} | - | - | not run |"
+                )
+                continue
             means = {n: {r["classifier"]: r for r in found["rows"]} for n, found in last.items()}
             winners = {n: found["rows"][0]["classifier"] for n, found in last.items()}
             moved = [
