@@ -19,12 +19,12 @@ from sklearn.base import BaseEstimator
 
 from touchbench.benchmark.artifacts import dumps_artifact, loads_artifact
 from touchbench.benchmark.catalogue import get_spec
+from touchbench.benchmark.catalogue.predicting import predicts_most_probable
 from touchbench.benchmark.dataset import Dataset, Schema
 from touchbench.benchmark.errors import ConfigurationError
 from touchbench.benchmark.estimators import build_estimator, check_classifier, group_fit_params
 from touchbench.benchmark.evaluation.metrics import expand_proba
 from touchbench.benchmark.forest_inference import forest_proba
-from touchbench.benchmark.predicting import predicts_most_probable
 from touchbench.benchmark.problem import feature_matrix, problem_from_dataset
 
 #: Libraries whose versions are recorded with a model.
@@ -121,9 +121,9 @@ class TrainedModel:
         """Codes and probabilities at once, in one pass where the classifier allows it.
 
         A classifier that predicts its class of highest probability
-        (:func:`benchmark.predicting.predicts_most_probable`) has its codes read off the
-        probabilities instead of running twice: live and served predictions pay for each
-        pass.
+        (:func:`benchmark.catalogue.predicting.predicts_most_probable`) has its codes read
+        off the probabilities instead of running twice: live and served predictions pay for
+        each pass.
 
         Returns
         -------

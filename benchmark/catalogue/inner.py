@@ -18,7 +18,7 @@ import numpy as np
 from sklearn.base import clone
 from sklearn.model_selection import KFold, StratifiedKFold
 
-from touchbench.benchmark.predicting import labels_and_probabilities
+from touchbench.benchmark.catalogue.predicting import labels_and_probabilities
 
 #: Inner folds of every choice made inside a training fold.
 INNER_FOLDS = 3

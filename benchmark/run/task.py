@@ -20,10 +20,10 @@ import numpy as np
 
 from touchbench.benchmark.catalogue import ClassifierSpec
 from touchbench.benchmark.catalogue.inner import inner_splits, out_of_fold
+from touchbench.benchmark.catalogue.predicting import labels_and_probabilities
 from touchbench.benchmark.estimators import build_estimator, group_fit_params
 from touchbench.benchmark.evaluation.fold_scores import score_fold
 from touchbench.benchmark.evaluation.metrics import expand_proba
-from touchbench.benchmark.predicting import labels_and_probabilities
 from touchbench.benchmark.predictions import FoldPredictions
 from touchbench.benchmark.problem import Problem
 from touchbench.benchmark.results import Status, TaskKey, TaskResult

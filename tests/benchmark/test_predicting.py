@@ -12,9 +12,12 @@ from sklearn.preprocessing import StandardScaler
 from sklearn.svm import SVC
 
 from touchbench.benchmark.catalogue import get_spec, suite
+from touchbench.benchmark.catalogue.predicting import (
+    labels_and_probabilities,
+    predicts_most_probable,
+)
 from touchbench.benchmark.estimators import build_estimator, reads_sequences
 from touchbench.benchmark.io.arff import read_arff
-from touchbench.benchmark.predicting import labels_and_probabilities, predicts_most_probable
 from touchbench.benchmark.problem import Problem
 from touchbench.benchmark.weka.ibk import WekaIBk
 
