@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pytest
 from sklearn.ensemble import BaggingClassifier
 from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import StandardScaler
@@ -18,7 +20,7 @@ from touchbench.benchmark.catalogue.predicting import (
 )
 from touchbench.benchmark.estimators import build_estimator, reads_sequences
 from touchbench.benchmark.io.arff import read_arff
-from touchbench.benchmark.problem import Problem
+from touchbench.benchmark.problem import Problem, problem_from_dataset, restrict_targets
 from touchbench.benchmark.weka.ibk import WekaIBk
 
 
@@ -93,21 +95,16 @@ def test_without_probabilities_only_predict_is_asked() -> None:
 
 
 def _mini(shared: Path, rows: int) -> Problem:
-    data = read_arff(shared / "uc3m-touch" / "mini" / "gesture_and_place.arff")
-    names = list(data.schema.target_names)
-    target = data.schema.target_indices[names.index("gesture")]
-    features = np.array(
-        [i for i in range(data.schema.n_attributes) if i not in data.schema.target_indices]
+    """About ``rows`` of Mini's touches, every k-th, with the gesture as the target."""
+    data = restrict_targets(
+        read_arff(shared / "uc3m-touch" / "mini" / "gesture_and_place.arff"), ["gesture"]
     )
-    take = np.arange(0, data.values.shape[0], max(1, data.values.shape[0] // rows))
-    return Problem(
-        X=data.values[np.ix_(take, features)],
-        Y=data.values[take, target][:, None].astype(np.int64),
-        n_classes=(len(data.schema.targets[names.index("gesture")].values),),
-        target_names=("gesture",),
-    )
+    problem, _ = problem_from_dataset(data)
+    take = np.arange(0, problem.X.shape[0], max(1, problem.X.shape[0] // rows))
+    return replace(problem, X=problem.X[take], Y=problem.Y[take])
 
 
+@pytest.mark.shared
 def test_every_default_entry_read_off_its_probabilities_agrees_with_predict(
     shared_datasets: Path,
 ) -> None:
